@@ -1,0 +1,703 @@
+#include "cli.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <new>
+#include <system_error>
+#include <utility>
+
+namespace tilesplat::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr size_t kHelpFlagColumn = 30;  // where the help text of a flag starts
+constexpr size_t kHelpWidth = 100;      // wrap help text at this column
+
+std::string single_quoted(std::string_view text) {
+  std::string out;
+  out.reserve(text.size() + 2);
+  out += '\'';
+  out += text;
+  out += '\'';
+  return out;
+}
+
+std::string trim(std::string_view text) {
+  const auto first = text.find_first_not_of(" \t");
+  if (first == std::string_view::npos) return {};
+  const auto last = text.find_last_not_of(" \t");
+  return std::string(text.substr(first, last - first + 1));
+}
+
+// Appends `text` word-wrapped into [indent, kHelpWidth), the first line continuing at `column`.
+void append_wrapped(std::string& out, std::string_view text, size_t column, size_t indent) {
+  size_t pos = 0;
+  bool first_word = true;
+  while (pos < text.size()) {
+    const auto end = std::min(text.find(' ', pos), text.size());
+    const std::string_view word = text.substr(pos, end - pos);
+    pos = end + 1;
+    if (word.empty()) continue;
+    if (!first_word && column + 1 + word.size() > kHelpWidth) {
+      out += '\n';
+      out.append(indent, ' ');
+      column = indent;
+    } else if (!first_word) {
+      out += ' ';
+      ++column;
+    }
+    out += word;
+    column += word.size();
+    first_word = false;
+  }
+}
+
+std::string join(const std::vector<std::string>& items, std::string_view separator) {
+  std::string out;
+  for (size_t i = 0; i < items.size(); ++i) {
+    if (i) out += separator;
+    out += items[i];
+  }
+  return out;
+}
+
+std::string group_thousands(uint64_t value) {
+  std::string digits = std::to_string(value);
+  std::string out;
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+std::vector<std::string> available_sorts() {
+  try {
+    return sort_strategies();
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
+std::string sort_name_checked(std::string_view flag, const std::string& name,
+                              const std::vector<std::string>& available) {
+  const std::string trimmed = trim(name);
+  if (std::find(available.begin(), available.end(), trimmed) == available.end())
+    throw UsageError("unknown sort strategy " + single_quoted(trimmed) + " for " + std::string(flag) +
+                     " (available: " + join(available, ", ") + ")");
+  return trimmed;
+}
+
+// An error message that names `path`: library messages normally do; this makes sure.
+std::string naming_file(const fs::path& path, std::string_view message) {
+  const std::string text = one_line(message);
+  if (text.find(path.filename().string()) != std::string::npos) return text;
+  return path.string() + ": " + text;
+}
+
+void require_input_file(const fs::path& path, std::string_view what) {
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (!fs::exists(status))
+    throw std::runtime_error("cannot read " + std::string(what) + " " + single_quoted(path.string()) +
+                             ": no such file");
+  if (fs::is_directory(status))
+    throw std::runtime_error("cannot read " + std::string(what) + " " + single_quoted(path.string()) +
+                             ": it is a directory");
+}
+
+double elapsed_ms(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// ArgParser
+
+ArgParser::ArgParser(std::string program, std::string usage, std::string description)
+    : program_(std::move(program)), usage_(std::move(usage)), description_(std::move(description)) {
+  sections_.push_back("options");
+}
+
+void ArgParser::section(std::string title) { sections_.push_back(std::move(title)); }
+
+void ArgParser::add_value(std::string name, std::string value_name, std::string help,
+                          std::function<void(const std::string&)> on_value, std::string short_name) {
+  Option option;
+  option.name = std::move(name);
+  option.short_name = std::move(short_name);
+  option.value_name = std::move(value_name);
+  option.help = std::move(help);
+  option.on_value = std::move(on_value);
+  option.section = sections_.size() - 1;
+  options_.push_back(std::move(option));
+}
+
+void ArgParser::add_string(std::string name, std::string value_name, std::string help, std::string* target,
+                           std::string short_name) {
+  const std::string flag = name;
+  add_value(
+      std::move(name), std::move(value_name), std::move(help),
+      [target, flag](const std::string& text) {
+        if (text.empty()) throw UsageError(flag + " expects a value, got an empty string");
+        *target = text;
+      },
+      std::move(short_name));
+}
+
+void ArgParser::add_int(std::string name, std::string value_name, std::string help, int* target, int min,
+                        int max) {
+  const std::string flag = name;
+  add_value(std::move(name), std::move(value_name), std::move(help),
+            [target, flag, min, max](const std::string& text) { *target = parse_int(flag, text, min, max); });
+}
+
+void ArgParser::add_double(std::string name, std::string value_name, std::string help, double* target) {
+  const std::string flag = name;
+  add_value(std::move(name), std::move(value_name), std::move(help),
+            [target, flag](const std::string& text) { *target = parse_double(flag, text); });
+}
+
+void ArgParser::add_switch(std::string name, std::string help, bool* target) {
+  Option option;
+  option.name = std::move(name);
+  option.help = std::move(help);
+  option.switch_target = target;
+  option.section = sections_.size() - 1;
+  options_.push_back(std::move(option));
+}
+
+void ArgParser::add_positional(std::string value_name, std::string help, std::string* target) {
+  positionals_.push_back({std::move(value_name), std::move(help), target});
+}
+
+const ArgParser::Option* ArgParser::find(std::string_view name) const {
+  for (const auto& option : options_)
+    if (option.name == name || (!option.short_name.empty() && option.short_name == name)) return &option;
+  return nullptr;
+}
+
+ArgParser::Outcome ArgParser::parse(int argc, const char* const* argv) {
+  // --help wins over any other mistake on the line: whoever asks for help gets it.
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (arg == "--") break;
+    if (arg == "-h" || arg == "--help") return Outcome::kHelp;
+  }
+
+  size_t next_positional = 0;
+  bool flags_ended = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (!flags_ended && arg == "--") {
+      flags_ended = true;
+      continue;
+    }
+    if (!flags_ended && arg.size() > 1 && arg[0] == '-') {
+      std::string name = arg;
+      std::string inline_value;
+      bool has_inline_value = false;
+      if (arg.rfind("--", 0) == 0) {
+        if (const auto eq = arg.find('='); eq != std::string::npos) {
+          name = arg.substr(0, eq);
+          inline_value = arg.substr(eq + 1);
+          has_inline_value = true;
+        }
+      }
+      const Option* option = find(name);
+      if (!option) throw UsageError("unknown flag " + single_quoted(name) + " (see --help)");
+      if (option->switch_target) {
+        if (has_inline_value) throw UsageError(option->name + " takes no value");
+        *option->switch_target = true;
+      } else {
+        std::string value;
+        if (has_inline_value) {
+          value = inline_value;
+        } else if (i + 1 < argc) {
+          // The next argument is the value even when it starts with '-' ("--azimuth -30").
+          value = argv[++i];
+        } else {
+          throw UsageError(name + " expects a value (" + option->value_name + ")");
+        }
+        option->on_value(value);
+      }
+      seen_.insert(option->name);
+      continue;
+    }
+    if (next_positional >= positionals_.size())
+      throw UsageError("unexpected argument " + single_quoted(arg) + " (see --help)");
+    *positionals_[next_positional++].target = arg;
+  }
+  return Outcome::kRun;
+}
+
+std::string ArgParser::help_text() const {
+  std::string out = "usage: " + usage_ + "\n\n";
+  append_wrapped(out, description_, 0, 0);
+  out += "\n";
+
+  auto append_entry = [&out](const std::string& left, const std::string& help) {
+    out += left;
+    size_t column = left.size();
+    if (column + 1 >= kHelpFlagColumn) {
+      out += '\n';
+      column = 0;
+    }
+    out.append(kHelpFlagColumn - column, ' ');
+    append_wrapped(out, help, kHelpFlagColumn, kHelpFlagColumn);
+    out += '\n';
+  };
+
+  if (!positionals_.empty()) {
+    out += "\narguments:\n";
+    for (const auto& positional : positionals_) append_entry("  " + positional.value_name, positional.help);
+  }
+  for (size_t section = 0; section < sections_.size(); ++section) {
+    const bool has_entries = std::any_of(options_.begin(), options_.end(),
+                                         [section](const Option& option) { return option.section == section; });
+    if (!has_entries && section != 0) continue;
+    out += "\n" + sections_[section] + ":\n";
+    if (section == 0) append_entry("  -h, --help", "print this help and exit");
+    for (const auto& option : options_) {
+      if (option.section != section) continue;
+      std::string left = "  ";
+      left += option.short_name.empty() ? "    " : option.short_name + ", ";
+      left += option.name;
+      if (!option.value_name.empty()) left += " " + option.value_name;
+      append_entry(left, option.help);
+    }
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Value parsers
+
+int parse_int(std::string_view flag, std::string_view text, int min, int max) {
+  const std::string expectation = min >= 1   ? "a positive integer"
+                                  : min == 0 ? "a non-negative integer"
+                                             : "an integer";
+  const std::string got = ", got " + single_quoted(text);
+  long long value = 0;
+  const char* first = text.data();
+  const char* last = text.data() + text.size();
+  const auto [end, error] = std::from_chars(first, last, value);
+  if (text.empty() || error == std::errc::invalid_argument || end != last)
+    throw UsageError(std::string(flag) + " expects " + expectation + got);
+  if (error == std::errc::result_out_of_range || value > max) {
+    if (error == std::errc::result_out_of_range && text.front() == '-')
+      throw UsageError(std::string(flag) + " expects " + expectation + got);
+    throw UsageError(std::string(flag) + " must be at most " + std::to_string(max) + got);
+  }
+  if (value < min) {
+    if (min == 0 || min == 1) throw UsageError(std::string(flag) + " expects " + expectation + got);
+    throw UsageError(std::string(flag) + " must be at least " + std::to_string(min) + got);
+  }
+  return static_cast<int>(value);
+}
+
+double parse_double(std::string_view flag, std::string_view text) {
+  const std::string trimmed = trim(text);
+  double value = 0;
+  const char* first = trimmed.data();
+  const char* last = trimmed.data() + trimmed.size();
+  const auto [end, error] = std::from_chars(first, last, value);
+  if (trimmed.empty() || error != std::errc() || end != last)
+    throw UsageError(std::string(flag) + " expects a number, got " + single_quoted(text));
+  if (!std::isfinite(value))
+    throw UsageError(std::string(flag) + " expects a finite number, got " + single_quoted(text));
+  return value;
+}
+
+std::array<float, 3> parse_rgb(std::string_view flag, std::string_view text) {
+  const auto parts = split(text, ',');
+  const std::string expectation =
+      std::string(flag) + " expects three numbers r,g,b (e.g. 0.5,0.5,0.5), got " + single_quoted(text);
+  if (parts.size() != 3) throw UsageError(expectation);
+  std::array<float, 3> rgb{};
+  for (size_t c = 0; c < 3; ++c) {
+    const std::string part = trim(parts[c]);
+    double value = 0;
+    const auto [end, error] = std::from_chars(part.data(), part.data() + part.size(), value);
+    if (part.empty() || error != std::errc() || end != part.data() + part.size())
+      throw UsageError(expectation);
+    if (!std::isfinite(value) || std::fabs(value) > double(std::numeric_limits<float>::max()))
+      throw UsageError(std::string(flag) + " expects finite numbers, got " + single_quoted(part) + " in " +
+                       single_quoted(text));
+    rgb[c] = static_cast<float>(value);
+  }
+  return rgb;
+}
+
+std::vector<std::string> split(std::string_view text, char separator) {
+  std::vector<std::string> parts;
+  size_t start = 0;
+  while (true) {
+    const auto end = text.find(separator, start);
+    if (end == std::string_view::npos) {
+      parts.emplace_back(text.substr(start));
+      return parts;
+    }
+    parts.emplace_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Common options
+
+void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice) {
+  const OrbitParams orbit_defaults;
+  parser.add_positional("SCENE.ply", "the scene: a 3D Gaussian Splatting .ply as the trainer writes it",
+                        &options.scene);
+
+  parser.section("camera");
+  parser.add_string("--cameras", "FILE.json",
+                    "take the camera from the trainer's cameras.json (default: an orbit camera framing the "
+                    "scene, see --azimuth)",
+                    &options.cameras);
+  parser.add_int("--view", "N", "which view of --cameras, counting from 0 (default 0)", &options.view, 0,
+                 std::numeric_limits<int>::max());
+  parser.add_int("--width", "W",
+                 "image width in pixels; given alone, the height follows the view's aspect ratio (default: "
+                 "the view's size, or 1920x1080 for the orbit camera)",
+                 &options.width, 1, kMaxImageSide);
+  parser.add_int("--height", "H", "image height in pixels; given alone, the width follows the aspect ratio",
+                 &options.height, 1, kMaxImageSide);
+  parser.add_value("--azimuth", "DEG",
+                   "orbit camera: angle around the scene (default " + format_fixed(orbit_defaults.azimuth_deg, 0) +
+                       ")",
+                   [&options](const std::string& text) {
+                     options.orbit.azimuth_deg = parse_double("--azimuth", text);
+                   });
+  parser.add_value("--elevation", "DEG",
+                   "orbit camera: angle above the horizon, between -90 and 90 (default " +
+                       format_fixed(orbit_defaults.elevation_deg, 0) + ")",
+                   [&options](const std::string& text) {
+                     const double degrees = parse_double("--elevation", text);
+                     if (!(degrees > -90 && degrees < 90))
+                       throw UsageError("--elevation must be strictly between -90 and 90, got " + single_quoted(text));
+                     options.orbit.elevation_deg = degrees;
+                   });
+  parser.add_value("--fov", "DEG",
+                   "orbit camera: vertical field of view (default " +
+                       format_fixed(orbit_defaults.vertical_fov_deg, 0) + ")",
+                   [&options](const std::string& text) {
+                     const double degrees = parse_double("--fov", text);
+                     if (!(degrees > 0 && degrees < 180))
+                       throw UsageError("--fov must be strictly between 0 and 180 degrees, got " + single_quoted(text));
+                     options.orbit.vertical_fov_deg = degrees;
+                   });
+  parser.add_value("--distance", "SCALE",
+                   "orbit camera: multiply the distance that frames the scene (default 1)",
+                   [&options](const std::string& text) {
+                     const double scale = parse_double("--distance", text);
+                     if (!(scale > 0)) throw UsageError("--distance must be positive, got " + single_quoted(text));
+                     options.orbit.distance_scale = scale;
+                   });
+
+  parser.section("scene and device");
+  parser.add_switch("--strict",
+                    "fail on the first non-finite value in the scene (default: drop such Gaussians and report "
+                    "them)",
+                    &options.strict);
+  parser.add_string("--device", "NAME_OR_INDEX",
+                    "Vulkan device: an index from --list-devices or part of its name (default: "
+                    "$TILESPLAT_DEVICE, else the first discrete GPU, else the first device)",
+                    &options.device);
+  parser.add_switch("--list-devices", "print the Vulkan devices with their indices and exit",
+                    &options.list_devices);
+  parser.add_switch("--validation",
+                    "enable the Khronos validation layer and report its messages (also TILESPLAT_VALIDATION=1)",
+                    &options.validation);
+
+  const auto available = available_sorts();
+  const std::string default_sort = available.empty() ? "radix" : available.front();
+  if (sort_choice == SortChoice::kOne) {
+    parser.add_value("--sort", "NAME",
+                     "key sort strategy: " + join(available, ", ") + " (default " + default_sort + ")",
+                     [&options, available](const std::string& text) {
+                       options.sorts = {sort_name_checked("--sort", text, available)};
+                     });
+  } else {
+    parser.add_value("--sort", "NAME[,NAME...]",
+                     "key sort strategies to measure, comma-separated, or 'all': " + join(available, ", ") +
+                         " (default all)",
+                     [&options, available](const std::string& text) {
+                       options.sorts.clear();
+                       for (const auto& part : split(text, ',')) {
+                         if (trim(part) == "all") {
+                           for (const auto& name : available)
+                             if (std::find(options.sorts.begin(), options.sorts.end(), name) ==
+                                 options.sorts.end())
+                               options.sorts.push_back(name);
+                           continue;
+                         }
+                         if (trim(part).empty())
+                           throw UsageError("--sort expects comma-separated names, got " + single_quoted(text));
+                         const auto name = sort_name_checked("--sort", part, available);
+                         if (std::find(options.sorts.begin(), options.sorts.end(), name) == options.sorts.end())
+                           options.sorts.push_back(name);
+                       }
+                     });
+  }
+}
+
+void check_common_options(const ArgParser& parser, const CommonOptions& options) {
+  if (options.scene.empty()) throw UsageError("missing the SCENE.ply argument (see --help)");
+  if (!options.cameras.empty()) {
+    for (const char* orbit_flag : {"--azimuth", "--elevation", "--fov", "--distance"})
+      if (parser.seen(orbit_flag))
+        throw UsageError(std::string(orbit_flag) +
+                         " applies only to the orbit camera and cannot be combined with --cameras");
+  } else if (parser.seen("--view")) {
+    throw UsageError("--view needs --cameras FILE.json (without it the camera is an orbit)");
+  }
+}
+
+void print_devices() {
+  const auto devices = list_devices();
+  if (devices.empty()) throw std::runtime_error("no Vulkan devices found");
+  for (size_t i = 0; i < devices.size(); ++i) std::printf("%zu: %s\n", i, devices[i].c_str());
+}
+
+LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program) {
+  LoadedScene loaded;
+  loaded.path = options.scene;
+  require_input_file(loaded.path, "scene");
+
+  const auto start = std::chrono::steady_clock::now();
+  LoadOptions load_options;
+  load_options.strict = options.strict;
+  try {
+    loaded.scene = load_scene(loaded.path, load_options, &loaded.report);
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(loaded.path.string() + ": out of memory while loading the scene");
+  } catch (const std::exception& error) {
+    throw std::runtime_error(naming_file(loaded.path, error.what()));
+  }
+  loaded.load_ms = elapsed_ms(start);
+  if (loaded.report.dropped > 0) {
+    std::string summary = loaded.report.summary();
+    if (summary.empty())
+      summary = "dropped " + group_thousands(loaded.report.dropped) + " Gaussians with non-finite values";
+    print_warning(program, naming_file(loaded.path, summary));
+  }
+
+  auto check_size = [](const Camera& camera) {
+    if (camera.width < 1 || camera.height < 1 || camera.width > kMaxImageSide || camera.height > kMaxImageSide)
+      throw UsageError("the image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                       " is out of range (1 to " + std::to_string(kMaxImageSide) + " pixels a side)");
+  };
+
+  if (!options.cameras.empty()) {
+    const fs::path cameras_path = options.cameras;
+    require_input_file(cameras_path, "cameras");
+    std::vector<CameraView> views;
+    try {
+      views = load_cameras_json(cameras_path);
+    } catch (const std::exception& error) {
+      throw std::runtime_error(naming_file(cameras_path, error.what()));
+    }
+    if (views.empty()) throw std::runtime_error(single_quoted(cameras_path.string()) + " has no views");
+    if (static_cast<size_t>(options.view) >= views.size())
+      throw UsageError("--view " + std::to_string(options.view) + " is out of range: " +
+                       single_quoted(cameras_path.string()) + " has " + std::to_string(views.size()) + " views (0.." +
+                       std::to_string(views.size() - 1) + ")");
+    const auto& view = views[static_cast<size_t>(options.view)];
+    check_size(view.camera);
+    loaded.camera = resize_camera(view.camera, options.width, options.height);
+    loaded.camera_description = "view " + std::to_string(options.view);
+    if (!view.name.empty()) loaded.camera_description += " (" + view.name + ")";
+    loaded.camera_description += " of " + cameras_path.filename().string();
+  } else {
+    if (loaded.scene.empty())
+      throw std::runtime_error(single_quoted(loaded.path.string()) +
+                               " has no Gaussians for the orbit camera to frame; pass --cameras FILE.json");
+    int width = options.width;
+    int height = options.height;
+    const double aspect = double(kOrbitDefaultWidth) / double(kOrbitDefaultHeight);
+    if (width <= 0 && height <= 0) {
+      width = kOrbitDefaultWidth;
+      height = kOrbitDefaultHeight;
+    } else if (height <= 0) {
+      height = static_cast<int>(std::max(1.0, std::round(double(width) / aspect)));
+    } else if (width <= 0) {
+      width = static_cast<int>(std::min(double(kMaxImageSide) + 1, std::max(1.0, std::round(double(height) * aspect))));
+    }
+    loaded.camera = orbit_camera(loaded.scene, width, height, options.orbit);
+    loaded.camera_description = "orbit azimuth " + format_fixed(options.orbit.azimuth_deg, 1) + " elevation " +
+                                format_fixed(options.orbit.elevation_deg, 1) + " fov " +
+                                format_fixed(options.orbit.vertical_fov_deg, 1);
+  }
+  check_size(loaded.camera);
+  return loaded;
+}
+
+RendererOptions renderer_options(const CommonOptions& options) {
+  RendererOptions renderer;
+  renderer.device = options.device;
+  renderer.validation = options.validation;
+  renderer.timestamps = true;
+  return renderer;
+}
+
+std::string describe_scene(const GaussianScene& scene) {
+  return group_thousands(scene.size()) + " Gaussians (SH" + std::to_string(scene.sh_degree) + ")";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors
+
+std::string one_line(std::string_view message) {
+  std::string out;
+  out.reserve(message.size());
+  bool pending_break = false;
+  for (const char c : message) {
+    if (c == '\n' || c == '\r') {
+      pending_break = !out.empty();
+      continue;
+    }
+    if (pending_break) {
+      out += "; ";
+      pending_break = false;
+    }
+    out += c;
+  }
+  return out;
+}
+
+void print_error(std::string_view program, std::string_view message) {
+  std::fflush(stdout);
+  const std::string line = std::string(program) + ": error: " + one_line(message) + "\n";
+  std::fputs(line.c_str(), stderr);
+  std::fflush(stderr);
+}
+
+void print_warning(std::string_view program, std::string_view message) {
+  const std::string line = std::string(program) + ": warning: " + one_line(message) + "\n";
+  std::fputs(line.c_str(), stderr);
+}
+
+int run_app(std::string_view program, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const UsageError& error) {
+    print_error(program, error.what());
+    return kExitUsage;
+  } catch (const std::bad_alloc&) {
+    print_error(program, "out of memory");
+    return kExitFailure;
+  } catch (const std::exception& error) {
+    print_error(program, error.what());
+    return kExitFailure;
+  } catch (...) {
+    print_error(program, "unexpected error");
+    return kExitFailure;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Files
+
+bool has_extension(const fs::path& path, std::string_view extension) {
+  const std::string actual = path.extension().string();
+  return actual.size() == extension.size() &&
+         std::equal(actual.begin(), actual.end(), extension.begin(), [](char a, char b) {
+           return std::tolower(static_cast<unsigned char>(a)) == std::tolower(static_cast<unsigned char>(b));
+         });
+}
+
+void check_output_path(const fs::path& path, std::string_view flag) {
+  if (path.empty()) throw UsageError(std::string(flag) + " expects a file name");
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw std::runtime_error("cannot write " + single_quoted(path.string()) + " (" + std::string(flag) +
+                             "): it is a directory");
+  fs::path directory = path.parent_path();
+  if (directory.empty()) directory = ".";
+  const auto status = fs::status(directory, ec);
+  if (!fs::exists(status))
+    throw std::runtime_error("cannot write " + single_quoted(path.string()) + " (" + std::string(flag) +
+                             "): directory " + single_quoted(directory.string()) + " does not exist");
+  if (!fs::is_directory(status))
+    throw std::runtime_error("cannot write " + single_quoted(path.string()) + " (" + std::string(flag) + "): " +
+                             single_quoted(directory.string()) + " is not a directory");
+  if (::access(directory.c_str(), W_OK) != 0)
+    throw std::runtime_error("cannot write " + single_quoted(path.string()) + " (" + std::string(flag) +
+                             "): directory " + single_quoted(directory.string()) + " is not writable");
+}
+
+void check_distinct_paths(const std::vector<std::pair<std::string, fs::path>>& paths) {
+  std::vector<std::pair<std::string, fs::path>> resolved;
+  for (const auto& [flag, path] : paths) {
+    if (path.empty()) continue;
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(path, ec);
+    if (ec) canonical = fs::absolute(path, ec).lexically_normal();
+    for (const auto& [other_flag, other] : resolved)
+      if (other == canonical)
+        throw UsageError(other_flag + " and " + flag + " name the same file " + single_quoted(path.string()));
+    resolved.emplace_back(flag, canonical);
+  }
+}
+
+void write_file_atomic(const fs::path& path, std::string_view contents) {
+  const fs::path temporary =
+      path.parent_path() / ("." + path.filename().string() + ".tmp." + std::to_string(::getpid()));
+  auto fail = [&](const std::string& why) {
+    std::error_code ignored;
+    fs::remove(temporary, ignored);
+    throw std::runtime_error("cannot write " + single_quoted(path.string()) + ": " + why);
+  };
+
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail(std::strerror(errno));
+  size_t written = 0;
+  while (written < contents.size()) {
+    const ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int saved = errno;
+      ::close(fd);
+      fail(std::strerror(saved));
+    }
+    written += static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0 && errno != EINVAL) {
+    const int saved = errno;
+    ::close(fd);
+    fail(std::strerror(saved));
+  }
+  if (::close(fd) != 0) fail(std::strerror(errno));
+  std::error_code ec;
+  fs::rename(temporary, path, ec);
+  if (ec) fail(ec.message());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Formatting
+
+std::string format_fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) != 0; }
+
+}  // namespace tilesplat::cli

@@ -1,0 +1,181 @@
+// What tilesplat-render and tilesplat-bench share: a small declarative flag parser, the
+// "scene + camera + device" options, error reporting with the apps' exit codes, and atomic
+// writes of text outputs.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tilesplat/camera.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;  // a runtime error: a bad file, a failed render or write
+inline constexpr int kExitUsage = 2;    // a command-line mistake
+
+// A mistake on the command line: reported like any error but exits with kExitUsage.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The largest width or height the apps accept before asking the device (which has its own limit).
+inline constexpr int kMaxImageSide = 65536;
+
+// Declarative parser: flags are registered with their help text, so --help lists exactly what
+// the parser accepts. Value flags take "--flag value" or "--flag=value"; "--" ends the flags.
+class ArgParser {
+ public:
+  enum class Outcome { kRun, kHelp };
+
+  ArgParser(std::string program, std::string usage, std::string description);
+
+  // Flags registered after this call are listed under `title` in --help.
+  void section(std::string title);
+
+  // A flag with a value. on_value throws UsageError when the text is not acceptable.
+  // short_name is e.g. "-o" (may be empty).
+  void add_value(std::string name, std::string value_name, std::string help,
+                 std::function<void(const std::string&)> on_value, std::string short_name = {});
+  void add_string(std::string name, std::string value_name, std::string help, std::string* target,
+                  std::string short_name = {});
+  // An integer in [min, max]; see parse_int for the messages.
+  void add_int(std::string name, std::string value_name, std::string help, int* target, int min, int max);
+  // Any finite number.
+  void add_double(std::string name, std::string value_name, std::string help, double* target);
+  // A boolean switch: present = true. It takes no value.
+  void add_switch(std::string name, std::string help, bool* target);
+  // Positional arguments fill their targets in registration order.
+  void add_positional(std::string value_name, std::string help, std::string* target);
+
+  // Throws UsageError. Returns kHelp (without parsing anything else) when -h/--help is given.
+  Outcome parse(int argc, const char* const* argv);
+
+  // Whether the flag (its long name) appeared on the command line.
+  bool seen(std::string_view name) const { return seen_.count(std::string(name)) != 0; }
+
+  std::string help_text() const;
+  const std::string& program() const { return program_; }
+
+ private:
+  struct Option {
+    std::string name;
+    std::string short_name;
+    std::string value_name;  // empty for switches
+    std::string help;
+    std::function<void(const std::string&)> on_value;
+    bool* switch_target = nullptr;
+    size_t section = 0;
+  };
+  struct Positional {
+    std::string value_name;
+    std::string help;
+    std::string* target = nullptr;
+  };
+
+  const Option* find(std::string_view name) const;
+
+  std::string program_;
+  std::string usage_;
+  std::string description_;
+  std::vector<std::string> sections_;
+  std::vector<Option> options_;
+  std::vector<Positional> positionals_;
+  std::set<std::string> seen_;
+};
+
+// Value parsers shared by the flags; all throw UsageError naming the flag and the text.
+// "--width expects a positive integer, got 'abc'"; "--width must be at most 65536, got '70000'".
+int parse_int(std::string_view flag, std::string_view text, int min, int max);
+double parse_double(std::string_view flag, std::string_view text);
+// "r,g,b": three finite floats.
+std::array<float, 3> parse_rgb(std::string_view flag, std::string_view text);
+std::vector<std::string> split(std::string_view text, char separator);
+
+// The options every app has: which scene, which camera, which device.
+struct CommonOptions {
+  std::string scene;
+  std::string cameras;
+  int view = 0;
+  int width = 0;   // 0: the view's size (or kOrbitDefaultWidth), keeping the aspect when one is given
+  int height = 0;
+  OrbitParams orbit;
+  bool strict = false;
+  std::string device;
+  bool list_devices = false;
+  bool validation = false;
+  std::vector<std::string> sorts;  // validated against sort_strategies(); empty = the app's default
+};
+
+inline constexpr int kOrbitDefaultWidth = 1920;
+inline constexpr int kOrbitDefaultHeight = 1080;
+
+enum class SortChoice { kOne, kList };
+
+// Registers SCENE, --cameras, --view, --width, --height, the orbit flags, --strict, --device,
+// --list-devices, --validation and --sort (one name, or a comma list / "all" for kList).
+void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice);
+
+// Checks what the parser cannot check flag by flag (a SCENE was given, orbit flags are not
+// mixed with --cameras, ...). Throws UsageError.
+void check_common_options(const ArgParser& parser, const CommonOptions& options);
+
+// Prints list_devices() with the indices --device accepts.
+void print_devices();
+
+struct LoadedScene {
+  std::filesystem::path path;
+  GaussianScene scene;
+  LoadReport report;
+  Camera camera;
+  std::string camera_description;  // "view 0 of cams.json" or "orbit azimuth 0 elevation 20 fov 50"
+  double load_ms = 0;
+};
+
+// Loads the scene (printing LoadReport::summary() to stderr as a warning when Gaussians were
+// dropped) and builds the camera at the requested size. A missing or unreadable file throws
+// std::runtime_error naming it; an out-of-range --view throws UsageError naming the file and
+// its number of views.
+LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program);
+
+RendererOptions renderer_options(const CommonOptions& options);
+
+// "SH3" style summary of the scene: "64 Gaussians (SH3)".
+std::string describe_scene(const GaussianScene& scene);
+
+// Runs an app's body, turning exceptions into one line "PROGRAM: error: MESSAGE" on stderr and
+// the exit codes above.
+int run_app(std::string_view program, const std::function<int()>& body);
+void print_error(std::string_view program, std::string_view message);
+void print_warning(std::string_view program, std::string_view message);
+
+// Fails early (std::runtime_error) when `path` cannot be an output: its directory does not
+// exist, or it names a directory. `flag` names the option in the message.
+void check_output_path(const std::filesystem::path& path, std::string_view flag);
+// Throws UsageError when two of the given (flag, path) pairs name the same file; empty paths
+// are skipped. Keeps an output from overwriting an input or another output.
+void check_distinct_paths(const std::vector<std::pair<std::string, std::filesystem::path>>& paths);
+// Whether the path's extension is `extension` (".exr"), ignoring case.
+bool has_extension(const std::filesystem::path& path, std::string_view extension);
+
+// Writes `contents` to a temporary file beside `path`, then renames it over `path`, so a
+// failure never leaves a partial file. Throws std::runtime_error naming the file.
+void write_file_atomic(const std::filesystem::path& path, std::string_view contents);
+
+// Collapses an exception message to one line.
+std::string one_line(std::string_view message);
+// Fixed-point number with `decimals` digits.
+std::string format_fixed(double value, int decimals);
+bool stderr_is_terminal();
+
+}  // namespace tilesplat::cli

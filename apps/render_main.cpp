@@ -1,0 +1,207 @@
+// tilesplat-render: renders one view of a scene to an EXR (and optionally a PNG preview).
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "cli.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/image.h"
+#include "tilesplat/reference.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+
+namespace {
+
+namespace cli = tilesplat::cli;
+namespace fs = std::filesystem;
+
+constexpr const char* kProgram = "tilesplat-render";
+
+struct RenderOptions {
+  cli::CommonOptions common;
+  std::string output;
+  std::string png;
+  std::array<float, 3> background = {0, 0, 0};
+  double exposure = 1.0;
+  bool half = false;
+  bool no_depth = false;
+  bool no_count = false;
+  bool reference = false;
+  bool stats = false;
+};
+
+std::string single_quoted(const std::string& text) { return "'" + text + "'"; }
+
+// Library writers name the file in their messages; this keeps that true whatever they say.
+std::string write_failure(const fs::path& path, const std::exception& error) {
+  const std::string message = cli::one_line(error.what());
+  if (message.find(path.filename().string()) != std::string::npos) return message;
+  return "cannot write " + single_quoted(path.string()) + ": " + message;
+}
+
+void print_row(const std::string& name, const std::string& value, const std::string& unit) {
+  if (unit.empty())
+    std::printf("%-22s %14s\n", name.c_str(), value.c_str());
+  else
+    std::printf("%-22s %14s %s\n", name.c_str(), value.c_str(), unit.c_str());
+}
+
+void print_frame_stats(const tilesplat::FrameStats& stats, const tilesplat::DeviceInfo& device) {
+  std::printf("device: %s (driver %s), subgroup size %u\n", device.name.c_str(), device.driver.c_str(),
+              device.subgroup_size);
+  for (const auto& pass : stats.passes) print_row(pass.name, cli::format_fixed(pass.gpu_ms, 3), "ms");
+  print_row("gpu frame", cli::format_fixed(stats.gpu_ms, 3), "ms");
+  print_row("cpu frame", cli::format_fixed(stats.cpu_ms, 3), "ms");
+  print_row("gaussians", std::to_string(stats.gaussians), "");
+  print_row("visible", std::to_string(stats.visible), "");
+  print_row("intersections", std::to_string(stats.intersections), "");
+  print_row("sort bits", std::to_string(stats.sort_bits), "");
+  print_row("retries", std::to_string(stats.retries), "");
+  print_row("device memory", cli::format_fixed(double(stats.device_bytes) / (1024.0 * 1024.0), 2), "MiB");
+}
+
+void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
+  cli::add_common_options(parser, options.common, cli::SortChoice::kOne);
+
+  parser.section("output");
+  parser.add_string("--output", "OUT.exr",
+                    "the EXR to write (required): R G B A, plus Z (expected depth) and 'splats' (blended "
+                    "splats per pixel) unless turned off",
+                    &options.output, "-o");
+  parser.add_string("--png", "FILE.png", "also write an 8-bit sRGB preview of the colours", &options.png);
+  parser.add_value("--exposure", "X", "multiply the colours of the --png preview (default 1)",
+                   [&options](const std::string& text) {
+                     const double exposure = cli::parse_double("--exposure", text);
+                     if (!(exposure > 0))
+                       throw cli::UsageError("--exposure must be positive, got " + single_quoted(text));
+                     options.exposure = exposure;
+                   });
+  parser.add_switch("--half", "store the EXR channels as 16-bit HALF instead of 32-bit FLOAT", &options.half);
+  parser.add_switch("--no-depth", "do not compute or store the depth channel (Z)", &options.no_depth);
+  parser.add_switch("--no-count", "do not compute or store the per-pixel splat count", &options.no_count);
+
+  parser.section("rendering");
+  parser.add_value("--background", "R,G,B", "linear background colour (default 0,0,0)",
+                   [&options](const std::string& text) {
+                     options.background = cli::parse_rgb("--background", text);
+                   });
+  parser.add_switch("--reference",
+                    "render with the float64 CPU reference instead of the GPU (slow; for checking)",
+                    &options.reference);
+  parser.add_switch("--stats",
+                    "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
+                    "intersections, retries",
+                    &options.stats);
+}
+
+int run(int argc, char** argv) {
+  RenderOptions options;
+  cli::ArgParser parser(kProgram, "tilesplat-render SCENE.ply -o OUT.exr [options]",
+                        "Renders one view of a 3D Gaussian Splatting scene with the Vulkan compute renderer "
+                        "and writes it as an EXR. The camera comes from the trainer's cameras.json "
+                        "(--cameras, --view) or orbits the scene (--azimuth, --elevation, --fov).");
+  add_render_options(parser, options);
+  if (parser.parse(argc, argv) == cli::ArgParser::Outcome::kHelp) {
+    std::fputs(parser.help_text().c_str(), stdout);
+    return cli::kExitOk;
+  }
+  if (options.common.list_devices) {
+    cli::print_devices();
+    return cli::kExitOk;
+  }
+  cli::check_common_options(parser, options.common);
+  if (options.output.empty()) throw cli::UsageError("missing -o OUT.exr: where to write the image (see --help)");
+  if (!cli::has_extension(options.output, ".exr"))
+    throw cli::UsageError("-o expects an .exr file, got " + single_quoted(options.output) +
+                          " (use --png for a PNG preview)");
+  if (!options.png.empty() && !cli::has_extension(options.png, ".png"))
+    throw cli::UsageError("--png expects a .png file, got " + single_quoted(options.png));
+  if (parser.seen("--exposure") && options.png.empty())
+    throw cli::UsageError("--exposure applies to the --png preview, and no --png was given");
+  cli::check_distinct_paths({{"SCENE", options.common.scene},
+                             {"--cameras", options.common.cameras},
+                             {"-o", options.output},
+                             {"--png", options.png}});
+  if (options.reference) {
+    for (const char* gpu_flag : {"--device", "--validation", "--sort"})
+      if (parser.seen(gpu_flag))
+        cli::print_warning(kProgram, std::string(gpu_flag) + " has no effect with --reference (CPU renderer)");
+  }
+  // Fail before the (possibly long) load and render when the outputs cannot be written.
+  cli::check_output_path(options.output, "-o");
+  if (!options.png.empty()) cli::check_output_path(options.png, "--png");
+
+  const cli::LoadedScene loaded = cli::load_scene_and_camera(options.common, kProgram);
+
+  tilesplat::RenderSettings settings;
+  settings.background = options.background;
+  if (!options.common.sorts.empty()) settings.sort = options.common.sorts.front();
+  settings.depth = !options.no_depth;
+  settings.splat_count = !options.no_count;
+
+  tilesplat::RenderImage image;
+  std::string timing;
+  if (options.reference) {
+    const auto start = std::chrono::steady_clock::now();
+    image = tilesplat::render_reference(loaded.scene, loaded.camera, settings);
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    timing = "CPU reference " + cli::format_fixed(ms, 1) + " ms";
+    if (options.stats) {
+      print_row("cpu reference", cli::format_fixed(ms, 3), "ms");
+      print_row("gaussians", std::to_string(loaded.scene.size()), "");
+    }
+  } else {
+    const auto renderer = tilesplat::Renderer::create(cli::renderer_options(options.common));
+    renderer->set_scene(loaded.scene);
+    image = renderer->render(loaded.camera, settings);
+    const tilesplat::FrameStats& stats = renderer->last_frame_stats();
+    timing = "GPU " + cli::format_fixed(stats.gpu_ms, 2) + " ms, frame " + cli::format_fixed(stats.cpu_ms, 2) +
+             " ms";
+    if (options.stats) print_frame_stats(stats, renderer->device_info());
+    if (const auto messages = renderer->validation_messages(); messages > 0)
+      cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
+  }
+  if (image.width != loaded.camera.width || image.height != loaded.camera.height ||
+      image.rgba.size() != image.pixels() * 4)
+    throw std::runtime_error("the renderer returned a " + std::to_string(image.width) + "x" +
+                             std::to_string(image.height) + " image for a " + std::to_string(loaded.camera.width) +
+                             "x" + std::to_string(loaded.camera.height) + " camera");
+  if (options.no_depth) image.depth.clear();
+  if (options.no_count) image.splat_count.clear();
+
+  // The EXR first: a preview must never exist without the image it previews.
+  tilesplat::ExrWriteOptions exr_options;
+  exr_options.half = options.half;
+  try {
+    tilesplat::write_exr(options.output, image, exr_options);
+  } catch (const std::exception& error) {
+    throw std::runtime_error(write_failure(options.output, error));
+  }
+  std::string written = options.output;
+  if (!options.png.empty()) {
+    try {
+      tilesplat::write_png_preview(options.png, image, static_cast<float>(options.exposure));
+    } catch (const std::exception& error) {
+      throw std::runtime_error(write_failure(options.png, error));
+    }
+    written += ", " + options.png;
+  }
+
+  std::fflush(stdout);
+  const std::string summary = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
+                              cli::describe_scene(loaded.scene) + ", " + std::to_string(image.width) + "x" +
+                              std::to_string(image.height) + ", " + loaded.camera_description + ", " + timing +
+                              " -> " + written + "\n";
+  std::fputs(summary.c_str(), stderr);
+  return cli::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return cli::run_app(kProgram, [argc, argv] { return run(argc, argv); });
+}

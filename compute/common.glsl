@@ -1,0 +1,31 @@
+// Shared declarations for every tilesplat compute shader.
+// All buffers are reached through 64-bit device addresses passed in push constants: no descriptor
+// sets, and no maxStorageBufferRange limit (lavapipe caps a binding at 128 MiB; scenes exceed it).
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer FloatArray { float v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer UintArray { uint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) buffer Uint64Array { uint64_t v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) buffer Uvec2Array { uvec2 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vec4Array { vec4 v[]; };
+
+const uint TILE_SIZE = 16;
+
+// Counters written on the GPU during a frame and read by the host after it (see frame_counters.h).
+const uint COUNTER_INTERSECTIONS = 0;  // total (Gaussian, tile) pairs wanted this frame
+const uint COUNTER_SORT_COUNT = 1;     // pairs actually emitted and sorted: min(total, capacity)
+const uint COUNTER_OVERFLOW = 2;       // 1 when total exceeded capacity (the host grows and retries)
+const uint COUNTER_VISIBLE = 3;        // Gaussians that touch at least one tile
+const uint COUNTER_RANGES_ARGS = 4;    // 3 uints: indirect dispatch of the tile-range pass
+const uint COUNTER_SORT_ARGS = 8;      // 3 uints: indirect dispatch of the sort's per-block passes
+const uint COUNTER_SORT_BLOCKS = 11;   // blocks the sort splits its keys into
+
+// Projected splat record: three vec4 per Gaussian.
+//   [0] mean.x, mean.y (float hi parts), view depth, opacity
+//   [1] conic A, B, C, mean.x lo part
+//   [2] colour r, g, b, mean.y lo part
+const uint SPLAT_VEC4S = 3;
+
+// Popcount of a subgroup ballot, valid for any subgroup size up to 128.
+uint ballot_count(uvec4 b) { return bitCount(b.x) + bitCount(b.y) + bitCount(b.z) + bitCount(b.w); }

@@ -1,0 +1,23 @@
+#version 460
+// One invocation between the prefix sum and the key emission: decides how many keys this frame
+// sorts (never more than the buffers hold) and writes the indirect dispatch sizes that depend on
+// it, so the frame needs no CPU round trip. An overflow is flagged for the host to grow and retry.
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+layout(local_size_x = 1) in;
+
+layout(push_constant) uniform Push {
+  UintArray counters;
+  uint capacity;  // keys the key/value buffers hold
+} pc;
+
+void main() {
+  uint total = pc.counters.v[COUNTER_INTERSECTIONS];
+  uint sorted = min(total, pc.capacity);
+  pc.counters.v[COUNTER_SORT_COUNT] = sorted;
+  pc.counters.v[COUNTER_OVERFLOW] = total > pc.capacity ? 1u : 0u;
+  pc.counters.v[COUNTER_RANGES_ARGS + 0] = (sorted + 255) / 256;
+  pc.counters.v[COUNTER_RANGES_ARGS + 1] = 1;
+  pc.counters.v[COUNTER_RANGES_ARGS + 2] = 1;
+}

@@ -1,0 +1,21 @@
+// Shared by the radix sort kernels. The keys are split into blocks of BLOCK_KEYS; each block is owned by
+// ONE subgroup from start to end, so the histogram and scatter need no workgroup-wide synchronisation
+// and stay stable (a subgroup walks its block in order). Works for subgroup sizes 4 to 128.
+layout(local_size_x_id = 0) in;
+layout(constant_id = 1) const uint SUBGROUPS_PER_WORKGROUP = 8;
+layout(constant_id = 2) const uint BLOCK_KEYS = 2048;
+
+const uint RADIX = 256;
+
+layout(push_constant) uniform Push {
+  Uint64Array keys_in;
+  UintArray values_in;
+  Uint64Array keys_out;
+  UintArray values_out;
+  UintArray histogram;     // RADIX * blocks, digit-major: histogram[digit * blocks + block]
+  UintArray digit_totals;  // RADIX
+  UintArray counters;
+  uint shift;              // which 8-bit digit this pass sorts on
+} pc;
+
+uint digit_of(uint64_t key) { return uint(key >> pc.shift) & (RADIX - 1); }

@@ -1,0 +1,21 @@
+#version 460
+// Radix sort setup: sizes the per-block dispatches from this frame's key count (read on the GPU).
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+layout(local_size_x = 1) in;
+
+layout(push_constant) uniform Push {
+  UintArray counters;
+  uint block_keys;
+  uint subgroups_per_workgroup;
+} pc;
+
+void main() {
+  uint n = pc.counters.v[COUNTER_SORT_COUNT];
+  uint blocks = (n + pc.block_keys - 1) / pc.block_keys;
+  pc.counters.v[COUNTER_SORT_BLOCKS] = blocks;
+  pc.counters.v[COUNTER_SORT_ARGS + 0] = (blocks + pc.subgroups_per_workgroup - 1) / pc.subgroups_per_workgroup;
+  pc.counters.v[COUNTER_SORT_ARGS + 1] = 1;
+  pc.counters.v[COUNTER_SORT_ARGS + 2] = 1;
+}

@@ -1,0 +1,30 @@
+#version 460
+// Tile ranges: after the sort, each tile's keys are contiguous. One invocation per key finds the
+// boundaries where the tile id changes and records [start, end) for the tiles on either side.
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(push_constant) uniform Push {
+  Uint64Array keys;
+  Uvec2Array ranges;  // zero-filled before this pass
+  UintArray counters;
+} pc;
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  uint n = pc.counters.v[COUNTER_SORT_COUNT];
+  if (i >= n) return;
+  uint tile = uint(pc.keys.v[i] >> 32);
+  if (i == 0) {
+    pc.ranges.v[tile].x = 0;
+  } else {
+    uint prev = uint(pc.keys.v[i - 1] >> 32);
+    if (prev != tile) {
+      pc.ranges.v[prev].y = i;
+      pc.ranges.v[tile].x = i;
+    }
+  }
+  if (i == n - 1) pc.ranges.v[tile].y = n;
+}

@@ -1,0 +1,99 @@
+// The GPU renderer: a Vulkan compute pipeline that turns a GaussianScene and a Camera into an image.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tilesplat/camera.h"
+#include "tilesplat/image.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat {
+
+struct RendererOptions {
+  // Which Vulkan device: "" = the environment variable TILESPLAT_DEVICE if set, else the first
+  // discrete GPU, else the first device. Otherwise a device index ("1") or a case-insensitive
+  // substring of the device name ("llvmpipe").
+  std::string device;
+  // Enables VK_LAYER_KHRONOS_validation. Also enabled by TILESPLAT_VALIDATION=1. Messages go to
+  // the callback below (or stderr) and are counted in validation_messages().
+  bool validation = false;
+  // Record GPU timestamps around every pass (cheap; on by default).
+  bool timestamps = true;
+};
+
+// Everything that changes how one frame is rendered.
+struct RenderSettings {
+  std::array<float, 3> background = {0, 0, 0};
+  std::string sort = "radix";  // the key sort strategy (see sort_strategies())
+  bool depth = true;           // produce the expected-depth channel
+  bool splat_count = true;     // produce the per-pixel blended-splat count
+};
+
+struct PassTiming {
+  std::string name;
+  double gpu_ms = 0;
+};
+
+struct FrameStats {
+  std::vector<PassTiming> passes;  // GPU time of each pass, in frame order
+  double gpu_ms = 0;               // first pass start to last pass end
+  double cpu_ms = 0;               // wall time of render(), readback included
+  uint64_t gaussians = 0;
+  uint64_t visible = 0;            // Gaussians touching at least one tile
+  uint64_t intersections = 0;      // (Gaussian, tile) pairs sorted
+  uint32_t sort_bits = 0;          // key bits the sort processed
+  int retries = 0;                 // re-renders after growing the intersection buffers
+  uint64_t device_bytes = 0;       // device memory held by the renderer's buffers
+};
+
+struct DeviceInfo {
+  std::string name;
+  std::string driver;
+  uint32_t subgroup_size = 0;
+  uint64_t max_storage_buffer_range = 0;
+  uint32_t max_shared_memory = 0;
+  double timestamp_period_ns = 0;
+  uint32_t max_image_dimension = 0;
+};
+
+// Names of the available sort strategies, default first.
+std::vector<std::string> sort_strategies();
+
+// Lists the Vulkan devices this machine has, in the order RendererOptions::device indexes them.
+std::vector<std::string> list_devices();
+
+class Renderer {
+ public:
+  // Creates its own headless VkInstance and VkDevice. Throws std::runtime_error when no usable
+  // device exists (the message says why).
+  static std::unique_ptr<Renderer> create(const RendererOptions& options = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Uploads the scene; the previous scene is released.
+  void set_scene(const GaussianScene& scene);
+
+  // Renders one frame and reads it back. Throws std::runtime_error (for example when the
+  // camera's size exceeds the device's limits).
+  RenderImage render(const Camera& camera, const RenderSettings& settings = {});
+
+  const FrameStats& last_frame_stats() const;
+  DeviceInfo device_info() const;
+  // Validation-layer messages seen so far (0 unless validation is on).
+  uint64_t validation_messages() const;
+
+  struct Impl;
+  Impl& impl() { return *impl_; }
+
+ private:
+  explicit Renderer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+  friend struct RendererFactory;
+};
+
+}  // namespace tilesplat

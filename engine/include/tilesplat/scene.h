@@ -1,0 +1,77 @@
+// A 3D Gaussian Splatting scene as the trainer wrote it: raw (pre-activation) parameters.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace tilesplat {
+
+// Thrown for any file that cannot be read as a scene. what() names the file and the problem.
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Structure-of-arrays storage of N Gaussians. Values are kept as the trainer stores them
+// (log scales, opacity logits) so that every renderer applies the activations itself, in its
+// own precision: the float64 reference and the GPU see the same inputs.
+struct GaussianScene {
+  int sh_degree = 0;              // 0..3
+  std::vector<float> positions;   // 3N, world space x y z
+  std::vector<float> log_scales;  // 3N, scale = exp(log_scale)
+  std::vector<float> rotations;   // 4N, unit quaternion w x y z (normalized on load, zero -> identity)
+  std::vector<float> opacity_logits;  // N, opacity = sigmoid(logit)
+  // N * K * 3 with K = (sh_degree + 1)^2: coefficient-major, RGB innermost, i.e.
+  // sh[(i * K + k) * 3 + c]. k = 0 is the DC term (f_dc); the loader reorders the PLY's
+  // channel-major f_rest into this layout.
+  std::vector<float> sh;
+  std::vector<float> normals;  // 3N when the file has nx ny nz, else empty
+
+  size_t size() const { return opacity_logits.size(); }
+  bool empty() const { return opacity_logits.empty(); }
+  int sh_coefficients() const { return (sh_degree + 1) * (sh_degree + 1); }
+  bool has_normals() const { return !normals.empty(); }
+};
+
+struct LoadOptions {
+  // Strict: any non-finite value is an error naming the first bad Gaussian and property.
+  // Default: Gaussians with non-finite values are dropped and reported.
+  bool strict = false;
+};
+
+struct DroppedProperty {
+  std::string property;  // e.g. "scale_1"
+  size_t count = 0;      // Gaussians dropped whose first non-finite value was this property
+  size_t first_index = 0;
+};
+
+struct LoadReport {
+  std::string format;        // "ply binary_little_endian", "ply ascii", ...
+  size_t gaussians_in_file = 0;
+  size_t dropped = 0;        // Gaussians removed for non-finite values
+  std::vector<DroppedProperty> dropped_by_property;
+  std::vector<std::string> ignored_properties;  // extra properties the file carries
+  std::string summary() const;  // one human-readable line, empty when nothing was dropped
+};
+
+// Reads a 3DGS PLY (binary little/big endian or ASCII). Throws SceneError.
+GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& options = {},
+                       LoadReport* report = nullptr);
+
+// Picks the reader by extension (only .ply for now). Throws SceneError.
+GaussianScene load_scene(const std::filesystem::path& path, const LoadOptions& options = {},
+                         LoadReport* report = nullptr);
+
+struct Bounds {
+  double min[3] = {0, 0, 0};
+  double max[3] = {0, 0, 0};
+  double center[3] = {0, 0, 0};
+  double radius = 0;  // robust radius around center (covers most Gaussians, ignores outliers)
+};
+Bounds compute_bounds(const GaussianScene& scene);
+
+}  // namespace tilesplat

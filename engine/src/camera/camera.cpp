@@ -1,0 +1,132 @@
+// Pinhole camera helpers: world-to-camera transform, resizing, look-at and orbit framing.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "tilesplat/camera.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat {
+namespace {
+
+using Vec3 = std::array<double, 3>;
+
+Vec3 subtract(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Vec3 scaled(const Vec3& v, double s) { return {v[0] * s, v[1] * s, v[2] * s}; }
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double length(const Vec3& v) { return std::sqrt(dot(v, v)); }
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+double degrees_to_radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
+
+// Rounds a scaled image dimension, never below one pixel.
+int scaled_dimension(double value) { return std::max(1, static_cast<int>(std::lround(value))); }
+
+}  // namespace
+
+std::array<double, 3> Camera::to_camera(const std::array<double, 3>& world) const {
+  // Evaluated as W x + t with t = -W c, the view-matrix form the trainer's rasterizer uses: equal
+  // to W (x - c) mathematically, and rounding the same way keeps near-equal depths in the same
+  // order as the independent float64 reference images.
+  Vec3 camera_space{};
+  for (size_t row = 0; row < 3; ++row) {
+    const double* w = &rotation[row * 3];
+    const double translation = -(w[0] * position[0] + w[1] * position[1] + w[2] * position[2]);
+    camera_space[row] = w[0] * world[0] + w[1] * world[1] + w[2] * world[2] + translation;
+  }
+  return camera_space;
+}
+
+Camera resize_camera(const Camera& camera, int width, int height) {
+  if (camera.width <= 0 || camera.height <= 0)
+    throw std::invalid_argument("resize_camera: the camera has no size");
+  if (width <= 0 && height <= 0) return camera;
+  if (width <= 0) width = scaled_dimension(double(height) * camera.width / camera.height);
+  if (height <= 0) height = scaled_dimension(double(width) * camera.height / camera.width);
+
+  const double scale_x = double(width) / camera.width;
+  const double scale_y = double(height) / camera.height;
+  Camera resized = camera;
+  resized.width = width;
+  resized.height = height;
+  resized.fx = camera.fx * scale_x;
+  resized.cx = camera.cx * scale_x;
+  resized.fy = camera.fy * scale_y;
+  resized.cy = camera.cy * scale_y;
+  return resized;
+}
+
+Camera look_at_camera(const std::array<double, 3>& eye, const std::array<double, 3>& target,
+                      const std::array<double, 3>& up, int width, int height, double vertical_fov_deg) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("look_at_camera: width and height must be positive");
+  if (!(vertical_fov_deg > 0 && vertical_fov_deg < 180))
+    throw std::invalid_argument("look_at_camera: vertical_fov_deg must be in (0, 180)");
+
+  const Vec3 to_target = subtract(target, eye);
+  const double distance = length(to_target);
+  if (!(distance > 0) || !std::isfinite(distance))
+    throw std::invalid_argument("look_at_camera: eye and target must be distinct finite points");
+  const Vec3 forward = scaled(to_target, 1.0 / distance);
+
+  // Camera y points down, i.e. along -up with its component along the view direction removed.
+  // When up is (nearly) parallel to the view direction any perpendicular will do; pick the
+  // world axis least aligned with forward so the result is still well conditioned.
+  Vec3 world_up = up;
+  const double up_length = length(world_up);
+  if (!(up_length > 0) || !std::isfinite(up_length)) world_up = {0, -1, 0};
+  world_up = scaled(world_up, 1.0 / length(world_up));
+  Vec3 down = scaled(subtract(world_up, scaled(forward, dot(world_up, forward))), -1.0);
+  if (length(down) < 1e-9) {
+    size_t least_aligned = 0;
+    for (size_t k = 1; k < 3; ++k)
+      if (std::abs(forward[k]) < std::abs(forward[least_aligned])) least_aligned = k;
+    Vec3 axis = {0, 0, 0};
+    axis[least_aligned] = 1;
+    down = subtract(axis, scaled(forward, dot(axis, forward)));
+  }
+  down = scaled(down, 1.0 / length(down));
+  // Right-handed OpenCV frame: x = y cross z.
+  const Vec3 right = cross(down, forward);
+
+  Camera camera;
+  camera.width = width;
+  camera.height = height;
+  camera.fy = height / (2.0 * std::tan(degrees_to_radians(vertical_fov_deg) / 2.0));
+  camera.fx = camera.fy;  // square pixels
+  camera.cx = width / 2.0;
+  camera.cy = height / 2.0;
+  // Rows of world-to-camera are the camera axes expressed in world space.
+  camera.rotation = {right[0], right[1], right[2], down[0], down[1], down[2], forward[0], forward[1], forward[2]};
+  camera.position = eye;
+  return camera;
+}
+
+Camera orbit_camera(const GaussianScene& scene, int width, int height, const OrbitParams& params) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument("orbit_camera: width and height must be positive");
+  const Bounds bounds = compute_bounds(scene);
+  const Vec3 center = {bounds.center[0], bounds.center[1], bounds.center[2]};
+  const double radius = (bounds.radius > 0 && std::isfinite(bounds.radius)) ? bounds.radius : 1.0;
+
+  // The sphere of the bounds fits the narrower of the two fields of view.
+  const double tan_half_vertical = std::tan(degrees_to_radians(params.vertical_fov_deg) / 2.0);
+  const double tan_half_horizontal = tan_half_vertical * width / height;
+  const double half_fov = std::atan(std::min(tan_half_vertical, tan_half_horizontal));
+  const double distance = radius / std::sin(half_fov) * params.distance_scale;
+
+  // Trainer captures (COLMAP/OpenCV) have -Y up. Azimuth 0 sits on +Z looking toward -Z and
+  // positive azimuth turns toward -X, the convention of the shared scenes' orbit cameras.
+  const Vec3 world_up = {0, -1, 0};
+  const double azimuth = degrees_to_radians(params.azimuth_deg);
+  const double elevation = degrees_to_radians(params.elevation_deg);
+  const Vec3 offset = {-std::sin(azimuth) * std::cos(elevation), -std::sin(elevation),
+                       std::cos(azimuth) * std::cos(elevation)};
+  const Vec3 eye = {center[0] + distance * offset[0], center[1] + distance * offset[1],
+                    center[2] + distance * offset[2]};
+  return look_at_camera(eye, center, world_up, width, height, params.vertical_fov_deg);
+}
+
+}  // namespace tilesplat

@@ -1,0 +1,44 @@
+#include "passes/composite_pass.h"
+
+#include "tilesplat/reference.h"
+
+namespace tilesplat {
+
+namespace {
+struct CompositePush {
+  VkDeviceAddress splats, sorted_indices, ranges, out_rgba, out_depth, out_count;
+  float background[4];
+  uint32_t width, height, tiles_x, pad;
+};
+}  // namespace
+
+CompositePass::CompositePass(vk::Context& ctx) : ctx_(ctx) {}
+
+void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
+                           const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
+                           bool write_depth, bool write_count) {
+  auto key = std::make_pair(write_depth, write_count);
+  auto it = pipelines_.find(key);
+  if (it == pipelines_.end())
+    it = pipelines_
+             .emplace(key, vk::ComputePipeline(ctx_, "composite", sizeof(CompositePush),
+                                               {{0, write_depth ? 1u : 0u}, {1, write_count ? 1u : 0u}}))
+             .first;
+  const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
+  const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
+  CompositePush push{splats.address(),
+                     sorted_indices.address(),
+                     ranges.address(),
+                     out.rgba.address(),
+                     write_depth ? out.depth.address() : 0,
+                     write_count ? out.count.address() : 0,
+                     {background[0], background[1], background[2], 0.0f},
+                     out.width,
+                     out.height,
+                     tiles_x,
+                     0};
+  it->second.bind(cmd, push);
+  it->second.dispatch(cmd, tiles_x, tiles_y);
+}
+
+}  // namespace tilesplat

@@ -1,0 +1,31 @@
+// Composite: front-to-back alpha blending of each tile's sorted splats into the output images.
+#pragma once
+
+#include <array>
+#include <map>
+
+#include "vulkan/buffer.h"
+#include "vulkan/compute_pipeline.h"
+
+namespace tilesplat {
+
+struct OutputBuffers {
+  vk::Buffer rgba;   // vec4 per pixel
+  vk::Buffer depth;  // float per pixel (only when requested)
+  vk::Buffer count;  // uint per pixel (only when requested)
+  uint32_t width = 0, height = 0;
+};
+
+class CompositePass {
+ public:
+  explicit CompositePass(vk::Context& ctx);
+  void record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
+              const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
+              bool write_depth, bool write_count);
+
+ private:
+  vk::Context& ctx_;
+  std::map<std::pair<bool, bool>, vk::ComputePipeline> pipelines_;  // by (depth, count) outputs
+};
+
+}  // namespace tilesplat

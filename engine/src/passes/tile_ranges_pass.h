@@ -1,0 +1,20 @@
+// Tile ranges: [start, end) of each tile's run in the sorted keys.
+#pragma once
+
+#include "vulkan/buffer.h"
+#include "vulkan/compute_pipeline.h"
+
+namespace tilesplat {
+
+class TileRangesPass {
+ public:
+  explicit TileRangesPass(vk::Context& ctx);
+  // ranges must hold one uvec2 per tile; it is zero-filled here first.
+  void record(VkCommandBuffer cmd, const vk::Buffer& sorted_keys, vk::Buffer& ranges, const vk::Buffer& counters,
+              VkDeviceSize ranges_args_offset);
+
+ private:
+  vk::ComputePipeline pipeline_;
+};
+
+}  // namespace tilesplat

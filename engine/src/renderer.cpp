@@ -1,0 +1,297 @@
+// The frame: a fixed list of passes recorded into one command buffer.
+//   projection -> prefix sum -> key emission -> sort -> tile ranges -> composite
+// Data flows one way; the only host read-back is the counters (and the image) after the fence.
+#include "tilesplat/renderer.h"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "passes/composite_pass.h"
+#include "passes/frame_counters.h"
+#include "passes/key_emission_pass.h"
+#include "passes/prefix_sum_pass.h"
+#include "passes/projection_pass.h"
+#include "passes/tile_ranges_pass.h"
+#include "sort/sort_strategy.h"
+#include "tilesplat/reference.h"
+#include "vulkan/context.h"
+#include "vulkan/gpu_timer.h"
+#include "vulkan/vk_check.h"
+
+namespace tilesplat {
+
+namespace {
+
+constexpr uint32_t kMinKeyCapacity = 1u << 16;
+constexpr int kMaxRetries = 4;
+
+uint32_t grow_capacity(uint64_t needed) {
+  // Headroom so that a moving camera does not re-grow every frame.
+  uint64_t target = std::max<uint64_t>(kMinKeyCapacity, needed + needed / 4);
+  return uint32_t(std::min<uint64_t>(std::bit_ceil(target), 1ull << 31));
+}
+
+void check_camera(const Camera& camera, const vk::DeviceLimits& limits) {
+  auto fail = [](const std::string& why) { throw std::runtime_error("invalid camera: " + why); };
+  if (camera.width <= 0 || camera.height <= 0)
+    fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + " is not positive");
+  // Tile rects pack each coordinate in 16 bits, and the composite dispatches one workgroup per tile.
+  const uint64_t tiles_x = (uint64_t(camera.width) + kTileSize - 1) / kTileSize;
+  const uint64_t tiles_y = (uint64_t(camera.height) + kTileSize - 1) / kTileSize;
+  if (tiles_x > std::min<uint64_t>(0xffff, limits.max_workgroup_count_x) || tiles_y > 0xffff)
+    fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+         " exceeds the renderer's limit of 65535 tiles per axis");
+  const uint64_t rgba_bytes = uint64_t(camera.width) * uint64_t(camera.height) * 16;
+  if (rgba_bytes > limits.max_allocation_size)
+    fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + " needs " +
+         std::to_string(rgba_bytes >> 20) + " MiB for its colour buffer, more than the device's largest allocation (" +
+         std::to_string(limits.max_allocation_size >> 20) + " MiB)");
+  for (double v : {camera.fx, camera.fy, camera.cx, camera.cy})
+    if (!std::isfinite(v)) fail("non-finite intrinsics");
+  if (!(camera.fx > 0) || !(camera.fy > 0)) fail("focal lengths must be positive");
+  for (double v : camera.rotation)
+    if (!std::isfinite(v)) fail("non-finite rotation");
+  for (double v : camera.position)
+    if (!std::isfinite(v)) fail("non-finite position");
+}
+
+template <typename T>
+vk::Buffer make_buffer(vk::Context& ctx, size_t count, const char* name) {
+  return vk::Buffer(ctx, VkDeviceSize(count) * sizeof(T), vk::MemoryUse::Device, name);
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  explicit Impl(const RendererOptions& opts)
+      : options(opts),
+        ctx({opts.device, opts.validation}),
+        timer(ctx),
+        projection(ctx),
+        prefix_sum(ctx),
+        key_emission(ctx),
+        tile_ranges(ctx),
+        composite(ctx),
+        counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "frame counters") {}
+
+  SortStrategy& sort(const std::string& name) {
+    auto it = sorts.find(name);
+    if (it == sorts.end()) it = sorts.emplace(name, make_sort_strategy(name, ctx)).first;
+    return *it->second;
+  }
+
+  void ensure_outputs(uint32_t width, uint32_t height) {
+    if (outputs.width == width && outputs.height == height) return;
+    const size_t pixels = size_t(width) * height;
+    outputs.rgba = vk::Buffer(ctx, pixels * 16, vk::MemoryUse::Device, "output rgba");
+    outputs.depth = vk::Buffer(ctx, pixels * 4, vk::MemoryUse::Device, "output depth");
+    outputs.count = vk::Buffer(ctx, pixels * 4, vk::MemoryUse::Device, "output splat count");
+    outputs.width = width;
+    outputs.height = height;
+    const uint32_t tiles = vk::div_ceil(width, kTileSize) * vk::div_ceil(height, kTileSize);
+    ranges = vk::Buffer(ctx, VkDeviceSize(tiles) * 8, vk::MemoryUse::Device, "tile ranges");
+  }
+
+  void ensure_key_capacity(uint32_t capacity) {
+    if (keys.capacity >= capacity) return;
+    keys.keys = make_buffer<uint64_t>(ctx, capacity, "sort keys");
+    keys.keys_alt = make_buffer<uint64_t>(ctx, capacity, "sort keys (ping-pong)");
+    keys.values = make_buffer<uint32_t>(ctx, capacity, "sort values");
+    keys.values_alt = make_buffer<uint32_t>(ctx, capacity, "sort values (ping-pong)");
+    keys.capacity = capacity;
+  }
+
+  uint64_t device_bytes() const {
+    uint64_t bytes = 0;
+    for (const vk::Buffer* b : {&scene.positions, &scene.log_scales, &scene.rotations, &scene.opacity_logits,
+                                &scene.sh, &projected.splats, &projected.rects, &projected.tile_counts,
+                                &projected.offsets, &keys.keys, &keys.keys_alt, &keys.values, &keys.values_alt,
+                                &ranges, &outputs.rgba, &outputs.depth, &outputs.count, &counters})
+      bytes += b->size();
+    bytes += prefix_sum.device_bytes();
+    for (const auto& [name, s] : sorts) bytes += s->device_bytes();
+    return bytes;
+  }
+
+  // Records and runs one frame. Returns the counters the GPU wrote.
+  FrameCounters run_frame(const Camera& camera, const RenderSettings& settings, SortStrategy& sorter,
+                          bool* sorted_in_alt) {
+    const uint32_t tiles_x = vk::div_ceil(uint32_t(camera.width), kTileSize);
+    const uint32_t tiles_y = vk::div_ceil(uint32_t(camera.height), kTileSize);
+    const uint32_t tiles = tiles_x * tiles_y;
+    const uint32_t key_bits = 32 + uint32_t(std::bit_width(tiles - 1));
+    const uint32_t n = scene.count;
+
+    VkCommandBuffer cmd = ctx.begin_one_time();
+    timer.begin_frame(cmd);
+    vkCmdFillBuffer(cmd, counters.handle(), 0, VK_WHOLE_SIZE, 0);
+    vkCmdFillBuffer(cmd, ranges.handle(), 0, VK_WHOLE_SIZE, 0);
+    vk::barrier(cmd);
+
+    projection.record(cmd, scene, projected, counters.address());
+    vk::barrier(cmd);
+    timer.mark(cmd, "projection");
+
+    prefix_sum.record(cmd, projected.tile_counts.address(), projected.offsets.address(), n, counters.address());
+    timer.mark(cmd, "prefix_sum");
+
+    key_emission.record(cmd, projected, keys, n, tiles_x, counters.address());
+    vk::barrier(cmd);
+    timer.mark(cmd, "key_emission");
+
+    SortInput input{keys, counters, key_bits};
+    *sorted_in_alt = sorter.record(cmd, input);
+    timer.mark(cmd, "sort");
+
+    const vk::Buffer& sorted_keys = *sorted_in_alt ? keys.keys_alt : keys.keys;
+    const vk::Buffer& sorted_values = *sorted_in_alt ? keys.values_alt : keys.values;
+    tile_ranges.record(cmd, sorted_keys, ranges, counters, kRangesArgsOffset);
+    vk::barrier(cmd);
+    timer.mark(cmd, "tile_ranges");
+
+    composite.record(cmd, projected.splats, sorted_values, ranges, outputs, settings.background, settings.depth,
+                     settings.splat_count);
+    timer.mark(cmd, "composite");
+    (void)tiles_y;
+
+    // Host reads of mapped memory need the GPU writes made available to the host.
+    VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
+    ctx.end_submit_wait(cmd);
+
+    FrameCounters result;
+    std::memcpy(&result, counters.mapped(), sizeof(result));
+    (void)key_bits;
+    stats.sort_bits = key_bits;
+    return result;
+  }
+
+  template <typename T>
+  void read_output(const vk::Buffer& buffer, std::vector<T>& out, size_t count) {
+    out.resize(count);
+    if (buffer.mapped()) {
+      std::memcpy(out.data(), buffer.mapped(), count * sizeof(T));
+      return;
+    }
+    vk::Buffer staging(ctx, count * sizeof(T), vk::MemoryUse::Readback, buffer.name() + " (readback)");
+    ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+      VkBufferCopy region{0, 0, count * sizeof(T)};
+      vkCmdCopyBuffer(cmd, buffer.handle(), staging.handle(), 1, &region);
+    });
+    std::memcpy(out.data(), staging.mapped(), count * sizeof(T));
+  }
+
+  RendererOptions options;
+  vk::Context ctx;
+  vk::GpuTimer timer;
+  ProjectionPass projection;
+  PrefixSumPass prefix_sum;
+  KeyEmissionPass key_emission;
+  TileRangesPass tile_ranges;
+  CompositePass composite;
+  std::map<std::string, std::unique_ptr<SortStrategy>> sorts;
+
+  SceneBuffers scene;
+  ProjectedBuffers projected;
+  KeyBuffers keys;
+  vk::Buffer ranges;
+  OutputBuffers outputs;
+  vk::Buffer counters;
+  FrameStats stats;
+};
+
+Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Renderer::~Renderer() = default;
+
+std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
+  return std::unique_ptr<Renderer>(new Renderer(std::make_unique<Impl>(options)));
+}
+
+void Renderer::set_scene(const GaussianScene& scene) {
+  Impl& r = *impl_;
+  const size_t n = scene.size();
+  if (n > (1u << 30)) throw std::runtime_error("scene has " + std::to_string(n) + " Gaussians; the limit is 2^30");
+  const int k = scene.sh_coefficients();
+  if (scene.positions.size() != 3 * n || scene.log_scales.size() != 3 * n || scene.rotations.size() != 4 * n ||
+      scene.sh.size() != n * size_t(k) * 3 || scene.sh_degree < 0 || scene.sh_degree > 3)
+    throw std::invalid_argument("set_scene: inconsistent GaussianScene array sizes");
+  SceneBuffers& s = r.scene;
+  auto upload = [&](vk::Buffer& dst, const std::vector<float>& src, const char* name) {
+    dst = make_buffer<float>(r.ctx, src.size(), name);
+    vk::upload(r.ctx, dst, src.data(), src.size() * sizeof(float));
+  };
+  upload(s.positions, scene.positions, "positions");
+  upload(s.log_scales, scene.log_scales, "log scales");
+  upload(s.rotations, scene.rotations, "rotations");
+  upload(s.opacity_logits, scene.opacity_logits, "opacity logits");
+  upload(s.sh, scene.sh, "spherical harmonics");
+  s.count = uint32_t(n);
+  s.sh_degree = scene.sh_degree;
+
+  ProjectedBuffers& p = r.projected;
+  p.splats = vk::Buffer(r.ctx, n * 48, vk::MemoryUse::Device, "projected splats");
+  p.rects = make_buffer<uint64_t>(r.ctx, n, "tile rects");
+  p.tile_counts = make_buffer<uint32_t>(r.ctx, n, "tile counts");
+  p.offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets");
+  r.ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)));
+}
+
+RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
+  Impl& r = *impl_;
+  const auto start = std::chrono::steady_clock::now();
+  check_camera(camera, r.ctx.limits());
+  SortStrategy& sorter = r.sort(settings.sort);
+  r.ensure_outputs(uint32_t(camera.width), uint32_t(camera.height));
+  r.projection.set_camera(camera);
+
+  r.stats = {};
+  FrameCounters counters{};
+  bool sorted_in_alt = false;
+  for (int attempt = 0;; ++attempt) {
+    counters = r.run_frame(camera, settings, sorter, &sorted_in_alt);
+    if (!counters.overflow) break;
+    if (attempt == kMaxRetries || r.keys.capacity >= (1u << 31))
+      throw std::runtime_error("frame needs " + std::to_string(counters.intersections) +
+                               " tile intersections, more than the key buffers can hold");
+    r.ensure_key_capacity(grow_capacity(counters.intersections));
+    r.stats.retries = attempt + 1;
+  }
+
+  RenderImage image;
+  image.width = camera.width;
+  image.height = camera.height;
+  const size_t pixels = image.pixels();
+  r.read_output(r.outputs.rgba, image.rgba, pixels * 4);
+  if (settings.depth) r.read_output(r.outputs.depth, image.depth, pixels);
+  if (settings.splat_count) r.read_output(r.outputs.count, image.splat_count, pixels);
+
+  FrameStats& st = r.stats;
+  for (const auto& section : r.timer.read(&st.gpu_ms)) st.passes.push_back({section.name, section.ms});
+  st.gaussians = r.scene.count;
+  st.visible = counters.visible;
+  st.intersections = counters.sort_count;
+  st.device_bytes = r.device_bytes();
+  st.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return image;
+}
+
+const FrameStats& Renderer::last_frame_stats() const { return impl_->stats; }
+
+DeviceInfo Renderer::device_info() const {
+  const auto& l = impl_->ctx.limits();
+  return {impl_->ctx.device_name(), impl_->ctx.driver_name(), l.subgroup_size, l.max_storage_buffer_range,
+          l.max_shared_memory,      l.timestamp_period_ns,    l.max_image_dimension_2d};
+}
+
+uint64_t Renderer::validation_messages() const { return impl_->ctx.validation_messages(); }
+
+std::vector<std::string> sort_strategies() { return available_sort_strategies(); }
+std::vector<std::string> list_devices() { return vk::Context::list_devices(); }
+
+}  // namespace tilesplat

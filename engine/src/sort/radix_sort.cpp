@@ -1,0 +1,86 @@
+#include "sort/radix_sort.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "passes/frame_counters.h"
+
+namespace tilesplat {
+
+namespace {
+
+constexpr uint32_t kRadix = 256;
+constexpr uint32_t kDigitBits = 8;
+// Keys per block is a multiple of the subgroup size: a subgroup walks its block this many times.
+constexpr uint32_t kStepsPerBlock = 256;
+
+struct SetupPush {
+  VkDeviceAddress counters;
+  uint32_t block_keys, subgroups_per_workgroup;
+};
+struct PassPush {
+  VkDeviceAddress keys_in, values_in, keys_out, values_out, histogram, digit_totals, counters;
+  uint32_t shift, pad;
+};
+struct ScanPush {
+  VkDeviceAddress histogram, digit_totals, counters;
+};
+
+uint32_t workgroup_subgroups(const vk::Context& ctx) {
+  // Four subgroups per workgroup keeps the per-subgroup shared counters small (4 KiB) on every device.
+  (void)ctx;
+  return 4;
+}
+
+}  // namespace
+
+RadixSort::RadixSort(vk::Context& ctx)
+    : ctx_(ctx),
+      subgroups_per_workgroup_(workgroup_subgroups(ctx)),
+      block_keys_(ctx.limits().subgroup_size * kStepsPerBlock) {
+  const uint32_t sg = ctx.limits().subgroup_size;
+  const std::vector<vk::SpecConstant> spec{
+      {0, sg * subgroups_per_workgroup_}, {1, subgroups_per_workgroup_}, {2, block_keys_}};
+  setup_ = vk::ComputePipeline(ctx, "radix_setup", sizeof(SetupPush));
+  histogram_pass_ = vk::ComputePipeline(ctx, "radix_histogram", sizeof(PassPush), spec);
+  scan_pass_ = vk::ComputePipeline(ctx, "radix_scan", sizeof(ScanPush));
+  scatter_pass_ = vk::ComputePipeline(ctx, "radix_scatter", sizeof(PassPush), spec);
+  digit_totals_ = vk::Buffer(ctx, kRadix * sizeof(uint32_t), vk::MemoryUse::Device, "radix digit totals");
+}
+
+bool RadixSort::record(VkCommandBuffer cmd, SortInput& input) {
+  KeyBuffers& kb = input.keys;
+  const uint64_t max_blocks = std::max<uint64_t>(1, (uint64_t(kb.capacity) + block_keys_ - 1) / block_keys_);
+  const VkDeviceSize histogram_bytes = max_blocks * kRadix * sizeof(uint32_t);
+  if (histogram_.size() < histogram_bytes)
+    histogram_ = vk::Buffer(ctx_, histogram_bytes, vk::MemoryUse::Device, "radix histogram");
+
+  const VkDeviceAddress counters = input.counters.address();
+  setup_.bind(cmd, SetupPush{counters, block_keys_, subgroups_per_workgroup_});
+  setup_.dispatch(cmd, 1);
+  vk::barrier(cmd);
+
+  const uint32_t passes = (std::min<uint32_t>(input.key_bits, 64) + kDigitBits - 1) / kDigitBits;
+  bool in_alt = false;
+  for (uint32_t p = 0; p < passes; ++p) {
+    const vk::Buffer& keys_in = in_alt ? kb.keys_alt : kb.keys;
+    const vk::Buffer& values_in = in_alt ? kb.values_alt : kb.values;
+    const vk::Buffer& keys_out = in_alt ? kb.keys : kb.keys_alt;
+    const vk::Buffer& values_out = in_alt ? kb.values : kb.values_alt;
+    PassPush push{keys_in.address(),    values_in.address(),     keys_out.address(), values_out.address(),
+                  histogram_.address(), digit_totals_.address(), counters,           p * kDigitBits, 0};
+    histogram_pass_.bind(cmd, push);
+    histogram_pass_.dispatch_indirect(cmd, input.counters.handle(), kSortArgsOffset);
+    vk::barrier(cmd);
+    scan_pass_.bind(cmd, ScanPush{histogram_.address(), digit_totals_.address(), counters});
+    scan_pass_.dispatch(cmd, kRadix);
+    vk::barrier(cmd);
+    scatter_pass_.bind(cmd, push);
+    scatter_pass_.dispatch_indirect(cmd, input.counters.handle(), kSortArgsOffset);
+    vk::barrier(cmd);
+    in_alt = !in_alt;
+  }
+  return in_alt;
+}
+
+}  // namespace tilesplat

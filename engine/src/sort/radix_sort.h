@@ -1,0 +1,30 @@
+// LSD radix sort, 8-bit digits, reduce-then-scan: per pass a histogram of each block, a scan of the
+// counts per digit across blocks, then a stable scatter. Only the passes the key width needs are run.
+// Every block belongs to one subgroup, so it needs no inter-workgroup forward-progress guarantee and
+// works at any subgroup size (4 to 128).
+#pragma once
+
+#include "sort/sort_strategy.h"
+#include "vulkan/compute_pipeline.h"
+
+namespace tilesplat {
+
+class RadixSort final : public SortStrategy {
+ public:
+  explicit RadixSort(vk::Context& ctx);
+  std::string name() const override { return "radix"; }
+  bool record(VkCommandBuffer cmd, SortInput& input) override;
+  uint64_t device_bytes() const override { return histogram_.size() + digit_totals_.size(); }
+
+  uint32_t block_keys() const { return block_keys_; }
+
+ private:
+  vk::Context& ctx_;
+  uint32_t subgroups_per_workgroup_;
+  uint32_t block_keys_;
+  vk::ComputePipeline setup_, histogram_pass_, scan_pass_, scatter_pass_;
+  vk::Buffer histogram_;
+  vk::Buffer digit_totals_;
+};
+
+}  // namespace tilesplat

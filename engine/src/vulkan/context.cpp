@@ -1,0 +1,337 @@
+#include "vulkan/context.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string_view>
+
+#include "vulkan/vk_check.h"
+
+namespace tilesplat::vk {
+
+const char* result_name(VkResult result) {
+  switch (result) {
+    case VK_SUCCESS: return "VK_SUCCESS";
+    case VK_NOT_READY: return "VK_NOT_READY";
+    case VK_TIMEOUT: return "VK_TIMEOUT";
+    case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_FEATURE_NOT_PRESENT: return "VK_ERROR_FEATURE_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER (no Vulkan driver installed?)";
+    case VK_ERROR_TOO_MANY_OBJECTS: return "VK_ERROR_TOO_MANY_OBJECTS";
+    case VK_ERROR_FORMAT_NOT_SUPPORTED: return "VK_ERROR_FORMAT_NOT_SUPPORTED";
+    default: return "VkResult error";
+  }
+}
+
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+bool env_flag(const char* name) {
+  const char* v = std::getenv(name);
+  return v && *v && std::string_view(v) != "0";
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return s;
+}
+
+std::vector<VkPhysicalDevice> enumerate_devices(VkInstance instance) {
+  uint32_t count = 0;
+  TS_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+  std::vector<VkPhysicalDevice> devices(count);
+  TS_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
+  return devices;
+}
+
+VkInstance create_bare_instance(bool validation) {
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "tilesplat";
+  app.pEngineName = "tilesplat";
+  app.apiVersion = VK_API_VERSION_1_2;
+  std::vector<const char*> layers;
+  std::vector<const char*> extensions;
+  if (validation) {
+    uint32_t count = 0;
+    vkEnumerateInstanceLayerProperties(&count, nullptr);
+    std::vector<VkLayerProperties> available(count);
+    vkEnumerateInstanceLayerProperties(&count, available.data());
+    bool found = std::any_of(available.begin(), available.end(),
+                             [](const VkLayerProperties& p) { return std::strcmp(p.layerName, kValidationLayer) == 0; });
+    if (!found)
+      throw std::runtime_error(std::string("validation requested but ") + kValidationLayer +
+                               " is not installed (Debian: vulkan-validationlayers)");
+    layers.push_back(kValidationLayer);
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  info.pApplicationInfo = &app;
+  info.enabledLayerCount = uint32_t(layers.size());
+  info.ppEnabledLayerNames = layers.data();
+  info.enabledExtensionCount = uint32_t(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
+  VkInstance instance = VK_NULL_HANDLE;
+  TS_VK_CHECK(vkCreateInstance(&info, nullptr, &instance));
+  return instance;
+}
+
+std::string physical_device_name(VkPhysicalDevice device) {
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(device, &props);
+  return props.deviceName;
+}
+
+}  // namespace
+
+std::vector<std::string> Context::list_devices() {
+  VkInstance instance = create_bare_instance(false);
+  std::vector<std::string> names;
+  for (VkPhysicalDevice d : enumerate_devices(instance)) names.push_back(physical_device_name(d));
+  vkDestroyInstance(instance, nullptr);
+  return names;
+}
+
+Context::Context(const ContextOptions& options) {
+  try {
+    create_instance(options.validation || env_flag("TILESPLAT_VALIDATION"));
+    std::string selector = options.device_selector;
+    if (selector.empty())
+      if (const char* env = std::getenv("TILESPLAT_DEVICE")) selector = env;
+    pick_physical_device(selector);
+    create_device();
+  } catch (...) {
+    destroy();  // the destructor does not run for a constructor that throws
+    throw;
+  }
+}
+
+Context::~Context() { destroy(); }
+
+void Context::destroy() {
+  if (device_) {
+    vkDeviceWaitIdle(device_);
+    if (fence_) vkDestroyFence(device_, fence_, nullptr);
+    if (command_pool_) vkDestroyCommandPool(device_, command_pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+    device_ = VK_NULL_HANDLE;
+  }
+  if (messenger_) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    if (destroy) destroy(instance_, messenger_, nullptr);
+    messenger_ = VK_NULL_HANDLE;
+  }
+  if (instance_) {
+    vkDestroyInstance(instance_, nullptr);
+    instance_ = VK_NULL_HANDLE;
+  }
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL Context::debug_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                       VkDebugUtilsMessageTypeFlagsEXT,
+                                                       const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                       void* user) {
+  auto* self = static_cast<Context*>(user);
+  self->validation_messages_.fetch_add(1);
+  const char* level = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
+  std::fprintf(stderr, "tilesplat: vulkan validation %s: %s\n", level, data->pMessage);
+  return VK_FALSE;
+}
+
+void Context::create_instance(bool validation) {
+  instance_ = create_bare_instance(validation);
+  if (!validation) return;
+  VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  info.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  info.pfnUserCallback = &Context::debug_callback;
+  info.pUserData = this;
+  auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+  if (!create) throw std::runtime_error("vkCreateDebugUtilsMessengerEXT is unavailable");
+  TS_VK_CHECK(create(instance_, &info, nullptr, &messenger_));
+}
+
+void Context::pick_physical_device(const std::string& selector) {
+  std::vector<VkPhysicalDevice> devices = enumerate_devices(instance_);
+  if (devices.empty())
+    throw std::runtime_error("no Vulkan device found (install a driver, e.g. Debian's mesa-vulkan-drivers for lavapipe)");
+  if (selector.empty()) {
+    // Prefer a discrete GPU, then an integrated one, then anything (lavapipe).
+    auto rank = [](VkPhysicalDevice d) {
+      VkPhysicalDeviceProperties p;
+      vkGetPhysicalDeviceProperties(d, &p);
+      switch (p.deviceType) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+        default: return 3;
+      }
+    };
+    physical_device_ = *std::min_element(devices.begin(), devices.end(),
+                                         [&](auto a, auto b) { return rank(a) < rank(b); });
+  } else {
+    bool numeric = std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
+    std::string names;
+    for (size_t i = 0; i < devices.size(); ++i) {
+      std::string name = physical_device_name(devices[i]);
+      names += (i ? ", " : "") + std::to_string(i) + ": " + name;
+      if (physical_device_) continue;
+      if (numeric ? std::stoul(selector) == i : lower(name).find(lower(selector)) != std::string::npos)
+        physical_device_ = devices[i];
+    }
+    if (!physical_device_)
+      throw std::runtime_error("no Vulkan device matches '" + selector + "' (devices: " + names + ")");
+  }
+}
+
+void Context::create_device() {
+  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+  subgroup.pNext = &driver;
+  VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props2.pNext = &subgroup;
+  vkGetPhysicalDeviceProperties2(physical_device_, &props2);
+  const VkPhysicalDeviceProperties& props = props2.properties;
+  device_name_ = props.deviceName;
+  driver_name_ = std::string(driver.driverName) + " " + driver.driverInfo;
+  if (props.apiVersion < VK_API_VERSION_1_2)
+    throw std::runtime_error(device_name_ + ": Vulkan 1.2 is required");
+
+  const VkSubgroupFeatureFlags needed_ops =
+      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+  if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
+      (subgroup.supportedOperations & needed_ops) != needed_ops)
+    throw std::runtime_error(device_name_ + ": compute subgroup basic/ballot/arithmetic operations are required");
+  if (subgroup.subgroupSize < 4 || subgroup.subgroupSize > 128)
+    throw std::runtime_error(device_name_ + ": unsupported subgroup size " + std::to_string(subgroup.subgroupSize));
+
+  limits_.subgroup_size = subgroup.subgroupSize;
+  limits_.max_storage_buffer_range = props.limits.maxStorageBufferRange;
+  limits_.max_shared_memory = props.limits.maxComputeSharedMemorySize;
+  limits_.max_workgroup_invocations = props.limits.maxComputeWorkGroupInvocations;
+  limits_.max_workgroup_count_x = props.limits.maxComputeWorkGroupCount[0];
+  limits_.max_image_dimension_2d = props.limits.maxImageDimension2D;
+  limits_.timestamp_period_ns = props.limits.timestampPeriod;
+
+  VkPhysicalDeviceMaintenance3Properties maint3{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
+  VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  p2.pNext = &maint3;
+  vkGetPhysicalDeviceProperties2(physical_device_, &p2);
+  limits_.max_allocation_size = maint3.maxMemoryAllocationSize;
+
+  uint32_t family_count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &family_count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(family_count);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &family_count, families.data());
+  bool found = false;
+  // A compute queue with timestamps; prefer one that is not also graphics (async compute on GPUs).
+  for (int pass = 0; pass < 2 && !found; ++pass) {
+    for (uint32_t i = 0; i < family_count; ++i) {
+      const auto& f = families[i];
+      bool compute = f.queueFlags & VK_QUEUE_COMPUTE_BIT;
+      bool graphics = f.queueFlags & VK_QUEUE_GRAPHICS_BIT;
+      if (compute && f.timestampValidBits > 0 && (pass == 1 || !graphics)) {
+        queue_family_ = i;
+        limits_.timestamp_valid_bits = f.timestampValidBits;
+        found = true;
+        break;
+      }
+    }
+  }
+  if (!found) throw std::runtime_error(device_name_ + ": no compute queue with timestamp support");
+
+  VkPhysicalDeviceVulkan12Features has12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  has.pNext = &has12;
+  vkGetPhysicalDeviceFeatures2(physical_device_, &has);
+  if (!has12.bufferDeviceAddress) throw std::runtime_error(device_name_ + ": bufferDeviceAddress is required");
+  if (!has.features.shaderInt64) throw std::runtime_error(device_name_ + ": shaderInt64 is required");
+
+  VkPhysicalDeviceVulkan12Features want12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  want12.bufferDeviceAddress = VK_TRUE;
+  want12.hostQueryReset = has12.hostQueryReset;
+  VkPhysicalDeviceFeatures2 want{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  want.pNext = &want12;
+  want.features.shaderInt64 = VK_TRUE;
+  want.features.shaderFloat64 = has.features.shaderFloat64;
+  features_.shader_float64 = has.features.shaderFloat64 == VK_TRUE;
+
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queue_info.queueFamilyIndex = queue_family_;
+  queue_info.queueCount = 1;
+  queue_info.pQueuePriorities = &priority;
+  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  info.pNext = &want;
+  info.queueCreateInfoCount = 1;
+  info.pQueueCreateInfos = &queue_info;
+  TS_VK_CHECK(vkCreateDevice(physical_device_, &info, nullptr, &device_));
+  vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
+
+  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT | VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+  pool.queueFamilyIndex = queue_family_;
+  TS_VK_CHECK(vkCreateCommandPool(device_, &pool, nullptr, &command_pool_));
+  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  TS_VK_CHECK(vkCreateFence(device_, &fence, nullptr, &fence_));
+}
+
+uint32_t Context::find_memory_type(uint32_t type_bits, VkMemoryPropertyFlags required,
+                                   VkMemoryPropertyFlags preferred) const {
+  int fallback = -1;
+  for (uint32_t i = 0; i < memory_properties_.memoryTypeCount; ++i) {
+    if (!(type_bits & (1u << i))) continue;
+    VkMemoryPropertyFlags flags = memory_properties_.memoryTypes[i].propertyFlags;
+    if ((flags & required) != required) continue;
+    if ((flags & preferred) == preferred) return i;
+    if (fallback < 0) fallback = int(i);
+  }
+  if (fallback < 0) throw std::runtime_error(device_name_ + ": no suitable memory type");
+  return uint32_t(fallback);
+}
+
+VkMemoryPropertyFlags Context::memory_type_flags(uint32_t type_index) const {
+  return memory_properties_.memoryTypes[type_index].propertyFlags;
+}
+
+VkCommandBuffer Context::begin_one_time() {
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = command_pool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  TS_VK_CHECK(vkAllocateCommandBuffers(device_, &alloc, &cmd));
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  TS_VK_CHECK(vkBeginCommandBuffer(cmd, &begin));
+  return cmd;
+}
+
+void Context::end_submit_wait(VkCommandBuffer cmd) {
+  struct FreeOnExit {
+    Context* ctx;
+    VkCommandBuffer cmd;
+    ~FreeOnExit() { vkFreeCommandBuffers(ctx->device_, ctx->command_pool_, 1, &cmd); }
+  } free_on_exit{this, cmd};
+  TS_VK_CHECK(vkEndCommandBuffer(cmd));
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cmd;
+  TS_VK_CHECK(vkResetFences(device_, 1, &fence_));
+  TS_VK_CHECK(vkQueueSubmit(queue_, 1, &submit, fence_));
+  TS_VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
+}
+
+}  // namespace tilesplat::vk

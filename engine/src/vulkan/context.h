@@ -1,0 +1,100 @@
+// The Vulkan instance, device and compute queue the engine runs on, and the limits it adapts to.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace tilesplat::vk {
+
+struct ContextOptions {
+  std::string device_selector;  // index, or substring of the device name; "" = best device
+  bool validation = false;      // VK_LAYER_KHRONOS_validation; missing layer is an error
+};
+
+// The device properties the passes depend on.
+struct DeviceLimits {
+  uint32_t subgroup_size = 0;
+  uint64_t max_storage_buffer_range = 0;
+  uint32_t max_shared_memory = 0;
+  uint32_t max_workgroup_invocations = 0;
+  uint32_t max_workgroup_count_x = 0;
+  uint32_t max_image_dimension_2d = 0;
+  uint64_t max_allocation_size = 0;
+  double timestamp_period_ns = 0;
+  uint32_t timestamp_valid_bits = 0;
+};
+
+// Optional features the engine uses when present.
+struct DeviceFeatures {
+  bool shader_float64 = false;  // exact float64 depth keys (else float32: rare order swaps)
+};
+
+// Owns (or, for a host application, borrows) a VkInstance and VkDevice with one compute queue.
+// Everything else in the engine goes through this object for Vulkan handles.
+class Context {
+ public:
+  explicit Context(const ContextOptions& options);
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkInstance instance() const { return instance_; }
+  VkPhysicalDevice physical_device() const { return physical_device_; }
+  VkDevice device() const { return device_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queue_family() const { return queue_family_; }
+  const DeviceLimits& limits() const { return limits_; }
+  const DeviceFeatures& features() const { return features_; }
+  const std::string& device_name() const { return device_name_; }
+  const std::string& driver_name() const { return driver_name_; }
+
+  // Index of a memory type with all `required` flags (and `preferred` ones when possible).
+  uint32_t find_memory_type(uint32_t type_bits, VkMemoryPropertyFlags required,
+                            VkMemoryPropertyFlags preferred = 0) const;
+  VkMemoryPropertyFlags memory_type_flags(uint32_t type_index) const;
+
+  // Records with `record` into a one-time command buffer, submits it and waits.
+  template <typename Fn>
+  void submit_and_wait(Fn&& record) {
+    VkCommandBuffer cmd = begin_one_time();
+    record(cmd);
+    end_submit_wait(cmd);
+  }
+  VkCommandBuffer begin_one_time();
+  void end_submit_wait(VkCommandBuffer cmd);
+
+  uint64_t validation_messages() const { return validation_messages_.load(); }
+
+  static std::vector<std::string> list_devices();
+
+ private:
+  static VKAPI_ATTR VkBool32 VKAPI_CALL debug_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                       VkDebugUtilsMessageTypeFlagsEXT types,
+                                                       const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                       void* user);
+  void create_instance(bool validation);
+  void pick_physical_device(const std::string& selector);
+  void create_device();
+  void destroy();
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkPhysicalDeviceMemoryProperties memory_properties_{};
+  DeviceLimits limits_;
+  DeviceFeatures features_;
+  std::string device_name_;
+  std::string driver_name_;
+  std::atomic<uint64_t> validation_messages_{0};
+};
+
+}  // namespace tilesplat::vk

@@ -1,0 +1,347 @@
+// Runs tilesplat-render and tilesplat-bench as processes: exit codes, error messages, outputs.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "test_support.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using tilesplat::testing::bundled_sh3;
+using tilesplat::testing::bundled_sh3_cameras;
+using tilesplat::testing::temp_dir;
+
+constexpr const char* kRenderExe = TILESPLAT_RENDER_EXE;
+constexpr const char* kBenchExe = TILESPLAT_BENCH_EXE;
+
+struct ProcessResult {
+  int exit_code = -1;  // -1 when the process did not exit normally (a signal, a crash)
+  std::string out;
+  std::string err;
+};
+
+std::string shell_quote(const std::string& text) {
+  std::string quoted = "'";
+  for (const char c : text) {
+    if (c == '\'')
+      quoted += "'\\''";
+    else
+      quoted += c;
+  }
+  return quoted + "'";
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Runs `exe args...` through the shell with stdout captured and stderr in a file beside the
+// test's temporaries. VK_LOADER_DEBUG is emptied so that loader chatter cannot pollute stderr.
+ProcessResult run_exe(const char* exe, const std::vector<std::string>& args) {
+  static int invocation = 0;
+  std::string err_name = "stderr_";
+  err_name += std::to_string(invocation++);
+  err_name += ".txt";
+  const fs::path err_path = temp_dir() / err_name;
+  std::string command = "VK_LOADER_DEBUG= ";
+  command += shell_quote(exe);
+  for (const auto& arg : args) {
+    command += ' ';
+    command += shell_quote(arg);
+  }
+  command += " 2>";
+  command += shell_quote(err_path.string());
+  command += " </dev/null";
+
+  ProcessResult result;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) {
+    result.err = "popen failed for: " + command;
+    return result;
+  }
+  char buffer[4096];
+  size_t n = 0;
+  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) result.out.append(buffer, n);
+  const int status = ::pclose(pipe);
+  if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
+  result.err = read_file(err_path);
+  return result;
+}
+
+// An empty directory for a test's outputs (temporaries persist between runs, so start clean).
+fs::path fresh_output_dir() {
+  const fs::path dir = temp_dir() / "out";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<std::string> entries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+size_t line_count(const std::string& text) { return static_cast<size_t>(std::count(text.begin(), text.end(), '\n')); }
+
+size_t views_in(const fs::path& cameras_json) {
+  const std::string text = read_file(cameras_json);
+  size_t count = 0;
+  for (size_t pos = text.find("\"img_name\""); pos != std::string::npos; pos = text.find("\"img_name\"", pos + 1))
+    ++count;
+  return count;
+}
+
+// Every failure is exactly one line: "PROGRAM: error: ...".
+void expect_one_error_line(const ProcessResult& result, const std::string& program) {
+  EXPECT_EQ(result.err.rfind(program + ": error: ", 0), 0u) << result.err;
+  EXPECT_EQ(line_count(result.err), 1u) << result.err;
+}
+
+// ---------------------------------------------------------------------------------------------
+// --help
+
+TEST(CliRender, HelpListsEveryFlag) {
+  const auto result = run_exe(kRenderExe, {"--help"});
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(contains(result.out, "usage: tilesplat-render")) << result.out;
+  for (const char* flag :
+       {"-o,", "--output", "--png", "--exposure", "--half", "--no-depth", "--no-count", "--background", "--reference",
+        "--stats", "--cameras", "--view", "--width", "--height", "--azimuth", "--elevation", "--fov", "--distance",
+        "--strict", "--device", "--list-devices", "--sort", "--validation", "--help", "SCENE.ply"})
+    EXPECT_TRUE(contains(result.out, flag)) << "--help does not mention " << flag << "\n" << result.out;
+  EXPECT_TRUE(result.err.empty()) << result.err;
+}
+
+TEST(CliBench, HelpListsEveryFlag) {
+  const auto result = run_exe(kBenchExe, {"--help"});
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(contains(result.out, "usage: tilesplat-bench")) << result.out;
+  for (const char* flag : {"--warmup", "--repeat", "--csv", "--json", "--cameras", "--view", "--width", "--height",
+                           "--azimuth", "--elevation", "--fov", "--distance", "--strict", "--device",
+                           "--list-devices", "--sort", "--validation", "--help", "SCENE.ply"})
+    EXPECT_TRUE(contains(result.out, flag)) << "--help does not mention " << flag << "\n" << result.out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Usage errors: exit 2, one line, nothing written
+
+TEST(CliRender, UnknownFlagIsUsageError) {
+  const auto out = fresh_output_dir();
+  const auto result = run_exe(kRenderExe, {bundled_sh3().string(), "--foo", "-o", (out / "x.exr").string()});
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_TRUE(contains(result.err, "tilesplat-render: error: unknown flag '--foo' (see --help)")) << result.err;
+  expect_one_error_line(result, "tilesplat-render");
+  EXPECT_TRUE(entries(out).empty());
+}
+
+TEST(CliBench, UnknownFlagIsUsageError) {
+  const auto result = run_exe(kBenchExe, {bundled_sh3().string(), "--foo"});
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_TRUE(contains(result.err, "tilesplat-bench: error: unknown flag '--foo' (see --help)")) << result.err;
+  expect_one_error_line(result, "tilesplat-bench");
+}
+
+TEST(CliRender, MissingOutputIsUsageError) {
+  const auto result = run_exe(kRenderExe, {bundled_sh3().string()});
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_TRUE(contains(result.err, "-o")) << result.err;
+  expect_one_error_line(result, "tilesplat-render");
+}
+
+TEST(CliRender, MissingSceneArgumentIsUsageError) {
+  const auto out = fresh_output_dir();
+  const auto result = run_exe(kRenderExe, {"-o", (out / "x.exr").string()});
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_TRUE(contains(result.err, "SCENE")) << result.err;
+  expect_one_error_line(result, "tilesplat-render");
+}
+
+TEST(CliRender, MissingFlagValueIsUsageError) {
+  const auto out = fresh_output_dir();
+  const auto result = run_exe(kRenderExe, {bundled_sh3().string(), "-o", (out / "x.exr").string(), "--width"});
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_TRUE(contains(result.err, "--width expects a value")) << result.err;
+  expect_one_error_line(result, "tilesplat-render");
+}
+
+TEST(CliRender, BadBackgroundIsRejected) {
+  const auto out = fresh_output_dir();
+  for (const char* background : {"1,2", "a,b,c", "1,nan,0", "1,2,3,4", "0.5,inf,0"}) {
+    const auto result = run_exe(
+        kRenderExe, {bundled_sh3().string(), "-o", (out / "x.exr").string(), "--background", background});
+    EXPECT_EQ(result.exit_code, 2) << background << ": " << result.err;
+    EXPECT_TRUE(contains(result.err, "--background expects")) << result.err;
+    EXPECT_TRUE(contains(result.err, background)) << result.err;
+    expect_one_error_line(result, "tilesplat-render");
+  }
+  EXPECT_TRUE(entries(out).empty());
+}
+
+TEST(CliRender, BadSizeIsRejected) {
+  const auto out = fresh_output_dir();
+  const std::string exr = (out / "x.exr").string();
+  struct Case {
+    std::vector<std::string> flags;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"--width", "0"}, "--width expects a positive integer, got '0'"},
+      {{"--width", "abc"}, "--width expects a positive integer, got 'abc'"},
+      {{"--height", "-5"}, "--height expects a positive integer, got '-5'"},
+      {{"--height", "70000"}, "--height must be at most 65536"},
+      {{"--width", "12.5"}, "--width expects a positive integer, got '12.5'"},
+  };
+  for (const auto& c : cases) {
+    std::vector<std::string> args = {bundled_sh3().string(), "-o", exr};
+    args.insert(args.end(), c.flags.begin(), c.flags.end());
+    const auto result = run_exe(kRenderExe, args);
+    EXPECT_EQ(result.exit_code, 2) << c.flags[0] << " " << c.flags[1] << ": " << result.err;
+    EXPECT_TRUE(contains(result.err, c.message)) << result.err;
+    expect_one_error_line(result, "tilesplat-render");
+  }
+  EXPECT_TRUE(entries(out).empty());
+}
+
+TEST(CliRender, OrbitFlagsConflictWithCameras) {
+  const auto out = fresh_output_dir();
+  const auto result = run_exe(kRenderExe, {bundled_sh3().string(), "--cameras", bundled_sh3_cameras().string(),
+                                           "--azimuth", "30", "-o", (out / "x.exr").string()});
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_TRUE(contains(result.err, "--azimuth")) << result.err;
+  const auto view_alone = run_exe(kRenderExe, {bundled_sh3().string(), "--view", "1", "-o", (out / "x.exr").string()});
+  EXPECT_EQ(view_alone.exit_code, 2) << view_alone.err;
+  EXPECT_TRUE(contains(view_alone.err, "--cameras")) << view_alone.err;
+}
+
+TEST(CliBench, RejectsBadCountsAndSorts) {
+  const auto zero_repeat = run_exe(kBenchExe, {bundled_sh3().string(), "--repeat", "0"});
+  EXPECT_EQ(zero_repeat.exit_code, 2) << zero_repeat.err;
+  EXPECT_TRUE(contains(zero_repeat.err, "--repeat expects a positive integer, got '0'")) << zero_repeat.err;
+
+  const auto bad_sort = run_exe(kBenchExe, {bundled_sh3().string(), "--sort", "no-such-sort"});
+  EXPECT_EQ(bad_sort.exit_code, 2) << bad_sort.err;
+  EXPECT_TRUE(contains(bad_sort.err, "unknown sort strategy 'no-such-sort'")) << bad_sort.err;
+  expect_one_error_line(bad_sort, "tilesplat-bench");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Runtime errors: exit 1, the file named, nothing written
+
+TEST(CliRender, MissingSceneFileFails) {
+  const auto out = fresh_output_dir();
+  const fs::path missing = temp_dir() / "no_such_scene.ply";
+  fs::remove(missing);
+  const auto result = run_exe(kRenderExe, {missing.string(), "-o", (out / "x.exr").string()});
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_TRUE(contains(result.err, "no_such_scene.ply")) << result.err;
+  expect_one_error_line(result, "tilesplat-render");
+  EXPECT_TRUE(entries(out).empty());
+}
+
+TEST(CliRender, TruncatedPlyFails) {
+  const auto out = fresh_output_dir();
+  const std::string bytes = read_file(bundled_sh3());
+  ASSERT_GT(bytes.size(), 1000u);
+  const fs::path truncated = temp_dir() / "truncated_sh3.ply";
+  {
+    std::ofstream file(truncated, std::ios::binary | std::ios::trunc);
+    file.write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
+  }
+  const auto result = run_exe(kRenderExe, {truncated.string(), "--cameras", bundled_sh3_cameras().string(), "-o",
+                                           (out / "x.exr").string(), "--png", (out / "x.png").string()});
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_TRUE(contains(result.err, "truncated_sh3.ply")) << result.err;
+  expect_one_error_line(result, "tilesplat-render");
+  EXPECT_TRUE(entries(out).empty());
+}
+
+TEST(CliRender, OutOfRangeViewNamesTheCount) {
+  const auto out = fresh_output_dir();
+  const size_t views = views_in(bundled_sh3_cameras());
+  ASSERT_GT(views, 0u);
+  const auto result = run_exe(kRenderExe, {bundled_sh3().string(), "--cameras", bundled_sh3_cameras().string(),
+                                           "--view", std::to_string(views), "-o", (out / "x.exr").string()});
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  EXPECT_TRUE(contains(result.err, std::to_string(views) + " views")) << result.err;
+  EXPECT_TRUE(contains(result.err, bundled_sh3_cameras().filename().string())) << result.err;
+  expect_one_error_line(result, "tilesplat-render");
+  EXPECT_TRUE(entries(out).empty());
+}
+
+TEST(CliRender, OutputIntoMissingDirectoryFails) {
+  const auto out = fresh_output_dir();
+  const fs::path exr = out / "no_such_dir" / "x.exr";
+  const auto result = run_exe(kRenderExe, {bundled_sh3().string(), "-o", exr.string()});
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_TRUE(contains(result.err, "no_such_dir")) << result.err;
+  expect_one_error_line(result, "tilesplat-render");
+  EXPECT_FALSE(fs::exists(out / "no_such_dir"));
+  EXPECT_TRUE(entries(out).empty());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Real runs (need the GPU renderer)
+
+TEST(CliRender, RendersExrAndPngPreview) {
+  const auto out = fresh_output_dir();
+  const fs::path exr = out / "x.exr";
+  const fs::path png = out / "x.png";
+  const auto result =
+      run_exe(kRenderExe, {bundled_sh3().string(), "--cameras", bundled_sh3_cameras().string(), "--view", "0",
+                           "--width", "160", "--height", "90", "-o", exr.string(), "--png", png.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  ASSERT_TRUE(fs::exists(exr));
+  ASSERT_TRUE(fs::exists(png));
+  EXPECT_GT(fs::file_size(exr), 0u);
+  EXPECT_GT(fs::file_size(png), 0u);
+  // Only the two outputs: no temporary left beside them.
+  EXPECT_EQ(entries(out), (std::vector<std::string>{"x.exr", "x.png"}));
+  EXPECT_TRUE(contains(result.err, "160x90")) << result.err;
+  EXPECT_TRUE(contains(result.err, "x.exr")) << result.err;
+  EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+}
+
+TEST(CliBench, PrintsTableAndWritesCsvAndJson) {
+  const auto out = fresh_output_dir();
+  const fs::path csv = out / "c.csv";
+  const fs::path json = out / "j.json";
+  const auto result = run_exe(kBenchExe, {bundled_sh3().string(), "--width", "64", "--height", "36", "--warmup",
+                                          "1", "--repeat", "2", "--csv", csv.string(), "--json", json.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(contains(result.out, "projection")) << result.out;
+  EXPECT_TRUE(contains(result.out, "gpu frame")) << result.out;
+  EXPECT_TRUE(contains(result.out, "cpu frame")) << result.out;
+  EXPECT_TRUE(contains(result.out, "intersections")) << result.out;
+  EXPECT_TRUE(contains(result.out, "64x36")) << result.out;
+  ASSERT_TRUE(fs::exists(csv));
+  ASSERT_TRUE(fs::exists(json));
+  const std::string csv_text = read_file(csv);
+  const std::string json_text = read_file(json);
+  EXPECT_EQ(csv_text.rfind("device,", 0), 0u) << csv_text;
+  EXPECT_TRUE(contains(csv_text, "projection")) << csv_text;
+  EXPECT_EQ(json_text.rfind("{", 0), 0u) << json_text;
+  EXPECT_TRUE(contains(json_text, "\"projection\"")) << json_text;
+  EXPECT_EQ(entries(out), (std::vector<std::string>{"c.csv", "j.json"}));
+  EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+}
+
+TEST(CliRender, ListsDevices) {
+  const auto result = run_exe(kRenderExe, {"--list-devices"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(contains(result.out, "0: ")) << result.out;
+}
+
+}  // namespace

@@ -1,0 +1,147 @@
+// The radix sort and the prefix sum alone, against std::stable_sort / std::exclusive_scan, on the
+// device the tests run on (lavapipe in CI), with the validation layer on.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+#include <random>
+
+#include "passes/frame_counters.h"
+#include "passes/prefix_sum_pass.h"
+#include "sort/sort_strategy.h"
+#include "vulkan/context.h"
+
+namespace tilesplat {
+namespace {
+
+vk::Context& context() {
+  static vk::Context ctx({"", true});
+  return ctx;
+}
+
+template <typename T>
+std::vector<T> read_back(vk::Context& ctx, const vk::Buffer& buffer, size_t count) {
+  std::vector<T> out(count);
+  if (count == 0) return out;
+  vk::Buffer staging(ctx, count * sizeof(T), vk::MemoryUse::Readback, "test readback");
+  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    VkBufferCopy region{0, 0, count * sizeof(T)};
+    vkCmdCopyBuffer(cmd, buffer.handle(), staging.handle(), 1, &region);
+  });
+  std::memcpy(out.data(), staging.mapped(), count * sizeof(T));
+  return out;
+}
+
+// Sorts keys (values = input positions) with a strategy and returns (keys, values) as the GPU left them.
+std::pair<std::vector<uint64_t>, std::vector<uint32_t>> gpu_sort(const std::string& strategy,
+                                                                  const std::vector<uint64_t>& keys,
+                                                                  uint32_t key_bits) {
+  vk::Context& ctx = context();
+  const uint32_t n = uint32_t(keys.size());
+  const uint32_t capacity = std::max<uint32_t>(n, 1);
+  KeyBuffers kb;
+  kb.capacity = capacity;
+  kb.keys = vk::Buffer(ctx, capacity * 8ull, vk::MemoryUse::Device, "keys");
+  kb.keys_alt = vk::Buffer(ctx, capacity * 8ull, vk::MemoryUse::Device, "keys alt");
+  kb.values = vk::Buffer(ctx, capacity * 4ull, vk::MemoryUse::Device, "values");
+  kb.values_alt = vk::Buffer(ctx, capacity * 4ull, vk::MemoryUse::Device, "values alt");
+  std::vector<uint32_t> values(n);
+  std::iota(values.begin(), values.end(), 0u);
+  vk::upload(ctx, kb.keys, keys.data(), n * 8ull);
+  vk::upload(ctx, kb.values, values.data(), n * 4ull);
+  vk::Buffer counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "counters");
+  FrameCounters fc{};
+  fc.sort_count = n;
+  std::memcpy(counters.mapped(), &fc, sizeof(fc));
+
+  auto sorter = make_sort_strategy(strategy, ctx);
+  bool in_alt = false;
+  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    SortInput input{kb, counters, key_bits};
+    in_alt = sorter->record(cmd, input);
+  });
+  return {read_back<uint64_t>(ctx, in_alt ? kb.keys_alt : kb.keys, n),
+          read_back<uint32_t>(ctx, in_alt ? kb.values_alt : kb.values, n)};
+}
+
+void expect_sorted_like_stable_sort(const std::string& strategy, const std::vector<uint64_t>& keys,
+                                    uint32_t key_bits) {
+  std::vector<uint32_t> expected_order(keys.size());
+  std::iota(expected_order.begin(), expected_order.end(), 0u);
+  std::stable_sort(expected_order.begin(), expected_order.end(),
+                   [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
+  auto [sorted_keys, order] = gpu_sort(strategy, keys, key_bits);
+  ASSERT_EQ(order.size(), keys.size());
+  size_t mismatches = 0;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    if (order[i] != expected_order[i] || sorted_keys[i] != keys[expected_order[i]]) {
+      if (++mismatches <= 5)
+        ADD_FAILURE() << strategy << " n=" << keys.size() << ": position " << i << " has index " << order[i]
+                      << " (key " << sorted_keys[i] << "), expected index " << expected_order[i] << " (key "
+                      << keys[expected_order[i]] << ")";
+    }
+  }
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_EQ(context().validation_messages(), 0u);
+}
+
+std::vector<uint64_t> random_keys(size_t n, uint32_t bits, uint64_t seed, uint64_t distinct = 0) {
+  std::mt19937_64 rng(seed);
+  std::vector<uint64_t> keys(n);
+  const uint64_t mask = bits >= 64 ? ~0ull : (1ull << bits) - 1;
+  for (auto& k : keys) k = distinct ? (rng() % distinct) * 0x9e3779b97f4a7c15ull & mask : rng() & mask;
+  return keys;
+}
+
+class RadixSortSizes : public ::testing::TestWithParam<size_t> {};
+
+TEST_P(RadixSortSizes, MatchesStableSortOnRandom45BitKeys) {
+  for (const auto& strategy : available_sort_strategies())
+    expect_sorted_like_stable_sort(strategy, random_keys(GetParam(), 45, GetParam()), 45);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sizes, RadixSortSizes,
+                         ::testing::Values(0, 1, 2, 255, 256, 257, 2047, 2048, 2049, (1u << 16) + 1, 1u << 20));
+
+TEST(RadixSort, ManyEqualKeysKeepInputOrder) {
+  for (const auto& strategy : available_sort_strategies()) {
+    expect_sorted_like_stable_sort(strategy, random_keys(100000, 45, 7, 3), 45);
+    expect_sorted_like_stable_sort(strategy, std::vector<uint64_t>(50000, 12345), 45);
+  }
+}
+
+TEST(RadixSort, FullWidthAndNarrowKeys) {
+  for (const auto& strategy : available_sort_strategies()) {
+    expect_sorted_like_stable_sort(strategy, random_keys(30000, 64, 11), 64);
+    expect_sorted_like_stable_sort(strategy, random_keys(30000, 32, 12), 32);
+    expect_sorted_like_stable_sort(strategy, random_keys(30000, 9, 13), 9);
+  }
+}
+
+TEST(PrefixSum, MatchesExclusiveScanAtBlockBoundaries) {
+  vk::Context& ctx = context();
+  PrefixSumPass scan(ctx);
+  for (uint32_t n : {1u, 2u, 1023u, 1024u, 1025u, 4096u, 1048576u + 3u, 3000000u}) {
+    std::mt19937 rng(n);
+    std::vector<uint32_t> values(n);
+    for (auto& v : values) v = rng() % 300;
+    vk::Buffer src(ctx, n * 4ull, vk::MemoryUse::Device, "scan src");
+    vk::Buffer dst(ctx, n * 4ull, vk::MemoryUse::Device, "scan dst");
+    vk::Buffer total(ctx, 16, vk::MemoryUse::Readback, "scan total");
+    vk::upload(ctx, src, values.data(), n * 4ull);
+    ctx.submit_and_wait([&](VkCommandBuffer cmd) { scan.record(cmd, src.address(), dst.address(), n, total.address()); });
+    std::vector<uint32_t> expected(n);
+    std::exclusive_scan(values.begin(), values.end(), expected.begin(), 0u);
+    auto got = read_back<uint32_t>(ctx, dst, n);
+    size_t first_bad = n;
+    for (size_t i = 0; i < n && first_bad == n; ++i)
+      if (got[i] != expected[i]) first_bad = i;
+    EXPECT_EQ(first_bad, n) << "n=" << n << " first mismatch at " << first_bad;
+    EXPECT_EQ(*total.mapped_as<uint32_t>(), expected.back() + values.back()) << "n=" << n;
+  }
+  EXPECT_EQ(ctx.validation_messages(), 0u);
+}
+
+}  // namespace
+}  // namespace tilesplat

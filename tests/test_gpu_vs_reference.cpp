@@ -1,0 +1,176 @@
+// The GPU pipeline against the engine's float64 CPU reference, and against the independent reference
+// images in ../shared/scenes/reference, on real trained scenes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "test_support.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/image.h"
+#include "tilesplat/reference.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat {
+namespace {
+
+constexpr int kWidth = 480, kHeight = 270;  // the size of the independent references
+
+struct SceneCase {
+  std::string name;  // file stem, also the cameras/ and reference/ name
+  bool bundled;
+};
+
+std::filesystem::path scene_path(const SceneCase& c) {
+  if (c.name == "playbot_lod3_31000_sh2" && c.bundled) return testing::bundled_playbot();
+  if (c.name == "playcanvas_test_64_sh3" && c.bundled) return testing::bundled_sh3();
+  return testing::shared_scenes() / (c.name + ".ply");
+}
+std::filesystem::path cameras_path(const SceneCase& c) {
+  if (c.name == "playbot_lod3_31000_sh2" && c.bundled) return testing::bundled_playbot_cameras();
+  if (c.name == "playcanvas_test_64_sh3" && c.bundled) return testing::bundled_sh3_cameras();
+  return testing::shared_scenes() / "cameras" / (c.name + ".json");
+}
+
+void expect_all_finite(const RenderImage& image) {
+  size_t bad = 0;
+  for (float v : image.rgba) bad += !std::isfinite(v);
+  for (float v : image.depth) bad += !std::isfinite(v);
+  EXPECT_EQ(bad, 0u) << "non-finite output values";
+}
+
+class GpuVsReference : public ::testing::TestWithParam<SceneCase> {};
+
+TEST_P(GpuVsReference, TwoViewsMatchFloat64Reference) {
+  const SceneCase& c = GetParam();
+  if (!c.bundled) TILESPLAT_REQUIRE_SHARED_SCENES();
+  GaussianScene scene = load_scene(scene_path(c));
+  auto views = load_cameras_json(cameras_path(c));
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(scene);
+  for (int view : {0, 3}) {
+    Camera camera = resize_camera(views.at(size_t(view)).camera, kWidth, kHeight);
+    RenderImage gpu = renderer.render(camera);
+    RenderImage ref = render_reference(scene, camera);
+    expect_all_finite(gpu);
+    ImageDifference d = compare_images(gpu, ref);
+    std::printf("[ measure  ] %s view %d: GPU vs float64 reference PSNR %.2f dB, max abs %.2e (alpha %.2e)\n",
+                c.name.c_str(), view, d.psnr_db, d.max_abs, d.max_abs_alpha);
+    EXPECT_GE(d.psnr_db, 60.0) << c.name << " view " << view;
+    EXPECT_LE(d.max_abs, 2e-3) << c.name << " view " << view << " worst pixel (" << d.worst_x << ", " << d.worst_y
+                               << ") channel " << d.worst_channel;
+    EXPECT_LE(d.max_abs_alpha, 2e-3) << c.name << " view " << view;
+
+    // Splat counts and depth agree with the reference wherever both blended the same splats.
+    size_t count_mismatch = 0;
+    for (size_t i = 0; i < gpu.pixels(); ++i) count_mismatch += gpu.splat_count[i] != ref.splat_count[i];
+    EXPECT_LE(double(count_mismatch), 1e-3 * double(gpu.pixels())) << "per-pixel splat counts differ";
+
+    const auto reference_exr = testing::shared_scenes() / "reference" / (c.name + "_view" + std::to_string(view) + ".exr");
+    if (!testing::shared_scenes().empty() && std::filesystem::exists(reference_exr)) {
+      ImageDifference ind = compare_images(gpu, read_exr(reference_exr));
+      std::printf("[ measure  ] %s view %d: GPU vs independent reference PSNR %.2f dB, max abs %.2e\n",
+                  c.name.c_str(), view, ind.psnr_db, ind.max_abs);
+      EXPECT_GE(ind.psnr_db, 50.0) << c.name << " view " << view;
+    }
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(RealScenes, GpuVsReference,
+                         ::testing::Values(SceneCase{"playbot_lod3_31000_sh2", true},
+                                           SceneCase{"playcanvas_test_64_sh3", true},
+                                           SceneCase{"playbot_lod6_1873_sh2", false},
+                                           SceneCase{"guitar_90854_sh0", false},
+                                           SceneCase{"plant_113648_sh0", false},
+                                           SceneCase{"biker_152746_sh0", false}),
+                         [](const auto& info) { return info.param.name + (info.param.bundled ? "_bundled" : ""); });
+
+TEST(GpuRenderer, EmptySceneIsBackground) {
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(GaussianScene{});
+  Camera camera = look_at_camera({0, 0, -5}, {0, 0, 0}, {0, -1, 0}, 37, 21, 50);
+  RenderSettings settings;
+  settings.background = {0.25f, 0.5f, 0.75f};
+  RenderImage image = renderer.render(camera, settings);
+  ASSERT_EQ(image.pixels(), 37u * 21u);
+  for (size_t i = 0; i < image.pixels(); ++i) {
+    ASSERT_EQ(image.rgba[4 * i + 0], 0.25f);
+    ASSERT_EQ(image.rgba[4 * i + 1], 0.5f);
+    ASSERT_EQ(image.rgba[4 * i + 2], 0.75f);
+    ASSERT_EQ(image.rgba[4 * i + 3], 0.0f);
+    ASSERT_EQ(image.splat_count[i], 0u);
+  }
+  EXPECT_EQ(renderer.last_frame_stats().intersections, 0u);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(GpuRenderer, GrowsKeyBuffersWhenIntersectionsExceedCapacity) {
+  // A few huge splats near the camera touch every tile of a large image: far more intersections
+  // than the initial capacity (4 per Gaussian, at least 65536), forcing a grow-and-retry.
+  GaussianScene scene;
+  scene.sh_degree = 0;
+  for (int i = 0; i < 40; ++i) {
+    scene.positions.insert(scene.positions.end(), {0.01f * float(i), 0.0f, 2.0f + 0.01f * float(i)});
+    scene.log_scales.insert(scene.log_scales.end(), {1.0f, 1.0f, 1.0f});
+    scene.rotations.insert(scene.rotations.end(), {1, 0, 0, 0});
+    scene.opacity_logits.push_back(-3.0f);
+    scene.sh.insert(scene.sh.end(), {0.5f, 0.2f, -0.3f});
+  }
+  Camera camera = look_at_camera({0, 0, 0}, {0, 0, 1}, {0, -1, 0}, 1280, 960, 60);
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(scene);
+  RenderImage gpu = renderer.render(camera);
+  const FrameStats& stats = renderer.last_frame_stats();
+  EXPECT_GE(stats.retries, 1);
+  EXPECT_EQ(stats.intersections, 40u * 80u * 60u);
+  RenderImage ref = render_reference(scene, camera);
+  ImageDifference d = compare_images(gpu, ref);
+  EXPECT_GE(d.psnr_db, 60.0);
+  EXPECT_LE(d.max_abs, 2e-3);
+  // A second frame reuses the grown buffers.
+  renderer.render(camera);
+  EXPECT_EQ(renderer.last_frame_stats().retries, 0);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(GpuRenderer, ReportsPassTimingsAndCounts) {
+  Renderer& renderer = testing::validated_renderer();
+  GaussianScene scene = load_scene(testing::bundled_playbot());
+  renderer.set_scene(scene);
+  Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, 320, 180);
+  renderer.render(camera);
+  const FrameStats& stats = renderer.last_frame_stats();
+  std::vector<std::string> names;
+  for (const auto& p : stats.passes) names.push_back(p.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"projection", "prefix_sum", "key_emission", "sort", "tile_ranges",
+                                             "composite"}));
+  EXPECT_GT(stats.gpu_ms, 0.0);
+  EXPECT_EQ(stats.gaussians, scene.size());
+  EXPECT_GT(stats.visible, scene.size() / 2);
+  EXPECT_GE(stats.intersections, stats.visible);
+  EXPECT_EQ(stats.sort_bits, 32u + 8u);  // 20 x 12 = 240 tiles -> 8 tile bits
+}
+
+TEST(GpuRenderer, RejectsImpossibleImageSizes) {
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(load_scene(testing::bundled_sh3()));
+  Camera camera = look_at_camera({0, 0, -5}, {0, 0, 0}, {0, -1, 0}, 16, 16, 50);
+  camera.width = 0;
+  EXPECT_THROW(renderer.render(camera), std::runtime_error);
+  camera.width = 2'000'000;
+  camera.height = 16;
+  try {
+    renderer.render(camera);
+    ADD_FAILURE() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("2000000x16"), std::string::npos) << e.what();
+  }
+  RenderSettings bad_sort;
+  bad_sort.sort = "no-such-sort";
+  camera.width = 16;
+  EXPECT_THROW(renderer.render(camera, bad_sort), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace tilesplat

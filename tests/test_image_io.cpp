@@ -1,0 +1,689 @@
+// EXR and PNG files, atomic writes, and image comparison.
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "image/atomic_file.h"
+#include "test_support.h"
+#include "tilesplat/image.h"
+
+// The EXR channel checks read the header with the spec-level parser below, and additionally with
+// OpenEXR itself when the test target has OpenEXR's include directories.
+#if __has_include(<ImfInputFile.h>)
+#include <ImfChannelList.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#define TILESPLAT_TEST_HAS_OPENEXR 1
+#else
+#define TILESPLAT_TEST_HAS_OPENEXR 0
+#endif
+
+namespace tilesplat {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+
+RenderImage make_image(int width, int height, bool with_depth, bool with_counts) {
+  RenderImage image;
+  image.width = width;
+  image.height = height;
+  image.rgba.resize(4 * image.pixels());
+  for (size_t i = 0; i < image.rgba.size(); ++i)
+    image.rgba[i] = 0.37f * static_cast<float>(i % 97) - 3.1f + 1e-3f * static_cast<float>(i);
+  if (with_depth) {
+    image.depth.resize(image.pixels());
+    for (size_t i = 0; i < image.depth.size(); ++i)
+      image.depth[i] = 1.5f + 0.01234567f * static_cast<float>(i);
+  }
+  if (with_counts) {
+    image.splat_count.resize(image.pixels());
+    for (size_t i = 0; i < image.splat_count.size(); ++i)
+      image.splat_count[i] = static_cast<uint32_t>(i * 7919u);
+  }
+  return image;
+}
+
+// temp_dir() persists between runs; tests that inspect a directory's contents need it empty.
+fs::path fresh_dir() {
+  const fs::path dir = testing::temp_dir() / "files";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::vector<char> read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_bytes(const fs::path& path, const std::vector<char>& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::set<std::string> directory_entries(const fs::path& dir) {
+  std::set<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.insert(entry.path().filename().string());
+  return names;
+}
+
+template <typename Function>
+std::string error_message_of(Function&& function) {
+  try {
+    function();
+  } catch (const std::exception& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "expected an exception";
+  return {};
+}
+
+template <typename T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+// A minimal reader of the EXR header as laid out in the OpenEXR file-layout document, so the
+// channel list is checked independently of the library that wrote it.
+struct ExrChannelInfo {
+  std::string name;
+  int32_t pixel_type;  // 0 UINT, 1 HALF, 2 FLOAT
+  bool operator==(const ExrChannelInfo&) const = default;
+};
+constexpr int32_t kExrUint = 0, kExrHalf = 1, kExrFloat = 2;
+
+struct ExrHeaderInfo {
+  std::vector<ExrChannelInfo> channels;
+  int compression = -1;  // 3 = ZIP_COMPRESSION
+};
+
+template <typename T>
+T load_little_endian(const std::vector<char>& bytes, size_t offset) {
+  static_assert(std::endian::native == std::endian::little);
+  T value{};
+  if (offset + sizeof(T) > bytes.size()) throw std::runtime_error("EXR header truncated");
+  std::memcpy(&value, bytes.data() + offset, sizeof(T));
+  return value;
+}
+
+std::string load_name(const std::vector<char>& bytes, size_t& offset) {
+  std::string name;
+  while (offset < bytes.size() && bytes[offset] != '\0') name += bytes[offset++];
+  if (offset >= bytes.size()) throw std::runtime_error("EXR header truncated");
+  ++offset;
+  return name;
+}
+
+ExrHeaderInfo parse_exr_header(const fs::path& path) {
+  const std::vector<char> bytes = read_bytes(path);
+  if (load_little_endian<uint32_t>(bytes, 0) != 20000630u) throw std::runtime_error("bad EXR magic");
+  ExrHeaderInfo info;
+  size_t offset = 8;  // magic + version
+  for (;;) {
+    const std::string attribute = load_name(bytes, offset);
+    if (attribute.empty()) break;
+    const std::string type = load_name(bytes, offset);
+    const auto size = static_cast<size_t>(load_little_endian<int32_t>(bytes, offset));
+    offset += 4;
+    if (attribute == "channels") {
+      size_t at = offset;
+      for (;;) {
+        const std::string name = load_name(bytes, at);
+        if (name.empty()) break;
+        info.channels.push_back({name, load_little_endian<int32_t>(bytes, at)});
+        at += 16;  // pixel type, pLinear + 3 reserved, xSampling, ySampling
+      }
+    } else if (attribute == "compression") {
+      info.compression = static_cast<unsigned char>(bytes.at(offset));
+    }
+    offset += size;
+  }
+  return info;
+}
+
+// Writes an uncompressed scanline EXR of FLOAT channels by hand, to produce files our writer
+// never would: missing channels, a data window that does not start at (0, 0).
+struct HandChannel {
+  std::string name;
+  std::vector<float> values;  // width x height, row-major
+};
+
+void write_hand_made_exr(const fs::path& path, int x_min, int y_min, int width, int height,
+                         std::vector<HandChannel> channels) {
+  std::sort(channels.begin(), channels.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+  std::vector<char> out;
+  const auto put = [&](const auto& value) {
+    const char* raw = reinterpret_cast<const char*>(&value);
+    out.insert(out.end(), raw, raw + sizeof(value));
+  };
+  const auto put_name = [&](const std::string& text) {
+    out.insert(out.end(), text.begin(), text.end());
+    out.push_back('\0');
+  };
+  const auto put_attribute_start = [&](const std::string& name, const std::string& type, int32_t size) {
+    put_name(name);
+    put_name(type);
+    put(size);
+  };
+  put(uint32_t{20000630u});
+  put(uint32_t{2});
+  int32_t chlist_size = 1;
+  for (const auto& channel : channels) chlist_size += static_cast<int32_t>(channel.name.size()) + 1 + 16;
+  put_attribute_start("channels", "chlist", chlist_size);
+  for (const auto& channel : channels) {
+    put_name(channel.name);
+    put(kExrFloat);
+    put(uint32_t{0});  // pLinear and reserved
+    put(int32_t{1});
+    put(int32_t{1});
+  }
+  out.push_back('\0');
+  put_attribute_start("compression", "compression", 1);
+  out.push_back('\0');  // NO_COMPRESSION
+  for (const char* window : {"dataWindow", "displayWindow"}) {
+    put_attribute_start(window, "box2i", 16);
+    put(int32_t{x_min});
+    put(int32_t{y_min});
+    put(int32_t{x_min + width - 1});
+    put(int32_t{y_min + height - 1});
+  }
+  put_attribute_start("lineOrder", "lineOrder", 1);
+  out.push_back('\0');
+  put_attribute_start("pixelAspectRatio", "float", 4);
+  put(1.0f);
+  put_attribute_start("screenWindowCenter", "v2f", 8);
+  put(0.0f);
+  put(0.0f);
+  put_attribute_start("screenWindowWidth", "float", 4);
+  put(1.0f);
+  out.push_back('\0');
+
+  const auto line_bytes = static_cast<int32_t>(channels.size() * static_cast<size_t>(width) * sizeof(float));
+  const uint64_t first_line = out.size() + 8 * static_cast<uint64_t>(height);
+  const uint64_t chunk_bytes = 8u + static_cast<uint64_t>(line_bytes);  // y, size, then the data
+  for (int row = 0; row < height; ++row) put(uint64_t{first_line + static_cast<uint64_t>(row) * chunk_bytes});
+  for (int row = 0; row < height; ++row) {
+    put(int32_t{y_min + row});
+    put(line_bytes);
+    for (const auto& channel : channels)
+      for (int x = 0; x < width; ++x) put(channel.values[static_cast<size_t>(row * width + x)]);
+  }
+  write_bytes(path, out);
+}
+
+// PNG read back through libpng's simplified API.
+struct DecodedPng {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+};
+
+DecodedPng read_png_rgb(const fs::path& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, path.c_str())) throw std::runtime_error(png.message);
+  png.format = PNG_FORMAT_RGB;
+  DecodedPng decoded;
+  decoded.width = png.width;
+  decoded.height = png.height;
+  decoded.rgb.resize(PNG_IMAGE_SIZE(png));
+  if (!png_image_finish_read(&png, nullptr, decoded.rgb.data(), 0, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    throw std::runtime_error(message);
+  }
+  return decoded;
+}
+
+uint8_t expected_srgb_byte(double linear) {
+  const double clamped = std::clamp(linear, 0.0, 1.0);
+  const double encoded =
+      clamped <= 0.0031308 ? 12.92 * clamped : 1.055 * std::pow(clamped, 1.0 / 2.4) - 0.055;
+  return static_cast<uint8_t>(std::floor(encoded * 255.0 + 0.5));
+}
+
+// ---------------------------------------------------------------------------------------------
+// EXR
+
+TEST(ExrIo, FloatRoundTripIsBitExact) {
+  RenderImage image = make_image(13, 7, true, true);
+  // Values a lossy path would disturb: signed zero, subnormals, infinities, NaN, extremes.
+  image.rgba[0] = -0.0f;
+  image.rgba[1] = std::numeric_limits<float>::denorm_min();
+  image.rgba[2] = std::numeric_limits<float>::infinity();
+  image.rgba[3] = std::numeric_limits<float>::quiet_NaN();
+  image.rgba[4] = std::numeric_limits<float>::max();
+  image.rgba[5] = 1.0f + std::numeric_limits<float>::epsilon();
+  image.depth[0] = 0.0f;
+  image.depth[1] = 123456.789f;
+  image.splat_count[0] = std::numeric_limits<uint32_t>::max();
+
+  const fs::path path = fresh_dir() / "float.exr";
+  write_exr(path, image);
+  const RenderImage back = read_exr(path);
+  EXPECT_EQ(back.width, 13);
+  EXPECT_EQ(back.height, 7);
+  EXPECT_TRUE(same_bits(back.rgba, image.rgba));
+  EXPECT_TRUE(same_bits(back.depth, image.depth));
+  EXPECT_EQ(back.splat_count, image.splat_count);
+}
+
+TEST(ExrIo, HalfRoundTripKeepsHalfPrecisionAndExactDepth) {
+  RenderImage image = make_image(11, 6, true, true);
+  image.rgba[0] = 1e-6f;  // a half subnormal
+  const fs::path path = fresh_dir() / "half.exr";
+  write_exr(path, image, ExrWriteOptions{.half = true});
+  const RenderImage back = read_exr(path);
+  ASSERT_EQ(back.width, image.width);
+  ASSERT_EQ(back.height, image.height);
+  ASSERT_EQ(back.rgba.size(), image.rgba.size());
+  bool some_value_changed = false;
+  for (size_t i = 0; i < image.rgba.size(); ++i) {
+    // Round to nearest with an 11-bit significand: at most half an ulp, 2^-11 relative, and
+    // 2^-25 absolute in half's subnormal range.
+    const double tolerance =
+        std::max(std::fabs(double{image.rgba[i]}) * std::ldexp(1.0, -11), std::ldexp(1.0, -25));
+    EXPECT_NEAR(back.rgba[i], image.rgba[i], tolerance) << "value " << i;
+    some_value_changed |= back.rgba[i] != image.rgba[i];
+  }
+  EXPECT_TRUE(some_value_changed) << "the colour channels do not look like they were stored as half";
+  EXPECT_TRUE(same_bits(back.depth, image.depth)) << "Z must stay FLOAT in half mode";
+  EXPECT_EQ(back.splat_count, image.splat_count);
+}
+
+TEST(ExrIo, WrittenFileListsExpectedChannels) {
+  const fs::path dir = fresh_dir();
+  const RenderImage full = make_image(4, 3, true, true);
+  const RenderImage colour_only = make_image(4, 3, false, false);
+  write_exr(dir / "full_float.exr", full);
+  write_exr(dir / "full_half.exr", full, ExrWriteOptions{.half = true});
+  write_exr(dir / "colour_only.exr", colour_only);
+
+  using Channels = std::vector<ExrChannelInfo>;
+  // EXR stores channels sorted by name.
+  const Channels full_float = {
+      {"A", kExrFloat}, {"B", kExrFloat}, {"G", kExrFloat},
+      {"R", kExrFloat}, {"Z", kExrFloat}, {"splats", kExrUint}};
+  const Channels full_half = {
+      {"A", kExrHalf}, {"B", kExrHalf}, {"G", kExrHalf},
+      {"R", kExrHalf}, {"Z", kExrFloat}, {"splats", kExrUint}};
+  const Channels colour = {{"A", kExrFloat}, {"B", kExrFloat}, {"G", kExrFloat}, {"R", kExrFloat}};
+
+  const std::vector<std::pair<fs::path, Channels>> cases = {
+      {dir / "full_float.exr", full_float},
+      {dir / "full_half.exr", full_half},
+      {dir / "colour_only.exr", colour}};
+  for (const auto& [path, expected] : cases) {
+    const ExrHeaderInfo header = parse_exr_header(path);
+    EXPECT_EQ(header.channels, expected) << path;
+    EXPECT_EQ(header.compression, 3) << path << ": expected ZIP_COMPRESSION";
+#if TILESPLAT_TEST_HAS_OPENEXR
+    Imf::InputFile file(path.c_str());
+    Channels from_openexr;
+    const Imf::ChannelList& channels = file.header().channels();
+    for (auto channel = channels.begin(); channel != channels.end(); ++channel)
+      from_openexr.push_back({channel.name(), static_cast<int32_t>(channel.channel().type)});
+    EXPECT_EQ(from_openexr, expected) << path;
+    EXPECT_EQ(static_cast<int>(file.header().compression()), 3) << path;
+#endif
+  }
+}
+
+TEST(ExrIo, ReadsFileWithoutAlphaAndWithOffsetDataWindow) {
+  const int width = 3, height = 2;
+  std::vector<float> red = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f};
+  std::vector<float> green = {1, 2, 3, 4, 5, 6};
+  std::vector<float> blue = {-1, -2, -3, -4, -5, -6};
+  std::vector<float> depth = {10, 20, 30, 40, 50, 60};
+  const fs::path path = fresh_dir() / "rgbz_offset.exr";
+  write_hand_made_exr(path, 5, -2, width, height, {{"R", red}, {"G", green}, {"B", blue}, {"Z", depth}});
+
+  const RenderImage image = read_exr(path);
+  ASSERT_EQ(image.width, width);
+  ASSERT_EQ(image.height, height);
+  ASSERT_EQ(image.rgba.size(), 4u * 6u);
+  for (size_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(image.rgba[4 * i + 0], red[i]) << i;
+    EXPECT_EQ(image.rgba[4 * i + 1], green[i]) << i;
+    EXPECT_EQ(image.rgba[4 * i + 2], blue[i]) << i;
+    EXPECT_EQ(image.rgba[4 * i + 3], 1.0f) << "A defaults to 1 when absent, pixel " << i;
+  }
+  EXPECT_EQ(image.depth, depth);
+  EXPECT_TRUE(image.splat_count.empty());
+}
+
+TEST(ExrIo, MissingColourChannelIsAnErrorNamingTheFile) {
+  const fs::path path = fresh_dir() / "no_red.exr";
+  write_hand_made_exr(path, 0, 0, 2, 1, {{"G", {1, 2}}, {"B", {3, 4}}});
+  const std::string message = error_message_of([&] { read_exr(path); });
+  EXPECT_NE(message.find(path.string()), std::string::npos) << message;
+  EXPECT_NE(message.find("no R channel"), std::string::npos) << message;
+  EXPECT_THROW(read_exr(path), std::runtime_error);
+}
+
+TEST(ExrIo, MissingFileGivesClearError) {
+  const fs::path path = fresh_dir() / "does_not_exist.exr";
+  const std::string message = error_message_of([&] { read_exr(path); });
+  EXPECT_EQ(message, "cannot read " + path.string() + ": the file does not exist");
+  EXPECT_THROW(read_exr(path), std::runtime_error);
+}
+
+TEST(ExrIo, TruncatedOrForeignFileGivesClearError) {
+  const fs::path dir = fresh_dir();
+  const fs::path complete = dir / "complete.exr";
+  write_exr(complete, make_image(64, 48, true, true));
+  const std::vector<char> bytes = read_bytes(complete);
+
+  std::vector<fs::path> broken;
+  for (const size_t kept : {size_t{0}, size_t{3}, size_t{40}, bytes.size() / 3, bytes.size() - 5}) {
+    broken.push_back(dir / ("truncated_" + std::to_string(kept) + ".exr"));
+    write_bytes(broken.back(),
+                std::vector<char>(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(kept)));
+  }
+  broken.push_back(dir / "text.exr");
+  write_bytes(broken.back(), {'n', 'o', 't', ' ', 'a', 'n', ' ', 'e', 'x', 'r', '\n'});
+
+  for (const fs::path& path : broken) {
+    const std::string message = error_message_of([&] { read_exr(path); });
+    EXPECT_EQ(message.rfind("cannot read " + path.string() + ": ", 0), 0u) << message;
+  }
+}
+
+TEST(ExrIo, ReadsSharedReferenceImages) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  const fs::path reference_dir = testing::shared_scenes() / "reference";
+  std::vector<fs::path> files;
+  if (fs::is_directory(reference_dir))
+    for (const auto& entry : fs::directory_iterator(reference_dir))
+      if (entry.path().extension() == ".exr") files.push_back(entry.path());
+  if (files.empty()) GTEST_SKIP() << "no reference images in " << reference_dir;
+  std::sort(files.begin(), files.end());
+
+  for (const fs::path& path : files) {
+    const RenderImage image = read_exr(path);
+    EXPECT_EQ(image.width, 480) << path;
+    EXPECT_EQ(image.height, 270) << path;
+    ASSERT_EQ(image.rgba.size(), 4 * image.pixels()) << path;
+    const size_t non_finite = static_cast<size_t>(
+        std::count_if(image.rgba.begin(), image.rgba.end(), [](float v) { return !std::isfinite(v); }));
+    EXPECT_EQ(non_finite, 0u) << path;
+    float max_alpha = 0;
+    for (size_t pixel = 0; pixel < image.pixels(); ++pixel)
+      max_alpha = std::max(max_alpha, image.rgba[4 * pixel + 3]);
+    EXPECT_GT(max_alpha, 0.0f) << path << ": nothing was rendered";
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Atomic writes
+
+TEST(AtomicWrite, MissingDirectoryThrowsClearErrorAndCreatesNothing) {
+  const fs::path dir = fresh_dir();
+  const fs::path missing = dir / "missing";
+  const fs::path exr = missing / "x.exr";
+  EXPECT_EQ(error_message_of([&] { write_exr(exr, make_image(2, 2, false, false)); }),
+            "cannot write " + exr.string() + ": directory '" + missing.string() + "' does not exist");
+  const fs::path png = missing / "x.png";
+  EXPECT_EQ(error_message_of([&] { write_png_preview(png, make_image(2, 2, false, false)); }),
+            "cannot write " + png.string() + ": directory '" + missing.string() + "' does not exist");
+  EXPECT_THROW(write_exr(exr, make_image(2, 2, false, false)), std::runtime_error);
+  EXPECT_FALSE(fs::exists(missing));
+  EXPECT_TRUE(directory_entries(dir).empty());
+}
+
+TEST(AtomicWrite, InvalidImageLeavesNoFiles) {
+  const fs::path dir = fresh_dir();
+  const fs::path exr = dir / "bad.exr";
+  const fs::path png = dir / "bad.png";
+
+  RenderImage empty;
+  RenderImage short_rgba = make_image(4, 4, true, true);
+  short_rgba.rgba.pop_back();
+  RenderImage bad_depth = make_image(4, 4, true, false);
+  bad_depth.depth.resize(3);
+  RenderImage bad_counts = make_image(4, 4, false, true);
+  bad_counts.splat_count.resize(17);
+
+  for (const RenderImage* image : {&empty, &short_rgba, &bad_depth, &bad_counts}) {
+    const std::string message = error_message_of([&] { write_exr(exr, *image); });
+    EXPECT_EQ(message.rfind("cannot write " + exr.string() + ": ", 0), 0u) << message;
+    EXPECT_THROW(write_exr(exr, *image, ExrWriteOptions{.half = true}), std::runtime_error);
+  }
+  for (const RenderImage* image : {&empty, &short_rgba}) {
+    const std::string message = error_message_of([&] { write_png_preview(png, *image); });
+    EXPECT_EQ(message.rfind("cannot write " + png.string() + ": ", 0), 0u) << message;
+  }
+  EXPECT_THROW(write_png_preview(png, make_image(2, 2, false, false), std::nanf("")), std::runtime_error);
+  EXPECT_TRUE(directory_entries(dir).empty());
+}
+
+TEST(AtomicWrite, WriterFailingHalfWayLeavesNeitherTargetNorTempFile) {
+  const fs::path dir = fresh_dir();
+  const fs::path target = dir / "out.bin";
+  fs::path temp_seen;
+  const std::string message = error_message_of([&] {
+    detail::write_file_atomically(target, [&](const fs::path& temp) {
+      temp_seen = temp;
+      write_bytes(temp, {'p', 'a', 'r', 't'});
+      throw std::runtime_error("disk on fire");
+    });
+  });
+  EXPECT_EQ(message, "cannot write " + target.string() + ": disk on fire");
+  EXPECT_EQ(temp_seen.parent_path(), dir) << "the temporary file must be beside the target";
+  EXPECT_EQ(temp_seen.filename().string().rfind(".out.bin.tmp-", 0), 0u) << temp_seen;
+  EXPECT_TRUE(directory_entries(dir).empty());
+
+  // Non-std exceptions are cleaned up after too.
+  EXPECT_THROW(detail::write_file_atomically(target,
+                                             [&](const fs::path& temp) {
+                                               write_bytes(temp, {'x'});
+                                               throw 42;
+                                             }),
+               std::runtime_error);
+  EXPECT_TRUE(directory_entries(dir).empty());
+}
+
+TEST(AtomicWrite, FailedOverwriteKeepsExistingTarget) {
+  const fs::path dir = fresh_dir();
+  const fs::path target = dir / "keep.exr";
+  const RenderImage original = make_image(5, 4, true, false);
+  write_exr(target, original);
+  const std::vector<char> original_bytes = read_bytes(target);
+  ASSERT_FALSE(original_bytes.empty());
+
+  RenderImage invalid = make_image(5, 4, false, false);
+  invalid.rgba.resize(3);
+  EXPECT_THROW(write_exr(target, invalid), std::runtime_error);
+  EXPECT_THROW(detail::write_file_atomically(target,
+                                             [&](const fs::path& temp) {
+                                               write_bytes(temp, {'h', 'a', 'l', 'f'});
+                                               throw std::runtime_error("interrupted");
+                                             }),
+               std::runtime_error);
+  EXPECT_EQ(read_bytes(target), original_bytes);
+  EXPECT_EQ(directory_entries(dir), std::set<std::string>{"keep.exr"});
+
+  // A successful overwrite does replace it, again leaving no temporary file behind.
+  write_exr(target, make_image(2, 2, false, false));
+  EXPECT_EQ(read_exr(target).width, 2);
+  EXPECT_EQ(directory_entries(dir), std::set<std::string>{"keep.exr"});
+}
+
+TEST(AtomicWrite, PathWithoutDirectoryWritesToCurrentDirectory) {
+  const fs::path dir = fresh_dir();
+  {
+    // Restores the working directory even when the write throws, so later tests are unaffected.
+    struct WorkingDirectoryGuard {
+      fs::path previous = fs::current_path();
+      ~WorkingDirectoryGuard() { fs::current_path(previous); }
+    } guard;
+    fs::current_path(dir);
+    detail::write_file_atomically("plain.txt", [](const fs::path& temp) { write_bytes(temp, {'o', 'k'}); });
+  }
+  EXPECT_EQ(read_bytes(dir / "plain.txt"), (std::vector<char>{'o', 'k'}));
+  EXPECT_EQ(directory_entries(dir), std::set<std::string>{"plain.txt"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// PNG previews
+
+TEST(PngPreview, WritesSrgbEncodedPixels) {
+  const std::vector<float> linear = {0.0f, 1.0f,  0.5f, 0.0031308f, 0.2f, 0.0001f, 2.0f, -1.0f,
+                                     std::numeric_limits<float>::quiet_NaN(), 0.04f, 0.75f, 0.01f};
+  RenderImage image;
+  image.width = 2;
+  image.height = 2;
+  image.rgba.resize(16);
+  for (size_t pixel = 0; pixel < 4; ++pixel) {
+    for (size_t c = 0; c < 3; ++c) image.rgba[4 * pixel + c] = linear[3 * pixel + c];
+    image.rgba[4 * pixel + 3] = 0.25f;  // alpha is dropped, not applied
+  }
+  const fs::path path = fresh_dir() / "preview.png";
+  write_png_preview(path, image);
+
+  const std::vector<char> bytes = read_bytes(path);
+  ASSERT_GE(bytes.size(), 24u);
+  const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  EXPECT_EQ(std::memcmp(bytes.data(), signature, 8), 0);
+  EXPECT_EQ(std::string(bytes.data() + 12, 4), "IHDR");
+  const auto big_endian_at = [&](size_t offset) {
+    uint32_t value = 0;
+    for (size_t i = 0; i < 4; ++i) value = (value << 8) | static_cast<unsigned char>(bytes[offset + i]);
+    return value;
+  };
+  EXPECT_EQ(big_endian_at(16), 2u);  // width
+  EXPECT_EQ(big_endian_at(20), 2u);  // height
+  EXPECT_EQ(static_cast<unsigned char>(bytes[24]), 8u);  // bit depth
+  EXPECT_EQ(static_cast<unsigned char>(bytes[25]), 2u);  // colour type: RGB
+
+  const DecodedPng decoded = read_png_rgb(path);
+  ASSERT_EQ(decoded.width, 2u);
+  ASSERT_EQ(decoded.height, 2u);
+  ASSERT_EQ(decoded.rgb.size(), 12u);
+  for (size_t i = 0; i < linear.size(); ++i) {
+    const double value = std::isnan(linear[i]) ? 0.0 : double{linear[i]};
+    EXPECT_EQ(decoded.rgb[i], expected_srgb_byte(value)) << "linear " << linear[i];
+  }
+  // The anchors of the sRGB curve, as literal values.
+  EXPECT_EQ(decoded.rgb[0], 0);
+  EXPECT_EQ(decoded.rgb[1], 255);
+  EXPECT_EQ(decoded.rgb[2], 188);
+  EXPECT_EQ(decoded.rgb[3], 10);
+  EXPECT_EQ(decoded.rgb[6], 255) << "over-range values clamp to white";
+  EXPECT_EQ(decoded.rgb[7], 0) << "negative values clamp to black";
+  EXPECT_EQ(decoded.rgb[8], 0) << "NaN becomes black";
+}
+
+TEST(PngPreview, ExposureScalesLinearColour) {
+  RenderImage image;
+  image.width = 1;
+  image.height = 1;
+  image.rgba = {0.25f, 0.125f, 1.0f, 1.0f};
+  const fs::path path = fresh_dir() / "exposed.png";
+  write_png_preview(path, image, 2.0f);
+  const DecodedPng decoded = read_png_rgb(path);
+  ASSERT_EQ(decoded.rgb.size(), 3u);
+  EXPECT_EQ(decoded.rgb[0], expected_srgb_byte(0.5));
+  EXPECT_EQ(decoded.rgb[1], expected_srgb_byte(0.25));
+  EXPECT_EQ(decoded.rgb[2], 255);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Comparison
+
+TEST(CompareImages, IdenticalImagesHaveInfinitePsnrAndNoError) {
+  const RenderImage image = make_image(9, 5, false, false);
+  const ImageDifference difference = compare_images(image, image);
+  EXPECT_TRUE(std::isinf(difference.psnr_db) && difference.psnr_db > 0);
+  EXPECT_EQ(difference.max_abs, 0.0);
+  EXPECT_EQ(difference.max_abs_alpha, 0.0);
+  EXPECT_EQ(difference.rmse, 0.0);
+}
+
+TEST(CompareImages, SinglePixelDifferenceIsLocatedAndMeasured) {
+  const RenderImage a = make_image(8, 4, false, false);
+  RenderImage b = a;
+  const int x = 5, y = 2, channel = 1;
+  const double delta = 0.25;
+  b.rgba[4 * static_cast<size_t>(y * 8 + x) + channel] += static_cast<float>(delta);
+  const double actual_delta = double{b.rgba[4 * static_cast<size_t>(y * 8 + x) + channel]} -
+                              double{a.rgba[4 * static_cast<size_t>(y * 8 + x) + channel]};
+
+  const ImageDifference difference = compare_images(a, b);
+  EXPECT_DOUBLE_EQ(difference.max_abs, actual_delta);
+  EXPECT_NEAR(difference.max_abs, delta, 1e-6);
+  EXPECT_EQ(difference.worst_x, x);
+  EXPECT_EQ(difference.worst_y, y);
+  EXPECT_EQ(difference.worst_channel, channel);
+  EXPECT_EQ(difference.max_abs_alpha, 0.0);
+  const double mse = actual_delta * actual_delta / (3.0 * 8 * 4);
+  EXPECT_NEAR(difference.rmse, std::sqrt(mse), 1e-12);
+  EXPECT_NEAR(difference.psnr_db, 10.0 * std::log10(1.0 / mse), 1e-9);
+  EXPECT_NEAR(difference.psnr_db, 31.864, 0.001);  // 10 log10(96 / 0.0625)
+
+  // An alpha-only difference leaves the RGB metrics alone.
+  RenderImage c = a;
+  c.rgba[3] += 0.5f;
+  const ImageDifference alpha_only = compare_images(a, c);
+  EXPECT_NEAR(alpha_only.max_abs_alpha, 0.5, 1e-6);
+  EXPECT_EQ(alpha_only.max_abs, 0.0);
+  EXPECT_TRUE(std::isinf(alpha_only.psnr_db));
+}
+
+TEST(CompareImages, SizeMismatchThrowsNamingBothSizes) {
+  const RenderImage a = make_image(4, 3, false, false);
+  const RenderImage b = make_image(3, 4, false, false);
+  EXPECT_THROW(compare_images(a, b), std::invalid_argument);
+  const std::string message = error_message_of([&] { compare_images(a, b); });
+  EXPECT_NE(message.find("4x3"), std::string::npos) << message;
+  EXPECT_NE(message.find("3x4"), std::string::npos) << message;
+
+  RenderImage short_rgba = a;
+  short_rgba.rgba.resize(5);
+  EXPECT_THROW(compare_images(a, short_rgba), std::invalid_argument);
+}
+
+TEST(CompareImages, NonFiniteValuesFailLoudly) {
+  const RenderImage a = make_image(6, 3, false, false);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<std::pair<size_t, float>> poisons = {
+      {4 * 7 + 2, nan}, {4 * 3 + 0, inf}, {4 * 9 + 3, nan}};
+  for (const auto& [index, value] : poisons) {
+    for (const bool poison_first : {true, false}) {
+      RenderImage poisoned = a;
+      poisoned.rgba[index] = value;
+      const ImageDifference difference =
+          poison_first ? compare_images(poisoned, a) : compare_images(a, poisoned);
+      EXPECT_FALSE(difference.psnr_db >= -1e300) << "index " << index;
+      EXPECT_FALSE(difference.psnr_db >= 0.0);
+      EXPECT_EQ(difference.max_abs, std::numeric_limits<double>::infinity());
+      EXPECT_FALSE(difference.rmse <= 1e300);
+      EXPECT_EQ(difference.worst_x, static_cast<int>((index / 4) % 6));
+      EXPECT_EQ(difference.worst_y, static_cast<int>((index / 4) / 6));
+      EXPECT_EQ(difference.worst_channel, static_cast<int>(index % 4));
+    }
+  }
+  // Even a NaN in the same place in both images is a failure, not a match.
+  RenderImage both = a;
+  both.rgba[0] = nan;
+  EXPECT_FALSE(compare_images(both, both).psnr_db >= 0.0);
+}
+
+}  // namespace
+}  // namespace tilesplat

@@ -1,0 +1,53 @@
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+namespace tilesplat::testing {
+
+std::filesystem::path bundled_scene_dir() { return std::filesystem::path(TILESPLAT_SOURCE_DIR) / "scenes"; }
+std::filesystem::path bundled_playbot() {
+  return bundled_scene_dir() / "playbot_lod3" / "playbot_lod3_31000_sh2.ply";
+}
+std::filesystem::path bundled_playbot_cameras() {
+  return bundled_scene_dir() / "playbot_lod3" / "playbot_lod3_31000_sh2.json";
+}
+std::filesystem::path bundled_sh3() {
+  return bundled_scene_dir() / "playcanvas_test" / "playcanvas_test_64_sh3.ply";
+}
+std::filesystem::path bundled_sh3_cameras() {
+  return bundled_scene_dir() / "playcanvas_test" / "playcanvas_test_64_sh3.json";
+}
+
+std::filesystem::path shared_scenes() {
+  std::filesystem::path dir;
+  if (const char* env = std::getenv("TILESPLAT_SHARED_SCENES"); env && *env)
+    dir = env;
+  else
+    dir = TILESPLAT_SHARED_SCENES_DEFAULT;
+  std::error_code ec;
+  if (std::filesystem::is_directory(dir / "cameras", ec)) return dir;
+  return {};
+}
+
+std::filesystem::path temp_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "tilesplat";
+  for (char& c : name)
+    if (c == '/') c = '_';
+  auto dir = std::filesystem::temp_directory_path() / "tilesplat_tests" / name;
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+Renderer& validated_renderer() {
+  static std::unique_ptr<Renderer> renderer = [] {
+    RendererOptions options;
+    options.validation = true;
+    return Renderer::create(options);
+  }();
+  return *renderer;
+}
+
+}  // namespace tilesplat::testing

@@ -1,0 +1,36 @@
+// Helpers shared by the tests: where scenes live, and a renderer with validation that fails on messages.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "tilesplat/renderer.h"
+
+namespace tilesplat::testing {
+
+// The small real scenes bundled in this repository (always present).
+std::filesystem::path bundled_scene_dir();
+std::filesystem::path bundled_playbot();      // scenes/playbot_lod3/playbot_lod3_31000_sh2.ply
+std::filesystem::path bundled_playbot_cameras();
+std::filesystem::path bundled_sh3();          // scenes/playcanvas_test/playcanvas_test_64_sh3.ply
+std::filesystem::path bundled_sh3_cameras();
+
+// ../shared/scenes, or $TILESPLAT_SHARED_SCENES. Empty path when absent: callers GTEST_SKIP().
+std::filesystem::path shared_scenes();
+
+// A directory unique to the running test for temporary files (removed by the OS, not by tests).
+std::filesystem::path temp_dir();
+
+// One renderer per test binary with the Khronos validation layer on (the layer being absent
+// is itself a failure). Tests assert validation_messages() == 0 after rendering.
+Renderer& validated_renderer();
+
+}  // namespace tilesplat::testing
+
+// Skips the test, visibly, when ../shared/scenes is not available.
+#define TILESPLAT_REQUIRE_SHARED_SCENES()                                                       \
+  do {                                                                                          \
+    if (::tilesplat::testing::shared_scenes().empty())                                         \
+      GTEST_SKIP() << "shared scenes not found: set TILESPLAT_SHARED_SCENES or -DTILESPLAT_SHARED_SCENES"; \
+  } while (0)
