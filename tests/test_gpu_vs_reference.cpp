@@ -84,7 +84,7 @@ INSTANTIATE_TEST_SUITE_P(RealScenes, GpuVsReference,
                                            SceneCase{"guitar_90854_sh0", false},
                                            SceneCase{"plant_113648_sh0", false},
                                            SceneCase{"biker_152746_sh0", false}),
-                         [](const auto& info) { return info.param.name + (info.param.bundled ? "_bundled" : ""); });
+                         [](const auto& param_info) { return param_info.param.name + (param_info.param.bundled ? "_bundled" : ""); });
 
 TEST(GpuRenderer, EmptySceneIsBackground) {
   Renderer& renderer = testing::validated_renderer();

@@ -3,8 +3,8 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -32,9 +32,12 @@ enum class Encoding { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
 
 const char* format_name(Encoding encoding) {
   switch (encoding) {
-    case Encoding::kAscii: return "ascii";
-    case Encoding::kBinaryLittleEndian: return "binary_little_endian";
-    case Encoding::kBinaryBigEndian: return "binary_big_endian";
+    case Encoding::kAscii:
+      return "ascii";
+    case Encoding::kBinaryLittleEndian:
+      return "binary_little_endian";
+    case Encoding::kBinaryBigEndian:
+      return "binary_big_endian";
   }
   return "";
 }
@@ -97,7 +100,8 @@ std::string encode_header(Encoding encoding, const std::vector<TestElement>& ele
       if (property.list_count_type.empty()) {
         header += "property " + property.type + " " + property.name + "\n";
       } else {
-        header += "property list " + property.list_count_type + " " + property.type + " " + property.name + "\n";
+        header +=
+            "property list " + property.list_count_type + " " + property.type + " " + property.name + "\n";
       }
     }
   }
@@ -151,7 +155,8 @@ std::string replace_once(std::string text, std::string_view from, std::string_vi
 
 size_t header_line_count(const std::string& ply) {
   const size_t end = ply.find("end_header\n");
-  return static_cast<size_t>(std::count(ply.begin(), ply.begin() + static_cast<std::ptrdiff_t>(end), '\n')) + 1;
+  return static_cast<size_t>(std::count(ply.begin(), ply.begin() + static_cast<std::ptrdiff_t>(end), '\n')) +
+         1;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -159,7 +164,9 @@ size_t header_line_count(const std::string& ply) {
 
 constexpr size_t kTinyCount = 4;
 
-int coefficients_of(int degree) { return (degree + 1) * (degree + 1); }
+int coefficients_of(int degree) {
+  return (degree + 1) * (degree + 1);
+}
 
 float sh_value(size_t gaussian, size_t coefficient, size_t channel) {
   return static_cast<float>(1000 * gaussian + 10 * coefficient + channel) + 0.5f;
@@ -168,10 +175,14 @@ float sh_value(size_t gaussian, size_t coefficient, size_t channel) {
 // Un-normalized on purpose: 2x identity, zero, a 5-norm quaternion and a general one.
 std::array<double, 4> raw_rotation(size_t gaussian) {
   switch (gaussian % 4) {
-    case 0: return {2, 0, 0, 0};
-    case 1: return {0, 0, 0, 0};
-    case 2: return {1, 2, 2, 4};
-    default: return {2, -3, 6, 0};
+    case 0:
+      return {2, 0, 0, 0};
+    case 1:
+      return {0, 0, 0, 0};
+    case 2:
+      return {1, 2, 2, 4};
+    default:
+      return {2, -3, 6, 0};
   }
 }
 
@@ -209,7 +220,8 @@ double tiny_value(size_t i, const std::string& name, int degree) {
 
 TestElement make_vertex_element(const std::vector<std::string>& names, size_t count, int degree) {
   TestElement vertex{"vertex", {}, {}};
-  for (const std::string& name : names) vertex.properties.push_back({name == "confidence" ? "uchar" : "float", name});
+  for (const std::string& name : names)
+    vertex.properties.push_back({name == "confidence" ? "uchar" : "float", name});
   for (size_t i = 0; i < count; ++i) {
     std::vector<Cell> row;
     for (const std::string& name : names) row.push_back({tiny_value(i, name, degree)});
@@ -238,9 +250,11 @@ GaussianScene expected_tiny_scene(int degree, bool normals = true) {
   scene.sh_degree = degree;
   const size_t k_count = static_cast<size_t>(coefficients_of(degree));
   for (size_t i = 0; i < kTinyCount; ++i) {
-    for (const char* name : {"x", "y", "z"}) scene.positions.push_back(static_cast<float>(tiny_value(i, name, degree)));
+    for (const char* name : {"x", "y", "z"})
+      scene.positions.push_back(static_cast<float>(tiny_value(i, name, degree)));
     if (normals)
-      for (const char* name : {"nx", "ny", "nz"}) scene.normals.push_back(static_cast<float>(tiny_value(i, name, degree)));
+      for (const char* name : {"nx", "ny", "nz"})
+        scene.normals.push_back(static_cast<float>(tiny_value(i, name, degree)));
     for (const char* name : {"scale_0", "scale_1", "scale_2"})
       scene.log_scales.push_back(static_cast<float>(tiny_value(i, name, degree)));
     scene.opacity_logits.push_back(static_cast<float>(tiny_value(i, "opacity", degree)));
@@ -253,7 +267,8 @@ GaussianScene expected_tiny_scene(int degree, bool normals = true) {
       {0.2f, 0.4f, 0.4f, 0.8f},
       {static_cast<float>(2.0 / 7), static_cast<float>(-3.0 / 7), static_cast<float>(6.0 / 7), 0},
   }};  // |(2, -3, 6, 0)| = 7
-  for (size_t i = 0; i < kTinyCount; ++i) scene.rotations.insert(scene.rotations.end(), normalized[i].begin(), normalized[i].end());
+  for (size_t i = 0; i < kTinyCount; ++i)
+    scene.rotations.insert(scene.rotations.end(), normalized[i].begin(), normalized[i].end());
   return scene;
 }
 
@@ -266,14 +281,16 @@ void expect_same_scene(const GaussianScene& actual, const GaussianScene& expecte
   EXPECT_EQ(actual.sh, expected.sh);
   EXPECT_EQ(actual.normals, expected.normals);
   ASSERT_EQ(actual.rotations.size(), expected.rotations.size());
-  for (size_t i = 0; i < actual.rotations.size(); ++i) EXPECT_FLOAT_EQ(actual.rotations[i], expected.rotations[i]) << i;
+  for (size_t i = 0; i < actual.rotations.size(); ++i)
+    EXPECT_FLOAT_EQ(actual.rotations[i], expected.rotations[i]) << i;
 }
 
 void expect_unit_quaternions(const GaussianScene& scene) {
   size_t bad = 0;
   for (size_t i = 0; i < scene.size(); ++i) {
     const float* q = &scene.rotations[4 * i];
-    const double norm = std::sqrt(double{q[0]} * q[0] + double{q[1]} * q[1] + double{q[2]} * q[2] + double{q[3]} * q[3]);
+    const double norm =
+        std::sqrt(double{q[0]} * q[0] + double{q[1]} * q[1] + double{q[2]} * q[2] + double{q[3]} * q[3]);
     if (std::abs(norm - 1.0) > 1e-5) ++bad;
   }
   EXPECT_EQ(bad, 0u) << "quaternions without unit norm";
@@ -334,7 +351,8 @@ TEST(PlyLoader, LoadsBundledSh3Scene) {
 
 TEST(PlyLoader, LoadSceneDispatchesPlyCaseInsensitively) {
   const std::filesystem::path upper = testing::temp_dir() / "SH3_COPY.PLY";
-  std::filesystem::copy_file(testing::bundled_sh3(), upper, std::filesystem::copy_options::overwrite_existing);
+  std::filesystem::copy_file(testing::bundled_sh3(), upper,
+                             std::filesystem::copy_options::overwrite_existing);
   EXPECT_EQ(load_scene(upper).size(), 64u);
   EXPECT_EQ(load_scene(testing::bundled_sh3()).size(), 64u);
 }
@@ -363,7 +381,8 @@ TEST_P(TinyScene, IdenticalInEveryEncodingAndMatchesKnownValues) {
 
 TEST_P(TinyScene, ReordersChannelMajorRestToCoefficientMajor) {
   const int degree = GetParam();
-  const auto path = write_file("tiny_rest.ply", encode_ply(Encoding::kBinaryLittleEndian, tiny_scene_elements(degree)));
+  const auto path =
+      write_file("tiny_rest.ply", encode_ply(Encoding::kBinaryLittleEndian, tiny_scene_elements(degree)));
   const GaussianScene scene = load_ply(path);
   const size_t k_count = static_cast<size_t>(coefficients_of(degree));
   ASSERT_EQ(scene.sh_degree, degree);
@@ -371,7 +390,8 @@ TEST_P(TinyScene, ReordersChannelMajorRestToCoefficientMajor) {
   for (size_t i = 0; i < kTinyCount; ++i)
     for (size_t k = 0; k < k_count; ++k)
       for (size_t c = 0; c < 3; ++c)
-        EXPECT_EQ(scene.sh[(i * k_count + k) * 3 + c], sh_value(i, k, c)) << "i " << i << " k " << k << " c " << c;
+        EXPECT_EQ(scene.sh[(i * k_count + k) * 3 + c], sh_value(i, k, c))
+            << "i " << i << " k " << k << " c " << c;
   if (degree == 1) {
     // Spelled out once: f_rest_4 is channel 1 (green), coefficient 2 (4 = 1 * 3 + (2 - 1)).
     EXPECT_EQ(scene.sh[(0 * 4 + 2) * 3 + 1], sh_value(0, 2, 1));
@@ -379,15 +399,18 @@ TEST_P(TinyScene, ReordersChannelMajorRestToCoefficientMajor) {
 }
 
 INSTANTIATE_TEST_SUITE_P(ShDegrees, TinyScene, ::testing::Values(0, 1, 2, 3),
-                         [](const ::testing::TestParamInfo<int>& param) { return "sh" + std::to_string(param.param); });
+                         [](const ::testing::TestParamInfo<int>& param) {
+                           return "sh" + std::to_string(param.param);
+                         });
 
 TEST(PlyLoader, NormalizesQuaternionsAndZeroBecomesIdentity) {
-  const auto path = write_file("rotations.ply", encode_ply(Encoding::kBinaryLittleEndian, tiny_scene_elements(1)));
+  const auto path =
+      write_file("rotations.ply", encode_ply(Encoding::kBinaryLittleEndian, tiny_scene_elements(1)));
   const GaussianScene scene = load_ply(path);
   ASSERT_EQ(scene.size(), kTinyCount);
   const auto rotation = [&](size_t i) {
-    return std::array<float, 4>{scene.rotations[4 * i], scene.rotations[4 * i + 1], scene.rotations[4 * i + 2],
-                                scene.rotations[4 * i + 3]};
+    return std::array<float, 4>{scene.rotations[4 * i], scene.rotations[4 * i + 1],
+                                scene.rotations[4 * i + 2], scene.rotations[4 * i + 3]};
   };
   EXPECT_EQ(rotation(0), (std::array<float, 4>{1, 0, 0, 0}));  // (2, 0, 0, 0)
   EXPECT_EQ(rotation(1), (std::array<float, 4>{1, 0, 0, 0}));  // zero -> identity
@@ -404,7 +427,8 @@ TEST(PlyLoader, TinyQuaternionsNormalizeInsteadOfBecomingIdentity) {
   ASSERT_EQ(vertex.properties[rot_1].name, "rot_1");
   vertex.rows[0][rot_1 - 1] = {0.0};
   vertex.rows[0][rot_1] = {1e-30};  // its square underflows float, not double
-  const GaussianScene scene = load_ply(write_file("tiny_quat.ply", encode_ply(Encoding::kBinaryLittleEndian, {vertex})));
+  const GaussianScene scene =
+      load_ply(write_file("tiny_quat.ply", encode_ply(Encoding::kBinaryLittleEndian, {vertex})));
   EXPECT_EQ(scene.rotations, (std::vector<float>{0, 1, 0, 0}));
 }
 
@@ -431,17 +455,51 @@ TEST(PlyLoader, ConvertsEveryScalarType) {
                       {"double", "huge"}},
                      {}};
   vertex.rows = {
-      {{-5}, {200}, {-300}, {60000}, {-70000}, {4000000000.0}, {0.1}, {-7}, {255}, {-32768}, {3}, {0}, {4}, {0},
-       {2.5}, {0.25}, {-1}, {0.5}, {1e300}},
-      {{127}, {0}, {32767}, {0}, {2147483647}, {0}, {-0.75}, {-128}, {0}, {0}, {0}, {0}, {0}, {0}, {0}, {0}, {0},
-       {0}, {-1e300}},
+      {{-5},
+       {200},
+       {-300},
+       {60000},
+       {-70000},
+       {4000000000.0},
+       {0.1},
+       {-7},
+       {255},
+       {-32768},
+       {3},
+       {0},
+       {4},
+       {0},
+       {2.5},
+       {0.25},
+       {-1},
+       {0.5},
+       {1e300}},
+      {{127},
+       {0},
+       {32767},
+       {0},
+       {2147483647},
+       {0},
+       {-0.75},
+       {-128},
+       {0},
+       {0},
+       {0},
+       {0},
+       {0},
+       {0},
+       {0},
+       {0},
+       {0},
+       {0},
+       {-1e300}},
   };
   for (Encoding encoding : kAllEncodings) {
     SCOPED_TRACE(format_name(encoding));
     LoadReport report;
-    const GaussianScene scene =
-        load_ply(write_file(std::string("types_") + format_name(encoding) + ".ply", encode_ply(encoding, {vertex})), {},
-                 &report);
+    const GaussianScene scene = load_ply(
+        write_file(std::string("types_") + format_name(encoding) + ".ply", encode_ply(encoding, {vertex})),
+        {}, &report);
     ASSERT_EQ(scene.size(), 2u);
     EXPECT_EQ(scene.sh_degree, 0);
     EXPECT_EQ(scene.positions, (std::vector<float>{-5, 200, -300, 127, 0, 32767}));
@@ -465,8 +523,8 @@ TEST(PlyLoader, ConvertsEveryScalarType) {
 TEST(PlyLoader, DegreeZeroWithoutNormals) {
   const GaussianScene expected = expected_tiny_scene(0, false);
   for (Encoding encoding : kAllEncodings) {
-    const auto path =
-        write_file(std::string("sh0_") + format_name(encoding) + ".ply", encode_ply(encoding, tiny_scene_elements(0, false)));
+    const auto path = write_file(std::string("sh0_") + format_name(encoding) + ".ply",
+                                 encode_ply(encoding, tiny_scene_elements(0, false)));
     const GaussianScene scene = load_ply(path);
     EXPECT_FALSE(scene.has_normals());
     expect_same_scene(scene, expected, format_name(encoding));
@@ -485,9 +543,9 @@ TEST(PlyLoader, AcceptsCrlfLinesAndEmptyVertexElement) {
   TestElement empty = make_vertex_element(trainer_property_names(2, true), 0, 2);
   for (Encoding encoding : kAllEncodings) {
     LoadReport report;
-    const GaussianScene scene =
-        load_ply(write_file(std::string("empty_") + format_name(encoding) + ".ply", encode_ply(encoding, {empty})), {},
-                 &report);
+    const GaussianScene scene = load_ply(
+        write_file(std::string("empty_") + format_name(encoding) + ".ply", encode_ply(encoding, {empty})), {},
+        &report);
     EXPECT_TRUE(scene.empty());
     EXPECT_EQ(scene.sh_degree, 2);
     EXPECT_EQ(report.gaussians_in_file, 0u);
@@ -524,8 +582,8 @@ TEST(PlyLoader, DropsNonFiniteGaussiansAndReportsThem) {
   const std::vector<size_t> kept = {0, 1, 3, 4, 6, 8, 11};
   for (Encoding encoding : kAllEncodings) {
     SCOPED_TRACE(format_name(encoding));
-    const auto path =
-        write_file(std::string("non_finite_") + format_name(encoding) + ".ply", encode_ply(encoding, {non_finite_vertex()}));
+    const auto path = write_file(std::string("non_finite_") + format_name(encoding) + ".ply",
+                                 encode_ply(encoding, {non_finite_vertex()}));
     LoadReport report;
     const GaussianScene scene = load_ply(path, {}, &report);
     ASSERT_EQ(scene.size(), kept.size());
@@ -548,9 +606,10 @@ TEST(PlyLoader, DropsNonFiniteGaussiansAndReportsThem) {
     expect_entry(1, "opacity", 1, 5);
     expect_entry(2, "f_rest_3", 1, 7);
     expect_entry(3, "ny", 1, 10);
-    EXPECT_EQ(report.summary(),
-              "dropped 5 of 12 Gaussians with non-finite values (scale_1: 2, first at 2; opacity: 1, first at 5; "
-              "f_rest_3: 1, first at 7; ny: 1, first at 10)");
+    EXPECT_EQ(
+        report.summary(),
+        "dropped 5 of 12 Gaussians with non-finite values (scale_1: 2, first at 2; opacity: 1, first at 5; "
+        "f_rest_3: 1, first at 7; ny: 1, first at 10)");
   }
 }
 
@@ -559,8 +618,8 @@ TEST(PlyLoader, StrictModeRejectsTheFirstNonFiniteGaussian) {
   strict.strict = true;
   for (Encoding encoding : kAllEncodings) {
     SCOPED_TRACE(format_name(encoding));
-    const auto path =
-        write_file(std::string("strict_") + format_name(encoding) + ".ply", encode_ply(encoding, {non_finite_vertex()}));
+    const auto path = write_file(std::string("strict_") + format_name(encoding) + ".ply",
+                                 encode_ply(encoding, {non_finite_vertex()}));
     expect_load_error(path, {"Gaussian 2 has a non-finite value in scale_1 (nan) (strict mode)"}, strict);
   }
   TestElement vertex = non_finite_vertex();
@@ -576,7 +635,8 @@ TEST(LoadReport, SummaryIsOneLineAndEmptyWhenNothingDropped) {
   report.dropped = 3;
   report.dropped_by_property = {{"scale_1", 2, 17}, {"opacity", 1, 40}};
   EXPECT_EQ(report.summary(),
-            "dropped 3 of 1000 Gaussians with non-finite values (scale_1: 2, first at 17; opacity: 1, first at 40)");
+            "dropped 3 of 1000 Gaussians with non-finite values (scale_1: 2, first at 17; opacity: 1, first "
+            "at 40)");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -613,15 +673,17 @@ TEST(PlyLoaderErrors, UnsupportedSceneExtension) {
   } catch (const SceneError& error) {
     const std::string message = error.what();
     EXPECT_TRUE(message.starts_with(path.string())) << message;
-    EXPECT_NE(message.find("unsupported scene format '.xyz' (supported: .ply)"), std::string::npos) << message;
+    EXPECT_NE(message.find("unsupported scene format '.xyz' (supported: .ply)"), std::string::npos)
+        << message;
   }
   EXPECT_THROW(load_scene(write_file("noextension", minimal_ply())), SceneError);
 }
 
 TEST(PlyLoaderErrors, HeaderProblems) {
   const std::string good = minimal_ply();
-  expect_load_error(write_file("format.ply", replace_once(good, "binary_little_endian", "binary_middle_endian")),
-                    {"unsupported format 'binary_middle_endian'"});
+  expect_load_error(
+      write_file("format.ply", replace_once(good, "binary_little_endian", "binary_middle_endian")),
+      {"unsupported format 'binary_middle_endian'"});
   expect_load_error(write_file("noformat.ply", replace_once(good, "format binary_little_endian 1.0\n", "")),
                     {"no 'format' line"});
   expect_load_error(write_file("version.ply", replace_once(good, " 1.0\n", " 2.0\n")), {"version"});
@@ -638,14 +700,18 @@ TEST(PlyLoaderErrors, HeaderProblems) {
                     {"duplicated property 'x'"});
   expect_load_error(write_file("count.ply", replace_once(good, "element vertex 3", "element vertex -3")),
                     {"invalid count '-3'"});
-  expect_load_error(write_file("count2.ply", replace_once(good, "element vertex 3", "element vertex 99999999999999999999999")),
+  expect_load_error(write_file("count2.ply", replace_once(good, "element vertex 3",
+                                                          "element vertex 99999999999999999999999")),
                     {"invalid count"});
-  expect_load_error(write_file("orphan.ply", replace_once(good, "element vertex 3\n", "")), {"property before any element"});
-  expect_load_error(write_file("listvertex.ply", replace_once(good, "property float y", "property list uchar float y")),
-                    {"list property 'y'"});
+  expect_load_error(write_file("orphan.ply", replace_once(good, "element vertex 3\n", "")),
+                    {"property before any element"});
   expect_load_error(
-      write_file("listcount.ply", replace_once(good, "element vertex", "element face 0\nproperty list float int idx\nelement vertex")),
-      {"not an integer type"});
+      write_file("listvertex.ply", replace_once(good, "property float y", "property list uchar float y")),
+      {"list property 'y'"});
+  expect_load_error(write_file("listcount.ply",
+                               replace_once(good, "element vertex",
+                                            "element face 0\nproperty list float int idx\nelement vertex")),
+                    {"not an integer type"});
 }
 
 TEST(PlyLoaderErrors, MissingRequiredProperty) {
@@ -654,25 +720,29 @@ TEST(PlyLoaderErrors, MissingRequiredProperty) {
                     {"missing required property 'opacity'"});
   expect_load_error(write_file("norot.ply", replace_once(good, "property float rot_3\n", "")),
                     {"missing required property 'rot_3'"});
-  expect_load_error(write_file("nox.ply", replace_once(good, "property float x\n", "property float packed_position\n")),
-                    {"missing required property 'x'", "compressed PLY"});
+  expect_load_error(
+      write_file("nox.ply", replace_once(good, "property float x\n", "property float packed_position\n")),
+      {"missing required property 'x'", "compressed PLY"});
 }
 
 TEST(PlyLoaderErrors, BadRestAndNormalProperties) {
   TestElement vertex = make_vertex_element(trainer_property_names(1, false), 2, 1);
   const std::string degree1 = encode_ply(Encoding::kBinaryLittleEndian, {vertex});
-  expect_load_error(write_file("rest10.ply",
-                               replace_once(degree1, "property float opacity", "property float f_rest_9\nproperty float opacity")),
+  expect_load_error(write_file("rest10.ply", replace_once(degree1, "property float opacity",
+                                                          "property float f_rest_9\nproperty float opacity")),
                     {"f_rest", "(10)", "0, 9, 24 or 45"});
   expect_load_error(write_file("rest8.ply", replace_once(degree1, "property float f_rest_8\n", "")),
                     {"f_rest", "(8)"});
-  expect_load_error(write_file("restgap.ply", replace_once(degree1, "property float f_rest_8\n", "property float f_rest_12\n")),
+  expect_load_error(write_file("restgap.ply", replace_once(degree1, "property float f_rest_8\n",
+                                                           "property float f_rest_12\n")),
                     {"f_rest", "not contiguous", "f_rest_12"});
-  expect_load_error(write_file("restname.ply", replace_once(degree1, "property float f_rest_8\n", "property float f_rest_08\n")),
+  expect_load_error(write_file("restname.ply", replace_once(degree1, "property float f_rest_8\n",
+                                                            "property float f_rest_08\n")),
                     {"f_rest_08"});
-  expect_load_error(write_file("normals.ply", replace_once(minimal_ply(), "property float z\n",
-                                                           "property float z\nproperty float nx\nproperty float nz\n")),
-                    {"incomplete normals", "'ny'"});
+  expect_load_error(
+      write_file("normals.ply", replace_once(minimal_ply(), "property float z\n",
+                                             "property float z\nproperty float nx\nproperty float nz\n")),
+      {"incomplete normals", "'ny'"});
 }
 
 TEST(PlyLoaderErrors, TruncatedBinaryData) {
@@ -693,8 +763,9 @@ TEST(PlyLoaderErrors, TruncatedBinaryData) {
 }
 
 TEST(PlyLoaderErrors, TrailingBinaryData) {
-  expect_load_error(write_file("trailing.ply", minimal_ply() + "junk"),
-                    {"4 bytes of trailing data after the declared elements; the vertex count in the header may be wrong"});
+  expect_load_error(
+      write_file("trailing.ply", minimal_ply() + "junk"),
+      {"4 bytes of trailing data after the declared elements; the vertex count in the header may be wrong"});
   // The header undercounts: a whole vertex of data is left over.
   std::string undercount = replace_once(minimal_ply(), "element vertex 3", "element vertex 2");
   expect_load_error(write_file("undercount.ply", undercount), {"56 bytes of trailing data"});
@@ -704,21 +775,25 @@ TEST(PlyLoaderErrors, ImpossibleVertexCountIsRefusedBeforeAllocating) {
   for (Encoding encoding : kAllEncodings) {
     SCOPED_TRACE(format_name(encoding));
     const std::string good = minimal_ply(encoding);
-    expect_load_error(write_file("huge.ply", replace_once(good, "element vertex 3", "element vertex 1000000000000")),
-                      {"impossible vertex count 1000000000000"});
     expect_load_error(
-        write_file("overflow.ply", replace_once(good, "element vertex 3", "element vertex 18446744073709551615")),
-        {"impossible vertex count 18446744073709551615"});
+        write_file("huge.ply", replace_once(good, "element vertex 3", "element vertex 1000000000000")),
+        {"impossible vertex count 1000000000000"});
+    expect_load_error(write_file("overflow.ply", replace_once(good, "element vertex 3",
+                                                              "element vertex 18446744073709551615")),
+                      {"impossible vertex count 18446744073709551615"});
   }
   // Huge counts of other elements are walked against the data, never allocated.
   const std::string good = minimal_ply();
   expect_load_error(
-      write_file("hugefaces.ply",
-                 replace_once(good, "element vertex", "element face 18446744073709551615\nproperty list uchar int idx\nelement vertex")),
+      write_file(
+          "hugefaces.ply",
+          replace_once(good, "element vertex",
+                       "element face 18446744073709551615\nproperty list uchar int idx\nelement vertex")),
       {"truncated", "element 'face'"});
   expect_load_error(
       write_file("hugechunks.ply",
-                 replace_once(good, "element vertex", "element chunk 4611686018427387904\nproperty float a\nelement vertex")),
+                 replace_once(good, "element vertex",
+                              "element chunk 4611686018427387904\nproperty float a\nelement vertex")),
       {"element 'chunk'", "impossible"});
 }
 
@@ -749,10 +824,12 @@ TEST(PlyLoaderErrors, AsciiDataProblems) {
 
   expect_load_error(write_file("extra_line.ply", good + line2 + "\n"),
                     {"trailing data", "the vertex count in the header may be wrong"});
-  expect_load_error(write_file("undercount_ascii.ply", replace_once(good, "element vertex 3", "element vertex 2")),
-                    {"trailing data", "line " + std::to_string(first_data_line + 2)});
-  expect_load_error(write_file("overcount_ascii.ply", replace_once(good, "element vertex 3", "element vertex 4")),
-                    {"truncated", "expected 4 vertices", "ends after 3"});
+  expect_load_error(
+      write_file("undercount_ascii.ply", replace_once(good, "element vertex 3", "element vertex 2")),
+      {"trailing data", "line " + std::to_string(first_data_line + 2)});
+  expect_load_error(
+      write_file("overcount_ascii.ply", replace_once(good, "element vertex 3", "element vertex 4")),
+      {"truncated", "expected 4 vertices", "ends after 3"});
   // Trailing blank lines are harmless.
   EXPECT_EQ(load_ply(write_file("blank_tail.ply", good + "\n  \n")).size(), 3u);
 }
@@ -908,7 +985,8 @@ TEST(PlyLoaderSharedScenes, EveryScenePlyLoadsWithItsCount) {
     LoadReport report;
     const auto start = std::chrono::steady_clock::now();
     const GaussianScene scene = load_ply(path, {}, &report);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     std::cout << "[ load     ] " << name << ": " << scene.size() << " Gaussians in " << ms << " ms\n";
     EXPECT_EQ(report.gaussians_in_file, expected_count);
     EXPECT_EQ(scene.size(), expected_count) << report.summary();

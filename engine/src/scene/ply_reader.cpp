@@ -18,6 +18,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <unordered_set>
 #include <vector>
 
 #include "tilesplat/scene.h"
@@ -40,18 +41,24 @@ enum class ScalarType : uint8_t { kInt8, kUint8, kInt16, kUint16, kInt32, kUint3
 size_t scalar_size(ScalarType type) {
   switch (type) {
     case ScalarType::kInt8:
-    case ScalarType::kUint8: return 1;
+    case ScalarType::kUint8:
+      return 1;
     case ScalarType::kInt16:
-    case ScalarType::kUint16: return 2;
+    case ScalarType::kUint16:
+      return 2;
     case ScalarType::kInt32:
     case ScalarType::kUint32:
-    case ScalarType::kFloat32: return 4;
-    case ScalarType::kFloat64: return 8;
+    case ScalarType::kFloat32:
+      return 4;
+    case ScalarType::kFloat64:
+      return 8;
   }
   return 0;
 }
 
-bool is_integer(ScalarType type) { return type != ScalarType::kFloat32 && type != ScalarType::kFloat64; }
+bool is_integer(ScalarType type) {
+  return type != ScalarType::kFloat32 && type != ScalarType::kFloat64;
+}
 
 std::optional<ScalarType> parse_scalar_type(std::string_view name) {
   struct Alias {
@@ -59,11 +66,11 @@ std::optional<ScalarType> parse_scalar_type(std::string_view name) {
     ScalarType type;
   };
   static constexpr Alias kAliases[] = {
-      {"char", ScalarType::kInt8},     {"int8", ScalarType::kInt8},       {"uchar", ScalarType::kUint8},
-      {"uint8", ScalarType::kUint8},   {"short", ScalarType::kInt16},     {"int16", ScalarType::kInt16},
-      {"ushort", ScalarType::kUint16}, {"uint16", ScalarType::kUint16},   {"int", ScalarType::kInt32},
-      {"int32", ScalarType::kInt32},   {"uint", ScalarType::kUint32},     {"uint32", ScalarType::kUint32},
-      {"float", ScalarType::kFloat32}, {"float32", ScalarType::kFloat32}, {"double", ScalarType::kFloat64},
+      {"char", ScalarType::kInt8},       {"int8", ScalarType::kInt8},       {"uchar", ScalarType::kUint8},
+      {"uint8", ScalarType::kUint8},     {"short", ScalarType::kInt16},     {"int16", ScalarType::kInt16},
+      {"ushort", ScalarType::kUint16},   {"uint16", ScalarType::kUint16},   {"int", ScalarType::kInt32},
+      {"int32", ScalarType::kInt32},     {"uint", ScalarType::kUint32},     {"uint32", ScalarType::kUint32},
+      {"float", ScalarType::kFloat32},   {"float32", ScalarType::kFloat32}, {"double", ScalarType::kFloat64},
       {"float64", ScalarType::kFloat64},
   };
   for (const Alias& alias : kAliases)
@@ -127,14 +134,22 @@ T load_scalar(const unsigned char* bytes) {
 template <bool kSwap>
 float load_as_float(const unsigned char* bytes, ScalarType type) {
   switch (type) {
-    case ScalarType::kInt8: return static_cast<float>(load_scalar<int8_t, kSwap>(bytes));
-    case ScalarType::kUint8: return static_cast<float>(load_scalar<uint8_t, kSwap>(bytes));
-    case ScalarType::kInt16: return static_cast<float>(load_scalar<int16_t, kSwap>(bytes));
-    case ScalarType::kUint16: return static_cast<float>(load_scalar<uint16_t, kSwap>(bytes));
-    case ScalarType::kInt32: return static_cast<float>(load_scalar<int32_t, kSwap>(bytes));
-    case ScalarType::kUint32: return static_cast<float>(load_scalar<uint32_t, kSwap>(bytes));
-    case ScalarType::kFloat32: return load_scalar<float, kSwap>(bytes);
-    case ScalarType::kFloat64: return to_float(load_scalar<double, kSwap>(bytes));
+    case ScalarType::kInt8:
+      return static_cast<float>(load_scalar<int8_t, kSwap>(bytes));
+    case ScalarType::kUint8:
+      return static_cast<float>(load_scalar<uint8_t, kSwap>(bytes));
+    case ScalarType::kInt16:
+      return static_cast<float>(load_scalar<int16_t, kSwap>(bytes));
+    case ScalarType::kUint16:
+      return static_cast<float>(load_scalar<uint16_t, kSwap>(bytes));
+    case ScalarType::kInt32:
+      return static_cast<float>(load_scalar<int32_t, kSwap>(bytes));
+    case ScalarType::kUint32:
+      return static_cast<float>(load_scalar<uint32_t, kSwap>(bytes));
+    case ScalarType::kFloat32:
+      return load_scalar<float, kSwap>(bytes);
+    case ScalarType::kFloat64:
+      return to_float(load_scalar<double, kSwap>(bytes));
   }
   return 0.0f;
 }
@@ -144,14 +159,27 @@ template <bool kSwap>
 std::optional<uint64_t> load_list_count(const unsigned char* bytes, ScalarType type) {
   int64_t value = 0;
   switch (type) {
-    case ScalarType::kInt8: value = load_scalar<int8_t, kSwap>(bytes); break;
-    case ScalarType::kUint8: value = load_scalar<uint8_t, kSwap>(bytes); break;
-    case ScalarType::kInt16: value = load_scalar<int16_t, kSwap>(bytes); break;
-    case ScalarType::kUint16: value = load_scalar<uint16_t, kSwap>(bytes); break;
-    case ScalarType::kInt32: value = load_scalar<int32_t, kSwap>(bytes); break;
-    case ScalarType::kUint32: value = load_scalar<uint32_t, kSwap>(bytes); break;
+    case ScalarType::kInt8:
+      value = load_scalar<int8_t, kSwap>(bytes);
+      break;
+    case ScalarType::kUint8:
+      value = load_scalar<uint8_t, kSwap>(bytes);
+      break;
+    case ScalarType::kInt16:
+      value = load_scalar<int16_t, kSwap>(bytes);
+      break;
+    case ScalarType::kUint16:
+      value = load_scalar<uint16_t, kSwap>(bytes);
+      break;
+    case ScalarType::kInt32:
+      value = load_scalar<int32_t, kSwap>(bytes);
+      break;
+    case ScalarType::kUint32:
+      value = load_scalar<uint32_t, kSwap>(bytes);
+      break;
     case ScalarType::kFloat32:
-    case ScalarType::kFloat64: return std::nullopt;  // rejected while parsing the header
+    case ScalarType::kFloat64:
+      return std::nullopt;  // rejected while parsing the header
   }
   if (value < 0) return std::nullopt;
   return static_cast<uint64_t>(value);
@@ -162,7 +190,9 @@ std::string describe_value(float value) {
   return value > 0 ? "inf" : "-inf";
 }
 
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+bool is_blank(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
 
 std::vector<std::string_view> split_tokens(std::string_view line) {
   std::vector<std::string_view> tokens;
@@ -214,7 +244,7 @@ class FileContents {
 #if TILESPLAT_PLY_HAS_MMAP
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) return std::string("cannot open: ") + std::strerror(errno);
-    struct stat info {};
+    struct stat info{};
     if (fstat(fd, &info) != 0) {
       const std::string error = std::string("cannot open: ") + std::strerror(errno);
       ::close(fd);
@@ -331,10 +361,12 @@ class PlyReader {
     bool have_format = false;
     bool ended = false;
     std::optional<size_t> vertex_index;
+    // A set, not a scan of the element's properties: a hostile header may have millions.
+    std::unordered_set<std::string> element_property_names;
     while (pos < size_) {
       const void* newline = std::memchr(bytes_ + pos, '\n', size_ - pos);
-      const size_t line_end = newline ? static_cast<size_t>(static_cast<const unsigned char*>(newline) - bytes_)
-                                      : size_;
+      const size_t line_end =
+          newline ? static_cast<size_t>(static_cast<const unsigned char*>(newline) - bytes_) : size_;
       std::string_view line = text(pos, line_end);
       if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       pos = newline ? line_end + 1 : size_;
@@ -374,8 +406,8 @@ class PlyReader {
         PlyElement element;
         element.name = std::string(tokens[1]);
         const std::string_view count_text = tokens[2];
-        const auto [end, error] = std::from_chars(count_text.data(), count_text.data() + count_text.size(),
-                                                  element.count);
+        const auto [end, error] =
+            std::from_chars(count_text.data(), count_text.data() + count_text.size(), element.count);
         if (error != std::errc() || end != count_text.data() + count_text.size())
           fail(where + "invalid count '" + std::string(count_text) + "' for element '" + element.name + "'");
         if (element.name == "vertex") {
@@ -383,6 +415,7 @@ class PlyReader {
           vertex_index = header_.elements.size();
         }
         header_.elements.push_back(std::move(element));
+        element_property_names.clear();
         continue;
       }
       if (keyword == "property") {
@@ -408,9 +441,8 @@ class PlyReader {
           property.type = *type;
           property.name = std::string(tokens[2]);
         }
-        for (const PlyProperty& existing : element.properties)
-          if (existing.name == property.name)
-            fail(where + "duplicated property '" + property.name + "' in element '" + element.name + "'");
+        if (!element_property_names.insert(property.name).second)
+          fail(where + "duplicated property '" + property.name + "' in element '" + element.name + "'");
         property.row_offset = element.fixed_row_size;
         if (property.is_list) {
           element.has_list = true;
@@ -453,8 +485,8 @@ class PlyReader {
       const std::string_view digits = std::string_view(name).substr(7);
       size_t index = 0;
       const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), index);
-      const bool canonical = !digits.empty() && error == std::errc() && end == digits.data() + digits.size() &&
-                             (digits.size() == 1 || digits[0] != '0');
+      const bool canonical = !digits.empty() && error == std::errc() &&
+                             end == digits.data() + digits.size() && (digits.size() == 1 || digits[0] != '0');
       if (!canonical) fail("property '" + name + "' is not a valid f_rest_<index> name");
       return {Target::kShRest, index};
     }
@@ -487,9 +519,9 @@ class PlyReader {
       targets_.push_back(target);
     }
 
-    static constexpr std::string_view kRequired[] = {"x",       "y",       "z",       "f_dc_0", "f_dc_1",
-                                                     "f_dc_2",  "opacity", "scale_0", "scale_1", "scale_2",
-                                                     "rot_0",   "rot_1",   "rot_2",   "rot_3"};
+    static constexpr std::string_view kRequired[] = {"x",      "y",       "z",       "f_dc_0",  "f_dc_1",
+                                                     "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
+                                                     "rot_0",  "rot_1",   "rot_2",   "rot_3"};
     for (std::string_view required : kRequired) {
       const bool found = std::any_of(element.properties.begin(), element.properties.end(),
                                      [&](const PlyProperty& p) { return p.name == required; });
@@ -498,12 +530,15 @@ class PlyReader {
         const bool packed = std::any_of(element.properties.begin(), element.properties.end(),
                                         [](const PlyProperty& p) { return p.name.starts_with("packed_"); });
         if (packed)
-          message += " (this looks like a compressed PLY with packed_* properties, which this reader does not decode)";
+          message +=
+              " (this looks like a compressed PLY with packed_* properties, which this reader does not "
+              "decode)";
         fail(message);
       }
     }
 
-    const size_t present_normals = static_cast<size_t>(normal_present[0]) + static_cast<size_t>(normal_present[1]) +
+    const size_t present_normals = static_cast<size_t>(normal_present[0]) +
+                                   static_cast<size_t>(normal_present[1]) +
                                    static_cast<size_t>(normal_present[2]);
     if (present_normals != 0 && present_normals != 3) {
       static constexpr std::string_view kNames[] = {"nx", "ny", "nz"};
@@ -518,18 +553,26 @@ class PlyReader {
     has_normals_ = present_normals == 3;
 
     switch (rest_count) {
-      case 0: sh_degree_ = 0; break;
-      case 9: sh_degree_ = 1; break;
-      case 24: sh_degree_ = 2; break;
-      case 45: sh_degree_ = 3; break;
+      case 0:
+        sh_degree_ = 0;
+        break;
+      case 9:
+        sh_degree_ = 1;
+        break;
+      case 24:
+        sh_degree_ = 2;
+        break;
+      case 45:
+        sh_degree_ = 3;
+        break;
       default:
         fail("unsupported number of f_rest properties (" + std::to_string(rest_count) +
              "); expected 0, 9, 24 or 45 for SH degree 0, 1, 2 or 3");
     }
     // Names are unique, so indices 0..count-1 are all present exactly when the largest is count-1.
     if (rest_count > 0 && max_rest_index != rest_count - 1)
-      fail("the " + std::to_string(rest_count) + " f_rest properties are not contiguous: found '" + max_rest_name +
-           "', expected f_rest_0..f_rest_" + std::to_string(rest_count - 1));
+      fail("the " + std::to_string(rest_count) + " f_rest properties are not contiguous: found '" +
+           max_rest_name + "', expected f_rest_0..f_rest_" + std::to_string(rest_count - 1));
   }
 
   void allocate(GaussianScene& scene, size_t count) const {
@@ -590,7 +633,8 @@ class PlyReader {
           column.first = scene.rotations.data() + target.component;
           column.stride = 4;
           break;
-        case Target::kIgnored: break;
+        case Target::kIgnored:
+          break;
       }
       columns.push_back(column);
     }
@@ -603,8 +647,8 @@ class PlyReader {
       const float value = column.first[kept * column.stride];
       if (std::isfinite(value)) continue;
       if (options_.strict)
-        fail("Gaussian " + std::to_string(gaussian_index) + " has a non-finite value in " + *column.name + " (" +
-             describe_value(value) + ") (strict mode)");
+        fail("Gaussian " + std::to_string(gaussian_index) + " has a non-finite value in " + *column.name +
+             " (" + describe_value(value) + ") (strict mode)");
       ++dropped_;
       for (DroppedProperty& entry : dropped_by_property_) {
         if (entry.property == *column.name) {
@@ -648,9 +692,10 @@ class PlyReader {
              std::to_string(element.fixed_row_size) + " bytes need more than the whole file (" +
              std::to_string(size_) + " bytes); the file is truncated or the count is wrong");
       if (needed > available)
-        fail("truncated binary data in element '" + element.name + "': expected " + std::to_string(element.count) +
-             " items (" + std::to_string(needed) + " bytes) but only " + std::to_string(available) +
-             " bytes remain; " + std::to_string(needed - available) + " bytes missing");
+        fail("truncated binary data in element '" + element.name + "': expected " +
+             std::to_string(element.count) + " items (" + std::to_string(needed) + " bytes) but only " +
+             std::to_string(available) + " bytes remain; " + std::to_string(needed - available) +
+             " bytes missing");
       return offset + static_cast<size_t>(needed);
     }
     // Every item takes at least one byte, so this loop is bounded by the file size.
@@ -658,8 +703,8 @@ class PlyReader {
       for (const PlyProperty& property : element.properties) {
         const auto truncated = [&] {
           fail("truncated binary data in element '" + element.name + "': the data ends in item " +
-               std::to_string(item) + " of " + std::to_string(element.count) + " (property '" + property.name +
-               "')");
+               std::to_string(item) + " of " + std::to_string(element.count) + " (property '" +
+               property.name + "')");
         };
         if (!property.is_list) {
           const size_t item_size = scalar_size(property.type);
@@ -672,11 +717,12 @@ class PlyReader {
         const std::optional<uint64_t> list_length =
             load_list_count<kSwap>(bytes_ + offset, property.list_count_type);
         if (!list_length)
-          fail("element '" + element.name + "' item " + std::to_string(item) + " has a negative list count in '" +
-               property.name + "'");
+          fail("element '" + element.name + "' item " + std::to_string(item) +
+               " has a negative list count in '" + property.name + "'");
         offset += count_size;
         uint64_t list_bytes = 0;
-        if (!checked_multiply(*list_length, scalar_size(property.type), &list_bytes) || list_bytes > size_ - offset)
+        if (!checked_multiply(*list_length, scalar_size(property.type), &list_bytes) ||
+            list_bytes > size_ - offset)
           truncated();
         offset += static_cast<size_t>(list_bytes);
       }
@@ -699,9 +745,10 @@ class PlyReader {
       const size_t available = size_ - offset;
       uint64_t needed = 0;
       if (!checked_multiply(element.count, row_size, &needed) || needed > size_)
-        fail("impossible vertex count " + std::to_string(element.count) + ": " + std::to_string(element.count) +
-             " vertices of " + std::to_string(row_size) + " bytes need more than the whole file (" +
-             std::to_string(size_) + " bytes); the file is truncated or the count is wrong");
+        fail("impossible vertex count " + std::to_string(element.count) + ": " +
+             std::to_string(element.count) + " vertices of " + std::to_string(row_size) +
+             " bytes need more than the whole file (" + std::to_string(size_) +
+             " bytes); the file is truncated or the count is wrong");
       if (needed > available)
         fail("truncated binary data: expected " + std::to_string(element.count) + " vertices (" +
              std::to_string(needed) + " bytes) but only " + std::to_string(available) + " bytes remain; " +
@@ -711,8 +758,9 @@ class PlyReader {
       offset += static_cast<size_t>(needed);
     }
     if (offset != size_)
-      fail(std::to_string(size_ - offset) +
-           " bytes of trailing data after the declared elements; the vertex count in the header may be wrong");
+      fail(
+          std::to_string(size_ - offset) +
+          " bytes of trailing data after the declared elements; the vertex count in the header may be wrong");
 
     const size_t count = static_cast<size_t>(vertex_element.count);
     if (count == 0) return;
@@ -732,7 +780,8 @@ class PlyReader {
 
   // kFloatOnly: every used property is a native-endian float32, so a value is one memcpy.
   template <bool kFloatOnly, bool kSwap>
-  size_t decode_rows(const unsigned char* rows, size_t row_size, size_t count, const std::vector<Column>& columns) {
+  size_t decode_rows(const unsigned char* rows, size_t row_size, size_t count,
+                     const std::vector<Column>& columns) {
     size_t kept = 0;
     for (size_t i = 0; i < count; ++i) {
       const unsigned char* row = rows + i * row_size;
@@ -856,7 +905,8 @@ class PlyReader {
                           std::vector<double>& values) const {
     const PlyElement& element = vertex();
     const size_t expected = element.properties.size();
-    const std::string where = "line " + std::to_string(line_number) + " (vertex " + std::to_string(vertex_index) + "): ";
+    const std::string where =
+        "line " + std::to_string(line_number) + " (vertex " + std::to_string(vertex_index) + "): ";
     size_t pos = 0;
     for (size_t p = 0; p < expected; ++p) {
       while (pos < line.size() && is_blank(line[pos])) ++pos;
@@ -871,9 +921,11 @@ class PlyReader {
       double value = 0;
       const auto [parsed_end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
       if (error == std::errc::result_out_of_range)
-        fail(where + "value '" + std::string(token) + "' of " + element.properties[p].name + " is out of range");
+        fail(where + "value '" + std::string(token) + "' of " + element.properties[p].name +
+             " is out of range");
       if (error != std::errc() || parsed_end != digits.data() + digits.size())
-        fail(where + "'" + std::string(token) + "' is not a number (property " + element.properties[p].name + ")");
+        fail(where + "'" + std::string(token) + "' is not a number (property " + element.properties[p].name +
+             ")");
       values[p] = value;
       pos = end;
     }

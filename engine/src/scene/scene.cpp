@@ -1,11 +1,11 @@
 // Scene-level entry points: format dispatch, load reports and robust scene bounds.
+#include "tilesplat/scene.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <string>
 #include <vector>
-
-#include "tilesplat/scene.h"
 
 namespace tilesplat {
 namespace {
@@ -22,7 +22,8 @@ double median(std::vector<double> values) {
   std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle), values.end());
   const double upper = values[middle];
   if (values.size() % 2 == 1) return upper;
-  const double lower = *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle));
+  const double lower =
+      *std::max_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle));
   return 0.5 * (lower + upper);
 }
 
@@ -53,7 +54,8 @@ std::string LoadReport::summary() const {
     for (size_t i = 0; i < dropped_by_property.size(); ++i) {
       const DroppedProperty& entry = dropped_by_property[i];
       if (i > 0) line += "; ";
-      line += entry.property + ": " + std::to_string(entry.count) + ", first at " + std::to_string(entry.first_index);
+      line += entry.property + ": " + std::to_string(entry.count) + ", first at " +
+              std::to_string(entry.first_index);
     }
     line += ")";
   }
@@ -91,7 +93,8 @@ Bounds compute_bounds(const GaussianScene& scene) {
   // Nearest-rank 95th percentile: covers most Gaussians while ignoring the outlying 5%.
   const size_t rank = static_cast<size_t>(std::ceil(0.95 * static_cast<double>(count)));
   const size_t index = std::min(count - 1, rank > 0 ? rank - 1 : 0);
-  std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(index), distances.end());
+  std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(index),
+                   distances.end());
   bounds.radius = distances[index];
   return bounds;
 }
