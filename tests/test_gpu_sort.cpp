@@ -125,7 +125,7 @@ TEST(PrefixSum, MatchesExclusiveScanAtBlockBoundaries) {
   for (uint32_t n : {1u, 2u, 1023u, 1024u, 1025u, 4096u, 1048576u + 3u, 3000000u}) {
     std::mt19937 rng(n);
     std::vector<uint32_t> values(n);
-    for (auto& v : values) v = rng() % 300;
+    for (auto& v : values) v = uint32_t(rng() % 300);
     vk::Buffer src(ctx, n * 4ull, vk::MemoryUse::Device, "scan src");
     vk::Buffer dst(ctx, n * 4ull, vk::MemoryUse::Device, "scan dst");
     vk::Buffer total(ctx, 16, vk::MemoryUse::Readback, "scan total");
