@@ -12,7 +12,11 @@ struct CompositePush {
 };
 }  // namespace
 
-CompositePass::CompositePass(vk::Context& ctx) : ctx_(ctx) {}
+// On CPU drivers every shared-memory read is a scalar load per SIMD lane: there one invocation
+// blends a 16-pixel column so that each staged splat is read once per 16 pixels. GPUs want one
+// invocation per pixel.
+CompositePass::CompositePass(vk::Context& ctx)
+    : ctx_(ctx), pixels_per_invocation_(ctx.is_cpu_device() ? kTileSize : 1) {}
 
 void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
                            const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
@@ -22,7 +26,10 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
   if (it == pipelines_.end())
     it = pipelines_
              .emplace(key, vk::ComputePipeline(ctx_, "composite", sizeof(CompositePush),
-                                               {{0, write_depth ? 1u : 0u}, {1, write_count ? 1u : 0u}}))
+                                               {{0, write_depth ? 1u : 0u},
+                                                {1, write_count ? 1u : 0u},
+                                                {2, pixels_per_invocation_},
+                                                {3, kTileSize / pixels_per_invocation_}}))
              .first;
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);

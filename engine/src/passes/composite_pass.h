@@ -25,6 +25,7 @@ class CompositePass {
 
  private:
   vk::Context& ctx_;
+  uint32_t pixels_per_invocation_;
   std::map<std::pair<bool, bool>, vk::ComputePipeline> pipelines_;  // by (depth, count) outputs
 };
 

@@ -204,6 +204,7 @@ void Context::create_device() {
   vkGetPhysicalDeviceProperties2(physical_device_, &props2);
   const VkPhysicalDeviceProperties& props = props2.properties;
   device_name_ = props.deviceName;
+  is_cpu_ = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
   driver_name_ = std::string(driver.driverName) + " " + driver.driverInfo;
   if (props.apiVersion < VK_API_VERSION_1_2)
     throw std::runtime_error(device_name_ + ": Vulkan 1.2 is required");

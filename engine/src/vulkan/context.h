@@ -51,6 +51,8 @@ class Context {
   const DeviceFeatures& features() const { return features_; }
   const std::string& device_name() const { return device_name_; }
   const std::string& driver_name() const { return driver_name_; }
+  // A CPU implementation (lavapipe, SwiftShader): passes pick CPU-friendly layouts.
+  bool is_cpu_device() const { return is_cpu_; }
 
   // Index of a memory type with all `required` flags (and `preferred` ones when possible).
   uint32_t find_memory_type(uint32_t type_bits, VkMemoryPropertyFlags required,
@@ -94,6 +96,7 @@ class Context {
   DeviceFeatures features_;
   std::string device_name_;
   std::string driver_name_;
+  bool is_cpu_ = false;
   std::atomic<uint64_t> validation_messages_{0};
 };
 
