@@ -174,3 +174,32 @@ TEST(GpuRenderer, RejectsImpossibleImageSizes) {
 
 }  // namespace
 }  // namespace tilesplat
+
+namespace tilesplat {
+namespace {
+
+// The composite picks a 16-pixel column per invocation on CPU drivers and one pixel per invocation
+// on GPUs. Both layouts must give bit-identical images; this runs the GPU layout on lavapipe.
+TEST(GpuRenderer, CompositeLayoutsGiveIdenticalImages) {
+  GaussianScene scene = load_scene(testing::bundled_playbot());
+  Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(2).camera, 333, 187);
+  std::vector<RenderImage> images;
+  for (const char* pixels : {"1", "4", "16"}) {
+    ::setenv("TILESPLAT_COMPOSITE_PIXELS", pixels, 1);
+    RendererOptions options;
+    options.validation = true;
+    auto renderer = Renderer::create(options);
+    ::unsetenv("TILESPLAT_COMPOSITE_PIXELS");
+    renderer->set_scene(scene);
+    images.push_back(renderer->render(camera));
+    EXPECT_EQ(renderer->validation_messages(), 0u);
+  }
+  for (size_t k = 1; k < images.size(); ++k) {
+    EXPECT_EQ(images[k].rgba, images[0].rgba) << "layout " << k;
+    EXPECT_EQ(images[k].depth, images[0].depth) << "layout " << k;
+    EXPECT_EQ(images[k].splat_count, images[0].splat_count) << "layout " << k;
+  }
+}
+
+}  // namespace
+}  // namespace tilesplat

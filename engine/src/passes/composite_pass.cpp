@@ -1,5 +1,9 @@
 #include "passes/composite_pass.h"
 
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
@@ -15,8 +19,17 @@ struct CompositePush {
 // On CPU drivers every shared-memory read is a scalar load per SIMD lane: there one invocation
 // blends a 16-pixel column so that each staged splat is read once per 16 pixels. GPUs want one
 // invocation per pixel.
+// TILESPLAT_COMPOSITE_PIXELS (1, 2, 4, 8 or 16) overrides the choice, so that the tests run the
+// GPU layout on lavapipe too.
 CompositePass::CompositePass(vk::Context& ctx)
-    : ctx_(ctx), pixels_per_invocation_(ctx.is_cpu_device() ? kTileSize : 1) {}
+    : ctx_(ctx), pixels_per_invocation_(ctx.is_cpu_device() ? kTileSize : 1) {
+  if (const char* env = std::getenv("TILESPLAT_COMPOSITE_PIXELS"); env && *env) {
+    const std::string value = env;
+    if (value != "1" && value != "2" && value != "4" && value != "8" && value != "16")
+      throw std::invalid_argument("TILESPLAT_COMPOSITE_PIXELS must be 1, 2, 4, 8 or 16, got '" + value + "'");
+    pixels_per_invocation_ = uint32_t(std::stoul(value));
+  }
+}
 
 void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
                            const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
