@@ -21,11 +21,12 @@ const uint COUNTER_RANGES_ARGS = 4;    // 3 uints: indirect dispatch of the tile
 const uint COUNTER_SORT_ARGS = 8;      // 3 uints: indirect dispatch of the sort's per-block passes
 const uint COUNTER_SORT_BLOCKS = 11;   // blocks the sort splits its keys into
 
-// Projected splat record: three vec4 per Gaussian.
+// Projected splat record: four vec4 per Gaussian. The composite reads [0..2], the key emission [0], [3].
 //   [0] mean.x, mean.y (float hi parts), view depth, opacity
 //   [1] conic A, B, C, mean.x lo part
 //   [2] colour r, g, b, mean.y lo part
-const uint SPLAT_VEC4S = 3;
+//   [3] dilated 2D covariance a, b, c and its determinant (for the exact tile coverage)
+const uint SPLAT_VEC4S = 4;
 
 // Popcount of a subgroup ballot, valid for any subgroup size up to 128.
 uint ballot_count(uvec4 b) { return bitCount(b.x) + bitCount(b.y) + bitCount(b.z) + bitCount(b.w); }

@@ -4,6 +4,7 @@
 // index order, so a stable sort leaves equal keys ordered by index: every strategy agrees.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "tile_coverage.glsl"
 
 layout(local_size_x = 256) in;
 
@@ -17,6 +18,8 @@ layout(push_constant) uniform Push {
   uint count;
   uint tiles_x;
   uint capacity;
+  uint tiles;
+  uint pad;
 } pc;
 
 void main() {
@@ -31,12 +34,24 @@ void main() {
   uvec2 rect = pc.rects.v[i];
   uvec2 lo = uvec2(rect.x & 0xffffu, rect.x >> 16);
   uvec2 hi = uvec2(rect.y & 0xffffu, rect.y >> 16);
-  for (uint y = lo.y; y < hi.y; ++y) {
-    for (uint x = lo.x; x < hi.x; ++x) {
-      uint64_t tile = uint64_t(y * pc.tiles_x + x);
+  vec4 mdo = pc.splats.v[SPLAT_VEC4S * i];
+  vec4 cov_det = pc.splats.v[SPLAT_VEC4S * i + 3];
+  float tau = coverage_tau(mdo.w);
+  uint end = offset + n;
+  for (uint ty = lo.y; ty < hi.y; ++ty) {
+    uvec2 span = row_span(mdo.xy, cov_det, tau, ty, lo, hi);
+    for (uint tx = span.x; tx < span.y && offset < end; ++tx) {
+      uint64_t tile = uint64_t(ty * pc.tiles_x + tx);
       pc.keys.v[offset] = (tile << 32) | depth_bits;
       pc.values.v[offset] = i;
       ++offset;
     }
+  }
+  // The projection counted with the same function and inputs, so this never runs; it keeps every
+  // slot defined even if a driver's arithmetic differed: a tile id past the grid sorts last and is
+  // ignored by the tile-range pass.
+  for (; offset < end; ++offset) {
+    pc.keys.v[offset] = uint64_t(pc.tiles) << 32;
+    pc.values.v[offset] = i;
   }
 }

@@ -12,6 +12,7 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #include "common.glsl"
 #include "sh.glsl"
+#include "tile_coverage.glsl"
 
 #ifdef TS_FP32_PROJECTION
 #define real float
@@ -117,20 +118,30 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   real2 rect_max = clamp(floor((mean + radius + real(TILE_SIZE - 1)) / real(TILE_SIZE)), real2(0.0), grid);
   uvec2 lo = uvec2(rect_min);
   uvec2 hi = uvec2(rect_max);
-  uint area = (hi.x - lo.x) * (hi.y - lo.y);
-  if (area == 0) return 0;
+  if ((hi.x - lo.x) * (hi.y - lo.y) == 0) return 0;
 
+  // Of the reference rect, only the tiles the alpha >= 1/255 ellipse reaches (tile_coverage.glsl).
   float opacity = 1.0 / (1.0 + exp(-pc.opacity_logits.v[i]));
+  vec2 mean_hi = vec2(mean);
+  vec4 cov_det = vec4(a, b, c, det);
+  float tau = coverage_tau(opacity);
+  uint touched = 0;
+  for (uint ty = lo.y; ty < hi.y; ++ty) {
+    uvec2 span = row_span(mean_hi, cov_det, tau, ty, lo, hi);
+    touched += span.y - span.x;
+  }
+  if (touched == 0) return 0;
+
   vec3 dir = vec3(normalize(rel));
   vec3 colour = max(eval_sh(SH_DEGREE, pc.sh, i, dir) + 0.5, vec3(0.0));
   // The mean is stored as float hi + lo so that (pixel - mean) in the composite stays accurate.
-  vec2 mean_hi = vec2(mean);
   vec2 mean_lo = vec2(mean - real2(mean_hi));
   record[0] = vec4(mean_hi, float(t.z), opacity);
   record[1] = vec4(vec3(c / det, -b / det, a / det), mean_lo.x);
   record[2] = vec4(colour, mean_lo.y);
+  record[3] = cov_det;
   rect = uvec2(lo.x | (lo.y << 16), hi.x | (hi.y << 16));
-  return area;
+  return touched;
 }
 
 void main() {

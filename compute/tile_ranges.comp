@@ -10,6 +10,7 @@ layout(push_constant) uniform Push {
   Uint64Array keys;
   Uvec2Array ranges;  // zero-filled before this pass
   UintArray counters;
+  uint tiles;  // keys with a tile id >= tiles are padding (see key_emission.comp)
 } pc;
 
 void main() {
@@ -17,14 +18,10 @@ void main() {
   uint n = pc.counters.v[COUNTER_SORT_COUNT];
   if (i >= n) return;
   uint tile = uint(pc.keys.v[i] >> 32);
-  if (i == 0) {
-    pc.ranges.v[tile].x = 0;
-  } else {
-    uint prev = uint(pc.keys.v[i - 1] >> 32);
-    if (prev != tile) {
-      pc.ranges.v[prev].y = i;
-      pc.ranges.v[tile].x = i;
-    }
+  uint prev = i == 0 ? 0xffffffffu : uint(pc.keys.v[i - 1] >> 32);
+  if (prev != tile) {
+    if (i > 0 && prev < pc.tiles) pc.ranges.v[prev].y = i;
+    if (tile < pc.tiles) pc.ranges.v[tile].x = i;
   }
-  if (i == n - 1) pc.ranges.v[tile].y = n;
+  if (i == n - 1 && tile < pc.tiles) pc.ranges.v[tile].y = n;
 }

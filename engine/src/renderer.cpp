@@ -122,7 +122,8 @@ struct Renderer::Impl {
     const uint32_t tiles_x = vk::div_ceil(uint32_t(camera.width), kTileSize);
     const uint32_t tiles_y = vk::div_ceil(uint32_t(camera.height), kTileSize);
     const uint32_t tiles = tiles_x * tiles_y;
-    const uint32_t key_bits = 32 + uint32_t(std::bit_width(tiles - 1));
+    // Tile ids run to `tiles` inclusive: the key emission's padding uses that id (never in practice).
+    const uint32_t key_bits = 32 + uint32_t(std::bit_width(tiles));
     const uint32_t n = scene.count;
 
     VkCommandBuffer cmd = ctx.begin_one_time();
@@ -138,7 +139,7 @@ struct Renderer::Impl {
     prefix_sum.record(cmd, projected.tile_counts.address(), projected.offsets.address(), n, counters.address());
     timer.mark(cmd, "prefix_sum");
 
-    key_emission.record(cmd, projected, keys, n, tiles_x, counters.address());
+    key_emission.record(cmd, projected, keys, n, tiles_x, tiles, counters.address());
     vk::barrier(cmd);
     timer.mark(cmd, "key_emission");
 
@@ -148,7 +149,7 @@ struct Renderer::Impl {
 
     const vk::Buffer& sorted_keys = *sorted_in_alt ? keys.keys_alt : keys.keys;
     const vk::Buffer& sorted_values = *sorted_in_alt ? keys.values_alt : keys.values;
-    tile_ranges.record(cmd, sorted_keys, ranges, counters, kRangesArgsOffset);
+    tile_ranges.record(cmd, sorted_keys, ranges, counters, kRangesArgsOffset, tiles);
     vk::barrier(cmd);
     timer.mark(cmd, "tile_ranges");
 
@@ -235,7 +236,7 @@ void Renderer::set_scene(const GaussianScene& scene) {
   s.sh_degree = scene.sh_degree;
 
   ProjectedBuffers& p = r.projected;
-  p.splats = vk::Buffer(r.ctx, n * 48, vk::MemoryUse::Device, "projected splats");
+  p.splats = vk::Buffer(r.ctx, n * kSplatRecordBytes, vk::MemoryUse::Device, "projected splats");
   p.rects = make_buffer<uint64_t>(r.ctx, n, "tile rects");
   p.tile_counts = make_buffer<uint32_t>(r.ctx, n, "tile counts");
   p.offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets");

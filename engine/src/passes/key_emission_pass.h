@@ -18,7 +18,7 @@ class KeyEmissionPass {
  public:
   explicit KeyEmissionPass(vk::Context& ctx);
   void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, KeyBuffers& keys, uint32_t gaussians,
-              uint32_t tiles_x, VkDeviceAddress counters);
+              uint32_t tiles_x, uint32_t tiles, VkDeviceAddress counters);
 
  private:
   vk::ComputePipeline frame_setup_;

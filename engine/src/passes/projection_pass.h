@@ -17,9 +17,12 @@ struct SceneBuffers {
   int sh_degree = 0;
 };
 
+// Bytes of one projected splat record (SPLAT_VEC4S vec4 in compute/common.glsl).
+constexpr uint32_t kSplatRecordBytes = 4 * 16;
+
 // Per-Gaussian outputs of the projection, inputs of the later passes.
 struct ProjectedBuffers {
-  vk::Buffer splats;       // 3 vec4 per Gaussian (see compute/common.glsl)
+  vk::Buffer splats;       // kSplatRecordBytes per Gaussian
   vk::Buffer rects;        // uvec2 per Gaussian: packed tile rect
   vk::Buffer tile_counts;  // uint per Gaussian: tiles touched, 0 = culled
   vk::Buffer offsets;      // uint per Gaussian: exclusive prefix sum of tile_counts

@@ -11,7 +11,7 @@ class TileRangesPass {
   explicit TileRangesPass(vk::Context& ctx);
   // ranges must hold one uvec2 per tile; it is zero-filled here first.
   void record(VkCommandBuffer cmd, const vk::Buffer& sorted_keys, vk::Buffer& ranges, const vk::Buffer& counters,
-              VkDeviceSize ranges_args_offset);
+              VkDeviceSize ranges_args_offset, uint32_t tiles);
 
  private:
   vk::ComputePipeline pipeline_;
