@@ -344,14 +344,7 @@ int run(int argc, char** argv) {
                         "of every pass (median, min, max over the measured frames) for each sort strategy, "
                         "with the frame's visible Gaussians, intersections and device memory.");
   add_bench_options(parser, options);
-  if (parser.parse(argc, argv) == cli::ArgParser::Outcome::kHelp) {
-    std::fputs(parser.help_text().c_str(), stdout);
-    return cli::kExitOk;
-  }
-  if (options.common.list_devices) {
-    cli::print_devices();
-    return cli::kExitOk;
-  }
+  if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
   cli::check_common_options(parser, options.common);
   cli::check_distinct_paths({{"SCENE", options.common.scene},
                              {"--cameras", options.common.cameras},

@@ -700,4 +700,17 @@ std::string format_fixed(double value, int decimals) {
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) != 0; }
 
+bool parse_and_handle_info_flags(ArgParser& parser, int argc, const char* const* argv,
+                                 const CommonOptions& common) {
+  if (parser.parse(argc, argv) == ArgParser::Outcome::kHelp) {
+    std::fputs(parser.help_text().c_str(), stdout);
+    return true;
+  }
+  if (common.list_devices) {
+    print_devices();
+    return true;
+  }
+  return false;
+}
+
 }  // namespace tilesplat::cli

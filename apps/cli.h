@@ -133,6 +133,11 @@ void check_common_options(const ArgParser& parser, const CommonOptions& options)
 // Prints list_devices() with the indices --device accepts.
 void print_devices();
 
+// Parses the command line and handles the flags that end the program before it does any work
+// (--help, --list-devices). Returns true when the program should exit with kExitOk.
+bool parse_and_handle_info_flags(ArgParser& parser, int argc, const char* const* argv,
+                                 const CommonOptions& common);
+
 struct LoadedScene {
   std::filesystem::path path;
   GaussianScene scene;

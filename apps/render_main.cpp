@@ -104,14 +104,7 @@ int run(int argc, char** argv) {
                         "and writes it as an EXR. The camera comes from the trainer's cameras.json "
                         "(--cameras, --view) or orbits the scene (--azimuth, --elevation, --fov).");
   add_render_options(parser, options);
-  if (parser.parse(argc, argv) == cli::ArgParser::Outcome::kHelp) {
-    std::fputs(parser.help_text().c_str(), stdout);
-    return cli::kExitOk;
-  }
-  if (options.common.list_devices) {
-    cli::print_devices();
-    return cli::kExitOk;
-  }
+  if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
   cli::check_common_options(parser, options.common);
   if (options.output.empty()) throw cli::UsageError("missing -o OUT.exr: where to write the image (see --help)");
   if (!cli::has_extension(options.output, ".exr"))
