@@ -156,7 +156,6 @@ struct Renderer::Impl {
     composite.record(cmd, projected.splats, sorted_values, ranges, outputs, settings.background, settings.depth,
                      settings.splat_count);
     timer.mark(cmd, "composite");
-    (void)tiles_y;
 
     // Host reads of mapped memory need the GPU writes made available to the host.
     VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
@@ -168,7 +167,6 @@ struct Renderer::Impl {
 
     FrameCounters result;
     std::memcpy(&result, counters.mapped(), sizeof(result));
-    (void)key_bits;
     stats.sort_bits = key_bits;
     return result;
   }

@@ -87,13 +87,11 @@ class Renderer {
   // Validation-layer messages seen so far (0 unless validation is on).
   uint64_t validation_messages() const;
 
-  struct Impl;
-  Impl& impl() { return *impl_; }
+  struct Impl;  // the Vulkan context, buffers and passes (engine/src/renderer.cpp)
 
  private:
   explicit Renderer(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
-  friend struct RendererFactory;
 };
 
 }  // namespace tilesplat
