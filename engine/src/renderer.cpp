@@ -2,6 +2,7 @@
 //   projection -> prefix sum -> key emission -> sort -> tile ranges -> composite
 // Data flows one way; the only host read-back is the counters (and the image) after the fence.
 #include "tilesplat/renderer.h"
+#include "tilesplat/vulkan_interop.h"
 
 #include <algorithm>
 #include <bit>
@@ -66,9 +67,14 @@ vk::Buffer make_buffer(vk::Context& ctx, size_t count, const char* name) {
 }  // namespace
 
 struct Renderer::Impl {
-  explicit Impl(const RendererOptions& opts)
+  explicit Impl(const RendererOptions& opts) : Impl(opts, vk::ContextOptions{opts.device, opts.validation}) {}
+  Impl(const RendererOptions& opts, const ExternalVulkanDevice& ext)
+      : Impl(opts, vk::BorrowedDevice{ext.instance, ext.physical_device, ext.device, ext.queue, ext.queue_family,
+                                      ext.shader_float64_enabled}) {}
+  template <typename ContextSource>
+  Impl(const RendererOptions& opts, const ContextSource& source)
       : options(opts),
-        ctx({opts.device, opts.validation}),
+        ctx(source),
         timer(ctx),
         projection(ctx),
         prefix_sum(ctx),
@@ -171,6 +177,33 @@ struct Renderer::Impl {
     return result;
   }
 
+  // Renders into the output buffers, growing the key buffers and re-rendering on overflow, and
+  // fills the frame statistics (all but cpu_ms).
+  void render_frame(const Camera& camera, const RenderSettings& settings) {
+    check_camera(camera, ctx.limits());
+    SortStrategy& sorter = sort(settings.sort);
+    ensure_outputs(uint32_t(camera.width), uint32_t(camera.height));
+    projection.set_camera(camera);
+
+    stats = {};
+    FrameCounters frame{};
+    bool sorted_in_alt = false;
+    for (int attempt = 0;; ++attempt) {
+      frame = run_frame(camera, settings, sorter, &sorted_in_alt);
+      if (!frame.overflow) break;
+      if (attempt == kMaxRetries || keys.capacity >= (1u << 31))
+        throw std::runtime_error("frame needs " + std::to_string(frame.intersections) +
+                                 " tile intersections, more than the key buffers can hold");
+      ensure_key_capacity(grow_capacity(frame.intersections));
+      stats.retries = attempt + 1;
+    }
+    for (const auto& section : timer.read(&stats.gpu_ms)) stats.passes.push_back({section.name, section.ms});
+    stats.gaussians = scene.count;
+    stats.visible = frame.visible;
+    stats.intersections = frame.sort_count;
+    stats.device_bytes = device_bytes();
+  }
+
   template <typename T>
   void read_output(const vk::Buffer& buffer, std::vector<T>& out, size_t count) {
     out.resize(count);
@@ -244,24 +277,7 @@ void Renderer::set_scene(const GaussianScene& scene) {
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
   Impl& r = *impl_;
   const auto start = std::chrono::steady_clock::now();
-  check_camera(camera, r.ctx.limits());
-  SortStrategy& sorter = r.sort(settings.sort);
-  r.ensure_outputs(uint32_t(camera.width), uint32_t(camera.height));
-  r.projection.set_camera(camera);
-
-  r.stats = {};
-  FrameCounters counters{};
-  bool sorted_in_alt = false;
-  for (int attempt = 0;; ++attempt) {
-    counters = r.run_frame(camera, settings, sorter, &sorted_in_alt);
-    if (!counters.overflow) break;
-    if (attempt == kMaxRetries || r.keys.capacity >= (1u << 31))
-      throw std::runtime_error("frame needs " + std::to_string(counters.intersections) +
-                               " tile intersections, more than the key buffers can hold");
-    r.ensure_key_capacity(grow_capacity(counters.intersections));
-    r.stats.retries = attempt + 1;
-  }
-
+  r.render_frame(camera, settings);
   RenderImage image;
   image.width = camera.width;
   image.height = camera.height;
@@ -269,15 +285,54 @@ RenderImage Renderer::render(const Camera& camera, const RenderSettings& setting
   r.read_output(r.outputs.rgba, image.rgba, pixels * 4);
   if (settings.depth) r.read_output(r.outputs.depth, image.depth, pixels);
   if (settings.splat_count) r.read_output(r.outputs.count, image.splat_count, pixels);
-
-  FrameStats& st = r.stats;
-  for (const auto& section : r.timer.read(&st.gpu_ms)) st.passes.push_back({section.name, section.ms});
-  st.gaussians = r.scene.count;
-  st.visible = counters.visible;
-  st.intersections = counters.sort_count;
-  st.device_bytes = r.device_bytes();
-  st.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  r.stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return image;
+}
+
+std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device, const RendererOptions& options) {
+  return std::unique_ptr<Renderer>(new Renderer(std::make_unique<Renderer::Impl>(options, device)));
+}
+
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                     const ExternalImage& target) {
+  Renderer::Impl& r = *renderer.impl_;
+  if (target.image == VK_NULL_HANDLE) throw std::invalid_argument("render_to_image: no image");
+  if (target.width != uint32_t(camera.width) || target.height != uint32_t(camera.height))
+    throw std::invalid_argument("render_to_image: image is " + std::to_string(target.width) + "x" +
+                                std::to_string(target.height) + " but the camera renders " +
+                                std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  if (target.format != VK_FORMAT_R32G32B32A32_SFLOAT)
+    throw std::invalid_argument("render_to_image: only VK_FORMAT_R32G32B32A32_SFLOAT images are supported");
+  const auto start = std::chrono::steady_clock::now();
+  r.render_frame(camera, settings);
+  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    auto transition = [&](VkImageLayout from, VkImageLayout to, VkAccessFlags src_access, VkAccessFlags dst_access) {
+      VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+      b.oldLayout = from;
+      b.newLayout = to;
+      b.srcAccessMask = src_access;
+      b.dstAccessMask = dst_access;
+      b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      b.image = target.image;
+      b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
+                           nullptr, 0, nullptr, 1, &b);
+    };
+    transition(target.layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_MEMORY_WRITE_BIT,
+               VK_ACCESS_TRANSFER_WRITE_BIT);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {target.width, target.height, 1};
+    vkCmdCopyBufferToImage(cmd, r.outputs.rgba.handle(), target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                           &region);
+    // UNDEFINED cannot be a destination layout: an image handed over undefined is left GENERAL.
+    const VkImageLayout final_layout =
+        target.layout == VK_IMAGE_LAYOUT_UNDEFINED ? VK_IMAGE_LAYOUT_GENERAL : target.layout;
+    transition(VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout, VK_ACCESS_TRANSFER_WRITE_BIT,
+               VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
+  });
+  r.stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 const FrameStats& Renderer::last_frame_stats() const { return impl_->stats; }

@@ -60,6 +60,9 @@ struct DeviceInfo {
   uint32_t max_image_dimension = 0;
 };
 
+struct ExternalVulkanDevice;  // tilesplat/vulkan_interop.h
+struct ExternalImage;
+
 // Names of the available sort strategies, default first.
 std::vector<std::string> sort_strategies();
 
@@ -92,6 +95,8 @@ class Renderer {
  private:
   explicit Renderer(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
+  friend std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice&, const RendererOptions&);
+  friend void render_to_image(Renderer&, const Camera&, const RenderSettings&, const ExternalImage&);
 };
 
 }  // namespace tilesplat

@@ -106,9 +106,40 @@ Context::Context(const ContextOptions& options) {
     if (selector.empty())
       if (const char* env = std::getenv("TILESPLAT_DEVICE")) selector = env;
     pick_physical_device(selector);
+    read_device_properties();
+    queue_family_ = pick_queue_family();
     create_device();
+    create_command_objects();
   } catch (...) {
     destroy();  // the destructor does not run for a constructor that throws
+    throw;
+  }
+}
+
+Context::Context(const BorrowedDevice& borrowed) : owns_handles_(false) {
+  if (!borrowed.instance || !borrowed.physical_device || !borrowed.device || !borrowed.queue)
+    throw std::invalid_argument("borrowed Vulkan device: instance, physical device, device and queue are required");
+  instance_ = borrowed.instance;
+  physical_device_ = borrowed.physical_device;
+  device_ = borrowed.device;
+  queue_ = borrowed.queue;
+  queue_family_ = borrowed.queue_family;
+  try {
+    read_device_properties();
+    uint32_t family_count = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &family_count, nullptr);
+    std::vector<VkQueueFamilyProperties> families(family_count);
+    vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &family_count, families.data());
+    if (queue_family_ >= family_count || !(families[queue_family_].queueFlags & VK_QUEUE_COMPUTE_BIT) ||
+        families[queue_family_].timestampValidBits == 0)
+      throw std::invalid_argument(device_name_ + ": borrowed queue family " + std::to_string(queue_family_) +
+                                  " has no compute support with timestamps");
+    limits_.timestamp_valid_bits = families[queue_family_].timestampValidBits;
+    // The host enabled the device's features; shaderFloat64 only counts if it says so.
+    features_.shader_float64 = features_.shader_float64 && borrowed.shader_float64_enabled;
+    create_command_objects();
+  } catch (...) {
+    destroy();
     throw;
   }
 }
@@ -117,11 +148,19 @@ Context::~Context() { destroy(); }
 
 void Context::destroy() {
   if (device_) {
-    vkDeviceWaitIdle(device_);
+    // A borrowed device may be busy with the host's own work: wait only for our submissions.
+    if (owns_handles_) vkDeviceWaitIdle(device_);
+    else if (fence_) vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX);
     if (fence_) vkDestroyFence(device_, fence_, nullptr);
     if (command_pool_) vkDestroyCommandPool(device_, command_pool_, nullptr);
-    vkDestroyDevice(device_, nullptr);
+    fence_ = VK_NULL_HANDLE;
+    command_pool_ = VK_NULL_HANDLE;
+    if (owns_handles_) vkDestroyDevice(device_, nullptr);
     device_ = VK_NULL_HANDLE;
+  }
+  if (!owns_handles_) {
+    instance_ = VK_NULL_HANDLE;
+    return;
   }
   if (messenger_) {
     auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
@@ -195,7 +234,7 @@ void Context::pick_physical_device(const std::string& selector) {
   }
 }
 
-void Context::create_device() {
+void Context::read_device_properties() {
   VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
   VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
   subgroup.pNext = &driver;
@@ -231,6 +270,17 @@ void Context::create_device() {
   vkGetPhysicalDeviceProperties2(physical_device_, &p2);
   limits_.max_allocation_size = maint3.maxMemoryAllocationSize;
 
+  VkPhysicalDeviceVulkan12Features has12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  has.pNext = &has12;
+  vkGetPhysicalDeviceFeatures2(physical_device_, &has);
+  if (!has12.bufferDeviceAddress) throw std::runtime_error(device_name_ + ": bufferDeviceAddress is required");
+  if (!has.features.shaderInt64) throw std::runtime_error(device_name_ + ": shaderInt64 is required");
+  features_.shader_float64 = has.features.shaderFloat64 == VK_TRUE;
+  vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
+}
+
+uint32_t Context::pick_queue_family() {
   uint32_t family_count = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &family_count, nullptr);
   std::vector<VkQueueFamilyProperties> families(family_count);
@@ -251,22 +301,16 @@ void Context::create_device() {
     }
   }
   if (!found) throw std::runtime_error(device_name_ + ": no compute queue with timestamp support");
+  return queue_family_;
+}
 
-  VkPhysicalDeviceVulkan12Features has12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-  VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-  has.pNext = &has12;
-  vkGetPhysicalDeviceFeatures2(physical_device_, &has);
-  if (!has12.bufferDeviceAddress) throw std::runtime_error(device_name_ + ": bufferDeviceAddress is required");
-  if (!has.features.shaderInt64) throw std::runtime_error(device_name_ + ": shaderInt64 is required");
-
+void Context::create_device() {
   VkPhysicalDeviceVulkan12Features want12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   want12.bufferDeviceAddress = VK_TRUE;
-  want12.hostQueryReset = has12.hostQueryReset;
   VkPhysicalDeviceFeatures2 want{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   want.pNext = &want12;
   want.features.shaderInt64 = VK_TRUE;
-  want.features.shaderFloat64 = has.features.shaderFloat64;
-  features_.shader_float64 = has.features.shaderFloat64 == VK_TRUE;
+  want.features.shaderFloat64 = features_.shader_float64 ? VK_TRUE : VK_FALSE;
 
   float priority = 1.0f;
   VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
@@ -279,8 +323,9 @@ void Context::create_device() {
   info.pQueueCreateInfos = &queue_info;
   TS_VK_CHECK(vkCreateDevice(physical_device_, &info, nullptr, &device_));
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
-  vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
+}
 
+void Context::create_command_objects() {
   VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT | VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
   pool.queueFamilyIndex = queue_family_;

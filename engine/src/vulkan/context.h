@@ -28,6 +28,16 @@ struct DeviceLimits {
   uint32_t timestamp_valid_bits = 0;
 };
 
+// Handles of a device a host application created; the context borrows them and never destroys them.
+struct BorrowedDevice {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  uint32_t queue_family = 0;
+  bool shader_float64_enabled = false;
+};
+
 // Optional features the engine uses when present.
 struct DeviceFeatures {
   bool shader_float64 = false;  // exact float64 depth keys (else float32: rare order swaps)
@@ -38,6 +48,8 @@ struct DeviceFeatures {
 class Context {
  public:
   explicit Context(const ContextOptions& options);
+  // Runs on a host application's device (see tilesplat/vulkan_interop.h for the requirements).
+  explicit Context(const BorrowedDevice& borrowed);
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
@@ -80,9 +92,13 @@ class Context {
                                                        void* user);
   void create_instance(bool validation);
   void pick_physical_device(const std::string& selector);
+  void read_device_properties();
+  uint32_t pick_queue_family();
   void create_device();
+  void create_command_objects();
   void destroy();
 
+  bool owns_handles_ = true;  // false for a borrowed device: instance and device are the host's
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;

@@ -1,0 +1,239 @@
+// The renderer inside a host application's Vulkan: the test plays the host, creating its own
+// instance (with the validation layer and its own messenger), device, queue and image.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <stdexcept>
+
+#include "test_support.h"
+#include "tilesplat/vulkan_interop.h"
+
+namespace tilesplat {
+namespace {
+
+#define HOST_CHECK(call) ASSERT_EQ((call), VK_SUCCESS) << #call
+
+VKAPI_ATTR VkBool32 VKAPI_CALL count_messages(VkDebugUtilsMessageSeverityFlagBitsEXT,
+                                              VkDebugUtilsMessageTypeFlagsEXT,
+                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  ++*static_cast<int*>(user);
+  std::fprintf(stderr, "host validation: %s\n", data->pMessage);
+  return VK_FALSE;
+}
+
+class HostApplication : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.apiVersion = VK_API_VERSION_1_2;
+    const char* layer = "VK_LAYER_KHRONOS_validation";
+    const char* ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    ici.pApplicationInfo = &app;
+    ici.enabledLayerCount = 1;
+    ici.ppEnabledLayerNames = &layer;
+    ici.enabledExtensionCount = 1;
+    ici.ppEnabledExtensionNames = &ext;
+    HOST_CHECK(vkCreateInstance(&ici, nullptr, &instance));
+    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+    mci.pfnUserCallback = count_messages;
+    mci.pUserData = &messages;
+    auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+    HOST_CHECK(create_messenger(instance, &mci, nullptr, &messenger));
+
+    uint32_t count = 1;
+    VkResult r = vkEnumeratePhysicalDevices(instance, &count, &physical);
+    ASSERT_TRUE(r == VK_SUCCESS || r == VK_INCOMPLETE);
+    ASSERT_EQ(count, 1u);
+    uint32_t families = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, nullptr);
+    std::vector<VkQueueFamilyProperties> props(families);
+    vkGetPhysicalDeviceQueueFamilyProperties(physical, &families, props.data());
+    for (family = 0; family < families; ++family)
+      if (props[family].queueFlags & VK_QUEUE_COMPUTE_BIT) break;
+    ASSERT_LT(family, families);
+
+    VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    vkGetPhysicalDeviceFeatures2(physical, &has);
+    VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    f12.bufferDeviceAddress = VK_TRUE;
+    VkPhysicalDeviceFeatures2 f{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    f.pNext = &f12;
+    f.features.shaderInt64 = VK_TRUE;
+    f.features.shaderFloat64 = has.features.shaderFloat64;
+    float priority = 1;
+    VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    qci.queueFamilyIndex = family;
+    qci.queueCount = 1;
+    qci.pQueuePriorities = &priority;
+    VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    dci.pNext = &f;
+    dci.queueCreateInfoCount = 1;
+    dci.pQueueCreateInfos = &qci;
+    HOST_CHECK(vkCreateDevice(physical, &dci, nullptr, &device));
+    vkGetDeviceQueue(device, family, 0, &queue);
+    float64 = has.features.shaderFloat64 == VK_TRUE;
+  }
+
+  void TearDown() override {
+    if (device) vkDestroyDevice(device, nullptr);
+    if (messenger) {
+      auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+          vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"));
+      destroy(instance, messenger, nullptr);
+    }
+    if (instance) vkDestroyInstance(instance, nullptr);
+  }
+
+  uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags flags) {
+    VkPhysicalDeviceMemoryProperties mp;
+    vkGetPhysicalDeviceMemoryProperties(physical, &mp);
+    for (uint32_t i = 0; i < mp.memoryTypeCount; ++i)
+      if ((bits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & flags) == flags) return i;
+    throw std::runtime_error("no memory type");
+  }
+
+  ExternalVulkanDevice external() const { return {instance, physical, device, queue, family, float64}; }
+
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  uint32_t family = 0;
+  bool float64 = false;
+  int messages = 0;
+};
+
+TEST_F(HostApplication, RendersOnTheHostDeviceIntoTheHostImage) {
+  GaussianScene scene = load_scene(testing::bundled_playbot());
+  Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(1).camera, 200, 120);
+  RenderImage expected;
+  {
+    auto own = Renderer::create();
+    own->set_scene(scene);
+    expected = own->render(camera);
+  }
+
+  // The host's image and a host-visible buffer to read it back.
+  VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  ici.imageType = VK_IMAGE_TYPE_2D;
+  ici.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+  ici.extent = {200, 120, 1};
+  ici.mipLevels = 1;
+  ici.arrayLayers = 1;
+  ici.samples = VK_SAMPLE_COUNT_1_BIT;
+  ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+  ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+  VkImage image = VK_NULL_HANDLE;
+  HOST_CHECK(vkCreateImage(device, &ici, nullptr, &image));
+  VkMemoryRequirements req;
+  vkGetImageMemoryRequirements(device, image, &req);
+  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = memory_type(req.memoryTypeBits, 0);
+  VkDeviceMemory image_memory = VK_NULL_HANDLE;
+  HOST_CHECK(vkAllocateMemory(device, &mai, nullptr, &image_memory));
+  HOST_CHECK(vkBindImageMemory(device, image, image_memory, 0));
+
+  const VkDeviceSize bytes = 200 * 120 * 16;
+  VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bci.size = bytes;
+  bci.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  VkBuffer readback = VK_NULL_HANDLE;
+  HOST_CHECK(vkCreateBuffer(device, &bci, nullptr, &readback));
+  vkGetBufferMemoryRequirements(device, readback, &req);
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex =
+      memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+  VkDeviceMemory readback_memory = VK_NULL_HANDLE;
+  HOST_CHECK(vkAllocateMemory(device, &mai, nullptr, &readback_memory));
+  HOST_CHECK(vkBindBufferMemory(device, readback, readback_memory, 0));
+
+  {
+    auto renderer = create_renderer(external());
+    renderer->set_scene(scene);
+    ExternalImage target{image, 200, 120, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_LAYOUT_UNDEFINED};
+    render_to_image(*renderer, camera, {}, target);
+    EXPECT_GT(renderer->last_frame_stats().intersections, 0u);
+
+    // Errors the host can make.
+    ExternalImage wrong_size = target;
+    wrong_size.width = 100;
+    wrong_size.layout = VK_IMAGE_LAYOUT_GENERAL;
+    EXPECT_THROW(render_to_image(*renderer, camera, {}, wrong_size), std::invalid_argument);
+    ExternalImage wrong_format = target;
+    wrong_format.format = VK_FORMAT_R8G8B8A8_UNORM;
+    EXPECT_THROW(render_to_image(*renderer, camera, {}, wrong_format), std::invalid_argument);
+
+    // The same renderer also renders to host memory on the borrowed device.
+    RenderImage via_buffers = renderer->render(camera);
+    EXPECT_EQ(via_buffers.rgba, expected.rgba);
+  }  // the renderer is gone; the host's device must still work
+
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.queueFamilyIndex = family;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  HOST_CHECK(vkCreateCommandPool(device, &pci, nullptr, &pool));
+  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cai.commandPool = pool;
+  cai.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  HOST_CHECK(vkAllocateCommandBuffers(device, &cai, &cmd));
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  HOST_CHECK(vkBeginCommandBuffer(cmd, &begin));
+  VkImageMemoryBarrier to_src{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  to_src.oldLayout = VK_IMAGE_LAYOUT_GENERAL;  // an UNDEFINED image is left GENERAL
+  to_src.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+  to_src.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
+  to_src.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+  to_src.srcQueueFamilyIndex = to_src.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  to_src.image = image;
+  to_src.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                       nullptr, 1, &to_src);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageExtent = {200, 120, 1};
+  vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback, 1, &region);
+  VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr,
+                       0, nullptr);
+  HOST_CHECK(vkEndCommandBuffer(cmd));
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cmd;
+  HOST_CHECK(vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE));
+  HOST_CHECK(vkQueueWaitIdle(queue));
+
+  void* mapped = nullptr;
+  HOST_CHECK(vkMapMemory(device, readback_memory, 0, bytes, 0, &mapped));
+  std::vector<float> pixels(200 * 120 * 4);
+  std::memcpy(pixels.data(), mapped, bytes);
+  vkUnmapMemory(device, readback_memory);
+  EXPECT_EQ(pixels, expected.rgba);
+
+  vkDestroyCommandPool(device, pool, nullptr);
+  vkDestroyBuffer(device, readback, nullptr);
+  vkFreeMemory(device, readback_memory, nullptr);
+  vkDestroyImage(device, image, nullptr);
+  vkFreeMemory(device, image_memory, nullptr);
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
+TEST_F(HostApplication, RejectsMissingHandles) {
+  ExternalVulkanDevice missing = external();
+  missing.queue = VK_NULL_HANDLE;
+  EXPECT_THROW(create_renderer(missing), std::invalid_argument);
+  ExternalVulkanDevice bad_family = external();
+  bad_family.queue_family = 99;
+  EXPECT_THROW(create_renderer(bad_family), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace tilesplat
