@@ -68,9 +68,6 @@ vk::Buffer make_buffer(vk::Context& ctx, size_t count, const char* name) {
 
 struct Renderer::Impl {
   explicit Impl(const RendererOptions& opts) : Impl(opts, vk::ContextOptions{opts.device, opts.validation}) {}
-  Impl(const RendererOptions& opts, const ExternalVulkanDevice& ext)
-      : Impl(opts, vk::BorrowedDevice{ext.instance, ext.physical_device, ext.device, ext.queue, ext.queue_family,
-                                      ext.shader_float64_enabled}) {}
   template <typename ContextSource>
   Impl(const RendererOptions& opts, const ContextSource& source)
       : options(opts),

@@ -116,7 +116,7 @@ Context::Context(const ContextOptions& options) {
   }
 }
 
-Context::Context(const BorrowedDevice& borrowed) : owns_handles_(false) {
+Context::Context(const ExternalVulkanDevice& borrowed) : owns_handles_(false) {
   if (!borrowed.instance || !borrowed.physical_device || !borrowed.device || !borrowed.queue)
     throw std::invalid_argument("borrowed Vulkan device: instance, physical device, device and queue are required");
   instance_ = borrowed.instance;

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "tilesplat/vulkan_interop.h"
+
 namespace tilesplat::vk {
 
 struct ContextOptions {
@@ -28,16 +30,6 @@ struct DeviceLimits {
   uint32_t timestamp_valid_bits = 0;
 };
 
-// Handles of a device a host application created; the context borrows them and never destroys them.
-struct BorrowedDevice {
-  VkInstance instance = VK_NULL_HANDLE;
-  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
-  VkDevice device = VK_NULL_HANDLE;
-  VkQueue queue = VK_NULL_HANDLE;
-  uint32_t queue_family = 0;
-  bool shader_float64_enabled = false;
-};
-
 // Optional features the engine uses when present.
 struct DeviceFeatures {
   bool shader_float64 = false;  // exact float64 depth keys (else float32: rare order swaps)
@@ -48,8 +40,8 @@ struct DeviceFeatures {
 class Context {
  public:
   explicit Context(const ContextOptions& options);
-  // Runs on a host application's device (see tilesplat/vulkan_interop.h for the requirements).
-  explicit Context(const BorrowedDevice& borrowed);
+  // Runs on a host application's device, borrowing its handles (see tilesplat/vulkan_interop.h).
+  explicit Context(const ExternalVulkanDevice& borrowed);
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
