@@ -120,8 +120,7 @@ struct Renderer::Impl {
   }
 
   // Records and runs one frame. Returns the counters the GPU wrote.
-  FrameCounters run_frame(const Camera& camera, const RenderSettings& settings, SortStrategy& sorter,
-                          bool* sorted_in_alt) {
+  FrameCounters run_frame(const Camera& camera, const RenderSettings& settings, SortStrategy& sorter) {
     const uint32_t tiles_x = vk::div_ceil(uint32_t(camera.width), kTileSize);
     const uint32_t tiles_y = vk::div_ceil(uint32_t(camera.height), kTileSize);
     const uint32_t tiles = tiles_x * tiles_y;
@@ -147,11 +146,11 @@ struct Renderer::Impl {
     timer.mark(cmd, "key_emission");
 
     SortInput input{keys, counters, key_bits};
-    *sorted_in_alt = sorter.record(cmd, input);
+    const bool sorted_in_alt = sorter.record(cmd, input);
     timer.mark(cmd, "sort");
 
-    const vk::Buffer& sorted_keys = *sorted_in_alt ? keys.keys_alt : keys.keys;
-    const vk::Buffer& sorted_values = *sorted_in_alt ? keys.values_alt : keys.values;
+    const vk::Buffer& sorted_keys = sorted_in_alt ? keys.keys_alt : keys.keys;
+    const vk::Buffer& sorted_values = sorted_in_alt ? keys.values_alt : keys.values;
     tile_ranges.record(cmd, sorted_keys, ranges, counters, kRangesArgsOffset, tiles);
     vk::barrier(cmd);
     timer.mark(cmd, "tile_ranges");
@@ -184,9 +183,8 @@ struct Renderer::Impl {
 
     stats = {};
     FrameCounters frame{};
-    bool sorted_in_alt = false;
     for (int attempt = 0;; ++attempt) {
-      frame = run_frame(camera, settings, sorter, &sorted_in_alt);
+      frame = run_frame(camera, settings, sorter);
       if (!frame.overflow) break;
       if (attempt == kMaxRetries || keys.capacity >= (1u << 31))
         throw std::runtime_error("frame needs " + std::to_string(frame.intersections) +
