@@ -39,23 +39,22 @@ const uint P = PIXELS_PER_INVOCATION;
 const uint ROW_GROUP = P < 8 ? P : 8;  // rows skipped together; P > 8 makes two groups
 const uint BATCH = 256;
 const uint TILE_PIXELS = TILE_SIZE * TILE_SIZE;
-const uint EMPTY_BOX = 0x000Fu;  // x from 15 to 0: no column is inside
 
-shared vec4 s_mean_depth_opacity[BATCH];
-shared vec4 s_conic[BATCH];
-shared vec4 s_colour[BATCH];
-shared uint s_box[BATCH];  // tile-local pixel box: x0 | x1 << 4 | y0 << 8 | y1 << 12, inclusive
+// A staged splat, ready to evaluate: log2 alpha = log2_opacity + dx (A dx + B dy) + C dy^2 with the
+// conic pre-scaled by -log2(e)/2 (B by -log2(e)), and the mean relative to the tile origin.
+shared u64vec4 s_packed_a[BATCH];
+shared uint64_t s_packed_b[BATCH];
+shared uint s_reach[BATCH];  // bit 2 x + h: the splat reaches column x in rows [8 h, 8 h + 7]
 shared uint s_done_pixels;
 
-// The invocation's pixels, front to back state.
+// The invocation's pixels, front to back state. A pixel that is done keeps its final transmittance
+// negated, so `T > 0` is the "still blending" test without another register per pixel.
 float T[P];
 vec3 colour[P];
 float depth_sum[P];
 float weight_sum[P];
 uint blended[P];
-bool done[P];
-uint my_done = 0;     // pixels of this invocation that are done
-uint newly_done = 0;  // of those, the ones not yet added to s_done_pixels
+uint my_done = 0;  // pixels of this invocation that are done
 
 // Inclusive range of tile-local pixel indices i whose centres i + 0.5 lie in [lo, hi] (relative to
 // the tile origin), clamped to the tile; x > y when there is none. 1e-3 px of slack on top of
@@ -67,58 +66,68 @@ ivec2 pixel_span(float lo, float hi) {
   return ivec2(clamp(first, 0.0, float(TILE_SIZE - 1)), clamp(last, 0.0, float(TILE_SIZE - 1)));
 }
 
-// The tile-local pixel box of a splat's alpha >= 1/255 ellipse: its columns are where the ellipse
-// crosses the tile's band of rows, its rows the ellipse's full height.
-uint splat_box(vec4 mdo, vec4 conic, vec4 colour_lo, vec4 cov_det, vec2 tile_origin) {
-  float tau = coverage_tau(mdo.w);
-  vec2 centre = vec2((mdo.x - tile_origin.x) + conic.w, (mdo.y - tile_origin.y) + colour_lo.w);
-  vec2 x = ellipse_x_range(cov_det, tau, 0.5 - centre.y, float(TILE_SIZE) - 0.5 - centre.y);
-  if (!(x.x <= x.y)) return EMPTY_BOX;
-  float y_extent = sqrt(tau * cov_det.z);
-  ivec2 xs = pixel_span(centre.x + x.x, centre.x + x.y);
-  ivec2 ys = pixel_span(centre.y - y_extent, centre.y + y_extent);
-  if (xs.x > xs.y || ys.x > ys.y) return EMPTY_BOX;
-  return uint(xs.x) | (uint(xs.y) << 4) | (uint(ys.x) << 8) | (uint(ys.y) << 12);
+// Which 8-row half-columns of the tile the splat's alpha >= 1/255 ellipse reaches: on column x it
+// spans dy in (b dx +- sqrt(det (tau a - dx^2))) / a, dx = x + 0.5 - mean.x (cov = [[a b] [b c]]).
+uint splat_reach(vec2 centre, float opacity, vec4 cov_det) {
+  float tau = coverage_tau(opacity);
+  if (!(tau > 0.0)) return 0u;
+  float a = cov_det.x, b = cov_det.y, det = cov_det.w;
+  uint reach = 0u;
+  for (uint x = 0; x < TILE_SIZE; ++x) {
+    float dx = float(x) + 0.5 - centre.x;
+    float half_height = sqrt(max(0.0, det * (tau * a - dx * dx))) / a;
+    ivec2 rows = pixel_span(centre.y + b * dx / a - half_height, centre.y + b * dx / a + half_height);
+    bool column = dx * dx <= tau * a * 1.0001 && rows.x <= rows.y;
+    if (column && rows.x <= 7) reach |= 1u << (2 * x);
+    if (column && rows.y >= 8) reach |= 2u << (2 * x);
+  }
+  return reach;
 }
 
-// Blends one splat into rows [first, first + ROW_GROUP) of the invocation's column. Branch-free:
-// a no-op (w = 0, T unchanged) leaves every sum bit-identical, and selects are cheaper than
-// the lane-mask bookkeeping a CPU driver does for a divergent branch.
-void blend_rows(uint first, float dx, float py_first, vec4 mdo, vec4 conic, vec4 colour_lo) {
+// Blends one staged splat into rows [first, first + ROW_GROUP) of the invocation's column.
+// Branch-free: a no-op (w = 0, T unchanged) leaves every sum bit-identical, and selects are
+// cheaper than the lane-mask bookkeeping a CPU driver does for a divergent branch.
+void blend_rows(uint first, float local_y_first, vec4 mean_a_b, vec4 c_opacity_depth_r, vec2 green_blue,
+                float dx) {
+  // log2 alpha = k0 + dy (k1 + C dy): the dx terms are the same for the whole column.
+  float k0 = mean_a_b.z * dx * dx;
+  float k1 = mean_a_b.w * dx;
+  vec3 rgb = vec3(c_opacity_depth_r.w, green_blue);
   for (uint q = 0; q < ROW_GROUP; ++q) {
     uint p = min(first + q, P - 1);  // clamp only keeps a never-taken group in bounds
-    // mean = hi + lo (see projection.comp): hi - centre is exact for nearby pixels.
-    float dy = (mdo.y - (py_first + float(q) + 0.5)) + colour_lo.w;
-    float power = -0.5 * (conic.x * dx * dx + conic.z * dy * dy) - conic.y * dx * dy;
-    float alpha = min(0.99, mdo.w * exp(power));
-    bool hit = !done[p] && power <= 0.0 && alpha >= 1.0 / 255.0;
+    float dy = mean_a_b.y - (local_y_first + float(q) + 0.5);
+    float power = k0 + dy * (k1 + c_opacity_depth_r.x * dy);
+    float alpha = min(0.99, c_opacity_depth_r.y * exp(power));
+    bool hit = T[p] > 0.0 && alpha >= 1.0 / 255.0;
     float next_T = T[p] * (1.0 - alpha);
     bool finish = hit && next_T < 1e-4;  // done, and this splat is NOT blended (reference)
     bool blend = hit && !finish;
     float w = blend ? alpha * T[p] : 0.0;
-    colour[p] += colour_lo.rgb * w;
-    depth_sum[p] += mdo.z * w;
+    colour[p] += rgb * w;
+    depth_sum[p] += c_opacity_depth_r.z * w;
     weight_sum[p] += w;
-    T[p] = blend ? next_T : T[p];
+    T[p] = blend ? next_T : (finish ? -T[p] : T[p]);
     blended[p] += blend ? 1u : 0u;
-    done[p] = done[p] || finish;
     my_done += finish ? 1u : 0u;
-    newly_done += finish ? 1u : 0u;
   }
 }
 
-bool reaches_me(uint box, uint local_x, uint local_y0) {
-  uvec4 b = uvec4(box & 15u, (box >> 4) & 15u, (box >> 8) & 15u, (box >> 12) & 15u);
-  return local_x >= b.x && local_x <= b.y && local_y0 <= b.w && local_y0 + P - 1 >= b.z;
+// This invocation's half-column(s) in the splat's reach mask.
+uint my_reach_bits(uint local_x, uint local_y0) {
+  uint halves = P > 8 ? 3u : 1u << (local_y0 / 8);
+  return halves << (2 * local_x);
 }
 
-void blend_splat(uint j, uint px, uint py0) {
-  vec4 mdo = s_mean_depth_opacity[j];
-  vec4 conic = s_conic[j];
-  vec4 colour_lo = s_colour[j];
-  float dx = (mdo.x - (float(px) + 0.5)) + conic.w;
-  blend_rows(0, dx, float(py0), mdo, conic, colour_lo);
-  if (P > ROW_GROUP) blend_rows(ROW_GROUP, dx, float(py0 + ROW_GROUP), mdo, conic, colour_lo);
+void blend_splat(uint j, uint local_x, uint local_y0) {
+  u64vec4 a = s_packed_a[j];
+  uint64_t b = s_packed_b[j];
+  vec4 mean_a_b = vec4(uintBitsToFloat(unpack32(a.x)), uintBitsToFloat(unpack32(a.y)));
+  vec4 c_opacity_depth_r = vec4(uintBitsToFloat(unpack32(a.z)), uintBitsToFloat(unpack32(a.w)));
+  vec2 green_blue = uintBitsToFloat(unpack32(b));
+  float dx = mean_a_b.x - (float(local_x) + 0.5);
+  blend_rows(0, float(local_y0), mean_a_b, c_opacity_depth_r, green_blue, dx);
+  if (P > ROW_GROUP)
+    blend_rows(ROW_GROUP, float(local_y0 + ROW_GROUP), mean_a_b, c_opacity_depth_r, green_blue, dx);
 }
 
 void main() {
@@ -132,40 +141,41 @@ void main() {
   uint py0 = tile.y * TILE_SIZE + local_y0;
 
   for (uint p = 0; p < P; ++p) {
-    T[p] = 1.0;
+    bool outside = px >= pc.width || py0 + p >= pc.height;
+    T[p] = outside ? -1.0 : 1.0;
     colour[p] = vec3(0.0);
     depth_sum[p] = 0.0;
     weight_sum[p] = 0.0;
     blended[p] = 0;
-    done[p] = px >= pc.width || py0 + p >= pc.height;
-    my_done += done[p] ? 1u : 0u;
+    my_done += outside ? 1u : 0u;
   }
 
   if (thread == 0) s_done_pixels = 0;
   barrier();
   if (my_done > 0) atomicAdd(s_done_pixels, my_done);
+  uint published_done = my_done;  // pixels finishing in a batch are added to s_done_pixels after it
 
   uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
   for (uint batch_start = range.x; batch_start < range.y; batch_start += BATCH) {
     barrier();  // previous batch fully consumed; s_done_pixels up to date
     if (s_done_pixels == TILE_PIXELS) break;
-    for (uint k = thread; k < BATCH; k += threads) {
-      if (batch_start + k < range.y) {
-        uint g = pc.sorted_indices.v[batch_start + k];
-        vec4 mdo = pc.splats.v[SPLAT_VEC4S * g + 0];
-        vec4 conic = pc.splats.v[SPLAT_VEC4S * g + 1];
-        vec4 colour_lo = pc.splats.v[SPLAT_VEC4S * g + 2];
-        s_mean_depth_opacity[k] = mdo;
-        s_conic[k] = conic;
-        s_colour[k] = colour_lo;
-        s_box[k] = splat_box(mdo, conic, colour_lo, pc.splats.v[SPLAT_VEC4S * g + 3], tile_origin);
-      }
+    uint batch_size = min(BATCH, range.y - batch_start);
+    for (uint k = thread; k < batch_size; k += threads) {
+      uint g = pc.sorted_indices.v[batch_start + k];
+      vec4 mdo = pc.splats.v[SPLAT_VEC4S * g + 0];
+      vec4 conic = pc.splats.v[SPLAT_VEC4S * g + 1];
+      vec4 colour_lo = pc.splats.v[SPLAT_VEC4S * g + 2];
+      vec2 local_mean = vec2((mdo.x - tile_origin.x) + conic.w, (mdo.y - tile_origin.y) + colour_lo.w);
+      s_packed_a[k] = u64vec4(pack64(floatBitsToUint(local_mean)), pack64(floatBitsToUint(vec2(-0.5 * conic.x, -conic.y))),
+                              pack64(floatBitsToUint(vec2(-0.5 * conic.z, mdo.w))), pack64(floatBitsToUint(vec2(mdo.z, colour_lo.r))));
+      s_packed_b[k] = pack64(floatBitsToUint(colour_lo.gb));
+      s_reach[k] = splat_reach(local_mean, mdo.w, pc.splats.v[SPLAT_VEC4S * g + 3]);
     }
     barrier();
-    uint batch_size = min(BATCH, range.y - batch_start);
+    uint my_bits = my_reach_bits(local_x, local_y0);
     if (P == 1) {
       for (uint j = 0; my_done < P && j < batch_size; ++j) {
-        if (reaches_me(s_box[j], local_x, local_y0)) blend_splat(j, px, py0);
+        if ((s_reach[j] & my_bits) != 0) blend_splat(j, local_x, local_y0);
       }
     } else {
       // CPU drivers run both sides of every branch, so skipping a splat is only real when the
@@ -175,19 +185,20 @@ void main() {
       uint n = 0;
       for (uint j = 0; j < batch_size; ++j) {
         list[n] = j;
-        n += reaches_me(s_box[j], local_x, local_y0) ? 1u : 0u;
+        n += (s_reach[j] & my_bits) != 0 ? 1u : 0u;
       }
-      for (uint k = 0; my_done < P && k < n; ++k) blend_splat(list[k], px, py0);
+      for (uint k = 0; my_done < P && k < n; ++k) blend_splat(list[k], local_x, local_y0);
     }
-    if (newly_done > 0) atomicAdd(s_done_pixels, newly_done);
-    newly_done = 0;
+    if (my_done > published_done) atomicAdd(s_done_pixels, my_done - published_done);
+    published_done = my_done;
   }
 
   for (uint p = 0; p < P; ++p) {
     uint py = py0 + p;
     if (px >= pc.width || py >= pc.height) continue;
     uint i = py * pc.width + px;
-    pc.out_rgba.v[i] = vec4(colour[p] + T[p] * pc.background.rgb, 1.0 - T[p]);
+    float transmittance = abs(T[p]);
+    pc.out_rgba.v[i] = vec4(colour[p] + transmittance * pc.background.rgb, 1.0 - transmittance);
     if (WRITE_DEPTH) pc.out_depth.v[i] = weight_sum[p] > 0.0 ? depth_sum[p] / weight_sum[p] : 0.0;
     if (WRITE_COUNT) pc.out_count.v[i] = blended[p];
   }
