@@ -44,7 +44,7 @@ const uint TILE_PIXELS = TILE_SIZE * TILE_SIZE;
 // conic pre-scaled by -log2(e)/2 (B by -log2(e)), and the mean relative to the tile origin.
 shared u64vec4 s_packed_a[BATCH];
 shared uint64_t s_packed_b[BATCH];
-shared uint s_reach[BATCH];  // bit 2 x + h: the splat reaches column x in rows [8 h, 8 h + 7]
+shared uint s_reach[BATCH];  // bit 16 h + x: the splat reaches column x in rows [8 h, 8 h + 7]
 shared uint s_done_pixels;
 
 // The invocation's pixels, front to back state. A pixel that is done keeps its final transmittance
@@ -66,20 +66,18 @@ ivec2 pixel_span(float lo, float hi) {
   return ivec2(clamp(first, 0.0, float(TILE_SIZE - 1)), clamp(last, 0.0, float(TILE_SIZE - 1)));
 }
 
-// Which 8-row half-columns of the tile the splat's alpha >= 1/255 ellipse reaches: on column x it
-// spans dy in (b dx +- sqrt(det (tau a - dx^2))) / a, dx = x + 0.5 - mean.x (cov = [[a b] [b c]]).
+// Which columns of the tile the splat's alpha >= 1/255 ellipse reaches within rows 0-7 (bits 0-15)
+// and within rows 8-15 (bits 16-31): the ellipse cut to a band of rows is convex, so per band it
+// is one x-range (ellipse_x_range, shared with the tile coverage).
 uint splat_reach(vec2 centre, float opacity, vec4 cov_det) {
   float tau = coverage_tau(opacity);
-  if (!(tau > 0.0)) return 0u;
-  float a = cov_det.x, b = cov_det.y, det = cov_det.w;
   uint reach = 0u;
-  for (uint x = 0; x < TILE_SIZE; ++x) {
-    float dx = float(x) + 0.5 - centre.x;
-    float half_height = sqrt(max(0.0, det * (tau * a - dx * dx))) / a;
-    ivec2 rows = pixel_span(centre.y + b * dx / a - half_height, centre.y + b * dx / a + half_height);
-    bool column = dx * dx <= tau * a * 1.0001 && rows.x <= rows.y;
-    if (column && rows.x <= 7) reach |= 1u << (2 * x);
-    if (column && rows.y >= 8) reach |= 2u << (2 * x);
+  for (uint band = 0; band < 2; ++band) {
+    float band_top = float(band * 8) + 0.5 - centre.y;
+    vec2 x = ellipse_x_range(cov_det, tau, band_top, band_top + 7.0);
+    ivec2 columns = pixel_span(centre.x + x.x, centre.x + x.y);
+    if (x.x <= x.y && columns.x <= columns.y)
+      reach |= ((2u << columns.y) - (1u << columns.x)) << (16 * band);
   }
   return reach;
 }
@@ -112,10 +110,10 @@ void blend_rows(uint first, float local_y_first, vec4 mean_a_b, vec4 c_opacity_d
   }
 }
 
-// This invocation's half-column(s) in the splat's reach mask.
+// This invocation's bits in a splat's reach mask (see splat_reach).
 uint my_reach_bits(uint local_x, uint local_y0) {
-  uint halves = P > 8 ? 3u : 1u << (local_y0 / 8);
-  return halves << (2 * local_x);
+  uint bands = P > 8 ? 0x10001u : 1u << (16 * (local_y0 / 8));
+  return bands << local_x;
 }
 
 void blend_splat(uint j, uint local_x, uint local_y0) {
