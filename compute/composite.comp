@@ -8,11 +8,11 @@
 // SIMD lane, so reading each splat once and blending it into 16 pixels held in registers is 5-10x
 // faster, and the workgroup has 2 SIMD groups instead of 32 to switch between at each barrier.
 //
-// Each staged splat also carries the tile-local pixel box of its alpha >= 1/255 ellipse. Pixels
-// outside it would be no-ops (the reference skips them too), so a group of up to 8 rows whose
-// pixels all lie outside it is skipped. The skip is written as a loop that runs at most once: CPU
-// drivers execute both sides of an `if` under a lane mask, but leave a loop for real once no lane
-// is left in it, so only a loop saves the work when a whole SIMD group can skip.
+// Each staged splat also carries its reach: the columns its alpha >= 1/255 ellipse meets in rows
+// 0-7 and in rows 8-15. Pixels outside would be no-ops (the reference skips them too). GPUs simply
+// branch on it. CPU drivers execute both sides of every branch under a lane mask and only leave a
+// loop for real, so there each invocation first lists the splats that reach its column and then
+// loops over just those.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "tile_coverage.glsl"
@@ -36,14 +36,14 @@ layout(push_constant) uniform Push {
 } pc;
 
 const uint P = PIXELS_PER_INVOCATION;
-const uint ROW_GROUP = P < 8 ? P : 8;  // rows skipped together; P > 8 makes two groups
 const uint BATCH = 256;
 const uint TILE_PIXELS = TILE_SIZE * TILE_SIZE;
 
-// A staged splat, ready to evaluate: log2 alpha = log2_opacity + dx (A dx + B dy) + C dy^2 with the
-// conic pre-scaled by -log2(e)/2 (B by -log2(e)), and the mean relative to the tile origin.
-shared u64vec4 s_packed_a[BATCH];
-shared uint64_t s_packed_b[BATCH];
+// A staged splat, ready to evaluate (two 64-bit reads, where CPU drivers pay per read): its mean
+// relative to the tile origin, A' = -A/2, B' = -B, C' = -C/2 of its conic (exact scalings, so
+// power = A' dx^2 + B' dx dy + C' dy^2), opacity, view depth and colour.
+shared u64vec4 s_packed_a[BATCH];  // (mean x, mean y), (A', B'), (C', opacity), (depth, red)
+shared uint64_t s_packed_b[BATCH];  // (green, blue)
 shared uint s_reach[BATCH];  // bit 16 h + x: the splat reaches column x in rows [8 h, 8 h + 7]
 shared uint s_done_pixels;
 
@@ -82,18 +82,27 @@ uint splat_reach(vec2 centre, float opacity, vec4 cov_det) {
   return reach;
 }
 
-// Blends one staged splat into rows [first, first + ROW_GROUP) of the invocation's column.
-// Branch-free: a no-op (w = 0, T unchanged) leaves every sum bit-identical, and selects are
-// cheaper than the lane-mask bookkeeping a CPU driver does for a divergent branch.
-void blend_rows(uint first, float local_y_first, vec4 mean_a_b, vec4 c_opacity_depth_r, vec2 green_blue,
-                float dx) {
-  // log2 alpha = k0 + dy (k1 + C dy): the dx terms are the same for the whole column.
+// This invocation's bits in a splat's reach mask (see splat_reach).
+uint my_reach_bits(uint local_x, uint local_y0) {
+  uint bands = P > 8 ? 0x10001u : 1u << (16 * (local_y0 / 8));
+  return bands << local_x;
+}
+
+// Blends staged splat j into the invocation's column of P pixels. Branch-free: a no-op (w = 0,
+// T unchanged) leaves every sum bit-identical, and selects are cheaper than the lane-mask
+// bookkeeping a CPU driver does for a divergent branch.
+void blend_splat(uint j, uint local_x, uint local_y0) {
+  u64vec4 a = s_packed_a[j];
+  uint64_t b = s_packed_b[j];
+  vec4 mean_a_b = vec4(uintBitsToFloat(unpack32(a.x)), uintBitsToFloat(unpack32(a.y)));
+  vec4 c_opacity_depth_r = vec4(uintBitsToFloat(unpack32(a.z)), uintBitsToFloat(unpack32(a.w)));
+  vec3 rgb = vec3(c_opacity_depth_r.w, uintBitsToFloat(unpack32(b)));
+  float dx = mean_a_b.x - (float(local_x) + 0.5);
+  // power = k0 + dy (k1 + C' dy): the dx terms are the same for the whole column.
   float k0 = mean_a_b.z * dx * dx;
   float k1 = mean_a_b.w * dx;
-  vec3 rgb = vec3(c_opacity_depth_r.w, green_blue);
-  for (uint q = 0; q < ROW_GROUP; ++q) {
-    uint p = min(first + q, P - 1);  // clamp only keeps a never-taken group in bounds
-    float dy = mean_a_b.y - (local_y_first + float(q) + 0.5);
+  for (uint p = 0; p < P; ++p) {
+    float dy = mean_a_b.y - (float(local_y0 + p) + 0.5);
     float power = k0 + dy * (k1 + c_opacity_depth_r.x * dy);
     float alpha = min(0.99, c_opacity_depth_r.y * exp(power));
     bool hit = T[p] > 0.0 && alpha >= 1.0 / 255.0;
@@ -108,24 +117,6 @@ void blend_rows(uint first, float local_y_first, vec4 mean_a_b, vec4 c_opacity_d
     blended[p] += blend ? 1u : 0u;
     my_done += finish ? 1u : 0u;
   }
-}
-
-// This invocation's bits in a splat's reach mask (see splat_reach).
-uint my_reach_bits(uint local_x, uint local_y0) {
-  uint bands = P > 8 ? 0x10001u : 1u << (16 * (local_y0 / 8));
-  return bands << local_x;
-}
-
-void blend_splat(uint j, uint local_x, uint local_y0) {
-  u64vec4 a = s_packed_a[j];
-  uint64_t b = s_packed_b[j];
-  vec4 mean_a_b = vec4(uintBitsToFloat(unpack32(a.x)), uintBitsToFloat(unpack32(a.y)));
-  vec4 c_opacity_depth_r = vec4(uintBitsToFloat(unpack32(a.z)), uintBitsToFloat(unpack32(a.w)));
-  vec2 green_blue = uintBitsToFloat(unpack32(b));
-  float dx = mean_a_b.x - (float(local_x) + 0.5);
-  blend_rows(0, float(local_y0), mean_a_b, c_opacity_depth_r, green_blue, dx);
-  if (P > ROW_GROUP)
-    blend_rows(ROW_GROUP, float(local_y0 + ROW_GROUP), mean_a_b, c_opacity_depth_r, green_blue, dx);
 }
 
 void main() {
