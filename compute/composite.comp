@@ -76,7 +76,7 @@ uint splat_reach(vec2 centre, float opacity, vec4 cov_det) {
     float band_top = float(band * 8) + 0.5 - centre.y;
     vec2 x = ellipse_x_range(cov_det, tau, band_top, band_top + 7.0);
     ivec2 columns = pixel_span(centre.x + x.x, centre.x + x.y);
-    if (x.x <= x.y && columns.x <= columns.y)
+    if (columns.x <= columns.y)  // an empty x-range gives an empty span
       reach |= ((2u << columns.y) - (1u << columns.x)) << (16 * band);
   }
   return reach;
@@ -143,6 +143,7 @@ void main() {
   barrier();
   if (my_done > 0) atomicAdd(s_done_pixels, my_done);
   uint published_done = my_done;  // pixels finishing in a batch are added to s_done_pixels after it
+  uint my_bits = my_reach_bits(local_x, local_y0);
 
   uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
   for (uint batch_start = range.x; batch_start < range.y; batch_start += BATCH) {
@@ -161,15 +162,14 @@ void main() {
       s_reach[k] = splat_reach(local_mean, mdo.w, pc.splats.v[SPLAT_VEC4S * g + 3]);
     }
     barrier();
-    uint my_bits = my_reach_bits(local_x, local_y0);
     if (P == 1) {
       for (uint j = 0; my_done < P && j < batch_size; ++j) {
         if ((s_reach[j] & my_bits) != 0) blend_splat(j, local_x, local_y0);
       }
     } else {
       // CPU drivers run both sides of every branch, so skipping a splat is only real when the
-      // loop never gets to it: each invocation first lists the splats whose pixel box meets its
-      // column, then blends just those.
+      // loop never gets to it: each invocation first lists the splats whose reach includes its
+      // pixels, then blends just those.
       uint list[BATCH];
       uint n = 0;
       for (uint j = 0; j < batch_size; ++j) {
