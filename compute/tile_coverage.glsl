@@ -6,7 +6,8 @@
 // and composite work. tau carries a margin so float rounding can never drop a contributing tile.
 //
 // The projection counts with row_span() and the key emission emits with it, from the same stored
-// float inputs; `precise` keeps the two pipelines' arithmetic identical (no contraction).
+// float inputs; `precise` keeps the two pipelines' arithmetic identical (no contraction). The
+// composite uses ellipse_x_range() for the columns of a tile a splat reaches.
 
 float coverage_tau(float opacity) {
   precise float tau = 2.0 * log(255.0 * opacity);
