@@ -88,10 +88,12 @@ uint my_reach_bits(uint local_x, uint local_y0) {
   return bands << local_x;
 }
 
-// Blends staged splat j into the invocation's column of P pixels. Branch-free: a no-op (w = 0,
-// T unchanged) leaves every sum bit-identical, and selects are cheaper than the lane-mask
-// bookkeeping a CPU driver does for a divergent branch.
-void blend_splat(uint j, uint local_x, uint local_y0) {
+// Blends staged splat j into the invocation's pixels first .. first + count - 1 (indices into its
+// column; the call sites pass constants, so the register arrays stay statically indexed) and
+// returns how many of them finished. Branch-free: a no-op (w = 0, T unchanged) leaves every sum
+// bit-identical, and selects are cheaper than the lane-mask bookkeeping a CPU driver does for a
+// divergent branch.
+uint blend_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
   u64vec4 a = s_packed_a[j];
   uint64_t b = s_packed_b[j];
   vec4 mean_a_b = vec4(uintBitsToFloat(unpack32(a.x)), uintBitsToFloat(unpack32(a.y)));
@@ -101,7 +103,8 @@ void blend_splat(uint j, uint local_x, uint local_y0) {
   // power = k0 + dy (k1 + C' dy): the dx terms are the same for the whole column.
   float k0 = mean_a_b.z * dx * dx;
   float k1 = mean_a_b.w * dx;
-  for (uint p = 0; p < P; ++p) {
+  uint finished = 0;
+  for (uint p = first; p < first + count; ++p) {
     float dy = mean_a_b.y - (float(local_y0 + p) + 0.5);
     float power = k0 + dy * (k1 + c_opacity_depth_r.x * dy);
     float alpha = min(0.99, c_opacity_depth_r.y * exp(power));
@@ -115,8 +118,9 @@ void blend_splat(uint j, uint local_x, uint local_y0) {
     weight_sum[p] += w;
     T[p] = blend ? next_T : (finish ? -T[p] : T[p]);
     blended[p] += blend ? 1u : 0u;
-    my_done += finish ? 1u : 0u;
+    finished += finish ? 1u : 0u;
   }
+  return finished;
 }
 
 void main() {
@@ -144,6 +148,11 @@ void main() {
   if (my_done > 0) atomicAdd(s_done_pixels, my_done);
   uint published_done = my_done;  // pixels finishing in a batch are added to s_done_pixels after it
   uint my_bits = my_reach_bits(local_x, local_y0);
+  uint top_done = 0, bottom_done = 0;  // P == 16: done pixels among rows 0-7 and rows 8-15
+  for (uint p = 0; p < P; ++p) {
+    if (p < 8) top_done += T[p] < 0.0 ? 1u : 0u;
+    else bottom_done += T[p] < 0.0 ? 1u : 0u;
+  }
 
   uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
   for (uint batch_start = range.x; batch_start < range.y; batch_start += BATCH) {
@@ -164,9 +173,9 @@ void main() {
     barrier();
     if (P == 1) {
       for (uint j = 0; my_done < P && j < batch_size; ++j) {
-        if ((s_reach[j] & my_bits) != 0) blend_splat(j, local_x, local_y0);
+        if ((s_reach[j] & my_bits) != 0) my_done += blend_splat(j, local_x, local_y0, 0, P);
       }
-    } else {
+    } else if (P < 16) {
       // CPU drivers run both sides of every branch, so skipping a splat is only real when the
       // loop never gets to it: each invocation first lists the splats whose reach includes its
       // pixels, then blends just those.
@@ -176,7 +185,23 @@ void main() {
         list[n] = j;
         n += (s_reach[j] & my_bits) != 0 ? 1u : 0u;
       }
-      for (uint k = 0; my_done < P && k < n; ++k) blend_splat(list[k], local_x, local_y0);
+      for (uint k = 0; my_done < P && k < n; ++k) my_done += blend_splat(list[k], local_x, local_y0, 0, P);
+    } else {
+      // A column of 16 spans both row bands of the reach mask: one list per band, so that a splat
+      // reaching only rows 0-7 (or 8-15) of this column is evaluated on those 8 pixels alone.
+      uint top[BATCH], bottom[BATCH];
+      uint n_top = 0, n_bottom = 0;
+      for (uint j = 0; j < batch_size; ++j) {
+        uint reach = s_reach[j] >> local_x;
+        top[n_top] = j;
+        bottom[n_bottom] = j;
+        n_top += reach & 1u;
+        n_bottom += (reach >> 16) & 1u;
+      }
+      for (uint k = 0; top_done < 8 && k < n_top; ++k) top_done += blend_splat(top[k], local_x, local_y0, 0, 8);
+      for (uint k = 0; bottom_done < 8 && k < n_bottom; ++k)
+        bottom_done += blend_splat(bottom[k], local_x, local_y0, 8, 8);
+      my_done = top_done + bottom_done;
     }
     if (my_done > published_done) atomicAdd(s_done_pixels, my_done - published_done);
     published_done = my_done;
