@@ -14,12 +14,21 @@ const uint TILE_SIZE = 16;
 
 // Counters written on the GPU during a frame and read by the host after it (see frame_counters.h).
 const uint COUNTER_INTERSECTIONS = 0;  // total (Gaussian, tile) pairs wanted this frame
-const uint COUNTER_SORT_COUNT = 1;     // pairs actually emitted and sorted: min(total, capacity)
 const uint COUNTER_OVERFLOW = 2;       // 1 when total exceeded capacity (the host grows and retries)
 const uint COUNTER_VISIBLE = 3;        // Gaussians that touch at least one tile
 const uint COUNTER_RANGES_ARGS = 4;    // 3 uints: indirect dispatch of the tile-range pass
-const uint COUNTER_SORT_ARGS = 8;      // 3 uints: indirect dispatch of the sort's per-block passes
-const uint COUNTER_SORT_BLOCKS = 11;   // blocks the sort splits its keys into
+const uint COUNTER_DEPTH_SORT = 8;     // SORT_STATE_UINTS: the sort of the Gaussians by depth
+const uint COUNTER_TILE_SORT = 16;     // SORT_STATE_UINTS: the sort of the (tile, Gaussian) pairs
+
+// A sort's state block: the key count it sorts (set before the sort runs) and what the sort derives
+// from it on the GPU (its block count and the indirect dispatch of its per-block passes).
+const uint SORT_COUNT = 0;
+const uint SORT_BLOCKS = 1;
+const uint SORT_ARGS = 2;  // 3 uints
+const uint SORT_STATE_UINTS = 8;
+
+// Pairs actually emitted and sorted: min(total, capacity).
+const uint COUNTER_SORT_COUNT = COUNTER_TILE_SORT + SORT_COUNT;
 
 // Projected splat record: four vec4 per Gaussian. The composite reads [0..2], the key emission [0], [3].
 //   [0] mean.x, mean.y (float hi parts), view depth, opacity

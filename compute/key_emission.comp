@@ -1,7 +1,9 @@
 #version 460
-// Key emission: one invocation per Gaussian writes a (tile << 32 | depth bits) key and its index for
-// every tile its rectangle covers, at the offset the prefix sum gave it. Keys are emitted in Gaussian
-// index order, so a stable sort leaves equal keys ordered by index: every strategy agrees.
+// Key emission: one invocation per position in the depth order writes, for every tile its Gaussian's
+// ellipse covers, the tile id as the key and the Gaussian's index as the value, at the offset the
+// prefix sum (taken in the same depth order) gave it. The pairs come out front to back, equal depths
+// by Gaussian index, so the stable tile sort that follows leaves each tile's run in exactly the
+// (tile, depth, index) order of the reference, with only the tile bits to sort.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "tile_coverage.glsl"
@@ -12,7 +14,8 @@ layout(push_constant) uniform Push {
   Vec4Array splats;
   Uvec2Array rects;
   UintArray tile_counts;
-  UintArray offsets;
+  UintArray depth_order;  // Gaussian indices, front to back
+  UintArray offsets;      // exclusive prefix sum of tile_counts taken in depth order
   Uint64Array keys;
   UintArray values;
   uint count;
@@ -23,14 +26,13 @@ layout(push_constant) uniform Push {
 } pc;
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
-  if (i >= pc.count) return;
+  uint position = gl_GlobalInvocationID.x;
+  if (position >= pc.count) return;
+  uint i = pc.depth_order.v[position];
   uint n = pc.tile_counts.v[i];
   if (n == 0) return;
-  uint offset = pc.offsets.v[i];
+  uint offset = pc.offsets.v[position];
   if (uint64_t(offset) + n > pc.capacity) return;  // overflow: the frame is re-run with larger buffers
-  // View depth > near > 0, so its IEEE bits order like unsigned integers.
-  uint64_t depth_bits = uint64_t(floatBitsToUint(pc.splats.v[SPLAT_VEC4S * i].z));
   uvec2 rect = pc.rects.v[i];
   uvec2 lo = uvec2(rect.x & 0xffffu, rect.x >> 16);
   uvec2 hi = uvec2(rect.y & 0xffffu, rect.y >> 16);
@@ -41,8 +43,7 @@ void main() {
   for (uint ty = lo.y; ty < hi.y; ++ty) {
     uvec2 span = row_span(mdo.xy, cov_det, tau, ty, lo, hi);
     for (uint tx = span.x; tx < span.y && offset < end; ++tx) {
-      uint64_t tile = uint64_t(ty * pc.tiles_x + tx);
-      pc.keys.v[offset] = (tile << 32) | depth_bits;
+      pc.keys.v[offset] = uint64_t(ty * pc.tiles_x + tx);
       pc.values.v[offset] = i;
       ++offset;
     }
@@ -51,7 +52,7 @@ void main() {
   // slot defined even if a driver's arithmetic differed: a tile id past the grid sorts last and is
   // ignored by the tile-range pass.
   for (; offset < end; ++offset) {
-    pc.keys.v[offset] = uint64_t(pc.tiles) << 32;
+    pc.keys.v[offset] = uint64_t(pc.tiles);
     pc.values.v[offset] = i;
   }
 }

@@ -11,7 +11,9 @@ layout(push_constant) uniform Push {
   UintArray src;
   UintArray dst;         // may alias src
   UintArray block_sums;  // one per workgroup
+  UintArray order;       // when gather != 0, value k is src[order[k]] instead of src[k]
   uint count;
+  uint gather;
 } pc;
 
 void main() {
@@ -20,7 +22,9 @@ void main() {
   uint v[SCAN_ITEMS];
   uint thread_sum = 0;
   for (uint k = 0; k < SCAN_ITEMS; ++k) {
-    v[k] = base + k < pc.count ? pc.src.v[base + k] : 0u;
+    uint index = base + k;
+    if (pc.gather != 0u && index < pc.count) index = pc.order.v[index];
+    v[k] = base + k < pc.count ? pc.src.v[index] : 0u;
     thread_sum += v[k];
   }
   uint block_total;

@@ -52,6 +52,8 @@ layout(push_constant) uniform Push {
   Vec4Array splats;
   Uvec2Array rects;
   UintArray tile_counts;
+  Uint64Array depth_keys;  // the depth sort's input: view depth bits (culled: last), Gaussian index
+  UintArray depth_values;
   UintArray counters;
   uint count;
 } pc;
@@ -156,6 +158,10 @@ void main() {
       pc.rects.v[i] = rect;
     }
     pc.tile_counts.v[i] = touched;
+    // View depth > near > 0, so its IEEE bits order like unsigned integers. Culled Gaussians touch
+    // no tile; they sort last only to keep the visible ones together.
+    pc.depth_keys.v[i] = touched > 0 ? uint64_t(floatBitsToUint(record[0].z)) : uint64_t(0xffffffffu);
+    pc.depth_values.v[i] = i;
   }
   uint visible = subgroupAdd(touched > 0 ? 1u : 0u);
   if (subgroupElect() && visible > 0) atomicAdd(pc.counters.v[COUNTER_VISIBLE], visible);

@@ -14,7 +14,7 @@ layout(push_constant) uniform Push {
   UintArray values_out;
   UintArray histogram;     // RADIX * blocks, digit-major: histogram[digit * blocks + block]
   UintArray digit_totals;  // RADIX
-  UintArray counters;
+  UintArray state;         // the sort's state block (SORT_COUNT, SORT_BLOCKS)
   uint shift;              // which 8-bit digit this pass sorts on
 } pc;
 

@@ -8,8 +8,8 @@
 shared uint s_counts[SUBGROUPS_PER_WORKGROUP * RADIX];
 
 void main() {
-  uint n = pc.counters.v[COUNTER_SORT_COUNT];
-  uint blocks = pc.counters.v[COUNTER_SORT_BLOCKS];
+  uint n = pc.state.v[SORT_COUNT];
+  uint blocks = pc.state.v[SORT_BLOCKS];
   for (uint i = gl_LocalInvocationIndex; i < SUBGROUPS_PER_WORKGROUP * RADIX; i += gl_WorkGroupSize.x)
     s_counts[i] = 0;
   barrier();

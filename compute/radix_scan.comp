@@ -9,12 +9,12 @@
 layout(push_constant) uniform Push {
   UintArray histogram;
   UintArray digit_totals;
-  UintArray counters;
+  UintArray state;  // the sort's state block
 } pc;
 
 void main() {
   uint digit = gl_WorkGroupID.x;
-  uint blocks = pc.counters.v[COUNTER_SORT_BLOCKS];
+  uint blocks = pc.state.v[SORT_BLOCKS];
   uint row = digit * blocks;
   uint linear = gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
   uint running = 0;

@@ -12,8 +12,8 @@ shared uint s_digit_base[RADIX];
 shared uint s_offsets[SUBGROUPS_PER_WORKGROUP * RADIX];
 
 void main() {
-  uint n = pc.counters.v[COUNTER_SORT_COUNT];
-  uint blocks = pc.counters.v[COUNTER_SORT_BLOCKS];
+  uint n = pc.state.v[SORT_COUNT];
+  uint blocks = pc.state.v[SORT_BLOCKS];
   if (gl_LocalInvocationIndex == 0) {
     uint running = 0;
     for (uint d = 0; d < RADIX; ++d) {

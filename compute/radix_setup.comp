@@ -6,16 +6,16 @@
 layout(local_size_x = 1) in;
 
 layout(push_constant) uniform Push {
-  UintArray counters;
+  UintArray state;  // the sort's state block
   uint block_keys;
   uint subgroups_per_workgroup;
 } pc;
 
 void main() {
-  uint n = pc.counters.v[COUNTER_SORT_COUNT];
+  uint n = pc.state.v[SORT_COUNT];
   uint blocks = (n + pc.block_keys - 1) / pc.block_keys;
-  pc.counters.v[COUNTER_SORT_BLOCKS] = blocks;
-  pc.counters.v[COUNTER_SORT_ARGS + 0] = (blocks + pc.subgroups_per_workgroup - 1) / pc.subgroups_per_workgroup;
-  pc.counters.v[COUNTER_SORT_ARGS + 1] = 1;
-  pc.counters.v[COUNTER_SORT_ARGS + 2] = 1;
+  pc.state.v[SORT_BLOCKS] = blocks;
+  pc.state.v[SORT_ARGS + 0] = (blocks + pc.subgroups_per_workgroup - 1) / pc.subgroups_per_workgroup;
+  pc.state.v[SORT_ARGS + 1] = 1;
+  pc.state.v[SORT_ARGS + 2] = 1;
 }

@@ -1,5 +1,5 @@
 #version 460
-// Tile ranges: after the sort, each tile's keys are contiguous. One invocation per key finds the
+// Tile ranges: after the tile sort, each tile's keys (tile ids) are contiguous. One invocation per key finds the
 // boundaries where the tile id changes and records [start, end) for the tiles on either side.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
@@ -17,8 +17,8 @@ void main() {
   uint i = gl_GlobalInvocationID.x;
   uint n = pc.counters.v[COUNTER_SORT_COUNT];
   if (i >= n) return;
-  uint tile = uint(pc.keys.v[i] >> 32);
-  uint prev = i == 0 ? 0xffffffffu : uint(pc.keys.v[i - 1] >> 32);
+  uint tile = uint(pc.keys.v[i]);
+  uint prev = i == 0 ? 0xffffffffu : uint(pc.keys.v[i - 1]);
   if (prev != tile) {
     if (i > 0 && prev < pc.tiles) pc.ranges.v[prev].y = i;
     if (tile < pc.tiles) pc.ranges.v[tile].x = i;

@@ -51,14 +51,15 @@ std::pair<std::vector<uint64_t>, std::vector<uint32_t>> gpu_sort(const std::stri
   vk::upload(ctx, kb.keys, keys.data(), n * 8ull);
   vk::upload(ctx, kb.values, values.data(), n * 4ull);
   vk::Buffer counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "counters");
-  FrameCounters fc{};
-  fc.sort_count = n;
-  std::memcpy(counters.mapped(), &fc, sizeof(fc));
+  SortState state{};
+  state.count = n;
+  std::memcpy(static_cast<char*>(counters.mapped()) + kTileSortOffset, &state, sizeof(state));
 
   auto sorter = make_sort_strategy(strategy, ctx);
+  sorter->reserve(capacity);
   bool in_alt = false;
   ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    SortInput input{kb, counters, key_bits};
+    SortInput input{kb, counters, kTileSortOffset, key_bits};
     in_alt = sorter->record(cmd, input);
   });
   return {read_back<uint64_t>(ctx, in_alt ? kb.keys_alt : kb.keys, n),

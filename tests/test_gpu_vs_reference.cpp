@@ -143,8 +143,8 @@ TEST(GpuRenderer, ReportsPassTimingsAndCounts) {
   const FrameStats& stats = renderer.last_frame_stats();
   std::vector<std::string> names;
   for (const auto& p : stats.passes) names.push_back(p.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"projection", "prefix_sum", "key_emission", "sort", "tile_ranges",
-                                             "composite"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"projection", "depth_sort", "prefix_sum", "key_emission", "tile_sort",
+                                             "tile_ranges", "composite"}));
   EXPECT_GT(stats.gpu_ms, 0.0);
   EXPECT_EQ(stats.gaussians, scene.size());
   EXPECT_GT(stats.visible, scene.size() / 2);

@@ -1,5 +1,9 @@
 // The frame: a fixed list of passes recorded into one command buffer.
-//   projection -> prefix sum -> key emission -> sort -> tile ranges -> composite
+//   projection -> depth sort -> prefix sum -> key emission -> tile sort -> tile ranges -> composite
+// The Gaussians are sorted by depth once; the (tile, Gaussian) pairs are then emitted front to back
+// and sorted by tile alone (stable). That is the same order as one sort of (tile << 32 | depth)
+// keys, for far fewer key bits times keys: on playbot_lod0 at 1080p, 4 digit passes over 0.5M
+// Gaussians plus 2 over 1.5M pairs instead of 6 over 1.5M.
 // Data flows one way; the only host read-back is the counters (and the image) after the fence.
 #include "tilesplat/renderer.h"
 #include "tilesplat/vulkan_interop.h"
@@ -8,6 +12,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 
 #include "passes/composite_pass.h"
@@ -111,7 +116,9 @@ struct Renderer::Impl {
     uint64_t bytes = 0;
     for (const vk::Buffer* b : {&scene.positions, &scene.log_scales, &scene.rotations, &scene.opacity_logits,
                                 &scene.sh, &projected.splats, &projected.rects, &projected.tile_counts,
-                                &projected.offsets, &keys.keys, &keys.keys_alt, &keys.values, &keys.values_alt,
+                                &projected.offsets, &projected.depth_order.keys, &projected.depth_order.keys_alt,
+                                &projected.depth_order.values, &projected.depth_order.values_alt, &keys.keys,
+                                &keys.keys_alt, &keys.values, &keys.values_alt,
                                 &ranges, &outputs.rgba, &outputs.depth, &outputs.count, &counters})
       bytes += b->size();
     bytes += prefix_sum.device_bytes();
@@ -125,29 +132,38 @@ struct Renderer::Impl {
     const uint32_t tiles_y = vk::div_ceil(uint32_t(camera.height), kTileSize);
     const uint32_t tiles = tiles_x * tiles_y;
     // Tile ids run to `tiles` inclusive: the key emission's padding uses that id (never in practice).
-    const uint32_t key_bits = 32 + uint32_t(std::bit_width(tiles));
+    const uint32_t tile_bits = uint32_t(std::bit_width(tiles));
+    constexpr uint32_t kDepthBits = 32;  // the float bits of the view depth
     const uint32_t n = scene.count;
 
+    sorter.reserve(std::max(n, keys.capacity));
     VkCommandBuffer cmd = ctx.begin_one_time();
     timer.begin_frame(cmd);
     vkCmdFillBuffer(cmd, counters.handle(), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, ranges.handle(), 0, VK_WHOLE_SIZE, 0);
+    vkCmdFillBuffer(cmd, counters.handle(), kDepthSortOffset + offsetof(SortState, count), sizeof(uint32_t), n);
     vk::barrier(cmd);
 
     projection.record(cmd, scene, projected, counters.address());
     vk::barrier(cmd);
     timer.mark(cmd, "projection");
 
-    prefix_sum.record(cmd, projected.tile_counts.address(), projected.offsets.address(), n, counters.address());
+    SortInput depth_input{projected.depth_order, counters, kDepthSortOffset, kDepthBits};
+    const vk::Buffer& depth_order =
+        sorter.record(cmd, depth_input) ? projected.depth_order.values_alt : projected.depth_order.values;
+    timer.mark(cmd, "depth_sort");
+
+    prefix_sum.record(cmd, projected.tile_counts.address(), projected.offsets.address(), n, counters.address(),
+                      depth_order.address());
     timer.mark(cmd, "prefix_sum");
 
-    key_emission.record(cmd, projected, keys, n, tiles_x, tiles, counters.address());
+    key_emission.record(cmd, projected, depth_order, keys, n, tiles_x, tiles, counters.address());
     vk::barrier(cmd);
     timer.mark(cmd, "key_emission");
 
-    SortInput input{keys, counters, key_bits};
-    const bool sorted_in_alt = sorter.record(cmd, input);
-    timer.mark(cmd, "sort");
+    SortInput tile_input{keys, counters, kTileSortOffset, tile_bits};
+    const bool sorted_in_alt = sorter.record(cmd, tile_input);
+    timer.mark(cmd, "tile_sort");
 
     const vk::Buffer& sorted_keys = sorted_in_alt ? keys.keys_alt : keys.keys;
     const vk::Buffer& sorted_values = sorted_in_alt ? keys.values_alt : keys.values;
@@ -169,7 +185,7 @@ struct Renderer::Impl {
 
     FrameCounters result;
     std::memcpy(&result, counters.mapped(), sizeof(result));
-    stats.sort_bits = key_bits;
+    stats.sort_bits = kDepthBits + tile_bits;
     return result;
   }
 
@@ -195,7 +211,7 @@ struct Renderer::Impl {
     for (const auto& section : timer.read(&stats.gpu_ms)) stats.passes.push_back({section.name, section.ms});
     stats.gaussians = scene.count;
     stats.visible = frame.visible;
-    stats.intersections = frame.sort_count;
+    stats.intersections = frame.tile_sort.count;
     stats.device_bytes = device_bytes();
   }
 
@@ -266,6 +282,11 @@ void Renderer::set_scene(const GaussianScene& scene) {
   p.rects = make_buffer<uint64_t>(r.ctx, n, "tile rects");
   p.tile_counts = make_buffer<uint32_t>(r.ctx, n, "tile counts");
   p.offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets");
+  p.depth_order.keys = make_buffer<uint64_t>(r.ctx, n, "depth keys");
+  p.depth_order.keys_alt = make_buffer<uint64_t>(r.ctx, n, "depth keys (ping-pong)");
+  p.depth_order.values = make_buffer<uint32_t>(r.ctx, n, "depth order");
+  p.depth_order.values_alt = make_buffer<uint32_t>(r.ctx, n, "depth order (ping-pong)");
+  p.depth_order.capacity = uint32_t(n);
   r.ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)));
 }
 

@@ -45,7 +45,7 @@ struct FrameStats {
   uint64_t gaussians = 0;
   uint64_t visible = 0;            // Gaussians touching at least one tile
   uint64_t intersections = 0;      // (Gaussian, tile) pairs sorted
-  uint32_t sort_bits = 0;          // key bits the sort processed
+  uint32_t sort_bits = 0;          // key bits sorted: 32 depth bits (per Gaussian) + the tile bits (per pair)
   int retries = 0;                 // re-renders after growing the intersection buffers
   uint64_t device_bytes = 0;       // device memory held by the renderer's buffers
 };

@@ -1,24 +1,36 @@
 // Layout of the small GPU counter buffer each frame writes and the host reads after it.
-// Must match the COUNTER_* constants in compute/common.glsl.
+// Must match the COUNTER_* and SORT_* constants in compute/common.glsl.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace tilesplat {
 
-struct FrameCounters {
-  uint32_t intersections;  // (Gaussian, tile) pairs wanted
-  uint32_t sort_count;     // pairs emitted and sorted (capped by capacity)
-  uint32_t overflow;       // 1 when the key buffers were too small
-  uint32_t visible;        // Gaussians touching at least one tile
-  uint32_t ranges_args[4]; // indirect dispatch of the tile-range pass (+ padding)
-  uint32_t sort_args[3];   // indirect dispatch of the sort's per-block passes
-  uint32_t sort_blocks;
-  uint32_t reserved[4];
+// One sort's state: the key count (set before the sort runs) and what the sort derives from it on
+// the GPU. A sort strategy is handed the buffer and offset of its block.
+struct SortState {
+  uint32_t count;    // keys to sort
+  uint32_t blocks;   // blocks the strategy split them into
+  uint32_t args[3];  // indirect dispatch of the strategy's per-block passes
+  uint32_t reserved[3];
 };
-static_assert(sizeof(FrameCounters) == 64);
+static_assert(sizeof(SortState) == 32);
 
-constexpr uint32_t kRangesArgsOffset = 4 * sizeof(uint32_t);
-constexpr uint32_t kSortArgsOffset = 8 * sizeof(uint32_t);
+struct FrameCounters {
+  uint32_t intersections;   // (Gaussian, tile) pairs wanted
+  uint32_t reserved0;
+  uint32_t overflow;        // 1 when the key buffers were too small
+  uint32_t visible;         // Gaussians touching at least one tile
+  uint32_t ranges_args[4];  // indirect dispatch of the tile-range pass (+ padding)
+  SortState depth_sort;     // the Gaussians by view depth
+  SortState tile_sort;      // the (tile, Gaussian) pairs by tile; count = pairs emitted (capped by capacity)
+};
+static_assert(sizeof(FrameCounters) == 96);
+
+constexpr uint32_t kRangesArgsOffset = offsetof(FrameCounters, ranges_args);
+constexpr uint32_t kDepthSortOffset = offsetof(FrameCounters, depth_sort);
+constexpr uint32_t kTileSortOffset = offsetof(FrameCounters, tile_sort);
+constexpr uint32_t kSortArgsOffset = offsetof(SortState, args);  // within a SortState
 
 }  // namespace tilesplat

@@ -1,24 +1,21 @@
 // Frame setup + key emission: caps the key count at the buffers' capacity, sizes the indirect
-// dispatches, then writes one (tile << 32 | depth bits, Gaussian index) pair per touched tile.
+// dispatches, then writes one (tile id, Gaussian index) pair per touched tile, front to back.
 #pragma once
 
+#include "passes/key_buffers.h"
 #include "passes/projection_pass.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
 
 namespace tilesplat {
 
-// The key/value pairs the sort orders, double-buffered for the sort's ping-pong.
-struct KeyBuffers {
-  vk::Buffer keys, values, keys_alt, values_alt;
-  uint32_t capacity = 0;
-};
-
 class KeyEmissionPass {
  public:
   explicit KeyEmissionPass(vk::Context& ctx);
-  void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, KeyBuffers& keys, uint32_t gaussians,
-              uint32_t tiles_x, uint32_t tiles, VkDeviceAddress counters);
+  // depth_order: the Gaussian indices front to back (the depth sort's values); projected.offsets
+  // must hold the prefix sum of the tile counts taken in that order.
+  void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer& depth_order, KeyBuffers& keys,
+              uint32_t gaussians, uint32_t tiles_x, uint32_t tiles, VkDeviceAddress counters);
 
  private:
   vk::ComputePipeline frame_setup_;

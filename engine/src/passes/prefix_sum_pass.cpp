@@ -4,8 +4,8 @@ namespace tilesplat {
 
 namespace {
 struct BlocksPush {
-  VkDeviceAddress src, dst, block_sums;
-  uint32_t count, pad;
+  VkDeviceAddress src, dst, block_sums, order;
+  uint32_t count, gather;
 };
 struct AddPush {
   VkDeviceAddress data, block_offsets;
@@ -19,7 +19,7 @@ PrefixSumPass::PrefixSumPass(vk::Context& ctx)
       add_offsets_(ctx, "prefix_sum_add", sizeof(AddPush)) {}
 
 void PrefixSumPass::record(VkCommandBuffer cmd, VkDeviceAddress src, VkDeviceAddress dst, uint32_t count,
-                           VkDeviceAddress total) {
+                           VkDeviceAddress total, VkDeviceAddress order) {
   if (count == 0) return;  // the caller's total stays at the zero it was cleared to
   // Levels: level 0 scans `count` values; level k scans the block totals of level k - 1.
   struct Level {
@@ -41,7 +41,8 @@ void PrefixSumPass::record(VkCommandBuffer cmd, VkDeviceAddress src, VkDeviceAdd
   for (size_t k = 0; k < levels.size(); ++k) {
     VkDeviceAddress in = k == 0 ? src : levels[k].data;
     VkDeviceAddress sums = k + 1 < levels.size() ? levels[k + 1].data : total;
-    scan_blocks_.bind(cmd, BlocksPush{in, levels[k].data, sums, levels[k].count, 0});
+    const bool gather = k == 0 && order != 0;
+    scan_blocks_.bind(cmd, BlocksPush{in, levels[k].data, sums, gather ? order : in, levels[k].count, gather});
     scan_blocks_.dispatch(cmd, vk::div_ceil(levels[k].count, kBlock));
     vk::barrier(cmd);
   }

@@ -15,7 +15,10 @@ class PrefixSumPass {
 
   explicit PrefixSumPass(vk::Context& ctx);
   // dst[i] = src[0] + ... + src[i-1] for i < count (dst may alias src); *total = sum of all.
-  void record(VkCommandBuffer cmd, VkDeviceAddress src, VkDeviceAddress dst, uint32_t count, VkDeviceAddress total);
+  // With an order (uint indices), the values are taken as src[order[0]], src[order[1]], ... instead;
+  // dst must not alias src then.
+  void record(VkCommandBuffer cmd, VkDeviceAddress src, VkDeviceAddress dst, uint32_t count, VkDeviceAddress total,
+              VkDeviceAddress order = 0);
   uint64_t device_bytes() const;
 
  private:

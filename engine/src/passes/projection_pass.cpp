@@ -22,7 +22,7 @@ static_assert(sizeof(CameraParams) == 160);
 
 struct ProjectionPush {
   VkDeviceAddress positions, log_scales, rotations, opacity_logits, sh, camera;
-  VkDeviceAddress splats, rects, tile_counts, counters;
+  VkDeviceAddress splats, rects, tile_counts, depth_keys, depth_values, counters;
   uint32_t count;
   uint32_t pad;
 };
@@ -68,7 +68,8 @@ void ProjectionPass::record(VkCommandBuffer cmd, const SceneBuffers& scene, Proj
                             VkDeviceAddress counters) {
   ProjectionPush push{scene.positions.address(), scene.log_scales.address(), scene.rotations.address(),
                       scene.opacity_logits.address(), scene.sh.address(), camera_params_.address(),
-                      out.splats.address(), out.rects.address(), out.tile_counts.address(), counters,
+                      out.splats.address(), out.rects.address(), out.tile_counts.address(),
+                      out.depth_order.keys.address(), out.depth_order.values.address(), counters,
                       scene.count, 0};
   const auto& pipeline = pipeline_for(scene.sh_degree);
   pipeline.bind(cmd, push);

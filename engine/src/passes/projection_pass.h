@@ -3,6 +3,7 @@
 
 #include <map>
 
+#include "passes/key_buffers.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
 
@@ -25,7 +26,8 @@ struct ProjectedBuffers {
   vk::Buffer splats;       // kSplatRecordBytes per Gaussian
   vk::Buffer rects;        // uvec2 per Gaussian: packed tile rect
   vk::Buffer tile_counts;  // uint per Gaussian: tiles touched, 0 = culled
-  vk::Buffer offsets;      // uint per Gaussian: exclusive prefix sum of tile_counts
+  vk::Buffer offsets;      // uint per Gaussian: exclusive prefix sum of tile_counts in depth order
+  KeyBuffers depth_order;  // the depth sort's pairs: view depth bits (culled: last), Gaussian index
 };
 
 class ProjectionPass {

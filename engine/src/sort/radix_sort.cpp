@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 
 #include "passes/frame_counters.h"
 
@@ -15,15 +16,15 @@ constexpr uint32_t kDigitBits = 8;
 constexpr uint32_t kStepsPerBlock = 256;
 
 struct SetupPush {
-  VkDeviceAddress counters;
+  VkDeviceAddress state;
   uint32_t block_keys, subgroups_per_workgroup;
 };
 struct PassPush {
-  VkDeviceAddress keys_in, values_in, keys_out, values_out, histogram, digit_totals, counters;
+  VkDeviceAddress keys_in, values_in, keys_out, values_out, histogram, digit_totals, state;
   uint32_t shift, pad;
 };
 struct ScanPush {
-  VkDeviceAddress histogram, digit_totals, counters;
+  VkDeviceAddress histogram, digit_totals, state;
 };
 
 uint32_t workgroup_subgroups(const vk::Context& ctx) {
@@ -48,15 +49,24 @@ RadixSort::RadixSort(vk::Context& ctx)
   digit_totals_ = vk::Buffer(ctx, kRadix * sizeof(uint32_t), vk::MemoryUse::Device, "radix digit totals");
 }
 
-bool RadixSort::record(VkCommandBuffer cmd, SortInput& input) {
-  KeyBuffers& kb = input.keys;
-  const uint64_t max_blocks = std::max<uint64_t>(1, (uint64_t(kb.capacity) + block_keys_ - 1) / block_keys_);
-  const VkDeviceSize histogram_bytes = max_blocks * kRadix * sizeof(uint32_t);
+uint32_t RadixSort::blocks_for(uint32_t keys) const {
+  return std::max<uint32_t>(1, uint32_t((uint64_t(keys) + block_keys_ - 1) / block_keys_));
+}
+
+void RadixSort::reserve(uint32_t max_keys) {
+  const VkDeviceSize histogram_bytes = VkDeviceSize(blocks_for(max_keys)) * kRadix * sizeof(uint32_t);
   if (histogram_.size() < histogram_bytes)
     histogram_ = vk::Buffer(ctx_, histogram_bytes, vk::MemoryUse::Device, "radix histogram");
+}
 
-  const VkDeviceAddress counters = input.counters.address();
-  setup_.bind(cmd, SetupPush{counters, block_keys_, subgroups_per_workgroup_});
+bool RadixSort::record(VkCommandBuffer cmd, SortInput& input) {
+  KeyBuffers& kb = input.keys;
+  if (histogram_.size() < VkDeviceSize(blocks_for(kb.capacity)) * kRadix * sizeof(uint32_t))
+    throw std::logic_error("radix sort: reserve() was not called for " + std::to_string(kb.capacity) + " keys");
+
+  const VkDeviceAddress state = input.state.address() + input.state_offset;
+  const VkDeviceSize args_offset = input.state_offset + kSortArgsOffset;
+  setup_.bind(cmd, SetupPush{state, block_keys_, subgroups_per_workgroup_});
   setup_.dispatch(cmd, 1);
   vk::barrier(cmd);
 
@@ -68,15 +78,15 @@ bool RadixSort::record(VkCommandBuffer cmd, SortInput& input) {
     const vk::Buffer& keys_out = in_alt ? kb.keys : kb.keys_alt;
     const vk::Buffer& values_out = in_alt ? kb.values : kb.values_alt;
     PassPush push{keys_in.address(),    values_in.address(),     keys_out.address(), values_out.address(),
-                  histogram_.address(), digit_totals_.address(), counters,           p * kDigitBits, 0};
+                  histogram_.address(), digit_totals_.address(), state,              p * kDigitBits, 0};
     histogram_pass_.bind(cmd, push);
-    histogram_pass_.dispatch_indirect(cmd, input.counters.handle(), kSortArgsOffset);
+    histogram_pass_.dispatch_indirect(cmd, input.state.handle(), args_offset);
     vk::barrier(cmd);
-    scan_pass_.bind(cmd, ScanPush{histogram_.address(), digit_totals_.address(), counters});
+    scan_pass_.bind(cmd, ScanPush{histogram_.address(), digit_totals_.address(), state});
     scan_pass_.dispatch(cmd, kRadix);
     vk::barrier(cmd);
     scatter_pass_.bind(cmd, push);
-    scatter_pass_.dispatch_indirect(cmd, input.counters.handle(), kSortArgsOffset);
+    scatter_pass_.dispatch_indirect(cmd, input.state.handle(), args_offset);
     vk::barrier(cmd);
     in_alt = !in_alt;
   }

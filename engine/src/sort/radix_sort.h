@@ -13,12 +13,15 @@ class RadixSort final : public SortStrategy {
  public:
   explicit RadixSort(vk::Context& ctx);
   std::string name() const override { return "radix"; }
+  void reserve(uint32_t max_keys) override;
   bool record(VkCommandBuffer cmd, SortInput& input) override;
   uint64_t device_bytes() const override { return histogram_.size() + digit_totals_.size(); }
 
   uint32_t block_keys() const { return block_keys_; }
 
  private:
+  uint32_t blocks_for(uint32_t keys) const;
+
   vk::Context& ctx_;
   uint32_t subgroups_per_workgroup_;
   uint32_t block_keys_;

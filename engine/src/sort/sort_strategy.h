@@ -1,28 +1,35 @@
-// The key sort as a swappable strategy. Every strategy must produce the same order: ascending 64-bit
-// keys, equal keys in their input order (the key emission writes them in Gaussian index order).
+// The key sort as a swappable strategy. A frame sorts twice with it: the Gaussians by view depth,
+// then the (tile, Gaussian) pairs by tile. Every strategy must produce the same order: ascending
+// 64-bit keys, equal keys in their input order (a stable sort), which is what makes the two sorts
+// together equal to one sort by (tile, depth, Gaussian index).
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "passes/key_emission_pass.h"
+#include "passes/key_buffers.h"
 #include "vulkan/buffer.h"
 #include "vulkan/context.h"
 
 namespace tilesplat {
 
 struct SortInput {
-  KeyBuffers& keys;           // input in keys/values; keys_alt/values_alt are scratch of equal size
-  const vk::Buffer& counters; // COUNTER_SORT_COUNT holds this frame's key count (set on the GPU)
-  uint32_t key_bits = 64;     // only the low key_bits bits vary; higher bits are zero
+  KeyBuffers& keys;              // input in keys/values; keys_alt/values_alt are scratch of equal size
+  const vk::Buffer& state;       // holds this sort's SortState (frame_counters.h) at state_offset;
+  VkDeviceSize state_offset;     //   its count is set on the GPU before the sort runs
+  uint32_t key_bits = 64;        // only the low key_bits bits vary; higher bits are zero
 };
 
 class SortStrategy {
  public:
   virtual ~SortStrategy() = default;
   virtual std::string name() const = 0;
-  // Records the sort. Returns true when the sorted result is in keys_alt/values_alt rather than
+  // Sizes the strategy's scratch for sorts of up to max_keys keys. Called outside command buffer
+  // recording: a frame records two sorts, and scratch replaced between them would be freed while
+  // the first one still uses it.
+  virtual void reserve(uint32_t max_keys) = 0;
+  // Records the sort (input.keys.capacity <= the reserved size). Returns true when the sorted result is in keys_alt/values_alt rather than
   // keys/values. The count is read on the GPU; the recording may not depend on it.
   virtual bool record(VkCommandBuffer cmd, SortInput& input) = 0;
   // Scratch memory the strategy holds, for the memory report.
