@@ -1,8 +1,8 @@
 #version 460
-// Key emission: one invocation per position in the depth order writes, for every tile its Gaussian's
-// ellipse covers, the tile id as the key and the Gaussian's index as the value, at the offset the
-// prefix sum (taken in the same depth order) gave it. The pairs come out front to back, equal depths
-// by Gaussian index, so the stable tile sort that follows leaves each tile's run in exactly the
+// Key emission, step 2: one invocation per Gaussian writes, for every tile its ellipse covers, the
+// tile id as the key and the Gaussian's index as the value, at the offset the prefix sum gave it.
+// The offsets were taken in depth order, so the pairs lie front to back in memory, equal depths by
+// Gaussian index, and the stable tile sort that follows leaves each tile's run in exactly the
 // (tile, depth, index) order of the reference, with only the tile bits to sort.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
@@ -14,8 +14,7 @@ layout(push_constant) uniform Push {
   Vec4Array splats;
   Uvec2Array rects;
   UintArray tile_counts;
-  UintArray depth_order;  // Gaussian indices, front to back
-  UintArray offsets;      // exclusive prefix sum of tile_counts taken in depth order
+  UintArray offsets;  // per Gaussian: where its pairs start (scatter_offsets.comp)
   Uint64Array keys;
   UintArray values;
   uint count;
@@ -26,12 +25,11 @@ layout(push_constant) uniform Push {
 } pc;
 
 void main() {
-  uint position = gl_GlobalInvocationID.x;
-  if (position >= pc.count) return;
-  uint i = pc.depth_order.v[position];
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= pc.count) return;
   uint n = pc.tile_counts.v[i];
   if (n == 0) return;
-  uint offset = pc.offsets.v[position];
+  uint offset = pc.offsets.v[i];
   if (uint64_t(offset) + n > pc.capacity) return;  // overflow: the frame is re-run with larger buffers
   uvec2 rect = pc.rects.v[i];
   uvec2 lo = uvec2(rect.x & 0xffffu, rect.x >> 16);

@@ -116,7 +116,7 @@ struct Renderer::Impl {
     uint64_t bytes = 0;
     for (const vk::Buffer* b : {&scene.positions, &scene.log_scales, &scene.rotations, &scene.opacity_logits,
                                 &scene.sh, &projected.splats, &projected.rects, &projected.tile_counts,
-                                &projected.offsets, &projected.depth_order.keys, &projected.depth_order.keys_alt,
+                                &projected.offsets, &projected.depth_offsets, &projected.depth_order.keys, &projected.depth_order.keys_alt,
                                 &projected.depth_order.values, &projected.depth_order.values_alt, &keys.keys,
                                 &keys.keys_alt, &keys.values, &keys.values_alt,
                                 &ranges, &outputs.rgba, &outputs.depth, &outputs.count, &counters})
@@ -153,7 +153,7 @@ struct Renderer::Impl {
         sorter.record(cmd, depth_input) ? projected.depth_order.values_alt : projected.depth_order.values;
     timer.mark(cmd, "depth_sort");
 
-    prefix_sum.record(cmd, projected.tile_counts.address(), projected.offsets.address(), n, counters.address(),
+    prefix_sum.record(cmd, projected.tile_counts.address(), projected.depth_offsets.address(), n, counters.address(),
                       depth_order.address());
     timer.mark(cmd, "prefix_sum");
 
@@ -281,6 +281,7 @@ void Renderer::set_scene(const GaussianScene& scene) {
   p.splats = vk::Buffer(r.ctx, n * kSplatRecordBytes, vk::MemoryUse::Device, "projected splats");
   p.rects = make_buffer<uint64_t>(r.ctx, n, "tile rects");
   p.tile_counts = make_buffer<uint32_t>(r.ctx, n, "tile counts");
+  p.depth_offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets (depth order)");
   p.offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets");
   p.depth_order.keys = make_buffer<uint64_t>(r.ctx, n, "depth keys");
   p.depth_order.keys_alt = make_buffer<uint64_t>(r.ctx, n, "depth keys (ping-pong)");

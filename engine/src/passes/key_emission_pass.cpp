@@ -7,23 +7,32 @@ struct SetupPush {
   VkDeviceAddress counters;
   uint32_t capacity, pad;
 };
+struct ScatterPush {
+  VkDeviceAddress depth_order, depth_offsets, offsets;
+  uint32_t count, pad;
+};
 struct EmitPush {
-  VkDeviceAddress splats, rects, tile_counts, depth_order, offsets, keys, values;
+  VkDeviceAddress splats, rects, tile_counts, offsets, keys, values;
   uint32_t count, tiles_x, capacity, tiles, pad[2];
 };
 }  // namespace
 
 KeyEmissionPass::KeyEmissionPass(vk::Context& ctx)
-    : frame_setup_(ctx, "frame_setup", sizeof(SetupPush)), emit_keys_(ctx, "key_emission", sizeof(EmitPush)) {}
+    : frame_setup_(ctx, "frame_setup", sizeof(SetupPush)),
+      scatter_offsets_(ctx, "scatter_offsets", sizeof(ScatterPush)),
+      emit_keys_(ctx, "key_emission", sizeof(EmitPush)) {}
 
 void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer& depth_order,
                              KeyBuffers& keys, uint32_t gaussians, uint32_t tiles_x, uint32_t tiles,
                              VkDeviceAddress counters) {
   frame_setup_.bind(cmd, SetupPush{counters, keys.capacity, 0});
   frame_setup_.dispatch(cmd, 1);
+  scatter_offsets_.bind(cmd, ScatterPush{depth_order.address(), projected.depth_offsets.address(),
+                                         projected.offsets.address(), gaussians, 0});
+  scatter_offsets_.dispatch(cmd, vk::div_ceil(gaussians, 256));
+  vk::barrier(cmd);
   emit_keys_.bind(cmd, EmitPush{projected.splats.address(), projected.rects.address(),
-                                projected.tile_counts.address(), depth_order.address(), projected.offsets.address(),
-                                keys.keys.address(),
+                                projected.tile_counts.address(), projected.offsets.address(), keys.keys.address(),
                                 keys.values.address(), gaussians, tiles_x, keys.capacity, tiles, {0, 0}});
   emit_keys_.dispatch(cmd, vk::div_ceil(gaussians, 256));
 }

@@ -1,5 +1,6 @@
 // Frame setup + key emission: caps the key count at the buffers' capacity, sizes the indirect
-// dispatches, then writes one (tile id, Gaussian index) pair per touched tile, front to back.
+// dispatches, hands each Gaussian its offset from the depth-order prefix sum, then writes one
+// (tile id, Gaussian index) pair per touched tile, front to back.
 #pragma once
 
 #include "passes/key_buffers.h"
@@ -12,13 +13,14 @@ namespace tilesplat {
 class KeyEmissionPass {
  public:
   explicit KeyEmissionPass(vk::Context& ctx);
-  // depth_order: the Gaussian indices front to back (the depth sort's values); projected.offsets
-  // must hold the prefix sum of the tile counts taken in that order.
+  // depth_order: the Gaussian indices front to back (the depth sort's values);
+  // projected.depth_offsets: the prefix sum of the tile counts taken in that order.
   void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer& depth_order, KeyBuffers& keys,
               uint32_t gaussians, uint32_t tiles_x, uint32_t tiles, VkDeviceAddress counters);
 
  private:
   vk::ComputePipeline frame_setup_;
+  vk::ComputePipeline scatter_offsets_;
   vk::ComputePipeline emit_keys_;
 };
 

@@ -26,7 +26,8 @@ struct ProjectedBuffers {
   vk::Buffer splats;       // kSplatRecordBytes per Gaussian
   vk::Buffer rects;        // uvec2 per Gaussian: packed tile rect
   vk::Buffer tile_counts;  // uint per Gaussian: tiles touched, 0 = culled
-  vk::Buffer offsets;      // uint per Gaussian: exclusive prefix sum of tile_counts in depth order
+  vk::Buffer depth_offsets;  // uint per depth position: exclusive prefix sum of tile_counts in depth order
+  vk::Buffer offsets;        // uint per Gaussian: where its (tile, Gaussian) pairs start (the same sums)
   KeyBuffers depth_order;  // the depth sort's pairs: view depth bits (culled: last), Gaussian index
 };
 
