@@ -1,10 +1,13 @@
-// tilesplat-bench: times the renderer's passes over repeated frames, per sort strategy.
+// tilesplat-bench: times the renderer's passes over repeated frames, per sort strategy; or, with
+// --sort-bench, the sort strategies alone on random keys against CPU sorts on the same keys.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <numeric>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -12,6 +15,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/sort.h"
 
 namespace {
 
@@ -26,6 +30,9 @@ struct BenchOptions {
   int repeat = 10;
   std::string csv;
   std::string json;
+  bool sort_bench = false;
+  std::vector<int> sort_sizes{10, 12, 14, 16, 18, 20, 22, 24};  // log2 of the key counts
+  std::vector<int> key_bits{32, 64};
 };
 
 enum class Unit { kMilliseconds, kCount, kMebibytes };
@@ -121,7 +128,8 @@ class Collector {
 // "[#####     ] 12/20 frames" redrawn in place on a terminal; occasional lines otherwise.
 class Progress {
  public:
-  Progress(int total, bool terminal) : total_(total), terminal_(terminal) {}
+  Progress(int total, bool terminal, std::string unit = "frames")
+      : total_(total), terminal_(terminal), unit_(std::move(unit)) {}
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
   ~Progress() { finish(); }
@@ -137,7 +145,7 @@ class Progress {
       const int filled = static_cast<int>(static_cast<long long>(done) * kBarWidth / total_);
       std::string line = "\r[" + std::string(static_cast<size_t>(filled), '#') +
                          std::string(static_cast<size_t>(kBarWidth - filled), ' ') + "] " + std::to_string(done) +
-                         "/" + std::to_string(total_) + " frames (" + label + ")";
+                         "/" + std::to_string(total_) + " " + unit_ + " (" + label + ")";
       const size_t visible = line.size() - 1;
       if (visible < width_) line.append(width_ - visible, ' ');
       width_ = std::max(width_, visible);
@@ -149,7 +157,7 @@ class Progress {
       const int quarter = static_cast<int>(static_cast<long long>(done) * 4 / total_);
       if (quarter <= last_quarter_ || (total_ < 8 && done < total_)) return;
       last_quarter_ = quarter;
-      std::fprintf(stderr, "%s: %d/%d frames (%s)\n", kProgram, done, total_, label.c_str());
+      std::fprintf(stderr, "%s: %d/%d %s (%s)\n", kProgram, done, total_, unit_.c_str(), label.c_str());
     }
   }
 
@@ -167,6 +175,7 @@ class Progress {
  private:
   int total_;
   bool terminal_;
+  std::string unit_;
   bool drawn_ = false;
   size_t width_ = 0;
   int last_quarter_ = 0;
@@ -324,6 +333,16 @@ std::string make_json(const std::vector<StrategyResult>& results, const RunInfo&
 
 // ---------------------------------------------------------------------------------------------
 
+std::vector<int> parse_int_list(std::string_view flag, const std::string& text, int min, int max) {
+  std::vector<int> values;
+  for (const auto& part : cli::split(text, ',')) {
+    const int value = cli::parse_int(flag, part, min, max);
+    if (std::find(values.begin(), values.end(), value) == values.end()) values.push_back(value);
+  }
+  if (values.empty()) throw cli::UsageError(std::string(flag) + " needs at least one value");
+  return values;
+}
+
 void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
   cli::add_common_options(parser, options.common, cli::SortChoice::kList);
 
@@ -335,6 +354,200 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     &options.csv);
   parser.add_string("--json", "FILE.json", "also write the results, every sample included, as JSON",
                     &options.json);
+
+  parser.section("sort micro-benchmark");
+  parser.add_switch("--sort-bench",
+                    "time the sort strategies alone on random keys (no SCENE), with std::sort and a CPU "
+                    "radix sort on the same keys for comparison; --warmup and --repeat count sorts",
+                    &options.sort_bench);
+  parser.add_value("--sort-sizes", "E[,E...]",
+                   "key counts as powers of two, each 0 to 26 (default 10,12,14,16,18,20,22,24)",
+                   [&options](const std::string& text) { options.sort_sizes = parse_int_list("--sort-sizes", text, 0, 26); });
+  parser.add_value("--key-bits", "B[,B...]", "key widths in bits, each 1 to 64 (default 32,64)",
+                   [&options](const std::string& text) { options.key_bits = parse_int_list("--key-bits", text, 1, 64); });
+}
+
+// ---------------------------------------------------------------------------------------------
+// The sort micro-benchmark: keys per second against key count, per strategy and key width, with
+// the CPU sorts measured in the same run so that every figure is also a ratio on this machine.
+
+struct SortRow {
+  int key_bits = 0;
+  uint64_t keys = 0;
+  std::string sorter;
+  std::string where;  // "gpu" (GPU timestamps of the sort alone) or "cpu" (wall clock, one thread)
+  std::vector<double> ms;
+};
+
+std::vector<uint64_t> random_keys(uint64_t n, int bits, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const uint64_t mask = bits >= 64 ? ~0ull : (1ull << bits) - 1;
+  std::vector<uint64_t> keys(n);
+  for (auto& key : keys) key = rng() & mask;
+  return keys;
+}
+
+template <typename F>
+double wall_ms(F&& body) {
+  const auto start = std::chrono::steady_clock::now();
+  body();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// std::sort on (key, position) pairs: the same job as the strategies' (ascending keys, equal keys in
+// input order), done the way a C++ programmer would without a radix sort.
+double time_std_sort(const std::vector<uint64_t>& keys) {
+  std::vector<std::pair<uint64_t, uint32_t>> pairs(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i) pairs[i] = {keys[i], uint32_t(i)};
+  return wall_ms([&] { std::sort(pairs.begin(), pairs.end()); });
+}
+
+double time_cpu_radix(const std::vector<uint64_t>& keys, int bits, std::vector<uint32_t>* order) {
+  std::vector<uint64_t> sorted = keys;
+  std::vector<uint32_t> values(keys.size());
+  std::iota(values.begin(), values.end(), 0u);
+  const double ms = wall_ms([&] { tilesplat::cpu_radix_sort(sorted, values, uint32_t(bits)); });
+  if (order) *order = std::move(values);
+  return ms;
+}
+
+double median_ms(const SortRow& row) { return summarize(row.ms).median; }
+
+std::string make_sort_csv(const std::vector<SortRow>& rows, const tilesplat::DeviceInfo& device) {
+  std::string csv = "device,key_bits,keys,sorter,where,median_ms,min_ms,max_ms,mkeys_per_s,vs_std_sort,samples\n";
+  for (const auto& row : rows) {
+    const Summary s = summarize(row.ms);
+    double std_ms = 0;
+    for (const auto& other : rows)
+      if (other.key_bits == row.key_bits && other.keys == row.keys && other.sorter == "std::sort")
+        std_ms = median_ms(other);
+    csv += csv_field(device.name) + "," + std::to_string(row.key_bits) + "," + std::to_string(row.keys) + "," +
+           csv_field(row.sorter) + "," + row.where + "," + json_number(s.median) + "," + json_number(s.min) + "," +
+           json_number(s.max) + "," + json_number(s.median > 0 ? double(row.keys) / s.median / 1e3 : 0) + "," +
+           json_number(s.median > 0 ? std_ms / s.median : 0) + "," + std::to_string(row.ms.size()) + "\n";
+  }
+  return csv;
+}
+
+std::string make_sort_json(const std::vector<SortRow>& rows, const tilesplat::DeviceInfo& device,
+                           const BenchOptions& options) {
+  std::string json = "{\n  \"tool\": \"tilesplat-bench --sort-bench\",\n";
+  json += "  \"device\": {\"name\": " + json_string(device.name) + ", \"driver\": " + json_string(device.driver) +
+          ", \"subgroup_size\": " + std::to_string(device.subgroup_size) + "},\n";
+  json += "  \"warmup\": " + std::to_string(options.warmup) + ",\n  \"repeat\": " + std::to_string(options.repeat) +
+          ",\n  \"results\": [";
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto& row = rows[i];
+    const Summary s = summarize(row.ms);
+    json += i ? ",\n" : "\n";
+    json += "    {\"key_bits\": " + std::to_string(row.key_bits) + ", \"keys\": " + std::to_string(row.keys) +
+            ", \"sorter\": " + json_string(row.sorter) + ", \"where\": \"" + row.where +
+            "\", \"median_ms\": " + json_number(s.median) + ", \"min_ms\": " + json_number(s.min) +
+            ", \"max_ms\": " + json_number(s.max) + ", \"samples_ms\": [";
+    for (size_t k = 0; k < row.ms.size(); ++k) json += (k ? ", " : "") + json_number(row.ms[k]);
+    json += "]}";
+  }
+  json += "\n  ]\n}\n";
+  return json;
+}
+
+int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
+  if (!options.common.scene.empty())
+    throw cli::UsageError("--sort-bench sorts random keys and takes no SCENE");
+  for (const char* flag : {"--cameras", "--view", "--width", "--height", "--azimuth", "--elevation", "--fov",
+                           "--distance", "--strict"})
+    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --sort-bench");
+  cli::check_distinct_paths({{"--csv", options.csv}, {"--json", options.json}});
+  if (!options.csv.empty()) cli::check_output_path(options.csv, "--csv");
+  if (!options.json.empty()) cli::check_output_path(options.json, "--json");
+
+  std::vector<std::string> sorts = options.common.sorts;
+  if (sorts.empty()) sorts = tilesplat::sort_strategies();
+  const auto renderer = tilesplat::Renderer::create(cli::renderer_options(options.common));
+  const tilesplat::DeviceInfo device = renderer->device_info();
+  std::printf("device  %s (driver %s), subgroup size %u\n", device.name.c_str(), device.driver.c_str(),
+              device.subgroup_size);
+  std::printf("sorts   %d warm-up + %d measured per row; GPU rows time the sort alone (timestamps), CPU rows\n"
+              "        are one thread of this machine's CPU; every GPU result is checked against the CPU radix sort\n",
+              options.warmup, options.repeat);
+  std::fflush(stdout);
+
+  const int runs_per_row = options.warmup + options.repeat;
+  const int rows_per_case = int(sorts.size()) + 2;
+  const int total = runs_per_row * rows_per_case * int(options.key_bits.size() * options.sort_sizes.size());
+  std::vector<SortRow> rows;
+  const auto start = std::chrono::steady_clock::now();
+  {
+    Progress progress(total, cli::stderr_is_terminal(), "sorts");
+    int done = 0;
+    for (const int bits : options.key_bits) {
+      for (const int exponent : options.sort_sizes) {
+        const uint64_t n = 1ull << exponent;
+        const auto keys = random_keys(n, bits, n * 131 + uint64_t(bits));
+        const std::string label = std::to_string(bits) + "-bit, 2^" + std::to_string(exponent) + " keys";
+        std::vector<uint32_t> expected;
+        SortRow cpu_radix{bits, n, "cpu radix", "cpu", {}};
+        for (int run = 0; run < runs_per_row; ++run) {
+          const double ms = time_cpu_radix(keys, bits, run == 0 ? &expected : nullptr);
+          if (run >= options.warmup) cpu_radix.ms.push_back(ms);
+          progress.update(++done, label + ", cpu radix");
+        }
+        SortRow std_sort{bits, n, "std::sort", "cpu", {}};
+        for (int run = 0; run < runs_per_row; ++run) {
+          const double ms = time_std_sort(keys);
+          if (run >= options.warmup) std_sort.ms.push_back(ms);
+          progress.update(++done, label + ", std::sort");
+        }
+        for (const auto& sort : sorts) {
+          SortRow row{bits, n, sort, "gpu", {}};
+          for (int run = 0; run < runs_per_row; ++run) {
+            const auto result = renderer->sort_keys(sort, keys, uint32_t(bits));
+            if (run == 0 && result.order != expected) {
+              progress.finish();
+              throw std::runtime_error("sort strategy '" + sort + "' gave a different order than the CPU radix "
+                                       "sort on " + label);
+            }
+            if (run >= options.warmup) row.ms.push_back(result.gpu_ms);
+            progress.update(++done, label + ", " + sort);
+          }
+          rows.push_back(std::move(row));
+        }
+        rows.push_back(std::move(std_sort));
+        rows.push_back(std::move(cpu_radix));
+      }
+    }
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  std::printf("\n  %4s %10s  %-12s %-4s %12s %12s %12s\n", "bits", "keys", "sorter", "on", "median ms",
+              "Mkeys/s", "vs std::sort");
+  for (const auto& row : rows) {
+    double std_ms = 0;
+    for (const auto& other : rows)
+      if (other.key_bits == row.key_bits && other.keys == row.keys && other.sorter == "std::sort")
+        std_ms = median_ms(other);
+    const double ms = median_ms(row);
+    std::printf("  %4d %10llu  %-12s %-4s %12s %12s %11sx\n", row.key_bits, static_cast<unsigned long long>(row.keys),
+                row.sorter.c_str(), row.where.c_str(), cli::format_fixed(ms, 3).c_str(),
+                cli::format_fixed(ms > 0 ? double(row.keys) / ms / 1e3 : 0, 2).c_str(),
+                cli::format_fixed(ms > 0 ? std_ms / ms : 0, 2).c_str());
+  }
+  std::fflush(stdout);
+
+  std::string written;
+  if (!options.csv.empty()) {
+    cli::write_file_atomic(options.csv, make_sort_csv(rows, device));
+    written += " -> " + options.csv;
+  }
+  if (!options.json.empty()) {
+    cli::write_file_atomic(options.json, make_sort_json(rows, device, options));
+    written += (written.empty() ? " -> " : ", ") + options.json;
+  }
+  if (const auto messages = renderer->validation_messages(); messages > 0)
+    cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
+  std::fprintf(stderr, "%s: sort micro-benchmark, %d sorts in %s s%s\n", kProgram, total,
+               cli::format_fixed(seconds, 2).c_str(), written.c_str());
+  return cli::kExitOk;
 }
 
 int run(int argc, char** argv) {
@@ -345,6 +558,9 @@ int run(int argc, char** argv) {
                         "with the frame's visible Gaussians, intersections and device memory.");
   add_bench_options(parser, options);
   if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
+  if (options.sort_bench) return run_sort_bench(parser, options);
+  for (const char* flag : {"--sort-sizes", "--key-bits"})
+    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --sort-bench");
   cli::check_common_options(parser, options.common);
   cli::check_distinct_paths({{"SCENE", options.common.scene},
                              {"--cameras", options.common.cameras},

@@ -14,6 +14,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 
 #include "passes/composite_pass.h"
 #include "passes/frame_counters.h"
@@ -353,6 +355,54 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
 }
 
 const FrameStats& Renderer::last_frame_stats() const { return impl_->stats; }
+
+Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::vector<uint64_t>& keys,
+                                      uint32_t key_bits) {
+  if (key_bits < 1 || key_bits > 64)
+    throw std::invalid_argument("sort_keys: key_bits must be 1 to 64, not " + std::to_string(key_bits));
+  if (keys.size() > (1u << 31))
+    throw std::invalid_argument("sort_keys: " + std::to_string(keys.size()) + " keys, more than 2^31");
+  const uint64_t allowed = key_bits == 64 ? ~0ull : (1ull << key_bits) - 1;
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (keys[i] & ~allowed)
+      throw std::invalid_argument("sort_keys: key " + std::to_string(i) + " has bits above the " +
+                                  std::to_string(key_bits) + " key bits");
+
+  Impl& r = *impl_;
+  SortStrategy& sorter = r.sort(strategy);
+  const uint32_t n = uint32_t(keys.size());
+  const uint32_t capacity = std::max<uint32_t>(n, 1);
+  KeyBuffers kb;
+  kb.keys = make_buffer<uint64_t>(r.ctx, capacity, "sort_keys keys");
+  kb.keys_alt = make_buffer<uint64_t>(r.ctx, capacity, "sort_keys keys (ping-pong)");
+  kb.values = make_buffer<uint32_t>(r.ctx, capacity, "sort_keys values");
+  kb.values_alt = make_buffer<uint32_t>(r.ctx, capacity, "sort_keys values (ping-pong)");
+  kb.capacity = capacity;
+  std::vector<uint32_t> positions(n);
+  for (uint32_t i = 0; i < n; ++i) positions[i] = i;
+  if (n > 0) {
+    vk::upload(r.ctx, kb.keys, keys.data(), VkDeviceSize(n) * sizeof(uint64_t));
+    vk::upload(r.ctx, kb.values, positions.data(), VkDeviceSize(n) * sizeof(uint32_t));
+  }
+  vk::Buffer state(r.ctx, sizeof(SortState), vk::MemoryUse::Readback, "sort_keys state");
+  SortState initial{};
+  initial.count = n;
+  std::memcpy(state.mapped(), &initial, sizeof(initial));
+
+  sorter.reserve(capacity);
+  VkCommandBuffer cmd = r.ctx.begin_one_time();
+  r.timer.begin_frame(cmd);
+  SortInput input{kb, state, 0, key_bits};
+  const bool in_alt = sorter.record(cmd, input);
+  r.timer.mark(cmd, "sort");
+  r.ctx.end_submit_wait(cmd);
+
+  SortRun run;
+  r.timer.read(&run.gpu_ms);
+  r.read_output(in_alt ? kb.keys_alt : kb.keys, run.keys, n);
+  r.read_output(in_alt ? kb.values_alt : kb.values, run.order, n);
+  return run;
+}
 
 DeviceInfo Renderer::device_info() const {
   const auto& l = impl_->ctx.limits();

@@ -86,6 +86,17 @@ class Renderer {
   RenderImage render(const Camera& camera, const RenderSettings& settings = {});
 
   const FrameStats& last_frame_stats() const;
+
+  // Sorts key/value pairs with a sort strategy outside any frame, the values being the input
+  // positions, and times the sort alone on the GPU (no transfers). For the sort micro-benchmark and
+  // tests. Only the low key_bits bits (1 to 64) may be set; throws std::invalid_argument otherwise.
+  struct SortRun {
+    std::vector<uint64_t> keys;   // ascending
+    std::vector<uint32_t> order;  // input position of each sorted key; equal keys in input order
+    double gpu_ms = 0;
+  };
+  SortRun sort_keys(const std::string& strategy, const std::vector<uint64_t>& keys, uint32_t key_bits);
+
   DeviceInfo device_info() const;
   // Validation-layer messages seen so far (0 unless validation is on).
   uint64_t validation_messages() const;

@@ -1,0 +1,72 @@
+// The public sort entry points: Renderer::sort_keys (every GPU strategy, outside a frame) and the
+// CPU radix sort the micro-benchmark compares them with. Both against std::stable_sort.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include "test_support.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/sort.h"
+
+namespace tilesplat {
+namespace {
+
+std::vector<uint32_t> stable_order(const std::vector<uint64_t>& keys) {
+  std::vector<uint32_t> order(keys.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
+  return order;
+}
+
+std::vector<uint64_t> random_keys(size_t n, uint32_t bits, uint64_t seed, uint64_t distinct = 0) {
+  std::mt19937_64 rng(seed);
+  std::vector<uint64_t> keys(n);
+  const uint64_t mask = bits >= 64 ? ~0ull : (1ull << bits) - 1;
+  for (auto& k : keys) k = (distinct ? rng() % distinct : rng()) & mask;
+  return keys;
+}
+
+TEST(CpuRadixSort, MatchesStableSort) {
+  for (uint32_t bits : {1u, 9u, 32u, 45u, 64u}) {
+    for (size_t n : {size_t(0), size_t(1), size_t(257), size_t(100000)}) {
+      const auto keys = random_keys(n, bits, n + bits, n > 1000 ? 50 : 0);
+      std::vector<uint64_t> sorted = keys;
+      std::vector<uint32_t> order(n);
+      std::iota(order.begin(), order.end(), 0u);
+      cpu_radix_sort(sorted, order, bits);
+      EXPECT_EQ(order, stable_order(keys)) << "bits " << bits << " n " << n;
+      EXPECT_TRUE(std::is_sorted(sorted.begin(), sorted.end()));
+    }
+  }
+  std::vector<uint64_t> keys(3);
+  std::vector<uint32_t> values(2);
+  EXPECT_THROW(cpu_radix_sort(keys, values, 8), std::invalid_argument);
+}
+
+TEST(SortKeys, EveryStrategyMatchesStableSortAndReportsItsTime) {
+  Renderer& renderer = testing::validated_renderer();
+  const auto keys = random_keys(70000, 45, 3, 1000);  // many equal keys
+  const auto expected = stable_order(keys);
+  for (const auto& strategy : sort_strategies()) {
+    const Renderer::SortRun run = renderer.sort_keys(strategy, keys, 45);
+    EXPECT_EQ(run.order, expected) << strategy;
+    ASSERT_EQ(run.keys.size(), keys.size());
+    for (size_t i = 0; i < keys.size(); ++i) ASSERT_EQ(run.keys[i], keys[expected[i]]) << strategy << " at " << i;
+    EXPECT_GT(run.gpu_ms, 0.0) << strategy;
+  }
+  EXPECT_TRUE(renderer.sort_keys("radix", {}, 32).keys.empty());
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(SortKeys, RejectsKeysWiderThanTheKeyBitsAndUnknownStrategies) {
+  Renderer& renderer = testing::validated_renderer();
+  EXPECT_THROW(renderer.sort_keys("radix", {1, 2, 1ull << 40}, 32), std::invalid_argument);
+  EXPECT_THROW(renderer.sort_keys("radix", {1}, 0), std::invalid_argument);
+  EXPECT_THROW(renderer.sort_keys("radix", {1}, 65), std::invalid_argument);
+  EXPECT_THROW(renderer.sort_keys("no-such-sort", {1}, 8), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace tilesplat
