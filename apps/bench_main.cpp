@@ -367,6 +367,25 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                    [&options](const std::string& text) { options.key_bits = parse_int_list("--key-bits", text, 1, 64); });
 }
 
+// Writes the --csv and --json files that were asked for, warns about validation messages, and
+// returns " -> a.csv, b.json" for the closing line.
+template <typename MakeCsv, typename MakeJson>
+std::string write_result_files(const BenchOptions& options, MakeCsv make_csv_text, MakeJson make_json_text,
+                               const tilesplat::Renderer& renderer) {
+  std::string written;
+  if (!options.csv.empty()) {
+    cli::write_file_atomic(options.csv, make_csv_text());
+    written += " -> " + options.csv;
+  }
+  if (!options.json.empty()) {
+    cli::write_file_atomic(options.json, make_json_text());
+    written += (written.empty() ? " -> " : ", ") + options.json;
+  }
+  if (const auto messages = renderer.validation_messages(); messages > 0)
+    cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
+  return written;
+}
+
 // ---------------------------------------------------------------------------------------------
 // The sort micro-benchmark: keys per second against key count, per strategy and key width, with
 // the CPU sorts measured in the same run so that every figure is also a ratio on this machine.
@@ -534,17 +553,9 @@ int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
   }
   std::fflush(stdout);
 
-  std::string written;
-  if (!options.csv.empty()) {
-    cli::write_file_atomic(options.csv, make_sort_csv(rows, device));
-    written += " -> " + options.csv;
-  }
-  if (!options.json.empty()) {
-    cli::write_file_atomic(options.json, make_sort_json(rows, device, options));
-    written += (written.empty() ? " -> " : ", ") + options.json;
-  }
-  if (const auto messages = renderer->validation_messages(); messages > 0)
-    cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
+  const std::string written = write_result_files(
+      options, [&] { return make_sort_csv(rows, device); }, [&] { return make_sort_json(rows, device, options); },
+      *renderer);
   std::fprintf(stderr, "%s: sort micro-benchmark, %d sorts in %s s%s\n", kProgram, total,
                cli::format_fixed(seconds, 2).c_str(), written.c_str());
   return cli::kExitOk;
@@ -621,17 +632,9 @@ int run(int argc, char** argv) {
   print_comparison(results);
   std::fflush(stdout);
 
-  std::string written;
-  if (!options.csv.empty()) {
-    cli::write_file_atomic(options.csv, make_csv(results, info));
-    written += " -> " + options.csv;
-  }
-  if (!options.json.empty()) {
-    cli::write_file_atomic(options.json, make_json(results, info, options));
-    written += (written.empty() ? " -> " : ", ") + options.json;
-  }
-  if (const auto messages = renderer->validation_messages(); messages > 0)
-    cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
+  const std::string written = write_result_files(
+      options, [&] { return make_csv(results, info); }, [&] { return make_json(results, info, options); },
+      *renderer);
   std::fprintf(stderr, "%s: %s, %s, %dx%d, %d frames in %s s%s\n", kProgram,
                loaded.path.filename().string().c_str(), info.scene_description.c_str(), info.width, info.height,
                total_frames, cli::format_fixed(seconds, 2).c_str(), written.c_str());
