@@ -27,7 +27,7 @@ const uint SORT_BLOCKS = 1;
 const uint SORT_ARGS = 2;  // 3 uints
 const uint SORT_STATE_UINTS = 8;
 
-// Pairs actually emitted and sorted: min(total, capacity).
+// Pairs emitted and sorted: the total, or 0 when it exceeds the capacity (the frame is re-run).
 const uint COUNTER_SORT_COUNT = COUNTER_TILE_SORT + SORT_COUNT;
 
 // Projected splat record: four vec4 per Gaussian. The composite reads [0..2], the key emission [0], [3].

@@ -14,7 +14,10 @@ layout(push_constant) uniform Push {
 
 void main() {
   uint total = pc.counters.v[COUNTER_INTERSECTIONS];
-  uint sorted = min(total, pc.capacity);
+  // An overflowing frame is thrown away and re-rendered with larger buffers, so it sorts and
+  // composites nothing: the key emission leaves the slots of the Gaussian that straddles the
+  // capacity unwritten, and sorting them would feed stale tile ids and indices to the composite.
+  uint sorted = total > pc.capacity ? 0u : total;
   pc.counters.v[COUNTER_SORT_COUNT] = sorted;
   pc.counters.v[COUNTER_OVERFLOW] = total > pc.capacity ? 1u : 0u;
   pc.counters.v[COUNTER_RANGES_ARGS + 0] = (sorted + 255) / 256;

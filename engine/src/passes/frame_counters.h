@@ -24,7 +24,7 @@ struct FrameCounters {
   uint32_t visible;         // Gaussians touching at least one tile
   uint32_t ranges_args[4];  // indirect dispatch of the tile-range pass (+ padding)
   SortState depth_sort;     // the Gaussians by view depth
-  SortState tile_sort;      // the (tile, Gaussian) pairs by tile; count = pairs emitted (capped by capacity)
+  SortState tile_sort;      // the (tile, Gaussian) pairs by tile; count = pairs sorted (0 on overflow)
 };
 static_assert(sizeof(FrameCounters) == 96);
 
