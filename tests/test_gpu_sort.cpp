@@ -33,7 +33,17 @@ std::vector<T> read_back(vk::Context& ctx, const vk::Buffer& buffer, size_t coun
   return out;
 }
 
-// Sorts keys (values = input positions) with a strategy and returns (keys, values) as the GPU left them.
+// The payload of input position i: a bijection that does not follow the input order, as in the
+// frame's tile sort (whose values are Gaussian indices in depth order). A strategy that broke ties
+// by value instead of by input position would be caught.
+uint32_t payload(uint32_t position) { return (position * 2654435761u) ^ 0x5bd1e995u; }
+uint32_t position_of(uint32_t value) {
+  // 2654435761 * 244002641 = 1 (mod 2^32): the inverse of the multiplication above.
+  return (value ^ 0x5bd1e995u) * 244002641u;
+}
+
+// Sorts keys (values = payload(input position)) with a strategy and returns (keys, input positions)
+// as the GPU left them.
 std::pair<std::vector<uint64_t>, std::vector<uint32_t>> gpu_sort(const std::string& strategy,
                                                                   const std::vector<uint64_t>& keys,
                                                                   uint32_t key_bits) {
@@ -47,7 +57,7 @@ std::pair<std::vector<uint64_t>, std::vector<uint32_t>> gpu_sort(const std::stri
   kb.values = vk::Buffer(ctx, capacity * 4ull, vk::MemoryUse::Device, "values");
   kb.values_alt = vk::Buffer(ctx, capacity * 4ull, vk::MemoryUse::Device, "values alt");
   std::vector<uint32_t> values(n);
-  std::iota(values.begin(), values.end(), 0u);
+  for (uint32_t i = 0; i < n; ++i) values[i] = payload(i);
   vk::upload(ctx, kb.keys, keys.data(), n * 8ull);
   vk::upload(ctx, kb.values, values.data(), n * 4ull);
   vk::Buffer counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "counters");
@@ -62,8 +72,9 @@ std::pair<std::vector<uint64_t>, std::vector<uint32_t>> gpu_sort(const std::stri
     SortInput input{kb, counters, kTileSortOffset, key_bits};
     in_alt = sorter->record(cmd, input);
   });
-  return {read_back<uint64_t>(ctx, in_alt ? kb.keys_alt : kb.keys, n),
-          read_back<uint32_t>(ctx, in_alt ? kb.values_alt : kb.values, n)};
+  std::vector<uint32_t> positions = read_back<uint32_t>(ctx, in_alt ? kb.values_alt : kb.values, n);
+  for (auto& v : positions) v = position_of(v);
+  return {read_back<uint64_t>(ctx, in_alt ? kb.keys_alt : kb.keys, n), positions};
 }
 
 void expect_sorted_like_stable_sort(const std::string& strategy, const std::vector<uint64_t>& keys,

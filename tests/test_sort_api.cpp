@@ -7,7 +7,9 @@
 #include <random>
 
 #include "test_support.h"
+#include "tilesplat/camera.h"
 #include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
 #include "tilesplat/sort.h"
 
 namespace tilesplat {
@@ -66,6 +68,24 @@ TEST(SortKeys, RejectsKeysWiderThanTheKeyBitsAndUnknownStrategies) {
   EXPECT_THROW(renderer.sort_keys("radix", {1}, 0), std::invalid_argument);
   EXPECT_THROW(renderer.sort_keys("radix", {1}, 65), std::invalid_argument);
   EXPECT_THROW(renderer.sort_keys("no-such-sort", {1}, 8), std::invalid_argument);
+}
+
+TEST(SortStrategies, GiveBitIdenticalImages) {
+  // Every strategy gives the same order, so every output of a real scene is identical to the bit.
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(load_ply(testing::bundled_playbot()));
+  const Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(3).camera, 320, 180);
+  RenderSettings settings;
+  const RenderImage first = renderer.render(camera, settings);
+  ASSERT_GT(renderer.last_frame_stats().intersections, 10000u);
+  for (const auto& strategy : sort_strategies()) {
+    settings.sort = strategy;
+    const RenderImage image = renderer.render(camera, settings);
+    EXPECT_EQ(image.rgba, first.rgba) << strategy;
+    EXPECT_EQ(image.depth, first.depth) << strategy;
+    EXPECT_EQ(image.splat_count, first.splat_count) << strategy;
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
 }  // namespace
