@@ -220,6 +220,7 @@ struct Renderer::Impl {
   template <typename T>
   void read_output(const vk::Buffer& buffer, std::vector<T>& out, size_t count) {
     out.resize(count);
+    if (count == 0) return;  // memcpy must not see the null data() of an empty vector
     if (buffer.mapped()) {
       std::memcpy(out.data(), buffer.mapped(), count * sizeof(T));
       return;
