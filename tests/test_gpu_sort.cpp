@@ -50,12 +50,7 @@ std::pair<std::vector<uint64_t>, std::vector<uint32_t>> gpu_sort(const std::stri
   vk::Context& ctx = context();
   const uint32_t n = uint32_t(keys.size());
   const uint32_t capacity = std::max<uint32_t>(n, 1);
-  KeyBuffers kb;
-  kb.capacity = capacity;
-  kb.keys = vk::Buffer(ctx, capacity * 8ull, vk::MemoryUse::Device, "keys");
-  kb.keys_alt = vk::Buffer(ctx, capacity * 8ull, vk::MemoryUse::Device, "keys alt");
-  kb.values = vk::Buffer(ctx, capacity * 4ull, vk::MemoryUse::Device, "values");
-  kb.values_alt = vk::Buffer(ctx, capacity * 4ull, vk::MemoryUse::Device, "values alt");
+  KeyBuffers kb = KeyBuffers::allocate(ctx, capacity, "test");
   std::vector<uint32_t> values(n);
   for (uint32_t i = 0; i < n; ++i) values[i] = payload(i);
   vk::upload(ctx, kb.keys, keys.data(), n * 8ull);

@@ -106,23 +106,17 @@ struct Renderer::Impl {
   }
 
   void ensure_key_capacity(uint32_t capacity) {
-    if (keys.capacity >= capacity) return;
-    keys.keys = make_buffer<uint64_t>(ctx, capacity, "sort keys");
-    keys.keys_alt = make_buffer<uint64_t>(ctx, capacity, "sort keys (ping-pong)");
-    keys.values = make_buffer<uint32_t>(ctx, capacity, "sort values");
-    keys.values_alt = make_buffer<uint32_t>(ctx, capacity, "sort values (ping-pong)");
-    keys.capacity = capacity;
+    if (keys.capacity < capacity) keys = KeyBuffers::allocate(ctx, capacity, "sort");
   }
 
   uint64_t device_bytes() const {
     uint64_t bytes = 0;
     for (const vk::Buffer* b : {&scene.positions, &scene.log_scales, &scene.rotations, &scene.opacity_logits,
                                 &scene.sh, &projected.splats, &projected.rects, &projected.tile_counts,
-                                &projected.offsets, &projected.depth_offsets, &projected.depth_order.keys, &projected.depth_order.keys_alt,
-                                &projected.depth_order.values, &projected.depth_order.values_alt, &keys.keys,
-                                &keys.keys_alt, &keys.values, &keys.values_alt,
-                                &ranges, &outputs.rgba, &outputs.depth, &outputs.count, &counters})
+                                &projected.offsets, &projected.depth_offsets, &ranges, &outputs.rgba,
+                                &outputs.depth, &outputs.count, &counters})
       bytes += b->size();
+    bytes += projected.depth_order.bytes() + keys.bytes();
     bytes += prefix_sum.device_bytes();
     for (const auto& [name, s] : sorts) bytes += s->device_bytes();
     return bytes;
@@ -286,11 +280,7 @@ void Renderer::set_scene(const GaussianScene& scene) {
   p.tile_counts = make_buffer<uint32_t>(r.ctx, n, "tile counts");
   p.depth_offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets (depth order)");
   p.offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets");
-  p.depth_order.keys = make_buffer<uint64_t>(r.ctx, n, "depth keys");
-  p.depth_order.keys_alt = make_buffer<uint64_t>(r.ctx, n, "depth keys (ping-pong)");
-  p.depth_order.values = make_buffer<uint32_t>(r.ctx, n, "depth order");
-  p.depth_order.values_alt = make_buffer<uint32_t>(r.ctx, n, "depth order (ping-pong)");
-  p.depth_order.capacity = uint32_t(n);
+  p.depth_order = KeyBuffers::allocate(r.ctx, uint32_t(n), "depth");
   r.ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)));
 }
 
@@ -373,12 +363,7 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
   SortStrategy& sorter = r.sort(strategy);
   const uint32_t n = uint32_t(keys.size());
   const uint32_t capacity = std::max<uint32_t>(n, 1);
-  KeyBuffers kb;
-  kb.keys = make_buffer<uint64_t>(r.ctx, capacity, "sort_keys keys");
-  kb.keys_alt = make_buffer<uint64_t>(r.ctx, capacity, "sort_keys keys (ping-pong)");
-  kb.values = make_buffer<uint32_t>(r.ctx, capacity, "sort_keys values");
-  kb.values_alt = make_buffer<uint32_t>(r.ctx, capacity, "sort_keys values (ping-pong)");
-  kb.capacity = capacity;
+  KeyBuffers kb = KeyBuffers::allocate(r.ctx, capacity, "sort_keys");
   std::vector<uint32_t> positions(n);
   for (uint32_t i = 0; i < n; ++i) positions[i] = i;
   if (n > 0) {
