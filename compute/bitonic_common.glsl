@@ -18,15 +18,18 @@
 layout(local_size_x = 256) in;
 // When the key and position fit one 64-bit word together (key << position_bits | position), the
 // network moves 8 bytes a key instead of 12 and compares with one min/max instead of two compares.
+// Packing needs 64-bit network words, so it is used with 64-bit key buffers only.
 layout(constant_id = 0) const bool PACKED = false;
+layout(constant_id = 1) const bool WIDE_KEYS = true;
+#include "sort_keys.glsl"
 
 const uint GROUP_BITS = 4;
 const uint GROUP = 16;
 
 layout(push_constant) uniform Push {
-  Uint64Array keys_in;   // the keys to sort (read by the first pass only)
+  uint64_t keys_in;      // the keys to sort (read by the first pass only; see sort_keys.glsl)
   UintArray values_in;   // the payloads, gathered by the last pass
-  Uint64Array keys;      // the network's keys, in place; the sorted keys at the end (keys_alt)
+  uint64_t keys;         // the network's keys, in place; the sorted keys at the end (keys_alt)
   UintArray positions;   // each key's input position while the network runs (not PACKED)
   UintArray values_out;  // the gathered payloads: values_alt, the same memory as the positions (a
                          // pass stores the indices it loaded, so the last one replaces each position)
@@ -66,8 +69,8 @@ Quad load_quad(uint quad, uint n, bool from_input) {
   uvec4 i = quad_indices(quad);
   bvec4 real = lessThan(i, uvec4(n));
   uvec4 at = min(i, uvec4(n - 1));
-  Uint64Array src = from_input ? pc.keys_in : pc.keys;
-  u64vec4 key = u64vec4(src.v[at.x], src.v[at.y], src.v[at.z], src.v[at.w]);
+  uint64_t src = from_input ? pc.keys_in : pc.keys;
+  u64vec4 key = u64vec4(load_key(src, at.x), load_key(src, at.y), load_key(src, at.z), load_key(src, at.w));
   uvec4 position = i;
   if (from_input && PACKED) key = key << pc.position_bits | u64vec4(i);
   if (!from_input && !PACKED)
@@ -79,13 +82,13 @@ Quad load_quad(uint quad, uint n, bool from_input) {
 // their sorted order; every other pass stores the network's state.
 void store_member(uint i, uint64_t key, uint position, bool last_pass) {
   if (!last_pass) {
-    pc.keys.v[i] = key;
+    store_key(pc.keys, i, key);
     if (!PACKED) pc.positions.v[i] = position;
   } else if (PACKED) {
-    pc.keys.v[i] = key >> pc.position_bits;
+    store_key(pc.keys, i, key >> pc.position_bits);
     pc.values_out.v[i] = pc.values_in.v[uint(key & ((uint64_t(1) << pc.position_bits) - 1))];
   } else {
-    pc.keys.v[i] = key;
+    store_key(pc.keys, i, key);
     pc.values_out.v[i] = pc.values_in.v[position];
   }
 }

@@ -15,7 +15,7 @@ layout(push_constant) uniform Push {
   Uvec2Array rects;
   UintArray tile_counts;
   UintArray offsets;  // per Gaussian: where its pairs start (scatter_offsets.comp)
-  Uint64Array keys;
+  UintArray keys;  // 32-bit keys: the tile sort's keys fit (passes/key_buffers.h)
   UintArray values;
   uint count;
   uint tiles_x;
@@ -41,7 +41,7 @@ void main() {
   for (uint ty = lo.y; ty < hi.y; ++ty) {
     uvec2 span = row_span(mdo.xy, cov_det, tau, ty, lo, hi);
     for (uint tx = span.x; tx < span.y && offset < end; ++tx) {
-      pc.keys.v[offset] = uint64_t(ty * pc.tiles_x + tx);
+      pc.keys.v[offset] = ty * pc.tiles_x + tx;
       pc.values.v[offset] = i;
       ++offset;
     }
@@ -50,7 +50,7 @@ void main() {
   // slot defined even if a driver's arithmetic differed: a tile id past the grid sorts last and is
   // ignored by the tile-range pass.
   for (; offset < end; ++offset) {
-    pc.keys.v[offset] = uint64_t(pc.tiles);
+    pc.keys.v[offset] = pc.tiles;
     pc.values.v[offset] = i;
   }
 }

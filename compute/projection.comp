@@ -52,7 +52,7 @@ layout(push_constant) uniform Push {
   Vec4Array splats;
   Uvec2Array rects;
   UintArray tile_counts;
-  Uint64Array depth_keys;  // the depth sort's input: view depth bits (culled: last), Gaussian index
+  UintArray depth_keys;  // the depth sort's input (32-bit keys): view depth bits, culled last
   UintArray depth_values;
   UintArray counters;
   uint count;
@@ -160,7 +160,7 @@ void main() {
     pc.tile_counts.v[i] = touched;
     // View depth > near > 0, so its IEEE bits order like unsigned integers. Culled Gaussians touch
     // no tile; they sort last only to keep the visible ones together.
-    pc.depth_keys.v[i] = touched > 0 ? uint64_t(floatBitsToUint(record[0].z)) : uint64_t(0xffffffffu);
+    pc.depth_keys.v[i] = touched > 0 ? floatBitsToUint(record[0].z) : 0xffffffffu;
     pc.depth_values.v[i] = i;
   }
   uint visible = subgroupAdd(touched > 0 ? 1u : 0u);

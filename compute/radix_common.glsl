@@ -4,18 +4,21 @@
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint SUBGROUPS_PER_WORKGROUP = 8;
 layout(constant_id = 2) const uint BLOCK_KEYS = 2048;
+layout(constant_id = 3) const bool WIDE_KEYS = true;
 
 const uint RADIX = 256;
 
 layout(push_constant) uniform Push {
-  Uint64Array keys_in;
+  uint64_t keys_in;  // see sort_keys.glsl
   UintArray values_in;
-  Uint64Array keys_out;
+  uint64_t keys_out;
   UintArray values_out;
   UintArray histogram;     // RADIX * blocks, digit-major: histogram[digit * blocks + block]
   UintArray digit_totals;  // RADIX
   UintArray state;         // the sort's state block (SORT_COUNT, SORT_BLOCKS)
   uint shift;              // which 8-bit digit this pass sorts on
 } pc;
+
+#include "sort_keys.glsl"
 
 uint digit_of(uint64_t key) { return uint(key >> pc.shift) & (RADIX - 1); }

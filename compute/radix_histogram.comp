@@ -19,7 +19,7 @@ void main() {
     uint start = block * BLOCK_KEYS;
     uint end = min(start + BLOCK_KEYS, n);
     for (uint k = start + gl_SubgroupInvocationID; k < end; k += gl_SubgroupSize)
-      atomicAdd(s_counts[gl_SubgroupID * RADIX + digit_of(pc.keys_in.v[k])], 1u);
+      atomicAdd(s_counts[gl_SubgroupID * RADIX + digit_of(load_key(pc.keys_in, k))], 1u);
   }
   barrier();
 

@@ -7,7 +7,7 @@
 layout(local_size_x = 256) in;
 
 layout(push_constant) uniform Push {
-  Uint64Array keys;
+  UintArray keys;  // the sorted tile ids (32-bit keys)
   Uvec2Array ranges;  // zero-filled before this pass
   UintArray counters;
   uint tiles;  // keys with a tile id >= tiles are padding (see key_emission.comp)
@@ -17,8 +17,8 @@ void main() {
   uint i = gl_GlobalInvocationID.x;
   uint n = pc.counters.v[COUNTER_SORT_COUNT];
   if (i >= n) return;
-  uint tile = uint(pc.keys.v[i]);
-  uint prev = i == 0 ? 0xffffffffu : uint(pc.keys.v[i - 1]);
+  uint tile = pc.keys.v[i];
+  uint prev = i == 0 ? 0xffffffffu : pc.keys.v[i - 1];
   if (prev != tile) {
     if (i > 0 && prev < pc.tiles) pc.ranges.v[prev].y = i;
     if (tile < pc.tiles) pc.ranges.v[tile].x = i;

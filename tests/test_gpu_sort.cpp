@@ -1,4 +1,4 @@
-// The radix sort and the prefix sum alone, against std::stable_sort / std::exclusive_scan, on the
+// The sort strategies and the prefix sum alone, against std::stable_sort / std::exclusive_scan, on the
 // device the tests run on (lavapipe in CI), with the validation layer on.
 #include <gtest/gtest.h>
 
@@ -50,10 +50,11 @@ std::pair<std::vector<uint64_t>, std::vector<uint32_t>> gpu_sort(const std::stri
   vk::Context& ctx = context();
   const uint32_t n = uint32_t(keys.size());
   const uint32_t capacity = std::max<uint32_t>(n, 1);
-  KeyBuffers kb = KeyBuffers::allocate(ctx, capacity, "test");
+  KeyBuffers kb = KeyBuffers::allocate(ctx, capacity, key_bits, "test");
   std::vector<uint32_t> values(n);
   for (uint32_t i = 0; i < n; ++i) values[i] = payload(i);
-  vk::upload(ctx, kb.keys, keys.data(), n * 8ull);
+  const std::vector<uint8_t> packed = kb.pack_keys(keys);
+  vk::upload(ctx, kb.keys, packed.data(), packed.size());
   vk::upload(ctx, kb.values, values.data(), n * 4ull);
   vk::Buffer counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "counters");
   SortState state{};
@@ -69,7 +70,8 @@ std::pair<std::vector<uint64_t>, std::vector<uint32_t>> gpu_sort(const std::stri
   });
   std::vector<uint32_t> positions = read_back<uint32_t>(ctx, in_alt ? kb.values_alt : kb.values, n);
   for (auto& v : positions) v = position_of(v);
-  return {read_back<uint64_t>(ctx, in_alt ? kb.keys_alt : kb.keys, n), positions};
+  const std::vector<uint8_t> sorted = read_back<uint8_t>(ctx, in_alt ? kb.keys_alt : kb.keys, size_t(n) * kb.key_bytes());
+  return {kb.unpack_keys(sorted.data(), n), positions};
 }
 
 void expect_sorted_like_stable_sort(const std::string& strategy, const std::vector<uint64_t>& keys,
@@ -101,24 +103,28 @@ std::vector<uint64_t> random_keys(size_t n, uint32_t bits, uint64_t seed, uint64
   return keys;
 }
 
-class RadixSortSizes : public ::testing::TestWithParam<size_t> {};
+class GpuSortSizes : public ::testing::TestWithParam<size_t> {};
 
-TEST_P(RadixSortSizes, MatchesStableSortOnRandom45BitKeys) {
-  for (const auto& strategy : available_sort_strategies())
-    expect_sorted_like_stable_sort(strategy, random_keys(GetParam(), 45, GetParam()), 45);
-}
-
-INSTANTIATE_TEST_SUITE_P(Sizes, RadixSortSizes,
-                         ::testing::Values(0, 1, 2, 255, 256, 257, 2047, 2048, 2049, (1u << 16) + 1, 1u << 20));
-
-TEST(RadixSort, ManyEqualKeysKeepInputOrder) {
+// 45-bit keys go through 64-bit key buffers, 32-bit keys through 32-bit ones (passes/key_buffers.h).
+TEST_P(GpuSortSizes, MatchesStableSortOnRandom45And32BitKeys) {
   for (const auto& strategy : available_sort_strategies()) {
-    expect_sorted_like_stable_sort(strategy, random_keys(100000, 45, 7, 3), 45);
-    expect_sorted_like_stable_sort(strategy, std::vector<uint64_t>(50000, 12345), 45);
+    expect_sorted_like_stable_sort(strategy, random_keys(GetParam(), 45, GetParam()), 45);
+    expect_sorted_like_stable_sort(strategy, random_keys(GetParam(), 32, GetParam() + 1), 32);
   }
 }
 
-TEST(RadixSort, FullWidthAndNarrowKeys) {
+INSTANTIATE_TEST_SUITE_P(Sizes, GpuSortSizes,
+                         ::testing::Values(0, 1, 2, 255, 256, 257, 2047, 2048, 2049, (1u << 16) + 1, 1u << 20));
+
+TEST(GpuSort, ManyEqualKeysKeepInputOrder) {
+  for (const auto& strategy : available_sort_strategies()) {
+    expect_sorted_like_stable_sort(strategy, random_keys(100000, 45, 7, 3), 45);
+    expect_sorted_like_stable_sort(strategy, std::vector<uint64_t>(50000, 12345), 45);
+    expect_sorted_like_stable_sort(strategy, random_keys(100000, 32, 8, 5), 32);
+  }
+}
+
+TEST(GpuSort, FullWidthAndNarrowKeys) {
   for (const auto& strategy : available_sort_strategies()) {
     expect_sorted_like_stable_sort(strategy, random_keys(30000, 64, 11), 64);
     expect_sorted_like_stable_sort(strategy, random_keys(30000, 32, 12), 32);

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <numeric>
 #include <random>
 
@@ -59,6 +61,48 @@ TEST(SortKeys, EveryStrategyMatchesStableSortAndReportsItsTime) {
     EXPECT_GT(run.gpu_ms, 0.0) << strategy;
   }
   EXPECT_TRUE(renderer.sort_keys("radix", {}, 32).keys.empty());
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// The keys a frame sorts, from a real scene: the float bits of each Gaussian's view depth (as the
+// projection writes them), the same depths quantized to 16 bits over their range (many equal keys,
+// as in viewers that sort 16-bit depths), and 13-bit tile ids of a 1080p grid taken from the
+// Gaussians' screen positions (runs of equal keys of every length).
+TEST(SortKeys, RealSceneKeysMatchStableSort) {
+  Renderer& renderer = testing::validated_renderer();
+  const GaussianScene scene = load_ply(testing::bundled_playbot());
+  const Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, 1920, 1080);
+  const size_t n = scene.size();
+  std::vector<float> depth(n);
+  std::vector<uint64_t> depth_bits(n), depth16(n), tile_ids(n);
+  float near = 1e30f, far = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const auto p = camera.to_camera({scene.positions[3 * i], scene.positions[3 * i + 1], scene.positions[3 * i + 2]});
+    depth[i] = float(p[2]);
+    depth_bits[i] = depth[i] > 0 ? std::bit_cast<uint32_t>(depth[i]) : 0xffffffffu;
+    if (depth[i] > 0) near = std::min(near, depth[i]), far = std::max(far, depth[i]);
+    const double u = p[2] > 0 ? camera.fx * p[0] / p[2] + camera.cx : -1;
+    const double v = p[2] > 0 ? camera.fy * p[1] / p[2] + camera.cy : -1;
+    const bool on_screen = u >= 0 && v >= 0 && u < camera.width && v < camera.height;
+    tile_ids[i] = on_screen ? uint64_t(v / 16) * 120 + uint64_t(u / 16) : 120 * 68;
+  }
+  ASSERT_LT(near, far);
+  for (size_t i = 0; i < n; ++i)
+    depth16[i] = depth[i] > 0 ? uint64_t(std::lround((depth[i] - near) / (far - near) * 65535.0)) : 65535;
+
+  struct Case {
+    const char* name;
+    const std::vector<uint64_t>& keys;
+    uint32_t bits;
+  };
+  for (const Case& c : {Case{"depth bits", depth_bits, 32}, Case{"16-bit depth", depth16, 16},
+                        Case{"tile ids", tile_ids, 13}}) {
+    const auto expected = stable_order(c.keys);
+    for (const auto& strategy : sort_strategies()) {
+      const Renderer::SortRun run = renderer.sort_keys(strategy, c.keys, c.bits);
+      EXPECT_EQ(run.order, expected) << strategy << ", " << c.name;
+    }
+  }
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 

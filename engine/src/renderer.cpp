@@ -106,7 +106,7 @@ struct Renderer::Impl {
   }
 
   void ensure_key_capacity(uint32_t capacity) {
-    if (keys.capacity < capacity) keys = KeyBuffers::allocate(ctx, capacity, "sort");
+    if (keys.capacity < capacity) keys = KeyBuffers::allocate(ctx, capacity, 32, "sort");
   }
 
   uint64_t device_bytes() const {
@@ -280,7 +280,7 @@ void Renderer::set_scene(const GaussianScene& scene) {
   p.tile_counts = make_buffer<uint32_t>(r.ctx, n, "tile counts");
   p.depth_offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets (depth order)");
   p.offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets");
-  p.depth_order = KeyBuffers::allocate(r.ctx, uint32_t(n), "depth");
+  p.depth_order = KeyBuffers::allocate(r.ctx, uint32_t(n), 32, "depth");
   r.ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)));
 }
 
@@ -363,11 +363,12 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
   SortStrategy& sorter = r.sort(strategy);
   const uint32_t n = uint32_t(keys.size());
   const uint32_t capacity = std::max<uint32_t>(n, 1);
-  KeyBuffers kb = KeyBuffers::allocate(r.ctx, capacity, "sort_keys");
+  KeyBuffers kb = KeyBuffers::allocate(r.ctx, capacity, key_bits, "sort_keys");
   std::vector<uint32_t> positions(n);
   for (uint32_t i = 0; i < n; ++i) positions[i] = i;
   if (n > 0) {
-    vk::upload(r.ctx, kb.keys, keys.data(), VkDeviceSize(n) * sizeof(uint64_t));
+    const std::vector<uint8_t> packed = kb.pack_keys(keys);
+    vk::upload(r.ctx, kb.keys, packed.data(), packed.size());
     vk::upload(r.ctx, kb.values, positions.data(), VkDeviceSize(n) * sizeof(uint32_t));
   }
   vk::Buffer state(r.ctx, sizeof(SortState), vk::MemoryUse::Readback, "sort_keys state");
@@ -385,7 +386,9 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
 
   SortRun run;
   r.timer.read(&run.gpu_ms);
-  r.read_output(in_alt ? kb.keys_alt : kb.keys, run.keys, n);
+  std::vector<uint8_t> sorted_keys;
+  r.read_output(in_alt ? kb.keys_alt : kb.keys, sorted_keys, size_t(n) * kb.key_bytes());
+  run.keys = kb.unpack_keys(sorted_keys.data(), n);
   r.read_output(in_alt ? kb.values_alt : kb.values, run.order, n);
   return run;
 }

@@ -2,30 +2,68 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 #include <string>
+#include <vector>
 
 #include "vulkan/buffer.h"
+#include "vulkan/context.h"
 
 namespace tilesplat {
 
 struct KeyBuffers {
-  vk::Buffer keys, values, keys_alt, values_alt;  // uint64_t keys, uint32_t values
+  vk::Buffer keys, values, keys_alt, values_alt;  // keys of key_bytes() each, uint32_t values
   uint32_t capacity = 0;
+  // Keys are 32-bit words when every key fits in 32 bits (both sorts of a frame: view depth bits and
+  // tile ids), 64-bit otherwise. The narrow layout halves the key traffic of every sort pass.
+  bool wide_keys = true;
 
-  // Device buffers for `capacity` pairs; `name` starts each buffer's name ("depth keys", ...).
-  static KeyBuffers allocate(vk::Context& ctx, uint32_t capacity, const std::string& name) {
+  uint32_t key_bytes() const { return wide_keys ? 8 : 4; }
+
+  // Device buffers for `capacity` pairs of keys up to key_bits wide; `name` starts each buffer's
+  // name ("depth keys", ...).
+  static KeyBuffers allocate(vk::Context& ctx, uint32_t capacity, uint32_t key_bits, const std::string& name) {
     KeyBuffers kb;
-    kb.keys = vk::Buffer(ctx, VkDeviceSize(capacity) * sizeof(uint64_t), vk::MemoryUse::Device, name + " keys");
-    kb.keys_alt = vk::Buffer(ctx, VkDeviceSize(capacity) * sizeof(uint64_t), vk::MemoryUse::Device,
-                             name + " keys (ping-pong)");
-    kb.values = vk::Buffer(ctx, VkDeviceSize(capacity) * sizeof(uint32_t), vk::MemoryUse::Device, name + " values");
-    kb.values_alt = vk::Buffer(ctx, VkDeviceSize(capacity) * sizeof(uint32_t), vk::MemoryUse::Device,
-                               name + " values (ping-pong)");
+    kb.wide_keys = key_bits > 32;
+    const VkDeviceSize key_bytes = VkDeviceSize(capacity) * kb.key_bytes();
+    const VkDeviceSize value_bytes = VkDeviceSize(capacity) * sizeof(uint32_t);
+    kb.keys = vk::Buffer(ctx, key_bytes, vk::MemoryUse::Device, name + " keys");
+    kb.keys_alt = vk::Buffer(ctx, key_bytes, vk::MemoryUse::Device, name + " keys (ping-pong)");
+    kb.values = vk::Buffer(ctx, value_bytes, vk::MemoryUse::Device, name + " values");
+    kb.values_alt = vk::Buffer(ctx, value_bytes, vk::MemoryUse::Device, name + " values (ping-pong)");
     kb.capacity = capacity;
     return kb;
   }
 
   uint64_t bytes() const { return keys.size() + values.size() + keys_alt.size() + values_alt.size(); }
+
+  // Host-side keys in and out of this layout (the caller guarantees narrow keys fit 32 bits).
+  std::vector<uint8_t> pack_keys(const std::vector<uint64_t>& host) const {
+    std::vector<uint8_t> bytes(host.size() * key_bytes());
+    for (size_t i = 0; i < host.size(); ++i) {
+      if (wide_keys) {
+        std::memcpy(bytes.data() + i * 8, &host[i], 8);
+      } else {
+        const uint32_t narrow = uint32_t(host[i]);
+        std::memcpy(bytes.data() + i * 4, &narrow, 4);
+      }
+    }
+    return bytes;
+  }
+  std::vector<uint64_t> unpack_keys(const void* data, size_t count) const {
+    std::vector<uint64_t> host(count);
+    const auto* bytes = static_cast<const uint8_t*>(data);
+    for (size_t i = 0; i < count; ++i) {
+      if (wide_keys) {
+        std::memcpy(&host[i], bytes + i * 8, 8);
+      } else {
+        uint32_t narrow;
+        std::memcpy(&narrow, bytes + i * 4, 4);
+        host[i] = narrow;
+      }
+    }
+    return host;
+  }
 };
 
 }  // namespace tilesplat

@@ -40,10 +40,12 @@ uint32_t workgroup_cap(const vk::Context& ctx) {
 
 BitonicSort::BitonicSort(vk::Context& ctx) : max_workgroups_(workgroup_cap(ctx)) {
   setup_ = vk::ComputePipeline(ctx, "bitonic_setup", sizeof(SetupPush));
-  for (uint32_t packed : {0u, 1u}) {
-    const std::vector<vk::SpecConstant> spec{{0, packed}};
-    sort_groups_[packed] = vk::ComputePipeline(ctx, "bitonic_sort_groups", sizeof(PassPush), spec);
-    merge_[packed] = vk::ComputePipeline(ctx, "bitonic_merge", sizeof(PassPush), spec);
+  // Variants: narrow keys, wide keys, wide keys packed with their positions.
+  const uint32_t variants[3][2] = {{0, 0}, {0, 1}, {1, 1}};
+  for (uint32_t v = 0; v < 3; ++v) {
+    const std::vector<vk::SpecConstant> spec{{0, variants[v][0]}, {1, variants[v][1]}};
+    sort_groups_[v] = vk::ComputePipeline(ctx, "bitonic_sort_groups", sizeof(PassPush), spec);
+    merge_[v] = vk::ComputePipeline(ctx, "bitonic_merge", sizeof(PassPush), spec);
   }
 }
 
@@ -59,7 +61,9 @@ bool BitonicSort::record(VkCommandBuffer cmd, SortInput& input) {
   // network for the capacity has index_bits stages. When the key's varying bits fit beside a
   // position, the network sorts single words.
   const uint32_t index_bits = uint32_t(std::bit_width(std::max<uint32_t>(kb.capacity, 1) - 1));
-  const uint32_t packed = std::min<uint32_t>(input.key_bits, 64) + index_bits <= 64 ? 1 : 0;
+  // position. Packing needs 64-bit words to run the network in, which narrow key buffers lack.
+  const bool packed = kb.wide_keys && std::min<uint32_t>(input.key_bits, 64) + index_bits <= 64;
+  const uint32_t variant = !kb.wide_keys ? 0 : packed ? 2 : 1;
 
   // The network runs in keys_alt and values_alt, so the input values stay intact for the final
   // gather. Each pass loads and stores the same indices in one invocation, which lets the last pass
@@ -67,8 +71,8 @@ bool BitonicSort::record(VkCommandBuffer cmd, SortInput& input) {
   PassPush push{kb.keys.address(),      kb.values.address(),     kb.keys_alt.address(), kb.values_alt.address(),
                 kb.values_alt.address(), state,                  kb.capacity,           index_bits,
                 0,                       0,                      0,                     0};
-  sort_groups_[packed].bind(cmd, push);
-  sort_groups_[packed].dispatch_indirect(cmd, input.state.handle(), args_offset);
+  sort_groups_[variant].bind(cmd, push);
+  sort_groups_[variant].dispatch_indirect(cmd, input.state.handle(), args_offset);
   vk::barrier(cmd);
 
   // The first pass ran the stages up to a group. The network is recorded up to the capacity's power
@@ -80,8 +84,8 @@ bool BitonicSort::record(VkCommandBuffer cmd, SortInput& input) {
     for (uint32_t steps_left = stage_bits; steps_left > 0; steps_left -= push.steps) {
       push.steps = (steps_left - 1) % kGroupBits + 1;
       push.stride = 1u << (steps_left - 1);
-      merge_[packed].bind(cmd, push);
-      merge_[packed].dispatch_indirect(cmd, input.state.handle(), args_offset);
+      merge_[variant].bind(cmd, push);
+      merge_[variant].dispatch_indirect(cmd, input.state.handle(), args_offset);
       vk::barrier(cmd);
     }
   }

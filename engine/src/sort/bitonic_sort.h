@@ -27,7 +27,7 @@ class BitonicSort final : public SortStrategy {
   uint32_t max_workgroups_;
   vk::ComputePipeline setup_;
   // Indexed by whether the key and its position share one 64-bit word (see compute/bitonic_common.glsl).
-  std::array<vk::ComputePipeline, 2> sort_groups_, merge_;
+  std::array<vk::ComputePipeline, 3> sort_groups_, merge_;  // [narrow, wide, wide packed]
 };
 
 }  // namespace tilesplat

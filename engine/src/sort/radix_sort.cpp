@@ -40,12 +40,14 @@ RadixSort::RadixSort(vk::Context& ctx)
       subgroups_per_workgroup_(workgroup_subgroups(ctx)),
       block_keys_(ctx.limits().subgroup_size * kStepsPerBlock) {
   const uint32_t sg = ctx.limits().subgroup_size;
-  const std::vector<vk::SpecConstant> spec{
-      {0, sg * subgroups_per_workgroup_}, {1, subgroups_per_workgroup_}, {2, block_keys_}};
   setup_ = vk::ComputePipeline(ctx, "radix_setup", sizeof(SetupPush));
-  histogram_pass_ = vk::ComputePipeline(ctx, "radix_histogram", sizeof(PassPush), spec);
   scan_pass_ = vk::ComputePipeline(ctx, "radix_scan", sizeof(ScanPush));
-  scatter_pass_ = vk::ComputePipeline(ctx, "radix_scatter", sizeof(PassPush), spec);
+  for (uint32_t wide : {0u, 1u}) {
+    const std::vector<vk::SpecConstant> spec{
+        {0, sg * subgroups_per_workgroup_}, {1, subgroups_per_workgroup_}, {2, block_keys_}, {3, wide}};
+    histogram_pass_[wide] = vk::ComputePipeline(ctx, "radix_histogram", sizeof(PassPush), spec);
+    scatter_pass_[wide] = vk::ComputePipeline(ctx, "radix_scatter", sizeof(PassPush), spec);
+  }
   digit_totals_ = vk::Buffer(ctx, kRadix * sizeof(uint32_t), vk::MemoryUse::Device, "radix digit totals");
 }
 
@@ -70,6 +72,7 @@ bool RadixSort::record(VkCommandBuffer cmd, SortInput& input) {
   setup_.dispatch(cmd, 1);
   vk::barrier(cmd);
 
+  const uint32_t wide = kb.wide_keys ? 1 : 0;
   const uint32_t passes = (std::min<uint32_t>(input.key_bits, 64) + kDigitBits - 1) / kDigitBits;
   bool in_alt = false;
   for (uint32_t p = 0; p < passes; ++p) {
@@ -79,14 +82,14 @@ bool RadixSort::record(VkCommandBuffer cmd, SortInput& input) {
     const vk::Buffer& values_out = in_alt ? kb.values : kb.values_alt;
     PassPush push{keys_in.address(),    values_in.address(),     keys_out.address(), values_out.address(),
                   histogram_.address(), digit_totals_.address(), state,              p * kDigitBits, 0};
-    histogram_pass_.bind(cmd, push);
-    histogram_pass_.dispatch_indirect(cmd, input.state.handle(), args_offset);
+    histogram_pass_[wide].bind(cmd, push);
+    histogram_pass_[wide].dispatch_indirect(cmd, input.state.handle(), args_offset);
     vk::barrier(cmd);
     scan_pass_.bind(cmd, ScanPush{histogram_.address(), digit_totals_.address(), state});
     scan_pass_.dispatch(cmd, kRadix);
     vk::barrier(cmd);
-    scatter_pass_.bind(cmd, push);
-    scatter_pass_.dispatch_indirect(cmd, input.state.handle(), args_offset);
+    scatter_pass_[wide].bind(cmd, push);
+    scatter_pass_[wide].dispatch_indirect(cmd, input.state.handle(), args_offset);
     vk::barrier(cmd);
     in_alt = !in_alt;
   }

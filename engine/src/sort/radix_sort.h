@@ -25,7 +25,8 @@ class RadixSort final : public SortStrategy {
   vk::Context& ctx_;
   uint32_t subgroups_per_workgroup_;
   uint32_t block_keys_;
-  vk::ComputePipeline setup_, histogram_pass_, scan_pass_, scatter_pass_;
+  vk::ComputePipeline setup_, scan_pass_;
+  vk::ComputePipeline histogram_pass_[2], scatter_pass_[2];  // [wide keys]
   vk::Buffer histogram_;
   vk::Buffer digit_totals_;
 };
