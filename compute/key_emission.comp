@@ -4,9 +4,14 @@
 // The offsets were taken in depth order, so the pairs lie front to back in memory, equal depths by
 // Gaussian index, and the stable tile sort that follows leaves each tile's run in exactly the
 // (tile, depth, index) order of the reference, with only the tile bits to sort.
+// With 64-bit keys (a strategy that sorts (tile, depth) pairs itself, FrameSortPlan::kTileDepthPairs)
+// the offsets are in Gaussian order and the key is tile << 32 | view depth bits.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "tile_coverage.glsl"
+
+layout(constant_id = 0) const bool WIDE_KEYS = false;
+#include "sort_keys.glsl"
 
 layout(local_size_x = 256) in;
 
@@ -15,7 +20,7 @@ layout(push_constant) uniform Push {
   Uvec2Array rects;
   UintArray tile_counts;
   UintArray offsets;  // per Gaussian: where its pairs start (scatter_offsets.comp)
-  UintArray keys;  // 32-bit keys: the tile sort's keys fit (passes/key_buffers.h)
+  uint64_t keys;  // see sort_keys.glsl
   UintArray values;
   uint count;
   uint tiles_x;
@@ -38,10 +43,11 @@ void main() {
   vec4 cov_det = pc.splats.v[SPLAT_VEC4S * i + 3];
   float tau = coverage_tau(mdo.w);
   uint end = offset + n;
+  uint64_t depth_bits = WIDE_KEYS ? uint64_t(floatBitsToUint(mdo.z)) : uint64_t(0);
   for (uint ty = lo.y; ty < hi.y; ++ty) {
     uvec2 span = row_span(mdo.xy, cov_det, tau, ty, lo, hi);
     for (uint tx = span.x; tx < span.y && offset < end; ++tx) {
-      pc.keys.v[offset] = ty * pc.tiles_x + tx;
+      store_key(pc.keys, offset, uint64_t(ty * pc.tiles_x + tx) << (WIDE_KEYS ? 32 : 0) | depth_bits);
       pc.values.v[offset] = i;
       ++offset;
     }
@@ -50,7 +56,7 @@ void main() {
   // slot defined even if a driver's arithmetic differed: a tile id past the grid sorts last and is
   // ignored by the tile-range pass.
   for (; offset < end; ++offset) {
-    pc.keys.v[offset] = pc.tiles;
+    store_key(pc.keys, offset, uint64_t(pc.tiles) << (WIDE_KEYS ? 32 : 0));
     pc.values.v[offset] = i;
   }
 }

@@ -63,11 +63,10 @@ std::pair<std::vector<uint64_t>, std::vector<uint32_t>> gpu_sort(const std::stri
 
   auto sorter = make_sort_strategy(strategy, ctx);
   sorter->reserve(capacity);
-  bool in_alt = false;
-  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    SortInput input{kb, counters, kTileSortOffset, key_bits};
-    in_alt = sorter->record(cmd, input);
-  });
+  vk::CommandStream stream(ctx);
+  SortInput input{kb, counters, kTileSortOffset, key_bits};
+  const bool in_alt = sorter->record(stream, input);
+  stream.finish();
   std::vector<uint32_t> positions = read_back<uint32_t>(ctx, in_alt ? kb.values_alt : kb.values, n);
   for (auto& v : positions) v = position_of(v);
   const std::vector<uint8_t> sorted = read_back<uint8_t>(ctx, in_alt ? kb.keys_alt : kb.keys, size_t(n) * kb.key_bytes());

@@ -105,8 +105,11 @@ struct Renderer::Impl {
     ranges = vk::Buffer(ctx, VkDeviceSize(tiles) * 8, vk::MemoryUse::Device, "tile ranges");
   }
 
-  void ensure_key_capacity(uint32_t capacity) {
-    if (keys.capacity < capacity) keys = KeyBuffers::allocate(ctx, capacity, 32, "sort");
+  // The pair keys are 32-bit tile ids, or 64-bit (tile, depth) keys for a strategy that sorts
+  // those itself (FrameSortPlan::kTileDepthPairs).
+  void ensure_key_capacity(uint32_t capacity, bool wide) {
+    if (keys.capacity < capacity || keys.wide_keys != wide)
+      keys = KeyBuffers::allocate(ctx, std::max(capacity, keys.capacity), wide ? 64 : 32, "sort");
   }
 
   uint64_t device_bytes() const {
@@ -131,9 +134,12 @@ struct Renderer::Impl {
     const uint32_t tile_bits = uint32_t(std::bit_width(tiles));
     constexpr uint32_t kDepthBits = 32;  // the float bits of the view depth
     const uint32_t n = scene.count;
+    const bool depth_first = sorter.frame_plan() == FrameSortPlan::kDepthThenTile;
+    ensure_key_capacity(keys.capacity, /*wide=*/!depth_first);
 
     sorter.reserve(std::max(n, keys.capacity));
-    VkCommandBuffer cmd = ctx.begin_one_time();
+    vk::CommandStream stream(ctx);
+    VkCommandBuffer cmd = stream.cmd();
     timer.begin_frame(cmd);
     vkCmdFillBuffer(cmd, counters.handle(), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, ranges.handle(), 0, VK_WHOLE_SIZE, 0);
@@ -144,44 +150,46 @@ struct Renderer::Impl {
     vk::barrier(cmd);
     timer.mark(cmd, "projection");
 
-    SortInput depth_input{projected.depth_order, counters, kDepthSortOffset, kDepthBits};
-    const vk::Buffer& depth_order =
-        sorter.record(cmd, depth_input) ? projected.depth_order.values_alt : projected.depth_order.values;
-    timer.mark(cmd, "depth_sort");
+    // Depth first: sort the Gaussians by depth, then emit the pairs front to back, so that the
+    // pair sort only needs the tile bits. Otherwise the strategy sorts (tile, depth) pairs itself.
+    const vk::Buffer* depth_order = nullptr;
+    if (depth_first) {
+      SortInput depth_input{projected.depth_order, counters, kDepthSortOffset, kDepthBits, true};
+      depth_order = sorter.record(stream, depth_input) ? &projected.depth_order.values_alt
+                                                       : &projected.depth_order.values;
+      timer.mark(stream.cmd(), "depth_sort");
+      prefix_sum.record(stream.cmd(), projected.tile_counts.address(), projected.depth_offsets.address(), n,
+                        counters.address(), depth_order->address());
+    } else {
+      prefix_sum.record(stream.cmd(), projected.tile_counts.address(), projected.offsets.address(), n,
+                        counters.address());
+    }
+    timer.mark(stream.cmd(), "prefix_sum");
 
-    prefix_sum.record(cmd, projected.tile_counts.address(), projected.depth_offsets.address(), n, counters.address(),
-                      depth_order.address());
-    timer.mark(cmd, "prefix_sum");
+    key_emission.record(stream.cmd(), projected, depth_order, keys, n, tiles_x, tiles, counters.address());
+    vk::barrier(stream.cmd());
+    timer.mark(stream.cmd(), "key_emission");
 
-    key_emission.record(cmd, projected, depth_order, keys, n, tiles_x, tiles, counters.address());
-    vk::barrier(cmd);
-    timer.mark(cmd, "key_emission");
-
-    SortInput tile_input{keys, counters, kTileSortOffset, tile_bits};
-    const bool sorted_in_alt = sorter.record(cmd, tile_input);
-    timer.mark(cmd, "tile_sort");
+    SortInput tile_input{keys, counters, kTileSortOffset, depth_first ? tile_bits : kDepthBits + tile_bits,
+                         !depth_first};
+    const bool sorted_in_alt = sorter.record(stream, tile_input);
+    timer.mark(stream.cmd(), "tile_sort");
 
     const vk::Buffer& sorted_keys = sorted_in_alt ? keys.keys_alt : keys.keys;
     const vk::Buffer& sorted_values = sorted_in_alt ? keys.values_alt : keys.values;
-    tile_ranges.record(cmd, sorted_keys, ranges, counters, kRangesArgsOffset, tiles);
-    vk::barrier(cmd);
-    timer.mark(cmd, "tile_ranges");
+    tile_ranges.record(stream.cmd(), sorted_keys, keys.wide_keys, ranges, counters, kRangesArgsOffset, tiles);
+    vk::barrier(stream.cmd());
+    timer.mark(stream.cmd(), "tile_ranges");
 
-    composite.record(cmd, projected.splats, sorted_values, ranges, outputs, settings.background, settings.depth,
-                     settings.splat_count);
-    timer.mark(cmd, "composite");
-
-    // Host reads of mapped memory need the GPU writes made available to the host.
-    VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
-    ctx.end_submit_wait(cmd);
+    composite.record(stream.cmd(), projected.splats, sorted_values, ranges, outputs, settings.background,
+                     settings.depth, settings.splat_count);
+    timer.mark(stream.cmd(), "composite");
+    stream.finish();
 
     FrameCounters result;
     std::memcpy(&result, counters.mapped(), sizeof(result));
     stats.sort_bits = kDepthBits + tile_bits;
+    stats.submissions = stream.submissions();
     return result;
   }
 
@@ -201,7 +209,7 @@ struct Renderer::Impl {
       if (attempt == kMaxRetries || keys.capacity >= (1u << 31))
         throw std::runtime_error("frame needs " + std::to_string(frame.intersections) +
                                  " tile intersections, more than the key buffers can hold");
-      ensure_key_capacity(grow_capacity(frame.intersections));
+      ensure_key_capacity(grow_capacity(frame.intersections), keys.wide_keys);
       stats.retries = attempt + 1;
     }
     for (const auto& section : timer.read(&stats.gpu_ms)) stats.passes.push_back({section.name, section.ms});
@@ -281,7 +289,7 @@ void Renderer::set_scene(const GaussianScene& scene) {
   p.depth_offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets (depth order)");
   p.offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets");
   p.depth_order = KeyBuffers::allocate(r.ctx, uint32_t(n), 32, "depth");
-  r.ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)));
+  r.ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)), /*wide=*/false);
 }
 
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
@@ -377,12 +385,12 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
   std::memcpy(state.mapped(), &initial, sizeof(initial));
 
   sorter.reserve(capacity);
-  VkCommandBuffer cmd = r.ctx.begin_one_time();
-  r.timer.begin_frame(cmd);
+  vk::CommandStream stream(r.ctx);
+  r.timer.begin_frame(stream.cmd());
   SortInput input{kb, state, 0, key_bits};
-  const bool in_alt = sorter.record(cmd, input);
-  r.timer.mark(cmd, "sort");
-  r.ctx.end_submit_wait(cmd);
+  const bool in_alt = sorter.record(stream, input);
+  r.timer.mark(stream.cmd(), "sort");
+  stream.finish();
 
   SortRun run;
   r.timer.read(&run.gpu_ms);

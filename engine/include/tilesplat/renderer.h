@@ -47,6 +47,7 @@ struct FrameStats {
   uint64_t intersections = 0;      // (Gaussian, tile) pairs sorted
   uint32_t sort_bits = 0;          // key bits sorted: 32 depth bits (per Gaussian) + the tile bits (per pair)
   int retries = 0;                 // re-renders after growing the intersection buffers
+  int submissions = 0;             // command buffers the frame took: 1, more for a strategy that sorts on the host
   uint64_t device_bytes = 0;       // device memory held by the renderer's buffers
 };
 

@@ -1,6 +1,8 @@
 // Frame setup + key emission: caps the key count at the buffers' capacity, sizes the indirect
 // dispatches, hands each Gaussian its offset from the depth-order prefix sum, then writes one
-// (tile id, Gaussian index) pair per touched tile, front to back.
+// (tile id, Gaussian index) pair per touched tile, front to back. Without a depth order (a strategy
+// that sorts (tile, depth) pairs itself) the offsets are already per Gaussian and the keys are
+// 64-bit tile << 32 | depth bits.
 #pragma once
 
 #include "passes/key_buffers.h"
@@ -13,15 +15,16 @@ namespace tilesplat {
 class KeyEmissionPass {
  public:
   explicit KeyEmissionPass(vk::Context& ctx);
-  // depth_order: the Gaussian indices front to back (the depth sort's values);
-  // projected.depth_offsets: the prefix sum of the tile counts taken in that order.
-  void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer& depth_order, KeyBuffers& keys,
+  // depth_order: the Gaussian indices front to back (the depth sort's values), with
+  // projected.depth_offsets the prefix sum of the tile counts taken in that order; or null, with
+  // projected.offsets the prefix sum in Gaussian order and keys.wide_keys.
+  void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer* depth_order, KeyBuffers& keys,
               uint32_t gaussians, uint32_t tiles_x, uint32_t tiles, VkDeviceAddress counters);
 
  private:
   vk::ComputePipeline frame_setup_;
   vk::ComputePipeline scatter_offsets_;
-  vk::ComputePipeline emit_keys_;
+  vk::ComputePipeline emit_keys_[2];  // [wide keys]
 };
 
 }  // namespace tilesplat

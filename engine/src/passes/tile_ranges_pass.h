@@ -9,12 +9,13 @@ namespace tilesplat {
 class TileRangesPass {
  public:
   explicit TileRangesPass(vk::Context& ctx);
-  // ranges must hold one uvec2 per tile; it is zero-filled here first.
-  void record(VkCommandBuffer cmd, const vk::Buffer& sorted_keys, vk::Buffer& ranges, const vk::Buffer& counters,
-              VkDeviceSize ranges_args_offset, uint32_t tiles);
+  // ranges must hold one uvec2 per tile, zero-filled. The tile id is the key, or its high 32 bits
+  // with 64-bit keys (tile << 32 | depth bits).
+  void record(VkCommandBuffer cmd, const vk::Buffer& sorted_keys, bool wide_keys, vk::Buffer& ranges,
+              const vk::Buffer& counters, VkDeviceSize ranges_args_offset, uint32_t tiles);
 
  private:
-  vk::ComputePipeline pipeline_;
+  vk::ComputePipeline pipeline_[2];  // [wide keys]
 };
 
 }  // namespace tilesplat

@@ -49,7 +49,8 @@ BitonicSort::BitonicSort(vk::Context& ctx) : max_workgroups_(workgroup_cap(ctx))
   }
 }
 
-bool BitonicSort::record(VkCommandBuffer cmd, SortInput& input) {
+bool BitonicSort::record(vk::CommandStream& stream, SortInput& input) {
+  VkCommandBuffer cmd = stream.cmd();
   KeyBuffers& kb = input.keys;
   const VkDeviceAddress state = input.state.address() + input.state_offset;
   const VkDeviceSize args_offset = input.state_offset + kSortArgsOffset;

@@ -20,7 +20,7 @@ class BitonicSort final : public SortStrategy {
   // until the last pass replaces each with its payload), and the padding to a power of two is never
   // stored.
   void reserve(uint32_t) override {}
-  bool record(VkCommandBuffer cmd, SortInput& input) override;
+  bool record(vk::CommandStream& stream, SortInput& input) override;
   uint64_t device_bytes() const override { return 0; }
 
  private:

@@ -61,7 +61,8 @@ void RadixSort::reserve(uint32_t max_keys) {
     histogram_ = vk::Buffer(ctx_, histogram_bytes, vk::MemoryUse::Device, "radix histogram");
 }
 
-bool RadixSort::record(VkCommandBuffer cmd, SortInput& input) {
+bool RadixSort::record(vk::CommandStream& stream, SortInput& input) {
+  VkCommandBuffer cmd = stream.cmd();
   KeyBuffers& kb = input.keys;
   if (histogram_.size() < VkDeviceSize(blocks_for(kb.capacity)) * kRadix * sizeof(uint32_t))
     throw std::logic_error("radix sort: reserve() was not called for " + std::to_string(kb.capacity) + " keys");

@@ -14,7 +14,7 @@ class RadixSort final : public SortStrategy {
   explicit RadixSort(vk::Context& ctx);
   std::string name() const override { return "radix"; }
   void reserve(uint32_t max_keys) override;
-  bool record(VkCommandBuffer cmd, SortInput& input) override;
+  bool record(vk::CommandStream& stream, SortInput& input) override;
   uint64_t device_bytes() const override { return histogram_.size() + digit_totals_.size(); }
 
   uint32_t block_keys() const { return block_keys_; }

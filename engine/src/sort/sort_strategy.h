@@ -10,6 +10,7 @@
 
 #include "passes/key_buffers.h"
 #include "vulkan/buffer.h"
+#include "vulkan/command_stream.h"
 #include "vulkan/context.h"
 
 namespace tilesplat {
@@ -17,9 +18,18 @@ namespace tilesplat {
 struct SortInput {
   KeyBuffers& keys;              // input in keys/values; keys_alt/values_alt are scratch of equal size
   const vk::Buffer& state;       // holds this sort's SortState (frame_counters.h) at state_offset;
-  VkDeviceSize state_offset;     //   its count is set on the GPU before the sort runs
+  VkDeviceSize state_offset;     //   its count is set on the GPU before the sort runs. Host-visible:
+                                 //   a strategy that sorts on the host reads it after a flush.
   uint32_t key_bits = 64;        // only the low key_bits bits vary; higher bits are zero
+  // The low 32 key bits are the bits of a positive float (a view depth), so that a strategy that
+  // quantizes depths (cpu-radix16) can do it linearly in depth; false for plain integer keys.
+  bool depth_in_low_bits = false;
 };
+
+// How a frame uses a strategy. A global sort runs twice: the Gaussians by depth, then the (tile,
+// Gaussian) pairs by tile id. A strategy that bins by tile itself sorts each pair's
+// (tile << 32 | depth bits) key once instead.
+enum class FrameSortPlan { kDepthThenTile, kTileDepthPairs };
 
 class SortStrategy {
  public:
@@ -29,9 +39,11 @@ class SortStrategy {
   // recording: a frame records two sorts, and scratch replaced between them would be freed while
   // the first one still uses it.
   virtual void reserve(uint32_t max_keys) = 0;
-  // Records the sort (input.keys.capacity <= the reserved size). Returns true when the sorted result is in keys_alt/values_alt rather than
-  // keys/values. The count is read on the GPU; the recording may not depend on it.
-  virtual bool record(VkCommandBuffer cmd, SortInput& input) = 0;
+  // Records the sort into the stream (input.keys.capacity <= the reserved size). Returns true when
+  // the sorted result is in keys_alt/values_alt rather than keys/values. The count is set on the
+  // GPU; a GPU strategy's recording may not depend on it (a host strategy flushes and reads it).
+  virtual bool record(vk::CommandStream& stream, SortInput& input) = 0;
+  virtual FrameSortPlan frame_plan() const { return FrameSortPlan::kDepthThenTile; }
   // Scratch memory the strategy holds, for the memory report.
   virtual uint64_t device_bytes() const = 0;
 };

@@ -380,4 +380,9 @@ void Context::end_submit_wait(VkCommandBuffer cmd) {
   TS_VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
 }
 
+void Context::discard(VkCommandBuffer cmd) {
+  vkEndCommandBuffer(cmd);
+  vkFreeCommandBuffers(device_, command_pool_, 1, &cmd);
+}
+
 }  // namespace tilesplat::vk

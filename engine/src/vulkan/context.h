@@ -72,6 +72,8 @@ class Context {
   }
   VkCommandBuffer begin_one_time();
   void end_submit_wait(VkCommandBuffer cmd);
+  // Frees a command buffer from begin_one_time without submitting it.
+  void discard(VkCommandBuffer cmd);
 
   uint64_t validation_messages() const { return validation_messages_.load(); }
 
