@@ -1,16 +1,20 @@
-// tilesplat-bench: times the renderer's passes over repeated frames, per sort strategy; or, with
-// --sort-bench, the sort strategies alone on random keys against CPU sorts on the same keys.
+// tilesplat-bench: times the renderer's passes over repeated frames, per scene, image size, camera
+// and sort strategy; or, with --sort-bench, the sort strategies alone on random keys against CPU
+// sorts on the same keys.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "bench_plot.h"
 #include "cli.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/renderer.h"
@@ -21,6 +25,7 @@ namespace {
 
 namespace cli = tilesplat::cli;
 namespace fs = std::filesystem;
+namespace plot = tilesplat::plot;
 
 constexpr const char* kProgram = "tilesplat-bench";
 
@@ -30,6 +35,11 @@ struct BenchOptions {
   int repeat = 10;
   std::string csv;
   std::string json;
+  std::string plot;
+  std::vector<cli::ImageSize> resolutions;  // --resolutions; empty: the one size of --width/--height
+  std::vector<int> views;                   // --views; empty: --view alone (or every view, with all_views)
+  bool all_views = false;
+  int orbit = 0;  // --orbit N: N orbit cameras; 0: the one at --azimuth
   bool sort_bench = false;
   std::vector<int> sort_sizes{10, 12, 14, 16, 18, 20, 22, 24};  // log2 of the key counts
   std::vector<int> key_bits{32, 64};
@@ -55,7 +65,8 @@ int unit_decimals(Unit unit) {
   return 3;
 }
 
-// One row of the table: a metric sampled once per measured frame.
+// One row of the table: a metric sampled once per measured frame (or, in a summary over the views
+// of a camera path, once per view).
 struct Series {
   std::string name;
   std::string kind;  // "pass" (GPU time of one pass) or "frame"
@@ -86,6 +97,24 @@ struct StrategyResult {
   std::vector<Series> frame;   // gpu frame, cpu frame, counts, memory
 };
 
+Series& find_series(std::vector<Series>& rows, const std::string& name, const std::string& kind, Unit unit) {
+  for (auto& row : rows)
+    if (row.name == name) return row;
+  rows.push_back({name, kind, unit, {}});
+  return rows.back();
+}
+
+const Series* find_series(const std::vector<Series>& rows, const std::string& name) {
+  for (const auto& row : rows)
+    if (row.name == name) return &row;
+  return nullptr;
+}
+
+double median_of(const std::vector<Series>& rows, const std::string& name) {
+  const Series* row = find_series(rows, name);
+  return row ? summarize(row->samples).median : 0;
+}
+
 // Gathers FrameStats of the measured frames into per-metric series.
 class Collector {
  public:
@@ -100,26 +129,22 @@ class Collector {
         if (name == pass.name) occurrence = ++count;
       if (occurrence == 1) occurrences.emplace_back(pass.name, 1);
       const std::string label = occurrence == 1 ? pass.name : pass.name + " #" + std::to_string(occurrence);
-      series(result_.passes, label, "pass", Unit::kMilliseconds).samples.push_back(pass.gpu_ms);
+      find_series(result_.passes, label, "pass", Unit::kMilliseconds).samples.push_back(pass.gpu_ms);
     }
-    series(result_.frame, "gpu frame", "frame", Unit::kMilliseconds).samples.push_back(stats.gpu_ms);
-    series(result_.frame, "cpu frame", "frame", Unit::kMilliseconds).samples.push_back(stats.cpu_ms);
-    series(result_.frame, "visible gaussians", "frame", Unit::kCount).samples.push_back(double(stats.visible));
-    series(result_.frame, "intersections", "frame", Unit::kCount).samples.push_back(double(stats.intersections));
-    series(result_.frame, "sort bits", "frame", Unit::kCount).samples.push_back(double(stats.sort_bits));
-    series(result_.frame, "retries", "frame", Unit::kCount).samples.push_back(double(stats.retries));
-    series(result_.frame, "device memory", "frame", Unit::kMebibytes)
-        .samples.push_back(double(stats.device_bytes) / (1024.0 * 1024.0));
+    add_frame("gpu frame", Unit::kMilliseconds, stats.gpu_ms);
+    add_frame("cpu frame", Unit::kMilliseconds, stats.cpu_ms);
+    add_frame("visible gaussians", Unit::kCount, double(stats.visible));
+    add_frame("intersections", Unit::kCount, double(stats.intersections));
+    add_frame("sort bits", Unit::kCount, double(stats.sort_bits));
+    add_frame("retries", Unit::kCount, double(stats.retries));
+    add_frame("device memory", Unit::kMebibytes, double(stats.device_bytes) / (1024.0 * 1024.0));
   }
 
   StrategyResult take() { return std::move(result_); }
 
  private:
-  static Series& series(std::vector<Series>& rows, const std::string& name, const char* kind, Unit unit) {
-    for (auto& row : rows)
-      if (row.name == name) return row;
-    rows.push_back({name, kind, unit, {}});
-    return rows.back();
+  void add_frame(const char* name, Unit unit, double value) {
+    find_series(result_.frame, name, "frame", unit).samples.push_back(value);
   }
 
   StrategyResult result_;
@@ -183,12 +208,117 @@ class Progress {
 };
 
 // ---------------------------------------------------------------------------------------------
+// The frame benchmark's plan: every scene loaded once, with the cameras of its path at every size.
+
+struct BenchScene {
+  cli::LoadedScene loaded;  // the camera fields are unused: the cameras are in the run's cases
+  std::string name;         // the file name
+  std::string description;  // "31,000 Gaussians (SH2)"
+  uint64_t gaussians = 0;   // kept apart from loaded.scene, which is released once the scene is measured
+  int sh_degree = 0;
+  std::string cameras;      // the scene's cameras.json; empty when its cameras orbit it
+};
+
+// One camera of the run, a row of the results per sort strategy.
+struct Case {
+  size_t scene = 0;        // index into the scenes
+  size_t size = 0;         // index into the run's sizes
+  std::string view_label;  // short: "view 2", "azimuth 120.0"
+  cli::NamedCamera camera;
+  std::vector<StrategyResult> results;  // one per sort, in --sort order
+};
+
+// The cases of one scene at one size (all the views of its path), and per sort strategy the
+// statistics over those views of each view's median.
+struct Group {
+  std::vector<const Case*> cases;
+  std::vector<StrategyResult> over_views;
+};
+
+std::string size_of(const Case& c) { return cli::format_size(c.camera.camera.width, c.camera.camera.height); }
+
+// "320x180"; without --resolutions or --width/--height, views of a cameras.json keep their own sizes,
+// which need not agree.
+std::string size_label(const Group& group) {
+  const std::string first = size_of(*group.cases.front());
+  for (const Case* c : group.cases)
+    if (size_of(*c) != first) return "each view's own size";
+  return first;
+}
+
+std::string orbit_label(double azimuth_deg) { return "azimuth " + cli::format_fixed(azimuth_deg, 1); }
+
+// The cameras of one scene: views of its cameras.json, or orbit positions evenly spaced in azimuth,
+// each at every size. Out-of-range views and sizes fail here, before anything is measured.
+std::vector<Case> plan_cases(const BenchOptions& options, const BenchScene& scene, size_t scene_index,
+                             const std::vector<cli::ImageSize>& sizes) {
+  std::vector<Case> cases;
+  auto add = [&](size_t size_index, std::string label, cli::NamedCamera camera) {
+    cases.push_back({scene_index, size_index, std::move(label), std::move(camera), {}});
+  };
+  if (!scene.cameras.empty()) {
+    const auto file_views = cli::load_camera_views(scene.cameras);
+    std::vector<int> indices = options.views;
+    if (options.all_views) {
+      indices.resize(file_views.size());
+      std::iota(indices.begin(), indices.end(), 0);
+    } else if (indices.empty()) {
+      indices = {options.common.view};
+    }
+    const char* flag = options.views.empty() && !options.all_views ? "--view" : "--views";
+    for (size_t s = 0; s < sizes.size(); ++s)
+      for (const int index : indices)
+        add(s, "view " + std::to_string(index),
+            cli::view_camera(file_views, index, scene.cameras, sizes[s].width, sizes[s].height, flag));
+  } else {
+    const int count = std::max(1, options.orbit);
+    for (size_t s = 0; s < sizes.size(); ++s) {
+      for (int v = 0; v < count; ++v) {
+        tilesplat::OrbitParams orbit = options.common.orbit;
+        orbit.azimuth_deg = std::fmod(orbit.azimuth_deg + 360.0 * v / count, 360.0);
+        add(s, orbit_label(orbit.azimuth_deg),
+            cli::orbit_view(scene.loaded, sizes[s].width, sizes[s].height, orbit));
+      }
+    }
+  }
+  return cases;
+}
+
+// Per metric, one sample per view: that view's median. Summarized, they give the median, min and
+// max over the views of a path.
+StrategyResult over_views(const std::vector<const Case*>& cases, size_t sort) {
+  StrategyResult summary;
+  summary.sort = cases.front()->results[sort].sort;
+  for (const Case* c : cases) {
+    const StrategyResult& result = c->results[sort];
+    for (const auto& row : result.passes)
+      find_series(summary.passes, row.name, row.kind, row.unit).samples.push_back(summarize(row.samples).median);
+    for (const auto& row : result.frame)
+      find_series(summary.frame, row.name, row.kind, row.unit).samples.push_back(summarize(row.samples).median);
+  }
+  return summary;
+}
+
+std::vector<Group> group_cases(const std::vector<Case>& cases, size_t sort_count) {
+  std::vector<Group> groups;
+  for (const auto& c : cases) {
+    if (groups.empty() || groups.back().cases.front()->scene != c.scene ||
+        groups.back().cases.front()->size != c.size)
+      groups.emplace_back();
+    groups.back().cases.push_back(&c);
+  }
+  for (auto& group : groups)
+    for (size_t sort = 0; sort < sort_count; ++sort) group.over_views.push_back(over_views(group.cases, sort));
+  return groups;
+}
+
+// ---------------------------------------------------------------------------------------------
 // Output
 
 std::string format_value(double value, Unit unit) { return cli::format_fixed(value, unit_decimals(unit)); }
 
-void print_table(const StrategyResult& result, const BenchOptions& options) {
-  std::printf("\nsort %s: %d frames after %d warm-up\n", result.sort.c_str(), options.repeat, options.warmup);
+void print_table(const StrategyResult& result, const std::string& heading) {
+  std::printf("\nsort %s: %s\n", result.sort.c_str(), heading.c_str());
   size_t name_width = 20;
   for (const auto* rows : {&result.passes, &result.frame})
     for (const auto& row : *rows) name_width = std::max(name_width, row.name.size());
@@ -204,21 +334,60 @@ void print_table(const StrategyResult& result, const BenchOptions& options) {
   }
 }
 
-double median_gpu_frame(const StrategyResult& result) {
-  for (const auto& row : result.frame)
-    if (row.name == "gpu frame") return summarize(row.samples).median;
-  return 0;
-}
-
-void print_comparison(const std::vector<StrategyResult>& results) {
+void print_comparison(const std::vector<StrategyResult>& results, const std::string& what) {
   if (results.size() < 2) return;
   size_t fastest = 0;
   for (size_t i = 1; i < results.size(); ++i)
-    if (median_gpu_frame(results[i]) < median_gpu_frame(results[fastest])) fastest = i;
-  std::printf("\nsort comparison (median gpu frame):\n");
+    if (median_of(results[i].frame, "gpu frame") < median_of(results[fastest].frame, "gpu frame")) fastest = i;
+  std::printf("\nsort comparison (%s):\n", what.c_str());
   for (size_t i = 0; i < results.size(); ++i)
     std::printf("  %-20s %12s ms%s\n", results[i].sort.c_str(),
-                cli::format_fixed(median_gpu_frame(results[i]), 3).c_str(), i == fastest ? "  (fastest)" : "");
+                cli::format_fixed(median_of(results[i].frame, "gpu frame"), 3).c_str(),
+                i == fastest ? "  (fastest)" : "");
+}
+
+// "(51.258..52.382)"
+std::string min_max(const Summary& summary) {
+  std::string text = "(";
+  text += cli::format_fixed(summary.min, 3) + ".." + cli::format_fixed(summary.max, 3) + ")";
+  return text;
+}
+
+// One group on stdout. A single camera gets the full table per sort; a path of several gets a line
+// per view and sort, then the full tables over the views, so that it stays readable at any length.
+void print_group(const Group& group, const BenchScene& scene, const BenchOptions& options) {
+  const std::string frames =
+      std::to_string(options.repeat) + " frames after " + std::to_string(options.warmup) + " warm-up";
+  if (group.cases.size() == 1) {
+    const Case& c = *group.cases.front();
+    std::printf("\n== %s at %s, %s ==\n", scene.name.c_str(), size_label(group).c_str(),
+                c.camera.description.c_str());
+    for (const auto& result : c.results) print_table(result, frames);
+    print_comparison(c.results, "median gpu frame");
+    return;
+  }
+
+  const size_t views = group.cases.size();
+  std::printf("\n== %s at %s: %zu views, %s each ==\n", scene.name.c_str(), size_label(group).c_str(), views,
+              frames.c_str());
+  size_t label_width = 8;
+  for (const Case* c : group.cases) label_width = std::max(label_width, c->view_label.size());
+  const int lw = static_cast<int>(label_width);
+  std::printf("  %-*s %-12s %12s  %-20s %12s %14s\n", lw, "view", "sort", "gpu frame ms", "(min..max)", "cpu ms",
+              "intersections");
+  for (const Case* c : group.cases) {
+    for (const auto& result : c->results) {
+      const Series* gpu = find_series(result.frame, "gpu frame");
+      const Summary s = gpu ? summarize(gpu->samples) : Summary{};
+      std::printf("  %-*s %-12s %12s  %-20s %12s %14s\n", lw, c->view_label.c_str(), result.sort.c_str(),
+                  cli::format_fixed(s.median, 3).c_str(), min_max(s).c_str(),
+                  cli::format_fixed(median_of(result.frame, "cpu frame"), 3).c_str(),
+                  cli::format_fixed(median_of(result.frame, "intersections"), 0).c_str());
+    }
+  }
+  const std::string over = "median, min and max over the " + std::to_string(views) + " views of each view's median";
+  for (const auto& summary : group.over_views) print_table(summary, over);
+  print_comparison(group.over_views, "median over the views of the median gpu frame");
 }
 
 std::string csv_field(const std::string& text) {
@@ -265,95 +434,232 @@ std::string json_string(const std::string& text) {
   return out + "\"";
 }
 
-struct RunInfo {
-  std::string scene_path;
-  std::string scene_description;
-  uint64_t gaussians = 0;
-  int sh_degree = 0;
-  std::string camera;
-  int width = 0;
-  int height = 0;
-  tilesplat::DeviceInfo device;
-};
+std::string json_device(const tilesplat::DeviceInfo& device) {
+  return "{\"name\": " + json_string(device.name) + ", \"driver\": " + json_string(device.driver) +
+         ", \"subgroup_size\": " + std::to_string(device.subgroup_size) +
+         ", \"timestamp_period_ns\": " + json_number(device.timestamp_period_ns) + "}";
+}
 
-std::string make_csv(const std::vector<StrategyResult>& results, const RunInfo& info) {
-  std::string csv = "device,scene,width,height,sort,kind,metric,unit,median,min,max,samples\n";
-  for (const auto& result : results) {
-    for (const auto* rows : {&result.passes, &result.frame}) {
-      for (const auto& row : *rows) {
-        const Summary summary = summarize(row.samples);
-        csv += csv_field(info.device.name) + "," + csv_field(info.scene_path) + "," + std::to_string(info.width) +
-               "," + std::to_string(info.height) + "," + csv_field(result.sort) + "," + row.kind + "," +
-               csv_field(row.name) + "," + unit_name(row.unit) + "," + json_number(summary.median) + "," +
-               json_number(summary.min) + "," + json_number(summary.max) + "," +
-               std::to_string(row.samples.size()) + "\n";
-      }
-    }
+// Calls visit(row) for every metric of a result, passes first.
+template <typename Visit>
+void for_each_metric(const StrategyResult& result, Visit&& visit) {
+  for (const auto* rows : {&result.passes, &result.frame})
+    for (const auto& row : *rows) visit(row);
+}
+
+// One CSV line per metric: the rows of each camera ("frames": statistics over the measured
+// frames), then with a path of several views the rows over its views (view "all").
+std::string make_csv(const std::vector<Group>& groups, const std::vector<BenchScene>& scenes,
+                     const tilesplat::DeviceInfo& device) {
+  std::string csv = "device,scene,width,height,view,camera,sort,kind,metric,unit,over,median,min,max,samples\n";
+  auto add = [&](const std::string& scene, const std::string& width, const std::string& height,
+                 const std::string& view, const std::string& camera, const StrategyResult& result,
+                 const char* over) {
+    for_each_metric(result, [&](const Series& row) {
+      const Summary summary = summarize(row.samples);
+      csv += csv_field(device.name) + "," + csv_field(scene) + "," + width + "," + height + "," + csv_field(view) +
+             "," + csv_field(camera) + "," + csv_field(result.sort) + "," + row.kind + "," + csv_field(row.name) +
+             "," + unit_name(row.unit) + "," + over + "," + json_number(summary.median) + "," +
+             json_number(summary.min) + "," + json_number(summary.max) + "," + std::to_string(row.samples.size()) +
+             "\n";
+    });
+  };
+  for (const auto& group : groups) {
+    const std::string& scene = scenes[group.cases.front()->scene].loaded.path.string();
+    for (const Case* c : group.cases)
+      for (const auto& result : c->results)
+        add(scene, std::to_string(c->camera.camera.width), std::to_string(c->camera.camera.height),
+            c->view_label, c->camera.description, result, "frames");
+    if (group.cases.size() < 2) continue;
+    const Case& first = *group.cases.front();
+    const bool one_size = size_label(group) == size_of(first);
+    const std::string width = one_size ? std::to_string(first.camera.camera.width) : "";
+    const std::string height = one_size ? std::to_string(first.camera.camera.height) : "";
+    for (const auto& summary : group.over_views)
+      add(scene, width, height, "all", std::to_string(group.cases.size()) + " views", summary, "views");
   }
   return csv;
 }
 
-std::string make_json(const std::vector<StrategyResult>& results, const RunInfo& info,
-                      const BenchOptions& options) {
-  std::string json = "{\n";
-  json += "  \"tool\": \"tilesplat-bench\",\n";
-  json += "  \"scene\": {\"path\": " + json_string(info.scene_path) + ", \"gaussians\": " +
-          json_number(double(info.gaussians)) + ", \"sh_degree\": " + std::to_string(info.sh_degree) + "},\n";
-  json += "  \"camera\": {\"description\": " + json_string(info.camera) + ", \"width\": " +
-          std::to_string(info.width) + ", \"height\": " + std::to_string(info.height) + "},\n";
-  json += "  \"device\": {\"name\": " + json_string(info.device.name) + ", \"driver\": " +
-          json_string(info.device.driver) + ", \"subgroup_size\": " + std::to_string(info.device.subgroup_size) +
-          ", \"timestamp_period_ns\": " + json_number(info.device.timestamp_period_ns) + "},\n";
+std::string json_metrics(const StrategyResult& result, bool with_samples) {
+  std::string json = "[";
+  bool first = true;
+  for_each_metric(result, [&](const Series& row) {
+    const Summary summary = summarize(row.samples);
+    json += first ? "\n" : ",\n";
+    first = false;
+    json += "        {\"name\": " + json_string(row.name) + ", \"kind\": \"" + row.kind + "\", \"unit\": \"" +
+            unit_name(row.unit) + "\", \"median\": " + json_number(summary.median) +
+            ", \"min\": " + json_number(summary.min) + ", \"max\": " + json_number(summary.max);
+    if (with_samples) {
+      json += ", \"samples\": [";
+      for (size_t i = 0; i < row.samples.size(); ++i) json += (i ? ", " : "") + json_number(row.samples[i]);
+      json += "]";
+    }
+    json += "}";
+  });
+  return json + "\n      ]";
+}
+
+// "results": one entry per camera and sort, every sample included; "summaries" (for paths of several
+// views, like the CSV's view "all"): per scene, size and sort, the median, min and max over the views
+// of each view's median.
+std::string make_json(const std::vector<Group>& groups, const std::vector<BenchScene>& scenes,
+                      const tilesplat::DeviceInfo& device, const BenchOptions& options) {
+  std::string json = "{\n  \"tool\": \"tilesplat-bench\",\n";
+  json += "  \"device\": " + json_device(device) + ",\n";
   json += "  \"warmup\": " + std::to_string(options.warmup) + ",\n";
   json += "  \"repeat\": " + std::to_string(options.repeat) + ",\n";
-  json += "  \"results\": [";
-  for (size_t r = 0; r < results.size(); ++r) {
-    const auto& result = results[r];
-    json += r ? ",\n" : "\n";
-    json += "    {\n      \"sort\": " + json_string(result.sort) + ",\n      \"metrics\": [";
-    bool first = true;
-    for (const auto* rows : {&result.passes, &result.frame}) {
-      for (const auto& row : *rows) {
-        const Summary summary = summarize(row.samples);
+  json += "  \"scenes\": [";
+  for (size_t s = 0; s < scenes.size(); ++s)
+    json += std::string(s ? ",\n" : "\n") + "    {\"path\": " + json_string(scenes[s].loaded.path.string()) +
+            ", \"gaussians\": " + json_number(double(scenes[s].gaussians)) +
+            ", \"sh_degree\": " + std::to_string(scenes[s].sh_degree) +
+            ", \"cameras\": " + (scenes[s].cameras.empty() ? "null" : json_string(scenes[s].cameras)) + "}";
+  json += "\n  ],\n  \"results\": [";
+  bool first = true;
+  for (const auto& group : groups) {
+    for (const Case* c : group.cases) {
+      for (const auto& result : c->results) {
         json += first ? "\n" : ",\n";
         first = false;
-        json += "        {\"name\": " + json_string(row.name) + ", \"kind\": \"" + row.kind + "\", \"unit\": \"" +
-                unit_name(row.unit) + "\", \"median\": " + json_number(summary.median) +
-                ", \"min\": " + json_number(summary.min) + ", \"max\": " + json_number(summary.max) +
-                ", \"samples\": [";
-        for (size_t i = 0; i < row.samples.size(); ++i) json += (i ? ", " : "") + json_number(row.samples[i]);
-        json += "]}";
+        json += "    {\n      \"scene\": " + json_string(scenes[c->scene].loaded.path.string()) +
+                ",\n      \"width\": " + std::to_string(c->camera.camera.width) +
+                ", \"height\": " + std::to_string(c->camera.camera.height) +
+                ",\n      \"view\": " + json_string(c->view_label) +
+                ", \"camera\": " + json_string(c->camera.description) +
+                ",\n      \"sort\": " + json_string(result.sort) +
+                ",\n      \"metrics\": " + json_metrics(result, true) + "\n    }";
       }
     }
-    json += "\n      ]\n    }";
+  }
+  json += "\n  ],\n  \"summaries\": [";
+  first = true;
+  for (const auto& group : groups) {
+    if (group.cases.size() < 2) continue;
+    const Case& c = *group.cases.front();
+    for (const auto& summary : group.over_views) {
+      json += first ? "\n" : ",\n";
+      first = false;
+      json += "    {\n      \"scene\": " + json_string(scenes[c.scene].loaded.path.string()) +
+              ",\n      \"size\": " + json_string(size_label(group)) +
+              ", \"views\": " + std::to_string(group.cases.size()) +
+              ",\n      \"sort\": " + json_string(summary.sort) +
+              ",\n      \"metrics\": " + json_metrics(summary, false) + "\n    }";
+    }
   }
   json += "\n  ]\n}\n";
   return json;
 }
 
+template <typename T>
+void add_unique(std::vector<T>& items, const T& item) {
+  if (std::find(items.begin(), items.end(), item) == items.end()) items.push_back(item);
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& item : items) out += (out.empty() ? "" : ", ") + item;
+  return out;
+}
+
+std::string device_line(const tilesplat::DeviceInfo& device) { return device.name + ", " + device.driver; }
+
+// A bar per scene, size and sort; its segments are the passes of the frame stats (the median over
+// the views of each view's median), in frame order.
+std::string make_frame_svg(const std::vector<Group>& groups, const std::vector<BenchScene>& scenes,
+                           const tilesplat::DeviceInfo& device, const BenchOptions& options) {
+  plot::StackedBarChart chart;
+  std::vector<std::string> scene_names;
+  std::vector<std::string> sizes;
+  for (const auto& group : groups) {
+    add_unique(scene_names, scenes[group.cases.front()->scene].name);
+    add_unique(sizes, size_label(group));
+    for (const auto& summary : group.over_views)
+      for (const auto& pass : summary.passes) add_unique(chart.segments, pass.name);
+  }
+  chart.title = "GPU time per pass: " + join(scene_names) + " at " + join(sizes);
+  std::string cameras;
+  if (groups.size() == 1 && groups.front().cases.size() == 1)
+    cameras = groups.front().cases.front()->camera.description;
+  else
+    cameras = "median over each path's views";
+  chart.subtitle = device_line(device) + "; " + cameras + "; median of " + std::to_string(options.repeat) +
+                   " frames after " + std::to_string(options.warmup) + " warm-up";
+  chart.axis_label = "GPU time (ms)";
+  for (const auto& group : groups) {
+    const Case& first = *group.cases.front();
+    std::string heading;
+    if (groups.size() > 1) {
+      heading = scenes[first.scene].name + ", " + size_label(group);
+      heading += group.cases.size() == 1 ? ", " + first.camera.description
+                                         : ", " + std::to_string(group.cases.size()) + " views";
+    }
+    for (const auto& summary : group.over_views) {
+      plot::StackedBar bar;
+      bar.group = heading;
+      bar.label = summary.sort;
+      for (const auto& segment : chart.segments) {
+        const Series* pass = find_series(summary.passes, segment);
+        bar.values.push_back(pass ? summarize(pass->samples).median : 0);
+      }
+      bar.note = "gpu frame " + cli::format_fixed(median_of(summary.frame, "gpu frame"), 1) + " ms";
+      chart.bars.push_back(std::move(bar));
+    }
+  }
+  return plot::stacked_bar_svg(chart);
+}
+
 // ---------------------------------------------------------------------------------------------
+// Options shared by both modes
 
 std::vector<int> parse_int_list(std::string_view flag, const std::string& text, int min, int max) {
   std::vector<int> values;
-  for (const auto& part : cli::split(text, ',')) {
-    const int value = cli::parse_int(flag, part, min, max);
-    if (std::find(values.begin(), values.end(), value) == values.end()) values.push_back(value);
-  }
+  for (const auto& part : cli::split(text, ',')) add_unique(values, cli::parse_int(flag, part, min, max));
   if (values.empty()) throw cli::UsageError(std::string(flag) + " needs at least one value");
   return values;
 }
 
 void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
-  cli::add_common_options(parser, options.common, cli::SortChoice::kList);
+  cli::add_common_options(parser, options.common, cli::SortChoice::kList, cli::SceneChoice::kList);
+
+  parser.section("camera path and sizes");
+  parser.add_value("--views", "N[,N...]|all",
+                   "several views of --cameras, comma-separated, or 'all': a row of results per view, then the "
+                   "median, min and max over the views of each view's median (default: --view alone)",
+                   [&options](const std::string& text) {
+                     options.all_views = text == "all";
+                     options.views.clear();
+                     if (!options.all_views)
+                       options.views = parse_int_list("--views", text, 0, std::numeric_limits<int>::max());
+                   });
+  parser.add_int("--orbit", "N",
+                 "N orbit cameras evenly spaced in azimuth, from --azimuth on (0, 360/N, ... by default), "
+                 "with --elevation, --fov and --distance as given; not with --cameras",
+                 &options.orbit, 1, 3600);
+  parser.add_value("--resolutions", "WxH[,WxH...]",
+                   "image sizes to measure each camera at, e.g. 1920x1080,1280x720 (instead of --width and "
+                   "--height)",
+                   [&options](const std::string& text) {
+                     options.resolutions = cli::parse_resolutions("--resolutions", text);
+                   });
 
   parser.section("benchmark");
-  parser.add_int("--warmup", "N", "frames rendered and discarded before measuring, per sort (default 2)",
+  parser.add_int("--warmup", "N", "frames rendered and discarded before measuring, per camera and sort (default 2)",
                  &options.warmup, 0, 1000000);
-  parser.add_int("--repeat", "N", "frames measured per sort (default 10)", &options.repeat, 1, 1000000);
-  parser.add_string("--csv", "FILE.csv", "also write the results as CSV: one row per sort and metric",
+  parser.add_int("--repeat", "N",
+                 "frames measured per camera and sort (default 10): the median, min and max are over these",
+                 &options.repeat, 1, 1000000);
+  parser.add_string("--csv", "FILE.csv",
+                    "also write the results as CSV: one line per scene, size, view, sort and metric; with several "
+                    "views also view 'all', the statistics over the views of each view's median",
                     &options.csv);
   parser.add_string("--json", "FILE.json", "also write the results, every sample included, as JSON",
                     &options.json);
+  parser.add_string("--plot", "FILE.svg",
+                    "also draw an SVG chart: the median GPU time of each pass as stacked bars, one per scene, "
+                    "size and sort; with --sort-bench, Mkeys/s against key count per sort and key width",
+                    &options.plot);
 
   parser.section("sort micro-benchmark");
   parser.add_switch("--sort-bench",
@@ -367,19 +673,33 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                    [&options](const std::string& text) { options.key_bits = parse_int_list("--key-bits", text, 1, 64); });
 }
 
-// Writes the --csv and --json files that were asked for, warns about validation messages, and
-// returns " -> a.csv, b.json" for the closing line.
-template <typename MakeCsv, typename MakeJson>
-std::string write_result_files(const BenchOptions& options, MakeCsv make_csv_text, MakeJson make_json_text,
-                               const tilesplat::Renderer& renderer) {
-  std::string written;
-  if (!options.csv.empty()) {
-    cli::write_file_atomic(options.csv, make_csv_text());
-    written += " -> " + options.csv;
+// Before any work: no output may overwrite an input or another output, the plot must be an SVG, and
+// every output's directory must exist, so that a long run never ends in a file it cannot write.
+void check_outputs(const BenchOptions& options, const std::vector<std::pair<std::string, fs::path>>& inputs) {
+  if (!options.plot.empty() && !cli::has_extension(options.plot, ".svg"))
+    throw cli::UsageError("--plot writes SVG: its file name must end in .svg, got '" + options.plot + "'");
+  const std::vector<std::pair<std::string, fs::path>> outputs = {
+      {"--csv", options.csv}, {"--json", options.json}, {"--plot", options.plot}};
+  cli::check_distinct_paths(outputs);
+  // Inputs may repeat (one cameras.json for every scene); only an output may not be one of them.
+  for (const auto& input : inputs) {
+    auto paths = outputs;
+    paths.insert(paths.begin(), input);
+    cli::check_distinct_paths(paths);
   }
-  if (!options.json.empty()) {
-    cli::write_file_atomic(options.json, make_json_text());
-    written += (written.empty() ? " -> " : ", ") + options.json;
+  for (const auto& [flag, path] : outputs)
+    if (!path.empty()) cli::check_output_path(path, flag);
+}
+
+// Writes the output files that were asked for (each atomically), warns about validation messages,
+// and returns " -> a.csv, b.json" for the closing line.
+std::string write_outputs(const std::vector<std::pair<std::string, std::function<std::string()>>>& files,
+                          const tilesplat::Renderer& renderer) {
+  std::string written;
+  for (const auto& [path, make] : files) {
+    if (path.empty()) continue;
+    cli::write_file_atomic(path, make());
+    written += (written.empty() ? " -> " : ", ") + path;
   }
   if (const auto messages = renderer.validation_messages(); messages > 0)
     cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
@@ -432,18 +752,28 @@ double time_cpu_radix(const std::vector<uint64_t>& keys, int bits, std::vector<u
 
 double median_ms(const SortRow& row) { return summarize(row.ms).median; }
 
+double mkeys_per_s(const SortRow& row) {
+  const double ms = median_ms(row);
+  return ms > 0 ? double(row.keys) / ms / 1e3 : 0;
+}
+
+// How many times faster than std::sort on the same keys (0 when unknown).
+double vs_std_sort(const std::vector<SortRow>& rows, const SortRow& row) {
+  const double ms = median_ms(row);
+  for (const auto& other : rows)
+    if (other.key_bits == row.key_bits && other.keys == row.keys && other.sorter == "std::sort")
+      return ms > 0 ? median_ms(other) / ms : 0;
+  return 0;
+}
+
 std::string make_sort_csv(const std::vector<SortRow>& rows, const tilesplat::DeviceInfo& device) {
   std::string csv = "device,key_bits,keys,sorter,where,median_ms,min_ms,max_ms,mkeys_per_s,vs_std_sort,samples\n";
   for (const auto& row : rows) {
     const Summary s = summarize(row.ms);
-    double std_ms = 0;
-    for (const auto& other : rows)
-      if (other.key_bits == row.key_bits && other.keys == row.keys && other.sorter == "std::sort")
-        std_ms = median_ms(other);
     csv += csv_field(device.name) + "," + std::to_string(row.key_bits) + "," + std::to_string(row.keys) + "," +
            csv_field(row.sorter) + "," + row.where + "," + json_number(s.median) + "," + json_number(s.min) + "," +
-           json_number(s.max) + "," + json_number(s.median > 0 ? double(row.keys) / s.median / 1e3 : 0) + "," +
-           json_number(s.median > 0 ? std_ms / s.median : 0) + "," + std::to_string(row.ms.size()) + "\n";
+           json_number(s.max) + "," + json_number(mkeys_per_s(row)) + "," + json_number(vs_std_sort(rows, row)) +
+           "," + std::to_string(row.ms.size()) + "\n";
   }
   return csv;
 }
@@ -470,15 +800,53 @@ std::string make_sort_json(const std::vector<SortRow>& rows, const tilesplat::De
   return json;
 }
 
+// A line per sorter and key width: the colour tells the sorter, the dash the key width.
+std::string make_sort_svg(const std::vector<SortRow>& rows, const tilesplat::DeviceInfo& device,
+                          const BenchOptions& options) {
+  plot::LineChart chart;
+  chart.title = "Sort throughput against key count";
+  chart.subtitle = device_line(device) + "; median of " + std::to_string(options.repeat) +
+                   " sorts; GPU: the sort alone (timestamps), CPU: one thread";
+  chart.x_label = "keys";
+  chart.y_label = "Mkeys/s";
+  chart.x_scale = plot::Scale::kLog2;
+  std::vector<std::string> sorters;
+  std::vector<int> widths;
+  double min = std::numeric_limits<double>::infinity();
+  double max = 0;
+  for (const auto& row : rows) {
+    add_unique(sorters, row.sorter);
+    add_unique(widths, row.key_bits);
+    const std::string label = row.sorter + (row.where == "cpu" ? " (cpu)" : "") + ", " +
+                              std::to_string(row.key_bits) + "-bit keys";
+    auto series = std::find_if(chart.series.begin(), chart.series.end(),
+                               [&](const plot::LineSeries& line) { return line.label == label; });
+    if (series == chart.series.end()) {
+      const auto index = [](const auto& items, const auto& item) {
+        return size_t(std::find(items.begin(), items.end(), item) - items.begin());
+      };
+      chart.series.push_back({label, index(sorters, row.sorter), index(widths, row.key_bits), {}});
+      series = chart.series.end() - 1;
+    }
+    const double rate = mkeys_per_s(row);
+    series->points.emplace_back(double(row.keys), rate);
+    if (rate > 0) {
+      min = std::min(min, rate);
+      max = std::max(max, rate);
+    }
+  }
+  // Small GPU sorts run at a hundredth of the CPU sorts' rate: a linear axis would flatten them to 0.
+  chart.y_scale = max >= 20 * min ? plot::Scale::kLog10 : plot::Scale::kLinear;
+  return plot::line_chart_svg(chart);
+}
+
 int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
-  if (!options.common.scene.empty())
+  if (!options.common.scenes.empty())
     throw cli::UsageError("--sort-bench sorts random keys and takes no SCENE");
-  for (const char* flag : {"--cameras", "--view", "--width", "--height", "--azimuth", "--elevation", "--fov",
-                           "--distance", "--strict"})
+  for (const char* flag : {"--cameras", "--view", "--views", "--orbit", "--width", "--height", "--resolutions",
+                           "--azimuth", "--elevation", "--fov", "--distance", "--strict"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --sort-bench");
-  cli::check_distinct_paths({{"--csv", options.csv}, {"--json", options.json}});
-  if (!options.csv.empty()) cli::check_output_path(options.csv, "--csv");
-  if (!options.json.empty()) cli::check_output_path(options.json, "--json");
+  check_outputs(options, {});
 
   std::vector<std::string> sorts = options.common.sorts;
   if (sorts.empty()) sorts = tilesplat::sort_strategies();
@@ -540,104 +908,147 @@ int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
 
   std::printf("\n  %4s %10s  %-12s %-4s %12s %12s %12s\n", "bits", "keys", "sorter", "on", "median ms",
               "Mkeys/s", "vs std::sort");
-  for (const auto& row : rows) {
-    double std_ms = 0;
-    for (const auto& other : rows)
-      if (other.key_bits == row.key_bits && other.keys == row.keys && other.sorter == "std::sort")
-        std_ms = median_ms(other);
-    const double ms = median_ms(row);
+  for (const auto& row : rows)
     std::printf("  %4d %10llu  %-12s %-4s %12s %12s %11sx\n", row.key_bits, static_cast<unsigned long long>(row.keys),
-                row.sorter.c_str(), row.where.c_str(), cli::format_fixed(ms, 3).c_str(),
-                cli::format_fixed(ms > 0 ? double(row.keys) / ms / 1e3 : 0, 2).c_str(),
-                cli::format_fixed(ms > 0 ? std_ms / ms : 0, 2).c_str());
-  }
+                row.sorter.c_str(), row.where.c_str(), cli::format_fixed(median_ms(row), 3).c_str(),
+                cli::format_fixed(mkeys_per_s(row), 2).c_str(), cli::format_fixed(vs_std_sort(rows, row), 2).c_str());
   std::fflush(stdout);
 
-  const std::string written = write_result_files(
-      options, [&] { return make_sort_csv(rows, device); }, [&] { return make_sort_json(rows, device, options); },
-      *renderer);
+  const std::string written =
+      write_outputs({{options.csv, [&] { return make_sort_csv(rows, device); }},
+                     {options.json, [&] { return make_sort_json(rows, device, options); }},
+                     {options.plot, [&] { return make_sort_svg(rows, device, options); }}},
+                    *renderer);
   std::fprintf(stderr, "%s: sort micro-benchmark, %d sorts in %s s%s\n", kProgram, total,
                cli::format_fixed(seconds, 2).c_str(), written.c_str());
   return cli::kExitOk;
 }
 
-int run(int argc, char** argv) {
-  BenchOptions options;
-  cli::ArgParser parser(kProgram, "tilesplat-bench SCENE.ply [options]",
-                        "Renders a view of a 3D Gaussian Splatting scene repeatedly and prints the GPU time "
-                        "of every pass (median, min, max over the measured frames) for each sort strategy, "
-                        "with the frame's visible Gaussians, intersections and device memory.");
-  add_bench_options(parser, options);
-  if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
-  if (options.sort_bench) return run_sort_bench(parser, options);
+// ---------------------------------------------------------------------------------------------
+// The frame benchmark
+
+// What the parser cannot check flag by flag. Throws UsageError.
+void check_frame_options(const cli::ArgParser& parser, const BenchOptions& options) {
   for (const char* flag : {"--sort-sizes", "--key-bits"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --sort-bench");
   cli::check_common_options(parser, options.common);
-  cli::check_distinct_paths({{"SCENE", options.common.scene},
-                             {"--cameras", options.common.cameras},
-                             {"--csv", options.csv},
-                             {"--json", options.json}});
-  if (!options.csv.empty()) cli::check_output_path(options.csv, "--csv");
-  if (!options.json.empty()) cli::check_output_path(options.json, "--json");
+  const size_t cameras = options.common.cameras_files.size();
+  const size_t scenes = options.common.scenes.size();
+  if (cameras > 1 && cameras != scenes)
+    throw cli::UsageError("--cameras was given " + std::to_string(cameras) + " times for " +
+                          std::to_string(scenes) + " scenes: give it once for every scene, or once per scene in "
+                          "the order of the scenes");
+  if (parser.seen("--views")) {
+    if (cameras == 0)
+      throw cli::UsageError("--views needs --cameras FILE.json (without it the cameras orbit the scene: see --orbit)");
+    if (parser.seen("--view")) throw cli::UsageError("--view and --views cannot be combined");
+  }
+  if (parser.seen("--orbit") && cameras > 0)
+    throw cli::UsageError("--orbit applies only to the orbit camera and cannot be combined with --cameras");
+  if (parser.seen("--resolutions"))
+    for (const char* flag : {"--width", "--height"})
+      if (parser.seen(flag))
+        throw cli::UsageError(std::string("--resolutions and ") + flag +
+                              " cannot be combined: give every size in --resolutions");
+}
+
+int run(int argc, char** argv) {
+  BenchOptions options;
+  cli::ArgParser parser(kProgram, "tilesplat-bench SCENE.ply [SCENE.ply...] [options]",
+                        "Renders 3D Gaussian Splatting scenes repeatedly and prints the GPU time of every pass "
+                        "(median, min, max over the measured frames) for each sort strategy, with the frame's "
+                        "CPU time, visible Gaussians, intersections and device memory. Every scene is measured "
+                        "at every size (--resolutions) from every camera of its path (--views of --cameras, or "
+                        "--orbit); a progress bar on stderr counts the frames of the whole run.");
+  add_bench_options(parser, options);
+  if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
+  if (options.sort_bench) return run_sort_bench(parser, options);
+  check_frame_options(parser, options);
+  std::vector<std::pair<std::string, fs::path>> inputs;
+  for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
+  for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
+  check_outputs(options, inputs);
 
   std::vector<std::string> sorts = options.common.sorts;
   if (sorts.empty()) sorts = tilesplat::sort_strategies();
   if (sorts.empty()) sorts = {tilesplat::RenderSettings{}.sort};
+  std::vector<cli::ImageSize> sizes = options.resolutions;
+  if (sizes.empty()) sizes = {{options.common.width, options.common.height}};
 
-  const cli::LoadedScene loaded = cli::load_scene_and_camera(options.common, kProgram);
+  // Every scene and camera first: a bad file or view fails now, not after an hour of measuring.
+  std::vector<BenchScene> scenes;
+  std::vector<Case> cases;
+  for (size_t s = 0; s < options.common.scenes.size(); ++s) {
+    BenchScene scene;
+    scene.loaded = cli::load_scene_file(options.common.scenes[s], options.common.strict, kProgram);
+    scene.name = scene.loaded.path.filename().string();
+    scene.description = cli::describe_scene(scene.loaded.scene);
+    scene.gaussians = scene.loaded.scene.size();
+    scene.sh_degree = scene.loaded.scene.sh_degree;
+    const auto& cameras = options.common.cameras_files;
+    if (!cameras.empty()) scene.cameras = cameras.size() == 1 ? cameras.front() : cameras[s];
+    auto scene_cases = plan_cases(options, scene, s, sizes);
+    cases.insert(cases.end(), std::make_move_iterator(scene_cases.begin()),
+                 std::make_move_iterator(scene_cases.end()));
+    scenes.push_back(std::move(scene));
+  }
+
   const auto renderer = tilesplat::Renderer::create(cli::renderer_options(options.common));
-  renderer->set_scene(loaded.scene);
-
-  RunInfo info;
-  info.scene_path = loaded.path.string();
-  info.scene_description = cli::describe_scene(loaded.scene);
-  info.gaussians = loaded.scene.size();
-  info.sh_degree = loaded.scene.sh_degree;
-  info.camera = loaded.camera_description;
-  info.width = loaded.camera.width;
-  info.height = loaded.camera.height;
-  info.device = renderer->device_info();
-
-  std::printf("scene   %s: %s, loaded in %s ms\n", loaded.path.filename().string().c_str(),
-              info.scene_description.c_str(), cli::format_fixed(loaded.load_ms, 1).c_str());
-  std::printf("camera  %s, %dx%d\n", info.camera.c_str(), info.width, info.height);
-  std::printf("device  %s (driver %s), subgroup size %u\n", info.device.name.c_str(), info.device.driver.c_str(),
-              info.device.subgroup_size);
+  const tilesplat::DeviceInfo device = renderer->device_info();
+  for (const auto& scene : scenes)
+    std::printf("scene   %s: %s, loaded in %s ms\n", scene.name.c_str(), scene.description.c_str(),
+                cli::format_fixed(scene.loaded.load_ms, 1).c_str());
+  std::printf("device  %s (driver %s), subgroup size %u\n", device.name.c_str(), device.driver.c_str(),
+              device.subgroup_size);
+  const int frames_per_row = options.warmup + options.repeat;
+  const int rows = static_cast<int>(cases.size() * sorts.size());
+  const int total_frames = frames_per_row * rows;
+  std::printf("frames  %d warm-up + %d measured per camera and sort; %zu cameras x %zu sorts, %d frames\n",
+              options.warmup, options.repeat, cases.size(), sorts.size(), total_frames);
   std::fflush(stdout);
 
-  const int frames_per_sort = options.warmup + options.repeat;
-  const int total_frames = frames_per_sort * static_cast<int>(sorts.size());
   const auto start = std::chrono::steady_clock::now();
-  std::vector<StrategyResult> results;
   {
     Progress progress(total_frames, cli::stderr_is_terminal());
     int done = 0;
-    for (const auto& sort : sorts) {
-      tilesplat::RenderSettings settings;
-      settings.sort = sort;
-      Collector collector(sort);
-      for (int frame = 0; frame < frames_per_sort; ++frame) {
-        // The image itself is not needed; rendering reads it back, which is part of cpu frame.
-        (void)renderer->render(loaded.camera, settings);
-        if (frame >= options.warmup) collector.add(renderer->last_frame_stats());
-        progress.update(++done, sort);
+    for (size_t i = 0; i < cases.size(); ++i) {
+      Case& c = cases[i];
+      BenchScene& scene = scenes[c.scene];
+      // One renderer for the whole run: set_scene replaces the scene, once per scene.
+      if (i == 0 || cases[i - 1].scene != c.scene) renderer->set_scene(scene.loaded.scene);
+      const std::string where = scene.name + " " + size_of(c) + " " + c.view_label + " ";
+      for (const auto& sort : sorts) {
+        tilesplat::RenderSettings settings;
+        settings.sort = sort;
+        Collector collector(sort);
+        for (int frame = 0; frame < frames_per_row; ++frame) {
+          // The image itself is not needed; rendering reads it back, which is part of cpu frame.
+          (void)renderer->render(c.camera.camera, settings);
+          if (frame >= options.warmup) collector.add(renderer->last_frame_stats());
+          progress.update(++done, where + sort);
+        }
+        c.results.push_back(collector.take());
       }
-      results.push_back(collector.take());
+      // The renderer holds its own copy; the next scene need not share memory with this one.
+      if (i + 1 == cases.size() || cases[i + 1].scene != c.scene) scene.loaded.scene = {};
     }
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  for (const auto& result : results) print_table(result, options);
-  print_comparison(results);
+  const std::vector<Group> groups = group_cases(cases, sorts.size());
+  for (const auto& group : groups) print_group(group, scenes[group.cases.front()->scene], options);
   std::fflush(stdout);
 
-  const std::string written = write_result_files(
-      options, [&] { return make_csv(results, info); }, [&] { return make_json(results, info, options); },
-      *renderer);
-  std::fprintf(stderr, "%s: %s, %s, %dx%d, %d frames in %s s%s\n", kProgram,
-               loaded.path.filename().string().c_str(), info.scene_description.c_str(), info.width, info.height,
-               total_frames, cli::format_fixed(seconds, 2).c_str(), written.c_str());
+  const std::string written =
+      write_outputs({{options.csv, [&] { return make_csv(groups, scenes, device); }},
+                     {options.json, [&] { return make_json(groups, scenes, device, options); }},
+                     {options.plot, [&] { return make_frame_svg(groups, scenes, device, options); }}},
+                    *renderer);
+  std::string what = scenes.size() == 1 ? scenes.front().name + ", " + scenes.front().description
+                                        : std::to_string(scenes.size()) + " scenes";
+  what += cases.size() == 1 ? ", " + size_of(cases.front()) : ", " + std::to_string(cases.size()) + " cameras";
+  std::fprintf(stderr, "%s: %s, %d frames in %s s%s\n", kProgram, what.c_str(), total_frames,
+               cli::format_fixed(seconds, 2).c_str(), written.c_str());
   return cli::kExitOk;
 }
 

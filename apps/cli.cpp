@@ -119,6 +119,12 @@ void require_input_file(const fs::path& path, std::string_view what) {
                              ": it is a directory");
 }
 
+void check_camera_size(const Camera& camera) {
+  if (camera.width < 1 || camera.height < 1 || camera.width > kMaxImageSide || camera.height > kMaxImageSide)
+    throw UsageError("the image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                     " is out of range (1 to " + std::to_string(kMaxImageSide) + " pixels a side)");
+}
+
 double elapsed_ms(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -182,7 +188,11 @@ void ArgParser::add_switch(std::string name, std::string help, bool* target) {
 }
 
 void ArgParser::add_positional(std::string value_name, std::string help, std::string* target) {
-  positionals_.push_back({std::move(value_name), std::move(help), target});
+  positionals_.push_back({std::move(value_name), std::move(help), target, nullptr});
+}
+
+void ArgParser::add_positional_list(std::string value_name, std::string help, std::vector<std::string>* target) {
+  positionals_.push_back({std::move(value_name) + "...", std::move(help), nullptr, target});
 }
 
 const ArgParser::Option* ArgParser::find(std::string_view name) const {
@@ -240,7 +250,10 @@ ArgParser::Outcome ArgParser::parse(int argc, const char* const* argv) {
     }
     if (next_positional >= positionals_.size())
       throw UsageError("unexpected argument " + single_quoted(arg) + " (see --help)");
-    *positionals_[next_positional++].target = arg;
+    if (auto* list = positionals_[next_positional].list_target)
+      list->push_back(arg);  // a list takes the rest, so next_positional stays on it
+    else
+      *positionals_[next_positional++].target = arg;
   }
   return Outcome::kRun;
 }
@@ -343,6 +356,35 @@ std::array<float, 3> parse_rgb(std::string_view flag, std::string_view text) {
   return rgb;
 }
 
+std::vector<ImageSize> parse_resolutions(std::string_view flag, std::string_view text) {
+  std::vector<ImageSize> sizes;
+  for (const auto& part : split(text, ',')) {
+    const std::string entry = trim(part);
+    auto fail = [&] {
+      throw UsageError(std::string(flag) + " expects WxH sizes from 1x1 to " +
+                       format_size(kMaxImageSide, kMaxImageSide) +
+                       ", comma-separated (e.g. 1920x1080,1280x720), got " + single_quoted(entry) +
+                       (entry == text ? "" : " in " + single_quoted(text)));
+    };
+    const auto x = entry.find('x');
+    if (x == std::string::npos) fail();
+    int side[2] = {0, 0};
+    const std::string_view halves[2] = {std::string_view(entry).substr(0, x), std::string_view(entry).substr(x + 1)};
+    for (int i = 0; i < 2; ++i) {
+      // The whole half must be the number: "2x3" after the first 'x' of "1x2x3" is not.
+      const auto [end, error] = std::from_chars(halves[i].data(), halves[i].data() + halves[i].size(), side[i]);
+      if (halves[i].empty() || error != std::errc() || end != halves[i].data() + halves[i].size() || side[i] < 1 ||
+          side[i] > kMaxImageSide)
+        fail();
+    }
+    const ImageSize size{side[0], side[1]};
+    if (std::find(sizes.begin(), sizes.end(), size) == sizes.end()) sizes.push_back(size);
+  }
+  return sizes;
+}
+
+std::string format_size(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
+
 std::vector<std::string> split(std::string_view text, char separator) {
   std::vector<std::string> parts;
   size_t start = 0;
@@ -360,16 +402,32 @@ std::vector<std::string> split(std::string_view text, char separator) {
 // ---------------------------------------------------------------------------------------------
 // Common options
 
-void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice) {
+void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice,
+                        SceneChoice scene_choice) {
   const OrbitParams orbit_defaults;
-  parser.add_positional("SCENE.ply", "the scene: a 3D Gaussian Splatting .ply as the trainer writes it",
-                        &options.scene);
+  const std::string cameras_help =
+      "take the camera from the trainer's cameras.json (default: an orbit camera framing the scene, see --azimuth)";
+  if (scene_choice == SceneChoice::kOne) {
+    parser.add_positional("SCENE.ply", "the scene: a 3D Gaussian Splatting .ply as the trainer writes it",
+                          &options.scene);
+  } else {
+    parser.add_positional_list("SCENE.ply",
+                               "the scenes: 3D Gaussian Splatting .ply files as the trainer writes them, each "
+                               "loaded once",
+                               &options.scenes);
+  }
 
   parser.section("camera");
-  parser.add_string("--cameras", "FILE.json",
-                    "take the camera from the trainer's cameras.json (default: an orbit camera framing the "
-                    "scene, see --azimuth)",
-                    &options.cameras);
+  if (scene_choice == SceneChoice::kOne) {
+    parser.add_string("--cameras", "FILE.json", cameras_help, &options.cameras);
+  } else {
+    parser.add_value("--cameras", "FILE.json",
+                     cameras_help + "; give it once for every SCENE, or once per SCENE in the same order",
+                     [&options](const std::string& text) {
+                       if (text.empty()) throw UsageError("--cameras expects a value, got an empty string");
+                       options.cameras_files.push_back(text);
+                     });
+  }
   parser.add_int("--view", "N", "which view of --cameras, counting from 0 (default 0)", &options.view, 0,
                  std::numeric_limits<int>::max());
   parser.add_int("--width", "W",
@@ -458,8 +516,8 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
 }
 
 void check_common_options(const ArgParser& parser, const CommonOptions& options) {
-  if (options.scene.empty()) throw UsageError("missing the SCENE.ply argument (see --help)");
-  if (!options.cameras.empty()) {
+  if (options.scene.empty() && options.scenes.empty()) throw UsageError("missing the SCENE.ply argument (see --help)");
+  if (!options.cameras.empty() || !options.cameras_files.empty()) {
     for (const char* orbit_flag : {"--azimuth", "--elevation", "--fov", "--distance"})
       if (parser.seen(orbit_flag))
         throw UsageError(std::string(orbit_flag) +
@@ -475,14 +533,14 @@ void print_devices() {
   for (size_t i = 0; i < devices.size(); ++i) std::printf("%zu: %s\n", i, devices[i].c_str());
 }
 
-LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program) {
+LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view program) {
   LoadedScene loaded;
-  loaded.path = options.scene;
+  loaded.path = path;
   require_input_file(loaded.path, "scene");
 
   const auto start = std::chrono::steady_clock::now();
   LoadOptions load_options;
-  load_options.strict = options.strict;
+  load_options.strict = strict;
   try {
     loaded.scene = load_scene(loaded.path, load_options, &loaded.report);
   } catch (const std::bad_alloc&) {
@@ -497,54 +555,68 @@ LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view
       summary = "dropped " + group_thousands(loaded.report.dropped) + " Gaussians with non-finite values";
     print_warning(program, naming_file(loaded.path, summary));
   }
+  return loaded;
+}
 
-  auto check_size = [](const Camera& camera) {
-    if (camera.width < 1 || camera.height < 1 || camera.width > kMaxImageSide || camera.height > kMaxImageSide)
-      throw UsageError("the image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                       " is out of range (1 to " + std::to_string(kMaxImageSide) + " pixels a side)");
-  };
-
-  if (!options.cameras.empty()) {
-    const fs::path cameras_path = options.cameras;
-    require_input_file(cameras_path, "cameras");
-    std::vector<CameraView> views;
-    try {
-      views = load_cameras_json(cameras_path);
-    } catch (const std::exception& error) {
-      throw std::runtime_error(naming_file(cameras_path, error.what()));
-    }
-    if (views.empty()) throw std::runtime_error(single_quoted(cameras_path.string()) + " has no views");
-    if (static_cast<size_t>(options.view) >= views.size())
-      throw UsageError("--view " + std::to_string(options.view) + " is out of range: " +
-                       single_quoted(cameras_path.string()) + " has " + std::to_string(views.size()) + " views (0.." +
-                       std::to_string(views.size() - 1) + ")");
-    const auto& view = views[static_cast<size_t>(options.view)];
-    check_size(view.camera);
-    loaded.camera = resize_camera(view.camera, options.width, options.height);
-    loaded.camera_description = "view " + std::to_string(options.view);
-    if (!view.name.empty()) loaded.camera_description += " (" + view.name + ")";
-    loaded.camera_description += " of " + cameras_path.filename().string();
-  } else {
-    if (loaded.scene.empty())
-      throw std::runtime_error(single_quoted(loaded.path.string()) +
-                               " has no Gaussians for the orbit camera to frame; pass --cameras FILE.json");
-    int width = options.width;
-    int height = options.height;
-    const double aspect = double(kOrbitDefaultWidth) / double(kOrbitDefaultHeight);
-    if (width <= 0 && height <= 0) {
-      width = kOrbitDefaultWidth;
-      height = kOrbitDefaultHeight;
-    } else if (height <= 0) {
-      height = static_cast<int>(std::max(1.0, std::round(double(width) / aspect)));
-    } else if (width <= 0) {
-      width = static_cast<int>(std::min(double(kMaxImageSide) + 1, std::max(1.0, std::round(double(height) * aspect))));
-    }
-    loaded.camera = orbit_camera(loaded.scene, width, height, options.orbit);
-    loaded.camera_description = "orbit azimuth " + format_fixed(options.orbit.azimuth_deg, 1) + " elevation " +
-                                format_fixed(options.orbit.elevation_deg, 1) + " fov " +
-                                format_fixed(options.orbit.vertical_fov_deg, 1);
+std::vector<CameraView> load_camera_views(const fs::path& path) {
+  require_input_file(path, "cameras");
+  std::vector<CameraView> views;
+  try {
+    views = load_cameras_json(path);
+  } catch (const std::exception& error) {
+    throw std::runtime_error(naming_file(path, error.what()));
   }
-  check_size(loaded.camera);
+  if (views.empty()) throw std::runtime_error(single_quoted(path.string()) + " has no views");
+  return views;
+}
+
+NamedCamera view_camera(const std::vector<CameraView>& views, int index, const fs::path& cameras_path, int width,
+                        int height, std::string_view flag) {
+  if (index < 0 || static_cast<size_t>(index) >= views.size())
+    throw UsageError(std::string(flag) + " " + std::to_string(index) + " is out of range: " +
+                     single_quoted(cameras_path.string()) + " has " + std::to_string(views.size()) + " views (0.." +
+                     std::to_string(views.size() - 1) + ")");
+  const auto& view = views[static_cast<size_t>(index)];
+  check_camera_size(view.camera);
+  NamedCamera named;
+  named.camera = resize_camera(view.camera, width, height);
+  named.description = "view " + std::to_string(index);
+  if (!view.name.empty()) named.description += " (" + view.name + ")";
+  named.description += " of " + cameras_path.filename().string();
+  check_camera_size(named.camera);
+  return named;
+}
+
+NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const OrbitParams& orbit) {
+  if (loaded.scene.empty())
+    throw std::runtime_error(single_quoted(loaded.path.string()) +
+                             " has no Gaussians for the orbit camera to frame; pass --cameras FILE.json");
+  const double aspect = double(kOrbitDefaultWidth) / double(kOrbitDefaultHeight);
+  if (width <= 0 && height <= 0) {
+    width = kOrbitDefaultWidth;
+    height = kOrbitDefaultHeight;
+  } else if (height <= 0) {
+    height = static_cast<int>(std::max(1.0, std::round(double(width) / aspect)));
+  } else if (width <= 0) {
+    width = static_cast<int>(std::min(double(kMaxImageSide) + 1, std::max(1.0, std::round(double(height) * aspect))));
+  }
+  NamedCamera named;
+  named.camera = orbit_camera(loaded.scene, width, height, orbit);
+  named.description = "orbit azimuth " + format_fixed(orbit.azimuth_deg, 1) + " elevation " +
+                      format_fixed(orbit.elevation_deg, 1) + " fov " + format_fixed(orbit.vertical_fov_deg, 1);
+  check_camera_size(named.camera);
+  return named;
+}
+
+LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program) {
+  LoadedScene loaded = load_scene_file(options.scene, options.strict, program);
+  const NamedCamera named =
+      options.cameras.empty()
+          ? orbit_view(loaded, options.width, options.height, options.orbit)
+          : view_camera(load_camera_views(options.cameras), options.view, options.cameras, options.width,
+                        options.height);
+  loaded.camera = named.camera;
+  loaded.camera_description = named.description;
   return loaded;
 }
 

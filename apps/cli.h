@@ -57,6 +57,8 @@ class ArgParser {
   void add_switch(std::string name, std::string help, bool* target);
   // Positional arguments fill their targets in registration order.
   void add_positional(std::string value_name, std::string help, std::string* target);
+  // Takes every positional argument left over (register it last); shown as "VALUE_NAME..." in --help.
+  void add_positional_list(std::string value_name, std::string help, std::vector<std::string>* target);
 
   // Throws UsageError. Returns kHelp (without parsing anything else) when -h/--help is given.
   Outcome parse(int argc, const char* const* argv);
@@ -81,6 +83,7 @@ class ArgParser {
     std::string value_name;
     std::string help;
     std::string* target = nullptr;
+    std::vector<std::string>* list_target = nullptr;  // set instead of target by add_positional_list
   };
 
   const Option* find(std::string_view name) const;
@@ -102,10 +105,25 @@ double parse_double(std::string_view flag, std::string_view text);
 std::array<float, 3> parse_rgb(std::string_view flag, std::string_view text);
 std::vector<std::string> split(std::string_view text, char separator);
 
+struct ImageSize {
+  int width = 0;
+  int height = 0;
+  bool operator==(const ImageSize&) const = default;
+};
+// "WxH[,WxH...]", each side 1 to kMaxImageSide; a repeated size is kept once, the order is kept.
+// "--resolutions expects WxH sizes from 1x1 to 65536x65536, comma-separated (e.g. 1920x1080,1280x720),
+// got '0x720' in '1920x1080,0x720'".
+std::vector<ImageSize> parse_resolutions(std::string_view flag, std::string_view text);
+std::string format_size(int width, int height);  // "1920x1080"
+
 // The options every app has: which scene, which camera, which device.
 struct CommonOptions {
   std::string scene;
   std::string cameras;
+  // With SceneChoice::kList, every SCENE and every --cameras in command-line order, and scene and
+  // cameras stay empty.
+  std::vector<std::string> scenes;
+  std::vector<std::string> cameras_files;
   int view = 0;
   int width = 0;   // 0: the view's size (or kOrbitDefaultWidth), keeping the aspect when one is given
   int height = 0;
@@ -121,10 +139,13 @@ inline constexpr int kOrbitDefaultWidth = 1920;
 inline constexpr int kOrbitDefaultHeight = 1080;
 
 enum class SortChoice { kOne, kList };
+// kList: one or more SCENE arguments, and --cameras may be given several times.
+enum class SceneChoice { kOne, kList };
 
 // Registers SCENE, --cameras, --view, --width, --height, the orbit flags, --strict, --device,
 // --list-devices, --validation and --sort (one name, or a comma list / "all" for kList).
-void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice);
+void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice,
+                        SceneChoice scene_choice = SceneChoice::kOne);
 
 // Checks what the parser cannot check flag by flag (a SCENE was given, orbit flags are not
 // mixed with --cameras, ...). Throws UsageError.
@@ -152,6 +173,24 @@ struct LoadedScene {
 // std::runtime_error naming it; an out-of-range --view throws UsageError naming the file and
 // its number of views.
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program);
+
+// The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
+// load_scene_file fills path, scene, report and load_ms only.
+LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program);
+// The views of a cameras.json; throws std::runtime_error naming the file when it is missing,
+// malformed or has no views.
+std::vector<CameraView> load_camera_views(const std::filesystem::path& path);
+
+struct NamedCamera {
+  Camera camera;
+  std::string description;  // as LoadedScene::camera_description
+};
+// View `index` of `views` (read from `cameras_path`) at width x height (0: see CommonOptions).
+// An out-of-range index throws UsageError naming `flag`, the file and its number of views.
+NamedCamera view_camera(const std::vector<CameraView>& views, int index, const std::filesystem::path& cameras_path,
+                        int width, int height, std::string_view flag = "--view");
+// The orbit camera framing the scene (which must not be empty) at width x height (0: see CommonOptions).
+NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const OrbitParams& orbit);
 
 RendererOptions renderer_options(const CommonOptions& options);
 

@@ -15,6 +15,8 @@
 namespace {
 
 namespace fs = std::filesystem;
+using tilesplat::testing::bundled_playbot;
+using tilesplat::testing::bundled_playbot_cameras;
 using tilesplat::testing::bundled_sh3;
 using tilesplat::testing::bundled_sh3_cameras;
 using tilesplat::testing::temp_dir;
@@ -129,9 +131,10 @@ TEST(CliBench, HelpListsEveryFlag) {
   const auto result = run_exe(kBenchExe, {"--help"});
   EXPECT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(contains(result.out, "usage: tilesplat-bench")) << result.out;
-  for (const char* flag : {"--warmup", "--repeat", "--csv", "--json", "--cameras", "--view", "--width", "--height",
-                           "--azimuth", "--elevation", "--fov", "--distance", "--strict", "--device",
-                           "--list-devices", "--sort", "--validation", "--help", "SCENE.ply"})
+  for (const char* flag : {"--warmup", "--repeat", "--csv", "--json", "--plot", "--cameras", "--view", "--views",
+                           "--orbit", "--resolutions", "--width", "--height", "--azimuth", "--elevation", "--fov",
+                           "--distance", "--strict", "--device", "--list-devices", "--sort", "--validation", "--help",
+                           "SCENE.ply...", "--sort-bench", "--sort-sizes", "--key-bits"})
     EXPECT_TRUE(contains(result.out, flag)) << "--help does not mention " << flag << "\n" << result.out;
 }
 
@@ -237,6 +240,51 @@ TEST(CliBench, RejectsBadCountsAndSorts) {
   expect_one_error_line(bad_sort, "tilesplat-bench");
 }
 
+TEST(CliBench, RejectsBadResolutions) {
+  for (const std::string sizes : {"0x720", "1920", "-5x3", "1920x1080,abc", "1280x"}) {
+    const auto result = run_exe(kBenchExe, {bundled_sh3().string(), "--resolutions", sizes});
+    EXPECT_EQ(result.exit_code, 2) << sizes << ": " << result.err;
+    EXPECT_TRUE(contains(result.err, "--resolutions expects WxH sizes")) << result.err;
+    std::string quoted = "'";
+    quoted += sizes;
+    quoted += "'";
+    EXPECT_TRUE(contains(result.err, quoted)) << result.err;
+    expect_one_error_line(result, "tilesplat-bench");
+  }
+  const auto with_width = run_exe(kBenchExe, {bundled_sh3().string(), "--resolutions", "64x36", "--width", "64"});
+  EXPECT_EQ(with_width.exit_code, 2) << with_width.err;
+  EXPECT_TRUE(contains(with_width.err, "--resolutions and --width cannot be combined")) << with_width.err;
+}
+
+TEST(CliBench, RejectsBadCameraPaths) {
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::string scene = bundled_sh3().string();
+  const std::string cameras = bundled_sh3_cameras().string();
+  const std::vector<Case> cases = {
+      {{scene, "--views", "0,1"}, "--views needs --cameras"},
+      {{scene, "--cameras", cameras, "--view", "0", "--views", "1"}, "--view and --views cannot be combined"},
+      {{scene, "--cameras", cameras, "--orbit", "3"}, "--orbit applies only to the orbit camera"},
+      {{scene, "--orbit", "0"}, "--orbit expects a positive integer, got '0'"},
+      {{scene, "--cameras", cameras, "--views", "0,x"}, "--views expects a non-negative integer, got 'x'"},
+      {{scene, scene, "--cameras", cameras, "--cameras", cameras, "--cameras", cameras},
+       "--cameras was given 3 times for 2 scenes"},
+      {{scene, "--cameras", cameras, "--views", "0," + std::to_string(views_in(bundled_sh3_cameras()))},
+       "is out of range"},
+      {{scene, "--plot", (temp_dir() / "p.png").string()}, "--plot writes SVG"},
+      {{scene, "--csv", (temp_dir() / "same.csv").string(), "--json", (temp_dir() / "same.csv").string()},
+       "name the same file"},
+  };
+  for (const auto& c : cases) {
+    const auto result = run_exe(kBenchExe, c.args);
+    EXPECT_EQ(result.exit_code, 2) << c.message << ": " << result.err;
+    EXPECT_TRUE(contains(result.err, c.message)) << result.err;
+    expect_one_error_line(result, "tilesplat-bench");
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Runtime errors: exit 1, the file named, nothing written
 
@@ -336,6 +384,103 @@ TEST(CliBench, PrintsTableAndWritesCsvAndJson) {
   EXPECT_TRUE(contains(json_text, "\"projection\"")) << json_text;
   EXPECT_EQ(entries(out), (std::vector<std::string>{"c.csv", "j.json"}));
   EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+}
+
+TEST(CliBench, OutputIntoMissingDirectoryFailsBeforeMeasuring) {
+  const auto out = fresh_output_dir();
+  for (const char* flag : {"--csv", "--json", "--plot"}) {
+    const fs::path file = out / "no_such_dir" / "x.svg";
+    // --repeat is large: the run must stop before measuring anything.
+    const auto result = run_exe(kBenchExe, {bundled_playbot().string(), "--repeat", "100000", flag, file.string()});
+    EXPECT_EQ(result.exit_code, 1) << flag << ": " << result.err;
+    EXPECT_TRUE(contains(result.err, "no_such_dir")) << result.err;
+    EXPECT_TRUE(contains(result.err, flag)) << result.err;
+    expect_one_error_line(result, "tilesplat-bench");
+    EXPECT_TRUE(result.out.empty()) << result.out;
+  }
+  const auto sort_bench = run_exe(kBenchExe, {"--sort-bench", "--plot", (out / "no_such_dir" / "s.svg").string()});
+  EXPECT_EQ(sort_bench.exit_code, 1) << sort_bench.err;
+  EXPECT_TRUE(contains(sort_bench.err, "no_such_dir")) << sort_bench.err;
+  EXPECT_TRUE(entries(out).empty());
+}
+
+// Two scenes, each with its cameras.json, two views each at two sizes: a row per camera and sort,
+// the statistics over the views, and a bar per scene and size in the plot.
+TEST(CliBench, MeasuresSeveralScenesViewsAndSizes) {
+  const auto out = fresh_output_dir();
+  const fs::path csv = out / "c.csv";
+  const fs::path json = out / "j.json";
+  const fs::path svg = out / "p.svg";
+  const auto result = run_exe(
+      kBenchExe, {bundled_sh3().string(), bundled_playbot().string(), "--cameras", bundled_sh3_cameras().string(),
+                  "--cameras", bundled_playbot_cameras().string(), "--views", "0,1", "--resolutions", "64x36,32x18",
+                  "--sort", "radix", "--warmup", "0", "--repeat", "2", "--csv", csv.string(), "--json",
+                  json.string(), "--plot", svg.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(entries(out), (std::vector<std::string>{"c.csv", "j.json", "p.svg"}));
+  for (const char* heading : {"playcanvas_test_64_sh3.ply at 64x36: 2 views", "playcanvas_test_64_sh3.ply at 32x18",
+                              "playbot_lod3_31000_sh2.ply at 64x36", "playbot_lod3_31000_sh2.ply at 32x18"})
+    EXPECT_TRUE(contains(result.out, heading)) << heading << "\n" << result.out;
+  EXPECT_TRUE(contains(result.out, "over the 2 views")) << result.out;
+  EXPECT_TRUE(contains(result.err, "16 frames")) << result.err;  // 2 scenes x 2 sizes x 2 views x 2 frames
+
+  const std::string csv_text = read_file(csv);
+  // 8 cameras measured over frames, 4 (scene, size) summaries over views; projection once in each.
+  size_t per_frames = 0, per_views = 0;
+  for (size_t pos = csv_text.find(",projection,ms,"); pos != std::string::npos;
+       pos = csv_text.find(",projection,ms,", pos + 1)) {
+    const std::string rest = csv_text.substr(pos + 15, 6);
+    per_frames += rest == "frames";
+    per_views += rest.rfind("views", 0) == 0;
+  }
+  EXPECT_EQ(per_frames, 8u) << csv_text;
+  EXPECT_EQ(per_views, 4u) << csv_text;
+  EXPECT_EQ(csv_text.rfind("device,scene,width,height,view,camera,sort,", 0), 0u) << csv_text;
+  EXPECT_TRUE(contains(csv_text, ",32,18,view 1,")) << csv_text;
+  EXPECT_TRUE(contains(csv_text, ",64,36,all,2 views,radix,")) << csv_text;
+
+  const std::string json_text = read_file(json);
+  size_t results = 0;
+  for (size_t pos = json_text.find("\"camera\": \"view "); pos != std::string::npos;
+       pos = json_text.find("\"camera\": \"view ", pos + 1))
+    ++results;
+  EXPECT_EQ(results, 8u) << json_text;
+  EXPECT_TRUE(contains(json_text, "\"summaries\"")) << json_text;
+
+  const std::string svg_text = read_file(svg);
+  EXPECT_EQ(svg_text.rfind("<?xml", 0), 0u);
+  EXPECT_TRUE(contains(svg_text, "data-bar=\"3\" data-segment=\"composite\"")) << svg_text;
+  EXPECT_FALSE(contains(svg_text, "data-bar=\"4\"")) << svg_text;
+  EXPECT_TRUE(contains(svg_text, "class=\"legend-label\">projection</text>")) << svg_text;
+  EXPECT_TRUE(contains(svg_text, "64x36")) << svg_text;
+  EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+}
+
+TEST(CliBench, OrbitPathIsEvenlySpacedInAzimuth) {
+  const auto out = fresh_output_dir();
+  const fs::path csv = out / "c.csv";
+  const auto result = run_exe(kBenchExe, {bundled_sh3().string(), "--orbit", "4", "--azimuth", "10", "--width", "32",
+                                          "--height", "18", "--sort", "radix", "--warmup", "0", "--repeat", "1",
+                                          "--csv", csv.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::string csv_text = read_file(csv);
+  for (const char* view : {",azimuth 10.0,orbit azimuth 10.0 elevation 20.0", ",azimuth 100.0,", ",azimuth 190.0,",
+                           ",azimuth 280.0,", ",all,4 views,"})
+    EXPECT_TRUE(contains(csv_text, view)) << view << "\n" << csv_text;
+}
+
+TEST(CliBench, SortBenchDrawsThroughputLines) {
+  const auto out = fresh_output_dir();
+  const fs::path svg = out / "s.svg";
+  const auto result = run_exe(kBenchExe, {"--sort-bench", "--sort", "radix", "--sort-sizes", "4,6,8", "--key-bits",
+                                          "16", "--warmup", "0", "--repeat", "1", "--plot", svg.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(entries(out), (std::vector<std::string>{"s.svg"}));
+  const std::string svg_text = read_file(svg);
+  for (const char* series : {"radix, 16-bit keys", "std::sort (cpu), 16-bit keys", "cpu radix (cpu), 16-bit keys"})
+    EXPECT_TRUE(contains(svg_text, "<polyline class=\"series\" data-series=\"" + std::string(series) + "\""))
+        << series << "\n" << svg_text;
+  EXPECT_TRUE(contains(svg_text, "Mkeys/s")) << svg_text;
 }
 
 TEST(CliRender, ListsDevices) {
