@@ -1,10 +1,17 @@
 #version 460
-// Radix sort, step 2 of a pass (scan): one workgroup per digit scans that digit's counts across all
-// blocks (exclusive, in place) and records the digit's total.
+// Radix sort, step 2 of a pass (scan): one subgroup per digit scans that digit's counts across all
+// blocks (exclusive, in place) and records the digit's total. Subgroup scans need no workgroup
+// barriers, and a workgroup covers several digits: a CPU driver pays for every workgroup and every
+// barrier, which made a workgroup-per-digit scan cost several milliseconds even for a few keys.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #include "common.glsl"
-#include "workgroup_scan.glsl"
+
+layout(local_size_x_id = 0) in;
+layout(constant_id = 1) const uint DIGITS_PER_WORKGROUP = 8;  // subgroups per workgroup
+
+const uint RADIX = 256;
 
 layout(push_constant) uniform Push {
   UintArray histogram;
@@ -13,27 +20,21 @@ layout(push_constant) uniform Push {
 } pc;
 
 void main() {
-  uint digit = gl_WorkGroupID.x;
+  // The loop keeps every digit covered once even where the driver picks another subgroup size than
+  // the one the workgroup was sized for.
+  uint first = gl_WorkGroupID.x * DIGITS_PER_WORKGROUP;
+  uint last = min(first + DIGITS_PER_WORKGROUP, RADIX);
   uint blocks = pc.state.v[SORT_BLOCKS];
-  uint row = digit * blocks;
-  uint linear = gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
-  uint running = 0;
-  for (uint chunk = 0; chunk < blocks; chunk += SCAN_BLOCK) {
-    uint base = chunk + linear * SCAN_ITEMS;
-    uint v[SCAN_ITEMS];
-    uint thread_sum = 0;
-    for (uint k = 0; k < SCAN_ITEMS; ++k) {
-      v[k] = base + k < blocks ? pc.histogram.v[row + base + k] : 0u;
-      thread_sum += v[k];
+  for (uint digit = first + gl_SubgroupID; digit < last; digit += gl_NumSubgroups) {
+    uint row = digit * blocks;
+    uint running = 0;
+    for (uint base = 0; base < blocks; base += gl_SubgroupSize) {
+      uint b = base + gl_SubgroupInvocationID;
+      uint count = b < blocks ? pc.histogram.v[row + b] : 0u;
+      uint prefix = running + subgroupExclusiveAdd(count);
+      if (b < blocks) pc.histogram.v[row + b] = prefix;
+      running += subgroupAdd(count);
     }
-    uint chunk_total;
-    uint prefix = running + workgroup_exclusive_scan(thread_sum, chunk_total);
-    for (uint k = 0; k < SCAN_ITEMS; ++k) {
-      if (base + k < blocks) pc.histogram.v[row + base + k] = prefix;
-      prefix += v[k];
-    }
-    running += chunk_total;
-    barrier();  // the scan's shared memory is reused by the next chunk
+    if (subgroupElect()) pc.digit_totals.v[digit] = running;
   }
-  if (gl_LocalInvocationIndex == 0) pc.digit_totals.v[digit] = running;
 }

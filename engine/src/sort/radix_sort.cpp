@@ -14,6 +14,8 @@ constexpr uint32_t kRadix = 256;
 constexpr uint32_t kDigitBits = 8;
 // Keys per block is a multiple of the subgroup size: a subgroup walks its block this many times.
 constexpr uint32_t kStepsPerBlock = 256;
+// The scan gives each digit one subgroup; a workgroup of 8 covers 8 digits.
+constexpr uint32_t kScanDigitsPerWorkgroup = 8;
 
 struct SetupPush {
   VkDeviceAddress state;
@@ -41,7 +43,8 @@ RadixSort::RadixSort(vk::Context& ctx)
       block_keys_(ctx.limits().subgroup_size * kStepsPerBlock) {
   const uint32_t sg = ctx.limits().subgroup_size;
   setup_ = vk::ComputePipeline(ctx, "radix_setup", sizeof(SetupPush));
-  scan_pass_ = vk::ComputePipeline(ctx, "radix_scan", sizeof(ScanPush));
+  scan_pass_ = vk::ComputePipeline(ctx, "radix_scan", sizeof(ScanPush),
+                                   {{0, sg * kScanDigitsPerWorkgroup}, {1, kScanDigitsPerWorkgroup}});
   for (uint32_t wide : {0u, 1u}) {
     const std::vector<vk::SpecConstant> spec{
         {0, sg * subgroups_per_workgroup_}, {1, subgroups_per_workgroup_}, {2, block_keys_}, {3, wide}};
@@ -87,7 +90,7 @@ bool RadixSort::record(vk::CommandStream& stream, SortInput& input) {
     histogram_pass_[wide].dispatch_indirect(cmd, input.state.handle(), args_offset);
     vk::barrier(cmd);
     scan_pass_.bind(cmd, ScanPush{histogram_.address(), digit_totals_.address(), state});
-    scan_pass_.dispatch(cmd, kRadix);
+    scan_pass_.dispatch(cmd, kRadix / kScanDigitsPerWorkgroup);
     vk::barrier(cmd);
     scatter_pass_[wide].bind(cmd, push);
     scatter_pass_[wide].dispatch_indirect(cmd, input.state.handle(), args_offset);
