@@ -25,6 +25,7 @@ const uint COUNTER_TILE_SORT = 16;     // SORT_STATE_UINTS: the sort of the (til
 const uint SORT_COUNT = 0;
 const uint SORT_BLOCKS = 1;
 const uint SORT_ARGS = 2;  // 3 uints
+const uint SORT_OWN = 5;   // 3 uints the running strategy may use for itself
 const uint SORT_STATE_UINTS = 8;
 
 // Pairs emitted and sorted: the total, or 0 when it exceeds the capacity (the frame is re-run).

@@ -16,8 +16,8 @@ void main() {
 
   uint block = gl_WorkGroupID.x * SUBGROUPS_PER_WORKGROUP + gl_SubgroupID;
   if (block < blocks) {
-    uint start = block * BLOCK_KEYS;
-    uint end = min(start + BLOCK_KEYS, n);
+    uint start = block * block_keys();
+    uint end = min(start + block_keys(), n);
     for (uint k = start + gl_SubgroupInvocationID; k < end; k += gl_SubgroupSize)
       atomicAdd(s_counts[gl_SubgroupID * RADIX + digit_of(load_key(pc.keys_in, k))], 1u);
   }

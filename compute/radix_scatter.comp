@@ -31,8 +31,8 @@ void main() {
   subgroupMemoryBarrierShared();
   subgroupBarrier();
 
-  uint start = block * BLOCK_KEYS;
-  uint end = min(start + BLOCK_KEYS, n);
+  uint start = block * block_keys();
+  uint end = min(start + block_keys(), n);
   for (uint base = start; base < end; base += gl_SubgroupSize) {
     uint k = base + gl_SubgroupInvocationID;
     bool valid = k < end;

@@ -13,7 +13,7 @@ struct SortState {
   uint32_t count;    // keys to sort
   uint32_t blocks;   // blocks the strategy split them into
   uint32_t args[3];  // indirect dispatch of the strategy's per-block passes
-  uint32_t reserved[3];
+  uint32_t own[3];   // for the running strategy's own use (SORT_OWN)
 };
 static_assert(sizeof(SortState) == 32);
 
