@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <random>
 
 #include "test_support.h"
 #include "tilesplat/camera.h"
+#include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/sort.h"
@@ -54,6 +56,7 @@ TEST(SortKeys, EveryStrategyMatchesStableSortAndReportsItsTime) {
   const auto keys = random_keys(70000, 45, 3, 1000);  // many equal keys
   const auto expected = stable_order(keys);
   for (const auto& strategy : sort_strategies()) {
+    if (!sort_strategy_is_exact(strategy)) continue;  // its order: test_cpu_radix_strategy.cpp
     const Renderer::SortRun run = renderer.sort_keys(strategy, keys, 45);
     EXPECT_EQ(run.order, expected) << strategy;
     ASSERT_EQ(run.keys.size(), keys.size());
@@ -99,6 +102,7 @@ TEST(SortKeys, RealSceneKeysMatchStableSort) {
                         Case{"tile ids", tile_ids, 13}}) {
     const auto expected = stable_order(c.keys);
     for (const auto& strategy : sort_strategies()) {
+      if (!sort_strategy_is_exact(strategy)) continue;
       const Renderer::SortRun run = renderer.sort_keys(strategy, c.keys, c.bits);
       EXPECT_EQ(run.order, expected) << strategy << ", " << c.name;
     }
@@ -115,7 +119,10 @@ TEST(SortKeys, RejectsKeysWiderThanTheKeyBitsAndUnknownStrategies) {
 }
 
 TEST(SortStrategies, GiveBitIdenticalImages) {
-  // Every strategy gives the same order, so every output of a real scene is identical to the bit.
+  // Every exact strategy gives the same order, so every output of a real scene is identical to the
+  // bit. An inexact one (cpu-radix16: 16-bit depths) swaps Gaussians whose depths share a level;
+  // its colour is held to 40 dB PSNR against the exact image instead.
+  constexpr double kInexactMinPsnrDb = 40;
   Renderer& renderer = testing::validated_renderer();
   renderer.set_scene(load_ply(testing::bundled_playbot()));
   const Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(3).camera, 320, 180);
@@ -125,6 +132,12 @@ TEST(SortStrategies, GiveBitIdenticalImages) {
   for (const auto& strategy : sort_strategies()) {
     settings.sort = strategy;
     const RenderImage image = renderer.render(camera, settings);
+    if (!sort_strategy_is_exact(strategy)) {
+      const double psnr = compare_images(image, first).psnr_db;
+      std::printf("%s: %.2f dB PSNR against the exact image\n", strategy.c_str(), psnr);
+      EXPECT_GE(psnr, kInexactMinPsnrDb) << strategy;
+      continue;
+    }
     EXPECT_EQ(image.rgba, first.rgba) << strategy;
     EXPECT_EQ(image.depth, first.depth) << strategy;
     EXPECT_EQ(image.splat_count, first.splat_count) << strategy;

@@ -410,6 +410,7 @@ DeviceInfo Renderer::device_info() const {
 uint64_t Renderer::validation_messages() const { return impl_->ctx.validation_messages(); }
 
 std::vector<std::string> sort_strategies() { return available_sort_strategies(); }
+bool sort_strategy_is_exact(const std::string& name) { return sort_strategy_exact(name); }
 std::vector<std::string> list_devices() { return vk::Context::list_devices(); }
 
 }  // namespace tilesplat

@@ -66,6 +66,10 @@ struct ExternalImage;
 
 // Names of the available sort strategies, default first.
 std::vector<std::string> sort_strategies();
+// Whether a strategy gives the exact order that all exact strategies share (and so bit-identical
+// images); false for one that sorts by approximated keys (cpu-radix16: 16-bit quantized depths).
+// Throws std::invalid_argument for an unknown name.
+bool sort_strategy_is_exact(const std::string& name);
 
 // Lists the Vulkan devices this machine has, in the order RendererOptions::device indexes them.
 std::vector<std::string> list_devices();
@@ -89,8 +93,10 @@ class Renderer {
   const FrameStats& last_frame_stats() const;
 
   // Sorts key/value pairs with a sort strategy outside any frame, the values being the input
-  // positions, and times the sort alone on the GPU (no transfers). For the sort micro-benchmark and
-  // tests. Only the low key_bits bits (1 to 64) may be set; throws std::invalid_argument otherwise.
+  // positions, and times the sort alone on the GPU (no transfers into or out of the key buffers; a
+  // strategy that sorts on the host counts its own transfers and host time). For the sort
+  // micro-benchmark and tests. Only the low key_bits bits (1 to 64) may be set; throws
+  // std::invalid_argument otherwise.
   struct SortRun {
     std::vector<uint64_t> keys;   // ascending
     std::vector<uint32_t> order;  // input position of each sorted key; equal keys in input order

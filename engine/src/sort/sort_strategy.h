@@ -1,7 +1,8 @@
 // The key sort as a swappable strategy. A frame sorts twice with it: the Gaussians by view depth,
 // then the (tile, Gaussian) pairs by tile. Every strategy must produce the same order: ascending
 // 64-bit keys, equal keys in their input order (a stable sort), which is what makes the two sorts
-// together equal to one sort by (tile, depth, Gaussian index).
+// together equal to one sort by (tile, depth, Gaussian index). The one exception says so with
+// exact(): cpu-radix16 orders by 16-bit quantized depths, stably.
 #pragma once
 
 #include <memory>
@@ -44,6 +45,9 @@ class SortStrategy {
   // GPU; a GPU strategy's recording may not depend on it (a host strategy flushes and reads it).
   virtual bool record(vk::CommandStream& stream, SortInput& input) = 0;
   virtual FrameSortPlan frame_plan() const { return FrameSortPlan::kDepthThenTile; }
+  // False for a strategy that orders by an approximation of the keys (cpu-radix16's 16-bit depths):
+  // its order, and so its images, differ from the exact strategies'.
+  virtual bool exact() const { return true; }
   // Scratch memory the strategy holds, for the memory report.
   virtual uint64_t device_bytes() const = 0;
 };
@@ -51,5 +55,7 @@ class SortStrategy {
 std::vector<std::string> available_sort_strategies();
 // Throws std::invalid_argument naming the strategy and the valid names.
 std::unique_ptr<SortStrategy> make_sort_strategy(const std::string& name, vk::Context& ctx);
+// SortStrategy::exact() of a strategy, without a device to make it on. Throws like make_sort_strategy.
+bool sort_strategy_exact(const std::string& name);
 
 }  // namespace tilesplat
