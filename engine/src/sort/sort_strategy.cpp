@@ -5,13 +5,14 @@
 
 #include "sort/bitonic_sort.h"
 #include "sort/cpu_radix_strategy.h"
+#include "sort/onesweep_sort.h"
 #include "sort/radix_sort.h"
 #include "sort/tile_local_sort.h"
 
 namespace tilesplat {
 
 std::vector<std::string> available_sort_strategies() {
-  return {"radix", "bitonic", "cpu-radix", "cpu-radix16", "tile-local"};
+  return {"radix", "bitonic", "cpu-radix", "cpu-radix16", "onesweep", "tile-local"};
 }
 
 std::unique_ptr<SortStrategy> make_sort_strategy(const std::string& name, vk::Context& ctx) {
@@ -19,6 +20,7 @@ std::unique_ptr<SortStrategy> make_sort_strategy(const std::string& name, vk::Co
   if (name == "bitonic") return std::make_unique<BitonicSort>(ctx);
   if (name == "cpu-radix") return std::make_unique<CpuRadixSort>(ctx, CpuRadixSort::Keys::kExact);
   if (name == "cpu-radix16") return std::make_unique<CpuRadixSort>(ctx, CpuRadixSort::Keys::kQuantized16);
+  if (name == "onesweep") return std::make_unique<OnesweepSort>(ctx);
   if (name == "tile-local") return std::make_unique<TileLocalSort>(ctx);
   std::string valid;
   for (const auto& n : available_sort_strategies()) valid += (valid.empty() ? "" : ", ") + n;

@@ -1,0 +1,28 @@
+#version 460
+// Onesweep sort setup: sizes the per-partition dispatches from this sort's key count (read on the GPU)
+// and clears the control block (digit counts, tickets) for this sort.
+#extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_memory_scope_semantics : require
+#include "common.glsl"
+#include "onesweep_common.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(push_constant) uniform Push {
+  UintArray state;    // the sort's state block
+  UintArray control;  // CTRL_UINTS
+  uint partition_keys;
+} pc;
+
+void main() {
+  if (gl_LocalInvocationIndex == 0) {
+    uint n = pc.state.v[SORT_COUNT];
+    uint partitions = (n + pc.partition_keys - 1) / pc.partition_keys;
+    pc.state.v[SORT_BLOCKS] = partitions;
+    pc.state.v[SORT_ARGS + 0] = partitions;
+    pc.state.v[SORT_ARGS + 1] = 1;
+    pc.state.v[SORT_ARGS + 2] = 1;
+  }
+  for (uint i = gl_LocalInvocationIndex; i < CTRL_UINTS; i += gl_WorkGroupSize.x) pc.control.v[i] = 0;
+}
