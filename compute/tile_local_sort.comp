@@ -1,22 +1,27 @@
 #version 460
 // Tile-local sort, step 4: each workgroup takes every gl_NumWorkGroups-th bin (a few workgroups cover
 // any bin count; interleaved bins spread a frame's large tiles over them), or of the BIG variant,
-// every gl_NumWorkGroups-th bin of the big-bin list the other variant made, and sorts a bin's elements, which the scatter left in arbitrary order, by (local key, input position) with the
-// network of tile_local_network.glsl. That order is the stable order. The last pass writes each key
-// back whole (bin << shift | local key) and gathers its payload from the input values.
-// Two variants: bins of up to CAPACITY elements run the network in shared memory (the group pass
-// reads the bin from global memory, the last pass writes the result there); larger bins (BIG) run it
-// in place in the bin's own range of keys_alt and values_alt. The network costs the same per pass
-// either way; only the memory it runs in differs.
+// every gl_NumWorkGroups-th bin of the big-bin list the other variant made, and sorts a bin's
+// elements, which the scatter left in arbitrary order, by (local key, input position). That order is
+// the stable order. The last pass writes each key back whole (bin << shift | local key) and gathers
+// its payload from the input values.
+// Two variants. Bins of up to CAPACITY elements are sorted in shared memory by a merge sort: runs
+// of 32 sorted in registers by the network of tile_local_network.glsl, then merges of sorted runs
+// between two shared buffers, each invocation writing one span of the outputs from where the merge
+// path puts its start. On lavapipe every pass costs its loads and stores lane by lane, and a bin of
+// 512 elements takes 5 passes this way, where the bitonic network in shared memory took 12.
+// Larger bins (BIG) run the bitonic network in place in the bin's own range of keys_alt and
+// values_alt.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "common.glsl"
 
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const bool WIDE_KEYS = true;   // 64-bit key buffers
 layout(constant_id = 2) const bool WIDE_LOCAL = false;  // local keys wider than 32 bits
 layout(constant_id = 3) const bool BIG = false;         // this variant takes the bins over CAPACITY
-layout(constant_id = 4) const uint CAPACITY = 2048;     // the largest bin sorted in shared memory
-layout(constant_id = 5) const uint HI_CAPACITY = 1;     // CAPACITY when WIDE_LOCAL, else 1 (unused)
+layout(constant_id = 4) const uint CAPACITY = 2048;     // the largest bin sorted in shared memory; 1 if BIG
+layout(constant_id = 5) const uint HI_CAPACITY = 0;     // CAPACITY when WIDE_LOCAL, else 0
 
 #include "tile_local_network.glsl"
 #include "tile_local_bins.glsl"
@@ -32,10 +37,15 @@ layout(push_constant) uniform Push {
   UintArray bins;      // see tile_local_bins.glsl
   uint bin_count;
   uint shift;          // local key bits: a key is bin << shift | local key
+  uint big_workgroups; // the most workgroups of the BIG variant's indirect dispatch
 } pc;
 
-shared uint64_t s_w[CAPACITY];
-shared uint s_hi[HI_CAPACITY];
+// Two buffers of CAPACITY elements: a merge reads runs from one and writes the merged runs to the other.
+// Element j of buffer b is s_w[b * CAPACITY + j], its hi part (WIDE_LOCAL) s_w[HI_BASE + b * HI_CAPACITY
+// + j]: one array, as another of uints would take shared memory even when unused, and that the
+// 2048-element buffers fill on lavapipe.
+const uint HI_BASE = 2 * CAPACITY;
+shared uint64_t s_w[2 * (CAPACITY + HI_CAPACITY)];
 
 // Where a pass loads from and stores to.
 const uint IN_SHARED = 0;
@@ -58,7 +68,7 @@ void store_global_key(uint i, uint64_t key) {
 void load_member(uint start, uint j, uint where, out uint64_t w, out uint hi) {
   if (where == IN_SHARED) {
     w = s_w[j];
-    hi = WIDE_LOCAL ? s_hi[j] : 0u;
+    hi = WIDE_LOCAL ? uint(s_w[HI_BASE + j]) : 0u;
     return;
   }
   uint64_t local_key = load_global_key(start + j) & ((uint64_t(1) << pc.shift) - 1u);
@@ -69,7 +79,7 @@ void load_member(uint start, uint j, uint where, out uint64_t w, out uint hi) {
 void store_member(uint start, uint j, uint bin, uint where, uint64_t w, uint hi) {
   if (where == IN_SHARED) {
     s_w[j] = w;
-    if (WIDE_LOCAL) s_hi[j] = hi;
+    if (WIDE_LOCAL) s_w[HI_BASE + j] = hi;
     return;
   }
   uint64_t key = uint64_t(bin) << pc.shift | uint64_t(hi) << 32 | w >> 32;
@@ -119,8 +129,149 @@ void pass_barrier() {
   barrier();
 }
 
-void sort_bin(uint bin, uint start, uint m) {
-  const uint network = BIG ? IN_GLOBAL : IN_SHARED;
+// One element of a bin for the merges: w and hi as in tile_local_network.glsl.
+struct Element {
+  uint64_t w;
+  uint hi;
+};
+
+const Element PADDING_ELEMENT = Element(~uint64_t(0), ~0u);
+
+bool element_before(Element a, Element b) {
+  if (!WIDE_LOCAL) return a.w < b.w;
+  return a.hi < b.hi || (a.hi == b.hi && a.w < b.w);
+}
+
+Element load_shared(uint buf, uint j) {
+  uint at = buf * CAPACITY + j;
+  return Element(s_w[at], WIDE_LOCAL ? uint(s_w[HI_BASE + buf * HI_CAPACITY + j]) : 0u);
+}
+
+// The last merge writes the bin's range of the output instead.
+void store_merged(uint buf, bool to_output, uint start, uint j, uint bin, Element e) {
+  if (to_output) {
+    store_member(start, j, bin, TO_OUTPUT, e.w, e.hi);
+    return;
+  }
+  s_w[buf * CAPACITY + j] = e.w;
+  if (WIDE_LOCAL) s_w[HI_BASE + buf * HI_CAPACITY + j] = e.hi;
+}
+
+// One merge of the sorted runs of `run` elements in buffer src into runs of 2 run. Each invocation
+// writes one span of outputs, 16 at a time: the merge path search finds where in the two runs its
+// first output comes from (the elements are unique, so the split is exact), and the merge then goes
+// on from there, across chunks, without searching again; a new pair of runs starts at its first
+// elements (a search of no steps). One span per invocation rather than chunks dealt out in turn
+// keeps the searches, a load pair per step, to one per invocation and merge.
+void merge_level(uint run, uint m, uint src, bool to_output, uint start, uint bin, uint span) {
+  uint dst = 1u - src;
+  uint first = gl_LocalInvocationIndex * span;
+  uint end = min(first + span, m);
+  uint ia = 0, ib = 0, a_end = 0, b_end = 0;
+  Element a = PADDING_ELEMENT, b = PADDING_ELEMENT;
+  for (uint out0 = first; out0 < end; out0 += GROUP) {
+    uint a0 = out0 & ~(2u * run - 1u);
+    uint pair_a_end = min(a0 + run, m);
+    uint pair_b_end = min(a0 + 2u * run, m);
+    uint diag = out0 - a0;
+    bool fresh = out0 == first || diag == 0u;
+    uint lo = fresh && diag > pair_b_end - pair_a_end ? diag - (pair_b_end - pair_a_end) : 0u;
+    uint hi = fresh ? min(diag, pair_a_end - a0) : 0u;
+    while (lo < hi) {
+      uint mid = (lo + hi) >> 1;
+      if (element_before(load_shared(src, a0 + mid), load_shared(src, pair_a_end + diag - 1u - mid)))
+        lo = mid + 1u;
+      else
+        hi = mid;
+    }
+    if (fresh) {
+      ia = a0 + lo;
+      ib = pair_a_end + diag - lo;
+      a_end = pair_a_end;
+      b_end = pair_b_end;
+      // Loads are clamped into the bin and replaced by padding past a run's end: a branch around
+      // them would cost lavapipe both sides.
+      a = load_shared(src, min(ia, m - 1u));
+      b = load_shared(src, min(ib, m - 1u));
+      if (ia >= a_end) a = PADDING_ELEMENT;
+      if (ib >= b_end) b = PADDING_ELEMENT;
+    }
+    [[unroll]] for (uint k = 0; k < GROUP; ++k) {
+      bool take_b = element_before(b, a);
+      if (out0 + k < m) store_merged(dst, to_output, start, out0 + k, bin, take_b ? b : a);
+      uint next = take_b ? ib + 1u : ia + 1u;
+      Element v = load_shared(src, min(next, m - 1u));
+      if (next >= (take_b ? b_end : a_end)) v = PADDING_ELEMENT;
+      if (take_b) {
+        b = v;
+        ib = next;
+      } else {
+        a = v;
+        ia = next;
+      }
+    }
+  }
+}
+
+// The runs the merges start from: pairs of groups sorted by the network in registers, which costs
+// lavapipe far less than a merge through shared memory.
+const uint RUN0 = 2 * GROUP;
+
+// Sorts the elements [32 g, 32 g + 32) of the bin into buffer 0: each half by the group network, then
+// the stage of 32 (the flip pairs member e of the first half with member 15 - e of the second).
+void sort_run0(uint g, uint start, uint m) {
+  g_low_bit = 0;
+  g_base = g * RUN0;
+  g_base_upper = g_base;
+  load_group(start, m, IN_GLOBAL);
+  sort_group();
+  Quad p0 = q0, p1 = q1, p2 = q2, p3 = q3;
+  g_base += GROUP;
+  g_base_upper = g_base;
+  load_group(start, m, IN_GLOBAL);
+  sort_group();
+  Quad r0 = reversed(q3), r1 = reversed(q2), r2 = reversed(q1), r3 = reversed(q0);
+  exchange(p0, r0);
+  exchange(p1, r1);
+  exchange(p2, r2);
+  exchange(p3, r3);
+  q0 = reversed(r3);
+  q1 = reversed(r2);
+  q2 = reversed(r1);
+  q3 = reversed(r0);
+  run_steps(GROUP_BITS, false);
+  store_group(start, m, 0u, IN_SHARED);
+  q0 = p0;
+  q1 = p1;
+  q2 = p2;
+  q3 = p3;
+  run_steps(GROUP_BITS, false);
+  g_base -= GROUP;
+  g_base_upper = g_base;
+  store_group(start, m, 0u, IN_SHARED);
+}
+
+void merge_sort_bin(uint bin, uint start, uint m) {
+  for (uint g = gl_LocalInvocationIndex; g * RUN0 < m; g += gl_WorkGroupSize.x) sort_run0(g, start, m);
+  // Whole groups per invocation, as few as cover the bin.
+  uint groups = (m + GROUP - 1u) / GROUP;
+  uint span = (groups + gl_WorkGroupSize.x - 1u) / gl_WorkGroupSize.x * GROUP;
+  // The last merge is a call of its own, so that where each merge stores is known when compiled:
+  // lavapipe would run the output stores masked in every merge otherwise. A bin of one run takes
+  // it too, as the copy of a single run.
+  uint src = 0;
+  uint run = RUN0;
+  for (; 2u * run < m; run *= 2u) {
+    pass_barrier();
+    merge_level(run, m, src, false, start, bin, span);
+    src = 1u - src;
+  }
+  pass_barrier();
+  merge_level(run, m, src, true, start, bin, span);
+}
+
+void network_sort_bin(uint bin, uint start, uint m) {
+  const uint network = IN_GLOBAL;  // only the BIG variant runs the network over a whole bin
   uint padded_bits = m <= 1u ? 0u : uint(findMSB(m - 1u)) + 1u;
   uint groups = max((1u << padded_bits) >> GROUP_BITS, 1u);
   bool single_group = padded_bits <= GROUP_BITS;
@@ -157,8 +308,11 @@ void sort_bin(uint bin, uint start, uint m) {
 uint next_small_bin(uint bin) {
   for (; bin < pc.bin_count; bin += gl_NumWorkGroups.x) {
     uint m = pc.bins.v[BINS_COUNTS + bin];
-    if (m > CAPACITY && gl_LocalInvocationIndex == 0u)
-      pc.bins.v[BINS_COUNTS + 2u * pc.bin_count + atomicAdd(pc.bins.v[BINS_BIG], 1u)] = bin;
+    if (m > CAPACITY && gl_LocalInvocationIndex == 0u) {
+      uint listed = atomicAdd(pc.bins.v[BINS_BIG], 1u);
+      pc.bins.v[BINS_COUNTS + 2u * pc.bin_count + listed] = bin;
+      if (listed < pc.big_workgroups) atomicAdd(pc.bins.v[BINS_BIG_ARGS], 1u);
+    }
     if (m != 0u && m <= CAPACITY) break;
   }
   return bin;
@@ -166,8 +320,12 @@ uint next_small_bin(uint bin) {
 
 void sort_listed_bin(uint bin) {
   uint m = pc.bins.v[BINS_COUNTS + bin];
-  sort_bin(bin, pc.bins.v[BINS_COUNTS + pc.bin_count + bin] - m, m);
-  pass_barrier();  // the next bin reuses the shared network
+  uint start = pc.bins.v[BINS_COUNTS + pc.bin_count + bin] - m;
+  if (BIG)
+    network_sort_bin(bin, start, m);
+  else
+    merge_sort_bin(bin, start, m);
+  pass_barrier();  // the next bin reuses the shared buffers
 }
 
 void main() {

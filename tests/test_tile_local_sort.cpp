@@ -150,6 +150,23 @@ TEST(TileLocalSort, BinsLargerThanSharedMemory) {
   expect_stable_sort(keys, 43);
 }
 
+TEST(TileLocalSort, ManyFullBinsInOneWorkgroup) {
+  // 2^17 keys of 41 bits make 512 bins (bin bits 9, local keys 32 bits) over 8 workgroups on
+  // lavapipe, workgroup w taking bins w, w + 8, ...: the bins of workgroup 0, each at the shared
+  // capacity, are the most work one workgroup gets, which must stay within lavapipe's loop limit.
+  const uint32_t cap = dynamic_cast<TileLocalSort&>(*strategy()).shared_capacity(false);
+  const uint32_t n = 1u << 17;
+  ASSERT_EQ(TileLocalSort::binning_for(41, n).shift, 32u);
+  std::mt19937_64 rng(11);
+  std::vector<uint64_t> keys(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint64_t bin = std::min<uint64_t>(i / cap, 63) * 8;
+    keys[i] = bin << 32 | (rng() & 0xffffffffu);
+  }
+  std::shuffle(keys.begin(), keys.end(), rng);
+  expect_stable_sort(keys, 41);
+}
+
 TEST(TileLocalSort, EqualKeysKeepInputOrder) {
   expect_stable_sort(std::vector<uint64_t>(50000, 12345), 45);
   expect_stable_sort(std::vector<uint64_t>(50000, 7), 32);

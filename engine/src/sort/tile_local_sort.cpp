@@ -10,7 +10,8 @@ namespace tilesplat {
 
 namespace {
 
-constexpr uint32_t kBinsHeader = 4;  // BINS_COUNTS in compute/tile_local_bins.glsl
+constexpr uint32_t kBinsHeader = 4;   // BINS_COUNTS in compute/tile_local_bins.glsl
+constexpr uint32_t kBinsBigArgs = 1;  // BINS_BIG_ARGS
 // 2^16 bins cover the 13 tile bits of a 1080p frame with room; more would make the table and its
 // scan costly for small sorts.
 constexpr uint32_t kMaxBinBits = 16;
@@ -29,8 +30,9 @@ constexpr uint32_t kSortWorkgroupSize = 64;
 // iterations in all (gallivm's loop limiter), so an invocation's share of a bin's passes must stay
 // below that: with 1024 invocations, bins up to 2^23 keys.
 constexpr uint32_t kBigWorkgroupSize = 1024;
-// Bins per sorting workgroup at most, for the same limit: a bin of the shared capacity takes about
-// 300 loop iterations in a workgroup of one 8-wide subgroup.
+// Bins per sorting workgroup at most, for the same limit: a bin of the shared capacity (2048) takes
+// about 200 loop iterations in a workgroup of one 8-wide subgroup (in each of its 6 merges, 16 groups
+// of outputs per invocation and one merge path search of up to 11 steps).
 constexpr uint32_t kMaxBinsPerWorkgroup = 64;
 constexpr uint32_t kMaxSharedCapacity = 4096;
 
@@ -48,14 +50,16 @@ struct ScanPush {
 };
 struct SortPush {
   VkDeviceAddress keys, positions, values_in, bins;
-  uint32_t bin_count, shift;
+  uint32_t bin_count, shift, big_workgroups, pad;
 };
 
-// The largest power of two of elements whose network fits the device's shared memory beside the
-// shader's few other shared words.
+// The most elements, a multiple of the 16 of a group, whose two merge buffers fill the device's
+// shared memory (the shader has no other shared memory). A wide local key's high part takes a 64-bit
+// word of its own: 16 bytes per element.
 uint32_t fit_shared(const vk::Context& ctx, uint32_t bytes_per_element) {
-  const uint32_t available = ctx.limits().max_shared_memory - 64;
-  return std::min(kMaxSharedCapacity, std::bit_floor(available / bytes_per_element));
+  constexpr uint32_t kGroup = 16;
+  const uint32_t elements = ctx.limits().max_shared_memory / (2 * bytes_per_element);
+  return std::min(kMaxSharedCapacity, elements / kGroup * kGroup);
 }
 
 // A CPU driver runs each workgroup on one thread and pays a setup per workgroup (see
@@ -83,7 +87,7 @@ TileLocalSort::TileLocalSort(vk::Context& ctx)
     : ctx_(ctx),
       key_workgroups_(workgroup_cap(ctx, ctx.limits().max_workgroup_count_x)),
       bin_workgroups_(workgroup_cap(ctx, 1u << kMaxBinBits)),
-      shared_capacity_{fit_shared(ctx, 8), fit_shared(ctx, 12)} {
+      shared_capacity_{fit_shared(ctx, 8), fit_shared(ctx, 16)} {
   setup_ = vk::ComputePipeline(ctx, "tile_local_setup", sizeof(SetupPush));
   scan_ = vk::ComputePipeline(ctx, "tile_local_scan", sizeof(ScanPush));
   for (uint32_t wide : {0u, 1u}) {
@@ -98,11 +102,12 @@ TileLocalSort::TileLocalSort(vk::Context& ctx)
 const vk::ComputePipeline& TileLocalSort::sort_pipeline(bool wide_keys, bool wide_local, bool big) {
   auto& slot = sort_[size_t(wide_keys) * 4 + size_t(wide_local) * 2 + size_t(big)];
   if (!slot) {
-    const uint32_t capacity = shared_capacity(wide_local);
+    // The big-bin variant sorts in global memory: its shared buffers only need to exist.
+    const uint32_t capacity = big ? 1 : shared_capacity(wide_local);
     const uint32_t small_size = ctx_.is_cpu_device() ? ctx_.limits().subgroup_size : kSortWorkgroupSize;
     const uint32_t size = big ? std::min(kBigWorkgroupSize, ctx_.limits().max_workgroup_invocations) : small_size;
     const std::vector<vk::SpecConstant> spec{{0, size},     {1, wide_keys}, {2, wide_local},
-                                             {3, big},      {4, capacity},  {5, wide_local ? capacity : 1}};
+                                             {3, big},      {4, capacity},  {5, wide_local ? capacity : 0}};
     slot = std::make_unique<vk::ComputePipeline>(ctx_, "tile_local_sort", uint32_t(sizeof(SortPush)), spec);
   }
   return *slot;
@@ -118,8 +123,11 @@ bool TileLocalSort::record(vk::CommandStream& stream, SortInput& input) {
   const VkDeviceAddress state = input.state.address() + input.state_offset;
   const VkDeviceSize args_offset = input.state_offset + kSortArgsOffset;
 
-  // The big-bin count and the bin counts (compute/tile_local_bins.glsl).
-  vkCmdFillBuffer(cmd, bins_.handle(), 0, (kBinsHeader + bin_count) * sizeof(uint32_t), 0);
+  // The big-bin count, its indirect dispatch (no workgroups yet) and the bin counts
+  // (compute/tile_local_bins.glsl).
+  vkCmdFillBuffer(cmd, bins_.handle(), 0, 2 * sizeof(uint32_t), 0);
+  vkCmdFillBuffer(cmd, bins_.handle(), 2 * sizeof(uint32_t), 2 * sizeof(uint32_t), 1);
+  vkCmdFillBuffer(cmd, bins_.handle(), kBinsHeader * sizeof(uint32_t), bin_count * sizeof(uint32_t), 0);
   setup_.bind(cmd, SetupPush{state, kb.capacity, kKeyWorkgroupSize, key_workgroups_, 0});
   setup_.dispatch(cmd, 1);
   vk::barrier(cmd);
@@ -139,14 +147,16 @@ bool TileLocalSort::record(vk::CommandStream& stream, SortInput& input) {
   // The small-bin variant lists the bins over the shared capacity for the big-bin variant, so that
   // its few workgroups of up to 1024 invocations do not scan every bin.
   const SortPush sort_push{kb.keys_alt.address(), kb.values_alt.address(), kb.values.address(), bins_.address(),
-                           bin_count,             binning.shift};
+                           bin_count,             binning.shift,           bin_workgroups_,    0};
   const vk::ComputePipeline& sort_small = sort_pipeline(kb.wide_keys, wide_local, false);
   sort_small.bind(cmd, sort_push);
   sort_small.dispatch(cmd, std::min(bin_count, std::max(bin_workgroups_, vk::div_ceil(bin_count, kMaxBinsPerWorkgroup))));
   vk::barrier(cmd);
   const vk::ComputePipeline& sort_big = sort_pipeline(kb.wide_keys, wide_local, true);
   sort_big.bind(cmd, sort_push);
-  sort_big.dispatch(cmd, std::min(bin_count, bin_workgroups_));
+  // A workgroup per big bin, as many as the small variant listed: a frame usually has none, and an
+  // empty dispatch of 1024-invocation workgroups still costs lavapipe a millisecond.
+  sort_big.dispatch_indirect(cmd, bins_.handle(), kBinsBigArgs * sizeof(uint32_t));
   vk::barrier(cmd);
   return true;
 }

@@ -1,8 +1,8 @@
 // Tile-local sort: a counting sort on the keys' high bits (the tile id of a frame's (tile, depth)
 // keys) puts every key into its bin, then one workgroup sorts each bin on the remaining low bits (the
 // depth) by (local key, input position), which is the stable order. Bins up to a shared-memory
-// capacity are sorted in shared memory; larger ones by the same network in global memory, in the
-// bin's own range of the output. The whole sort is six dispatches whatever the key width.
+// capacity are merge-sorted in shared memory; larger ones by a bitonic network in global memory, in
+// the bin's own range of the output. The whole sort is six dispatches whatever the key width.
 #pragma once
 
 #include <array>
