@@ -18,7 +18,8 @@
 layout(local_size_x = 256) in;
 // When the key and position fit one 64-bit word together (key << position_bits | position), the
 // network moves 8 bytes a key instead of 12 and compares with one min/max instead of two compares.
-// Packing needs 64-bit network words, so it is used with 64-bit key buffers only.
+// Packed network words are 64-bit whatever the key layout; with 32-bit keys they live in a scratch
+// buffer of the strategy's own.
 layout(constant_id = 0) const bool PACKED = false;
 layout(constant_id = 1) const bool WIDE_KEYS = true;
 #include "sort_keys.glsl"
@@ -29,7 +30,8 @@ const uint GROUP = 16;
 layout(push_constant) uniform Push {
   uint64_t keys_in;      // the keys to sort (read by the first pass only; see sort_keys.glsl)
   UintArray values_in;   // the payloads, gathered by the last pass
-  uint64_t keys;         // the network's keys, in place; the sorted keys at the end (keys_alt)
+  uint64_t keys;         // the network's keys, in place (keys_alt, or 64-bit scratch when PACKED)
+  uint64_t keys_out;     // the sorted keys, written by the last pass (keys_alt)
   UintArray positions;   // each key's input position while the network runs (not PACKED)
   UintArray values_out;  // the gathered payloads: values_alt, the same memory as the positions (a
                          // pass stores the indices it loaded, so the last one replaces each position)
@@ -62,6 +64,8 @@ uvec4 quad_indices(uint quad) {
   return (quad < 2 ? g_base : g_base_upper) + ((quad * 4 + uvec4(0, 1, 2, 3)) << g_low_bit);
 }
 
+uint64_t load_network_key(uint i) { return PACKED ? Uint64Array(pc.keys).v[i] : load_key(pc.keys, i); }
+
 // Members past the count are padding: +infinity, and a position above every real one so that no
 // real pair equals it. Loads are clamped rather than skipped: a branch around register writes costs
 // lavapipe more than the redundant load.
@@ -69,8 +73,12 @@ Quad load_quad(uint quad, uint n, bool from_input) {
   uvec4 i = quad_indices(quad);
   bvec4 real = lessThan(i, uvec4(n));
   uvec4 at = min(i, uvec4(n - 1));
-  uint64_t src = from_input ? pc.keys_in : pc.keys;
-  u64vec4 key = u64vec4(load_key(src, at.x), load_key(src, at.y), load_key(src, at.z), load_key(src, at.w));
+  u64vec4 key;
+  if (from_input)
+    key = u64vec4(load_key(pc.keys_in, at.x), load_key(pc.keys_in, at.y), load_key(pc.keys_in, at.z),
+                  load_key(pc.keys_in, at.w));
+  else
+    key = u64vec4(load_network_key(at.x), load_network_key(at.y), load_network_key(at.z), load_network_key(at.w));
   uvec4 position = i;
   if (from_input && PACKED) key = key << pc.position_bits | u64vec4(i);
   if (!from_input && !PACKED)
@@ -82,13 +90,16 @@ Quad load_quad(uint quad, uint n, bool from_input) {
 // their sorted order; every other pass stores the network's state.
 void store_member(uint i, uint64_t key, uint position, bool last_pass) {
   if (!last_pass) {
-    store_key(pc.keys, i, key);
+    if (PACKED)
+      Uint64Array(pc.keys).v[i] = key;
+    else
+      store_key(pc.keys, i, key);
     if (!PACKED) pc.positions.v[i] = position;
   } else if (PACKED) {
-    store_key(pc.keys, i, key >> pc.position_bits);
+    store_key(pc.keys_out, i, key >> pc.position_bits);
     pc.values_out.v[i] = pc.values_in.v[uint(key & ((uint64_t(1) << pc.position_bits) - 1))];
   } else {
-    store_key(pc.keys, i, key);
+    store_key(pc.keys_out, i, key);
     pc.values_out.v[i] = pc.values_in.v[position];
   }
 }

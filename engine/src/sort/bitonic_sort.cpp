@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <bit>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "passes/frame_counters.h"
@@ -22,7 +24,7 @@ struct SetupPush {
   uint32_t capacity, group_keys, workgroup_size, max_workgroups;
 };
 struct PassPush {
-  VkDeviceAddress keys_in, values_in, keys, positions, values_out, state;
+  VkDeviceAddress keys_in, values_in, keys, keys_out, positions, values_out, state;
   uint32_t capacity, position_bits, stage, stride, steps, pad;
 };
 
@@ -38,12 +40,11 @@ uint32_t workgroup_cap(const vk::Context& ctx) {
 
 }  // namespace
 
-BitonicSort::BitonicSort(vk::Context& ctx) : max_workgroups_(workgroup_cap(ctx)) {
+BitonicSort::BitonicSort(vk::Context& ctx) : ctx_(ctx), max_workgroups_(workgroup_cap(ctx)) {
   setup_ = vk::ComputePipeline(ctx, "bitonic_setup", sizeof(SetupPush));
-  // Variants: narrow keys, wide keys, wide keys packed with their positions.
-  const uint32_t variants[3][2] = {{0, 0}, {0, 1}, {1, 1}};
-  for (uint32_t v = 0; v < 3; ++v) {
-    const std::vector<vk::SpecConstant> spec{{0, variants[v][0]}, {1, variants[v][1]}};
+  // Variant packed * 2 + wide: keys packed with their positions or not, 32- or 64-bit key buffers.
+  for (uint32_t v = 0; v < 4; ++v) {
+    const std::vector<vk::SpecConstant> spec{{0, v / 2}, {1, v % 2}};
     sort_groups_[v] = vk::ComputePipeline(ctx, "bitonic_sort_groups", sizeof(PassPush), spec);
     merge_[v] = vk::ComputePipeline(ctx, "bitonic_merge", sizeof(PassPush), spec);
   }
@@ -62,16 +63,21 @@ bool BitonicSort::record(vk::CommandStream& stream, SortInput& input) {
   // network for the capacity has index_bits stages. When the key's varying bits fit beside a
   // position, the network sorts single words.
   const uint32_t index_bits = uint32_t(std::bit_width(std::max<uint32_t>(kb.capacity, 1) - 1));
-  // position. Packing needs 64-bit words to run the network in, which narrow key buffers lack.
-  const bool packed = kb.wide_keys && std::min<uint32_t>(input.key_bits, 64) + index_bits <= 64;
-  const uint32_t variant = !kb.wide_keys ? 0 : packed ? 2 : 1;
+  // position. Packed words are 64-bit: with 32-bit key buffers they run in the strategy's scratch.
+  const bool packed = std::min<uint32_t>(input.key_bits, 64) + index_bits <= 64;
+  const uint32_t variant = (packed ? 2 : 0) + (kb.wide_keys ? 1 : 0);
+  const bool scratch = packed && !kb.wide_keys;
+  if (scratch && network_.size() < VkDeviceSize(kb.capacity) * sizeof(uint64_t))
+    throw std::logic_error("bitonic sort: reserve() was not called for " + std::to_string(kb.capacity) + " keys");
+  const VkDeviceAddress network = scratch ? network_.address() : kb.keys_alt.address();
 
   // The network runs in keys_alt and values_alt, so the input values stay intact for the final
   // gather. Each pass loads and stores the same indices in one invocation, which lets the last pass
   // read a key's position from values_alt and overwrite it with the payload.
-  PassPush push{kb.keys.address(),      kb.values.address(),     kb.keys_alt.address(), kb.values_alt.address(),
-                kb.values_alt.address(), state,                  kb.capacity,           index_bits,
-                0,                       0,                      0,                     0};
+  PassPush push{kb.keys.address(), kb.values.address(),     network,     kb.keys_alt.address(),
+                kb.values_alt.address(), kb.values_alt.address(), state, kb.capacity,
+                index_bits,       0,                       0,           0,
+                0};
   sort_groups_[variant].bind(cmd, push);
   sort_groups_[variant].dispatch_indirect(cmd, input.state.handle(), args_offset);
   vk::barrier(cmd);
@@ -91,6 +97,13 @@ bool BitonicSort::record(vk::CommandStream& stream, SortInput& input) {
     }
   }
   return true;
+}
+
+void BitonicSort::reserve(uint32_t max_keys) {
+  // Packed words of 32-bit keys need 64-bit scratch; allocated for any capacity that may need it.
+  const VkDeviceSize bytes = VkDeviceSize(max_keys) * sizeof(uint64_t);
+  if (network_.size() < bytes)
+    network_ = vk::Buffer(ctx_, bytes, vk::MemoryUse::Device, "bitonic network (packed 32-bit keys)");
 }
 
 }  // namespace tilesplat

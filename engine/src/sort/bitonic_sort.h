@@ -16,18 +16,21 @@ class BitonicSort final : public SortStrategy {
  public:
   explicit BitonicSort(vk::Context& ctx);
   std::string name() const override { return "bitonic"; }
-  // Nothing to size: the network runs in keys_alt and values_alt (the positions live in values_alt
-  // until the last pass replaces each with its payload), and the padding to a power of two is never
-  // stored.
-  void reserve(uint32_t) override {}
+  // The network runs in keys_alt and values_alt (the positions live in values_alt until the last pass
+  // replaces each with its payload; the padding to a power of two is never stored), except that a key
+  // packed with its position needs a 64-bit word: with 32-bit key buffers, those run in a scratch
+  // buffer sized here.
+  void reserve(uint32_t max_keys) override;
   bool record(vk::CommandStream& stream, SortInput& input) override;
-  uint64_t device_bytes() const override { return 0; }
+  uint64_t device_bytes() const override { return network_.size(); }
 
  private:
+  vk::Context& ctx_;
+  vk::Buffer network_;
   uint32_t max_workgroups_;
   vk::ComputePipeline setup_;
   // Indexed by whether the key and its position share one 64-bit word (see compute/bitonic_common.glsl).
-  std::array<vk::ComputePipeline, 3> sort_groups_, merge_;  // [narrow, wide, wide packed]
+  std::array<vk::ComputePipeline, 4> sort_groups_, merge_;  // [packed * 2 + wide keys]
 };
 
 }  // namespace tilesplat
