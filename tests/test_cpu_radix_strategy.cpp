@@ -16,6 +16,7 @@
 
 #include "passes/frame_counters.h"
 #include "sort/cpu_radix_strategy.h"
+#include "sort_test_support.h"
 #include "test_support.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
@@ -31,19 +32,10 @@ namespace {
 using Keys = CpuRadixSort::Keys;
 using HostAccess = CpuRadixSort::HostAccess;
 
-vk::Context& context() {
-  static vk::Context ctx({"", true});
-  return ctx;
-}
-
-// A payload that does not follow the input order (as in test_gpu_sort.cpp): ties broken by value
-// instead of by input position would be caught.
-uint32_t payload(uint32_t position) { return (position * 2654435761u) ^ 0x5bd1e995u; }
-uint32_t position_of(uint32_t value) { return (value ^ 0x5bd1e995u) * 244002641u; }
+using namespace testing;
 
 struct HostSortResult {
-  std::vector<uint64_t> keys;
-  std::vector<uint32_t> order;  // input positions
+  SortedPairs pairs;
   bool used_staging = false;
   double host_ms = 0;   // the strategy's own sort time
   double timed_ms = 0;  // GPU timestamps around record(), across its submissions
@@ -52,27 +44,18 @@ struct HostSortResult {
 
 HostSortResult host_sort(Keys which, HostAccess access, const std::vector<uint64_t>& keys, uint32_t key_bits,
                          bool depth_in_low_bits) {
-  vk::Context& ctx = context();
-  const uint32_t n = uint32_t(keys.size());
-  const uint32_t capacity = std::max<uint32_t>(n, 1);
-  KeyBuffers kb = KeyBuffers::allocate(ctx, capacity, key_bits, "test");
-  std::vector<uint32_t> values(n);
-  for (uint32_t i = 0; i < n; ++i) values[i] = payload(i);
-  const std::vector<uint8_t> packed = kb.pack_keys(keys);
-  vk::upload(ctx, kb.keys, packed.data(), packed.size());
-  vk::upload(ctx, kb.values, values.data(), n * 4ull);
-  vk::Buffer counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "counters");
+  vk::Context& ctx = sort_test_context();
   // The count is set on the GPU, as in a frame: the strategy must flush before it reads it.
-  std::memset(counters.mapped(), 0, sizeof(FrameCounters));
+  DeviceSortInput in = upload_sort_input(keys, key_bits, 0, /*count_on_host=*/false);
 
   CpuRadixSort sorter(ctx, which, access);
-  sorter.reserve(capacity);
+  sorter.reserve(in.buffers.capacity);
   vk::GpuTimer timer(ctx);
   vk::CommandStream stream(ctx);
   timer.begin_frame(stream.cmd());
-  vkCmdFillBuffer(stream.cmd(), counters.handle(), kTileSortOffset + offsetof(SortState, count), 4, n);
+  vkCmdFillBuffer(stream.cmd(), in.counters.handle(), kTileSortOffset + offsetof(SortState, count), 4, in.count);
   vk::barrier(stream.cmd());
-  SortInput input{kb, counters, kTileSortOffset, key_bits, depth_in_low_bits};
+  SortInput input = in.input(key_bits, depth_in_low_bits);
   const bool in_alt = sorter.record(stream, input);
   timer.mark(stream.cmd(), "sort");
   stream.finish();
@@ -82,31 +65,13 @@ HostSortResult host_sort(Keys which, HostAccess access, const std::vector<uint64
   result.used_staging = sorter.last_used_staging();
   result.host_ms = sorter.last_host_ms();
   result.submissions = stream.submissions();
-  std::vector<uint8_t> sorted(size_t(n) * kb.key_bytes());
-  std::vector<uint32_t> positions(n);
-  if (n > 0) {
-    // Through staging copies, so that the check does not depend on the device memory being mapped.
-    vk::Buffer staging(ctx, sorted.size() + n * 4ull, vk::MemoryUse::Readback, "test readback");
-    ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-      const VkBufferCopy key_region{0, 0, sorted.size()};
-      const VkBufferCopy value_region{0, sorted.size(), n * 4ull};
-      vkCmdCopyBuffer(cmd, (in_alt ? kb.keys_alt : kb.keys).handle(), staging.handle(), 1, &key_region);
-      vkCmdCopyBuffer(cmd, (in_alt ? kb.values_alt : kb.values).handle(), staging.handle(), 1, &value_region);
-    });
-    std::memcpy(sorted.data(), staging.mapped(), sorted.size());
-    std::memcpy(positions.data(), staging.mapped_as<char>() + sorted.size(), n * 4ull);
-  }
-  for (auto& v : positions) v = position_of(v);
-  result.keys = kb.unpack_keys(sorted.data(), n);
-  result.order = std::move(positions);
+  result.pairs = read_sorted(in.buffers, in_alt, in.count);
   return result;
 }
 
-std::vector<uint32_t> stable_order_by(const std::vector<uint64_t>& sort_keys) {
-  std::vector<uint32_t> order(sort_keys.size());
-  std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return sort_keys[a] < sort_keys[b]; });
-  return order;
+void expect_host_order(const HostSortResult& got, const std::vector<uint64_t>& keys,
+                       const std::vector<uint32_t>& expected, const std::string& what) {
+  expect_order(keys, expected, got.pairs, what);
 }
 
 // The quantization as sort/cpu_radix_strategy.h states it, written out independently.
@@ -134,31 +99,6 @@ std::vector<uint64_t> quantized_keys(const std::vector<uint64_t>& keys, uint32_t
                        : 0;
   }
   return q;
-}
-
-// Checks a host sort against the expected order of input positions: the order, and the original
-// keys moved with it.
-void expect_order(const HostSortResult& got, const std::vector<uint64_t>& keys, const std::vector<uint32_t>& expected,
-                  const std::string& what) {
-  ASSERT_EQ(got.order.size(), expected.size()) << what;
-  size_t mismatches = 0;
-  for (size_t i = 0; i < expected.size(); ++i) {
-    if (got.order[i] != expected[i] || got.keys[i] != keys[expected[i]]) {
-      if (++mismatches <= 5)
-        ADD_FAILURE() << what << " n=" << keys.size() << ": position " << i << " has index " << got.order[i]
-                      << " (key " << got.keys[i] << "), expected index " << expected[i] << " (key "
-                      << keys[expected[i]] << ")";
-    }
-  }
-  EXPECT_EQ(mismatches, 0u) << what;
-}
-
-std::vector<uint64_t> random_keys(size_t n, uint32_t bits, uint64_t seed, uint64_t distinct = 0) {
-  std::mt19937_64 rng(seed);
-  std::vector<uint64_t> keys(n);
-  const uint64_t mask = bits >= 64 ? ~0ull : (1ull << bits) - 1;
-  for (auto& k : keys) k = (distinct ? (rng() % distinct) * 0x9e3779b97f4a7c15ull : rng()) & mask;
-  return keys;
 }
 
 // View depths as the projection writes them: float bits of depths in [0.2, 60], from `distinct`
@@ -198,16 +138,16 @@ TEST(CpuRadixStrategy, ExactOnBothPathsMatchesStableSort) {
         const auto keys = random_keys(n, bits, n * 64 + bits, n > 1000 ? 300 : 0);
         const std::string what = std::string("cpu-radix ") + path_name(access) + " " + std::to_string(bits) + " bits";
         const HostSortResult got = host_sort(Keys::kExact, access, keys, bits, false);
-        expect_order(got, keys, stable_order_by(keys), what);
-        EXPECT_EQ(got.used_staging, access == HostAccess::kStaging || !context().is_cpu_device()) << what;
+        expect_host_order(got, keys, stable_order(keys), what);
+        EXPECT_EQ(got.used_staging, access == HostAccess::kStaging || !sort_test_context().is_cpu_device()) << what;
       }
     }
   }
   // Depth keys in the depth sort's form: exact means exact, culled keys included.
   const auto keys = depth_keys(50000, 5, 0, 0.1, true);
-  expect_order(host_sort(Keys::kExact, HostAccess::kAuto, keys, 32, true), keys, stable_order_by(keys),
+  expect_host_order(host_sort(Keys::kExact, HostAccess::kAuto, keys, 32, true), keys, stable_order(keys),
                "cpu-radix depth keys");
-  EXPECT_EQ(context().validation_messages(), 0u);
+  EXPECT_EQ(sort_test_context().validation_messages(), 0u);
 }
 
 TEST(CpuRadixStrategy, Quantized16MatchesTheModelOnDepthKeys) {
@@ -228,15 +168,15 @@ TEST(CpuRadixStrategy, Quantized16MatchesTheModelOnDepthKeys) {
       {"wide tile and depth", depth_keys(20000, 6, 500, 0.05, true, 24), 56},
   };
   for (const Case& c : cases) {
-    const std::vector<uint32_t> expected = stable_order_by(quantized_keys(c.keys, c.bits, true));
+    const std::vector<uint32_t> expected = stable_order(quantized_keys(c.keys, c.bits, true));
     for (const HostAccess access : kBothPaths) {
       const std::string what = "cpu-radix16 " + std::string(path_name(access)) + ", " + c.name;
-      expect_order(host_sort(Keys::kQuantized16, access, c.keys, c.bits, true), c.keys, expected, what);
+      expect_host_order(host_sort(Keys::kQuantized16, access, c.keys, c.bits, true), c.keys, expected, what);
     }
   }
   // The model must tell a quantized order from the exact one, or the checks above prove nothing.
-  EXPECT_NE(stable_order_by(quantized_keys(cases[0].keys, 32, true)), stable_order_by(cases[0].keys));
-  EXPECT_EQ(context().validation_messages(), 0u);
+  EXPECT_NE(stable_order(quantized_keys(cases[0].keys, 32, true)), stable_order(cases[0].keys));
+  EXPECT_EQ(sort_test_context().validation_messages(), 0u);
 }
 
 TEST(CpuRadixStrategy, Quantized16MatchesTheModelOnIntegerKeys) {
@@ -246,21 +186,21 @@ TEST(CpuRadixStrategy, Quantized16MatchesTheModelOnIntegerKeys) {
         const auto keys = random_keys(70000, bits, bits + distinct, distinct);
         const std::string what = "cpu-radix16 " + std::string(path_name(access)) + " " + std::to_string(bits) +
                                  " bits, " + std::to_string(distinct) + " distinct";
-        expect_order(host_sort(Keys::kQuantized16, access, keys, bits, false), keys,
-                     stable_order_by(quantized_keys(keys, bits, false)), what);
+        expect_host_order(host_sort(Keys::kQuantized16, access, keys, bits, false), keys,
+                     stable_order(quantized_keys(keys, bits, false)), what);
       }
     }
     const std::vector<uint64_t> equal(1000, 123456789);
-    expect_order(host_sort(Keys::kQuantized16, access, equal, 32, false), equal, stable_order_by(equal),
+    expect_host_order(host_sort(Keys::kQuantized16, access, equal, 32, false), equal, stable_order(equal),
                  "cpu-radix16 all keys equal");
     // Up to 16 key bits nothing is quantized.
     const auto narrow = random_keys(50000, 16, 77, 0);
-    expect_order(host_sort(Keys::kQuantized16, access, narrow, 16, false), narrow, stable_order_by(narrow),
+    expect_host_order(host_sort(Keys::kQuantized16, access, narrow, 16, false), narrow, stable_order(narrow),
                  "cpu-radix16 16-bit keys");
   }
   const auto keys = random_keys(50000, 32, 9);
-  EXPECT_NE(stable_order_by(quantized_keys(keys, 32, false)), stable_order_by(keys));
-  EXPECT_EQ(context().validation_messages(), 0u);
+  EXPECT_NE(stable_order(quantized_keys(keys, 32, false)), stable_order(keys));
+  EXPECT_EQ(sort_test_context().validation_messages(), 0u);
 }
 
 // The sort's timer marks lie in different submissions, with the host sort between them: the time
@@ -280,7 +220,7 @@ TEST(CpuRadixStrategy, RegisteredAndExactnessAgrees) {
   for (const char* name : {"cpu-radix", "cpu-radix16"})
     EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
   for (const auto& name : names)
-    EXPECT_EQ(sort_strategy_is_exact(name), make_sort_strategy(name, context())->exact()) << name;
+    EXPECT_EQ(sort_strategy_is_exact(name), make_sort_strategy(name, sort_test_context())->exact()) << name;
   EXPECT_FALSE(sort_strategy_is_exact("cpu-radix16"));
   EXPECT_TRUE(sort_strategy_is_exact("cpu-radix"));
   EXPECT_THROW(sort_strategy_is_exact("no-such-sort"), std::invalid_argument);

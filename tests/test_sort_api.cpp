@@ -9,6 +9,7 @@
 #include <numeric>
 #include <random>
 
+#include "sort_test_support.h"
 #include "test_support.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
@@ -19,20 +20,8 @@
 namespace tilesplat {
 namespace {
 
-std::vector<uint32_t> stable_order(const std::vector<uint64_t>& keys) {
-  std::vector<uint32_t> order(keys.size());
-  std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
-  return order;
-}
-
-std::vector<uint64_t> random_keys(size_t n, uint32_t bits, uint64_t seed, uint64_t distinct = 0) {
-  std::mt19937_64 rng(seed);
-  std::vector<uint64_t> keys(n);
-  const uint64_t mask = bits >= 64 ? ~0ull : (1ull << bits) - 1;
-  for (auto& k : keys) k = (distinct ? rng() % distinct : rng()) & mask;
-  return keys;
-}
+using testing::random_keys;
+using testing::stable_order;
 
 TEST(CpuRadixSort, MatchesStableSort) {
   for (uint32_t bits : {1u, 9u, 32u, 45u, 64u}) {

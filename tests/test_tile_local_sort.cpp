@@ -7,9 +7,8 @@
 #include <numeric>
 #include <random>
 
-#include "passes/frame_counters.h"
-#include "sort/sort_strategy.h"
 #include "sort/tile_local_sort.h"
+#include "sort_test_support.h"
 #include "test_support.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/renderer.h"
@@ -19,83 +18,18 @@
 namespace tilesplat {
 namespace {
 
-vk::Context& context() {
-  static vk::Context ctx({"", true});
-  return ctx;
-}
+using namespace testing;
 
 std::unique_ptr<SortStrategy>& strategy() {
-  static std::unique_ptr<SortStrategy> sorter = make_sort_strategy("tile-local", context());
+  static std::unique_ptr<SortStrategy> sorter = make_sort_strategy("tile-local", sort_test_context());
   return sorter;
 }
 
-template <typename T>
-std::vector<T> read_back(vk::Context& ctx, const vk::Buffer& buffer, size_t count) {
-  std::vector<T> out(count);
-  if (count == 0) return out;
-  vk::Buffer staging(ctx, count * sizeof(T), vk::MemoryUse::Readback, "test readback");
-  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    VkBufferCopy region{0, 0, count * sizeof(T)};
-    vkCmdCopyBuffer(cmd, buffer.handle(), staging.handle(), 1, &region);
-  });
-  std::memcpy(out.data(), staging.mapped(), count * sizeof(T));
-  return out;
-}
-
-// Payloads that do not follow the input order, so that ties broken by payload would show.
-uint32_t payload(uint32_t position) { return position * 2654435761u ^ 0x5bd1e995u; }
-
-// Sorts keys with payload(position) values in buffers of `capacity` keys (the count stays n, as in
-// a frame whose buffers are larger than its pairs) and checks keys and payloads against
-// std::stable_sort.
+// Sorts in buffers of `capacity` keys (the count stays n, as in a frame whose buffers are larger than
+// its pairs) and checks against std::stable_sort.
 void expect_stable_sort(const std::vector<uint64_t>& keys, uint32_t key_bits, uint32_t capacity = 0) {
-  vk::Context& ctx = context();
-  const uint32_t n = uint32_t(keys.size());
-  capacity = std::max({capacity, n, 1u});
-  KeyBuffers kb = KeyBuffers::allocate(ctx, capacity, key_bits, "test");
-  std::vector<uint32_t> values(n);
-  for (uint32_t i = 0; i < n; ++i) values[i] = payload(i);
-  if (n > 0) {
-    const std::vector<uint8_t> packed = kb.pack_keys(keys);
-    vk::upload(ctx, kb.keys, packed.data(), packed.size());
-    vk::upload(ctx, kb.values, values.data(), n * 4ull);
-  }
-  vk::Buffer counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "counters");
-  SortState state{};
-  state.count = n;
-  std::memcpy(static_cast<char*>(counters.mapped()) + kTileSortOffset, &state, sizeof(state));
-
-  SortStrategy& sorter = *strategy();
-  sorter.reserve(capacity);
-  vk::CommandStream stream(ctx);
-  SortInput input{kb, counters, kTileSortOffset, key_bits};
-  const bool in_alt = sorter.record(stream, input);
-  stream.finish();
-  const std::vector<uint32_t> got_values = read_back<uint32_t>(ctx, in_alt ? kb.values_alt : kb.values, n);
-  const std::vector<uint8_t> bytes = read_back<uint8_t>(ctx, in_alt ? kb.keys_alt : kb.keys, size_t(n) * kb.key_bytes());
-  const std::vector<uint64_t> got_keys = kb.unpack_keys(bytes.data(), n);
-
-  std::vector<uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
-  size_t mismatches = 0;
-  for (uint32_t i = 0; i < n; ++i) {
-    if (got_keys[i] != keys[order[i]] || got_values[i] != payload(order[i])) {
-      if (++mismatches <= 5)
-        ADD_FAILURE() << "n=" << n << " bits=" << key_bits << ": at " << i << " key " << got_keys[i] << " value "
-                      << got_values[i] << ", expected key " << keys[order[i]] << " value " << payload(order[i]);
-    }
-  }
-  EXPECT_EQ(mismatches, 0u) << "n=" << n << " bits=" << key_bits;
-  EXPECT_EQ(ctx.validation_messages(), 0u);
-}
-
-std::vector<uint64_t> random_keys(size_t n, uint32_t bits, uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::vector<uint64_t> keys(n);
-  const uint64_t mask = bits >= 64 ? ~0ull : (1ull << bits) - 1;
-  for (auto& k : keys) k = rng() & mask;
-  return keys;
+  expect_stable_order(keys, sort_on_device(*strategy(), keys, key_bits, capacity),
+                      "bits=" + std::to_string(key_bits) + " capacity=" + std::to_string(capacity));
 }
 
 // Keys like a frame's: a few tile ids in the high word (so bins far larger than shared memory), a
