@@ -37,6 +37,15 @@ struct KeyBuffers {
 
   uint64_t bytes() const { return keys.size() + values.size() + keys_alt.size() + values_alt.size(); }
 
+  // One pass of a ping-pong sort: it reads the pair the previous pass wrote (keys/values first) and
+  // writes the other.
+  struct Pass {
+    const vk::Buffer &keys_in, &values_in, &keys_out, &values_out;
+  };
+  Pass pass(bool from_alt) const {
+    return from_alt ? Pass{keys_alt, values_alt, keys, values} : Pass{keys, values, keys_alt, values_alt};
+  }
+
   // Host-side keys in and out of this layout (the caller guarantees narrow keys fit 32 bits).
   std::vector<uint8_t> pack_keys(const std::vector<uint64_t>& host) const {
     std::vector<uint8_t> bytes(host.size() * key_bytes());

@@ -125,10 +125,7 @@ bool OnesweepSort::record(vk::CommandStream& stream, SortInput& input) {
 
   bool in_alt = false;
   for (uint32_t p = 0; p < passes; ++p) {
-    const vk::Buffer& keys_in = in_alt ? kb.keys_alt : kb.keys;
-    const vk::Buffer& values_in = in_alt ? kb.values_alt : kb.values;
-    const vk::Buffer& keys_out = in_alt ? kb.keys : kb.keys_alt;
-    const vk::Buffer& values_out = in_alt ? kb.values : kb.values_alt;
+    const auto [keys_in, values_in, keys_out, values_out] = kb.pass(in_alt);
     const PassPush push{keys_in.address(),  values_in.address(), keys_out.address(),
                         values_out.address(), control_.address(), status[p % 2],
                         status[(p + 1) % 2],  state,              fallbacks_.address(),

@@ -84,10 +84,7 @@ bool RadixSort::record(vk::CommandStream& stream, SortInput& input) {
   const uint32_t passes = (std::min<uint32_t>(input.key_bits, 64) + kDigitBits - 1) / kDigitBits;
   bool in_alt = false;
   for (uint32_t p = 0; p < passes; ++p) {
-    const vk::Buffer& keys_in = in_alt ? kb.keys_alt : kb.keys;
-    const vk::Buffer& values_in = in_alt ? kb.values_alt : kb.values;
-    const vk::Buffer& keys_out = in_alt ? kb.keys : kb.keys_alt;
-    const vk::Buffer& values_out = in_alt ? kb.values : kb.values_alt;
+    const auto [keys_in, values_in, keys_out, values_out] = kb.pass(in_alt);
     PassPush push{keys_in.address(),    values_in.address(),     keys_out.address(), values_out.address(),
                   histogram_.address(), digit_totals_.address(), state,              p * kDigitBits, 0};
     histogram_pass_[wide].bind(cmd, push);
