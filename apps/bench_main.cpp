@@ -164,6 +164,7 @@ class Collector {
     add_frame("intersections", Unit::kCount, double(stats.intersections));
     add_frame("sort bits", Unit::kCount, double(stats.sort_bits));
     add_frame("retries", Unit::kCount, double(stats.retries));
+    add_frame("sort fallbacks", Unit::kCount, double(stats.sort_fallbacks));
     add_frame("device memory", Unit::kMebibytes, double(stats.device_bytes) / (1024.0 * 1024.0));
   }
 
@@ -746,6 +747,9 @@ struct SortRow {
   // A quantizing strategy's cost in accuracy: the fraction of output positions whose key is not the
   // one an exact sort puts there (0 for the exact ones, which are checked to give the exact order).
   double misordered = 0;
+  // Sorts' look-back steps that stopped waiting and took the fallback path (onesweep), summed over
+  // the timed runs: the forward-progress cost the strategy paid on this device.
+  uint64_t fallbacks = 0;
 };
 
 // Checks that an inexact strategy's order is a permutation, and returns the fraction of positions
@@ -815,13 +819,14 @@ double vs_std_sort(const std::vector<SortRow>& rows, const SortRow& row) {
 
 std::string make_sort_csv(const std::vector<SortRow>& rows, const tilesplat::DeviceInfo& device) {
   std::string csv =
-      "device,key_bits,keys,sorter,where,median_ms,min_ms,max_ms,mkeys_per_s,vs_std_sort,misordered,samples\n";
+      "device,key_bits,keys,sorter,where,median_ms,min_ms,max_ms,mkeys_per_s,vs_std_sort,misordered,fallbacks,samples\n";
   for (const auto& row : rows) {
     const Summary s = summarize(row.ms);
     csv += csv_field(device.name) + "," + std::to_string(row.key_bits) + "," + std::to_string(row.keys) + "," +
            csv_field(row.sorter) + "," + row.where + "," + json_number(s.median) + "," + json_number(s.min) + "," +
            json_number(s.max) + "," + json_number(mkeys_per_s(row)) + "," + json_number(vs_std_sort(rows, row)) +
-           "," + json_number(row.misordered) + "," + std::to_string(row.ms.size()) + "\n";
+           "," + json_number(row.misordered) + "," + std::to_string(row.fallbacks) + "," +
+           std::to_string(row.ms.size()) + "\n";
   }
   return csv;
 }
@@ -841,7 +846,7 @@ std::string make_sort_json(const std::vector<SortRow>& rows, const tilesplat::De
             ", \"sorter\": " + json_string(row.sorter) + ", \"where\": \"" + row.where +
             "\", \"median_ms\": " + json_number(s.median) + ", \"min_ms\": " + json_number(s.min) +
             ", \"max_ms\": " + json_number(s.max) + ", \"misordered\": " + json_number(row.misordered) +
-            ", \"samples_ms\": [";
+            ", \"fallbacks\": " + std::to_string(row.fallbacks) + ", \"samples_ms\": [";
     for (size_t k = 0; k < row.ms.size(); ++k) json += (k ? ", " : "") + json_number(row.ms[k]);
     json += "]}";
   }
@@ -945,7 +950,10 @@ int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
                                        "sort on " + label);
             }
             if (run == 0 && !exact) row.misordered = misordered_fraction(keys, expected, result.order, sort, label);
-            if (run >= options.warmup) row.ms.push_back(result.gpu_ms);
+            if (run >= options.warmup) {
+              row.ms.push_back(result.gpu_ms);
+              row.fallbacks += result.fallbacks;
+            }
             progress.update(++done, label + ", " + sort);
           }
           rows.push_back(std::move(row));
@@ -957,14 +965,14 @@ int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  std::printf("\n  %4s %10s  %-12s %-4s %12s %12s %12s %11s\n", "bits", "keys", "sorter", "on", "median ms",
-              "Mkeys/s", "vs std::sort", "misordered");
+  std::printf("\n  %4s %10s  %-12s %-4s %12s %12s %12s %11s %10s\n", "bits", "keys", "sorter", "on", "median ms",
+              "Mkeys/s", "vs std::sort", "misordered", "fallbacks");
   for (const auto& row : rows)
-    std::printf("  %4d %10llu  %-12s %-4s %12s %12s %11sx %10s%%\n", row.key_bits,
+    std::printf("  %4d %10llu  %-12s %-4s %12s %12s %11sx %10s%% %10llu\n", row.key_bits,
                 static_cast<unsigned long long>(row.keys), row.sorter.c_str(), row.where.c_str(),
                 cli::format_fixed(median_ms(row), 3).c_str(), cli::format_fixed(mkeys_per_s(row), 2).c_str(),
                 cli::format_fixed(vs_std_sort(rows, row), 2).c_str(),
-                cli::format_fixed(100.0 * row.misordered, 2).c_str());
+                cli::format_fixed(100.0 * row.misordered, 2).c_str(), static_cast<unsigned long long>(row.fallbacks));
   std::fflush(stdout);
 
   const std::string written =

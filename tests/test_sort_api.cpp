@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numeric>
 #include <random>
 
@@ -54,6 +55,20 @@ TEST(SortKeys, EveryStrategyMatchesStableSortAndReportsItsTime) {
   }
   EXPECT_TRUE(renderer.sort_keys("radix", {}, 32).keys.empty());
   EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// The forward-progress cost is visible through the public API: with the spin limit at 0 every
+// onesweep look-back on an unpublished predecessor falls back, and the run reports it; strategies
+// that never wait report none.
+TEST(SortKeys, ReportsOnesweepStallFallbacks) {
+  auto renderer = Renderer::create({});  // its own: the strategy reads the limit when first used
+  const auto keys = random_keys(200000, 32, 11);
+  ::setenv("TILESPLAT_ONESWEEP_SPIN", "0", 1);
+  const Renderer::SortRun forced = renderer->sort_keys("onesweep", keys, 32);
+  ::unsetenv("TILESPLAT_ONESWEEP_SPIN");
+  EXPECT_EQ(forced.order, stable_order(keys));
+  EXPECT_GT(forced.fallbacks, 0u);
+  EXPECT_EQ(renderer->sort_keys("radix", keys, 32).fallbacks, 0u);
 }
 
 // The keys a frame sorts, from a real scene: the float bits of each Gaussian's view depth (as the

@@ -202,6 +202,7 @@ struct Renderer::Impl {
     projection.set_camera(camera);
 
     stats = {};
+    const uint64_t fallbacks_before = sorter.stall_fallbacks();
     FrameCounters frame{};
     for (int attempt = 0;; ++attempt) {
       frame = run_frame(camera, settings, sorter);
@@ -216,6 +217,7 @@ struct Renderer::Impl {
     stats.gaussians = scene.count;
     stats.visible = frame.visible;
     stats.intersections = frame.tile_sort.count;
+    stats.sort_fallbacks = sorter.stall_fallbacks() - fallbacks_before;
     stats.device_bytes = device_bytes();
   }
 
@@ -385,6 +387,7 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
   std::memcpy(state.mapped(), &initial, sizeof(initial));
 
   sorter.reserve(capacity);
+  const uint64_t fallbacks_before = sorter.stall_fallbacks();
   vk::CommandStream stream(r.ctx);
   r.timer.begin_frame(stream.cmd());
   SortInput input{kb, state, 0, key_bits};
@@ -394,6 +397,7 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
 
   SortRun run;
   r.timer.read(&run.gpu_ms);
+  run.fallbacks = sorter.stall_fallbacks() - fallbacks_before;
   std::vector<uint8_t> sorted_keys;
   r.read_output(in_alt ? kb.keys_alt : kb.keys, sorted_keys, size_t(n) * kb.key_bytes());
   run.keys = kb.unpack_keys(sorted_keys.data(), n);

@@ -48,6 +48,7 @@ struct FrameStats {
   uint32_t sort_bits = 0;          // key bits sorted: 32 depth bits (per Gaussian) + the tile bits (per pair)
   int retries = 0;                 // re-renders after growing the intersection buffers
   int submissions = 0;             // command buffers the frame took: 1, more for a strategy that sorts on the host
+  uint64_t sort_fallbacks = 0;     // onesweep look-backs that gave up waiting and counted keys themselves
   uint64_t device_bytes = 0;       // device memory held by the renderer's buffers
 };
 
@@ -101,6 +102,7 @@ class Renderer {
     std::vector<uint64_t> keys;   // ascending
     std::vector<uint32_t> order;  // input position of each sorted key; equal keys in input order
     double gpu_ms = 0;
+    uint64_t fallbacks = 0;  // see FrameStats::sort_fallbacks
   };
   SortRun sort_keys(const std::string& strategy, const std::vector<uint64_t>& keys, uint32_t key_bits);
 

@@ -54,6 +54,7 @@ class OnesweepSort final : public SortStrategy {
   // Look-back steps that gave up waiting and counted a predecessor's keys, over this object's life
   // (a 32-bit GPU counter). Read it once the recorded sorts have finished.
   uint64_t fallbacks() const;
+  uint64_t stall_fallbacks() const override { return fallbacks(); }
 
  private:
   uint32_t partitions_for(uint32_t keys) const;

@@ -50,6 +50,10 @@ class SortStrategy {
   virtual bool exact() const { return true; }
   // Scratch memory the strategy holds, for the memory report.
   virtual uint64_t device_bytes() const = 0;
+  // Times this object's sorts stopped waiting on another workgroup and took their slower fallback
+  // path (onesweep's look-back), over its life. 0 for a strategy that never waits. Read it once the
+  // recorded sorts have finished.
+  virtual uint64_t stall_fallbacks() const { return 0; }
 };
 
 std::vector<std::string> available_sort_strategies();
