@@ -2,8 +2,10 @@
 // are checked by reading their numbers back out of the SVG, not by looking at them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <regex>
 #include <string>
@@ -216,6 +218,210 @@ TEST(BenchPlot, LineChartPlacesPointsOnLogAxes) {
   EXPECT_EQ(occurrences(lines[1].attributes.at("points"), ","), 2u);
   EXPECT_EQ(svg.find("nan"), std::string::npos);
   EXPECT_EQ(svg.find("inf"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scatter with a Pareto front
+
+// The (x, y) pairs of an SVG points attribute.
+std::vector<std::pair<double, double>> polyline_points(const std::string& coordinates) {
+  std::vector<std::pair<double, double>> points;
+  const std::regex pair("(-?[\\d.]+),(-?[\\d.]+)");
+  for (auto it = std::sregex_iterator(coordinates.begin(), coordinates.end(), pair); it != std::sregex_iterator(); ++it)
+    points.emplace_back(std::stod((*it)[1]), std::stod((*it)[2]));
+  return points;
+}
+
+// Accuracy modes: (median ms, PSNR dB). The front, by x: fast (5, 30), mid (8, 40), fp32 (10, 50), exact.
+plot::ScatterChart sample_scatter() {
+  plot::ScatterChart chart;
+  chart.title = "PSNR against frame time";
+  chart.x_label = "median frame time (ms)";
+  chart.y_label = "PSNR (dB)";
+  chart.points = {{"exact", 12, 60, 0},  {"fp32", 10, 50, 1},      {"slow & bad", 11, 45, 2},
+                  {"mid", 8, 40, 3},     {"fast", 5, 30, 4},       {"dominated by mid", 9, 39.5, 5},
+                  {"ties fp32 on y", 10.5, 50, 6}};
+  return chart;
+}
+
+TEST(BenchPlot, ParetoFrontKeepsTheUndominatedPointsInOrderOfX) {
+  const auto chart = sample_scatter();
+  EXPECT_EQ(plot::pareto_front(chart.points, true), (std::vector<size_t>{4, 3, 1, 0}));
+  // Lower is better (say the y is an error): now only what is both fast and low survives.
+  EXPECT_EQ(plot::pareto_front(chart.points, false), (std::vector<size_t>{4}));
+
+  using Points = std::vector<plot::ScatterPoint>;
+  // Identical points are both on the front; a y tie at a larger x, or an x tie with a worse y, is not.
+  EXPECT_EQ(plot::pareto_front(Points{{"a", 2, 5}, {"b", 1, 3}, {"a again", 2, 5}, {"c", 3, 5}, {"d", 1, 2}}, true),
+            (std::vector<size_t>{1, 0, 2}));
+  EXPECT_EQ(plot::pareto_front(Points{{"a", 2, 5}, {"b", 1, 3}, {"d", 1, 2}}, false), (std::vector<size_t>{2}));
+  // +inf (an identical image's PSNR) is the best y there is; NaN and a non-finite x are never on the front
+  // and dominate nothing.
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(plot::pareto_front(Points{{"exact", 9, inf}, {"fast", 3, 30}, {"nan", 1, NAN}, {"no time", NAN, 99},
+                                      {"infinite time", inf, 99}, {"fp32", 5, 40}, {"slower exact", 10, inf}},
+                               true),
+            (std::vector<size_t>{1, 5, 0}));
+  EXPECT_TRUE(plot::pareto_front({}, true).empty());
+  EXPECT_EQ(plot::pareto_front(Points{{"only", 1, 1}}, false), (std::vector<size_t>{0}));
+}
+
+TEST(BenchPlot, ScatterDrawsEveryPointWithItsData) {
+  const auto chart = sample_scatter();
+  const std::string svg = plot::scatter_svg(chart);
+  expect_svg_document(svg);
+  const auto circles = elements(svg, "circle", "point");
+  ASSERT_EQ(circles.size(), chart.points.size()) << svg;
+  for (size_t i = 0; i < circles.size(); ++i) {
+    EXPECT_EQ(circles[i].attributes.at("data-label"), plot::xml_escape(chart.points[i].label));
+    EXPECT_DOUBLE_EQ(number(circles[i], "data-x"), chart.points[i].x);
+    EXPECT_DOUBLE_EQ(number(circles[i], "data-y"), chart.points[i].y);
+  }
+  // Positions are linear in the values (the x axis from 0, so cx is proportional to x), larger y higher up.
+  const double px_per_ms = (number(circles[0], "cx") - number(circles[4], "cx")) / (12 - 5);
+  const double px_per_db = (number(circles[4], "cy") - number(circles[0], "cy")) / (60 - 30);
+  ASSERT_GT(px_per_ms, 0);
+  ASSERT_GT(px_per_db, 0);
+  const double origin = number(circles[4], "cx") - 5 * px_per_ms;
+  for (size_t i = 0; i < circles.size(); ++i) {
+    EXPECT_NEAR(number(circles[i], "cx"), origin + chart.points[i].x * px_per_ms, 3e-3) << i;
+    EXPECT_NEAR(number(circles[i], "cy"), number(circles[4], "cy") - (chart.points[i].y - 30) * px_per_db, 3e-3) << i;
+  }
+  // The x axis starts at 0; the y axis spans the values only, from a round tick at or below 30 dB.
+  std::vector<double> ticks;
+  for (const auto& e : elements(svg, "text", "tick-label")) ticks.push_back(std::strtod(e.text.c_str(), nullptr));
+  EXPECT_NE(std::find(ticks.begin(), ticks.end(), 0.0), ticks.end());
+  EXPECT_NE(std::find(ticks.begin(), ticks.end(), 30.0), ticks.end());
+  EXPECT_NE(std::find(ticks.begin(), ticks.end(), 60.0), ticks.end());
+  EXPECT_EQ(std::find(ticks.begin(), ticks.end(), 20.0), ticks.end());
+
+  // Every point is labelled, inside the chart (at 0.6 em a character, as the writer reckons).
+  const auto labels = elements(svg, "text", "point-label");
+  ASSERT_EQ(labels.size(), chart.points.size());
+  const double width = std::strtod(svg.substr(svg.find("width=\"") + 7).c_str(), nullptr);
+  for (const auto& label : labels) {
+    const double extent = 0.6 * 12 * static_cast<double>(label.text.size());
+    const double x = number(label, "x");
+    if (label.attributes.at("text-anchor") == "end") {
+      EXPECT_GE(x - extent, 0) << label.text;
+    } else {
+      EXPECT_LE(x + extent, width) << label.text;
+    }
+  }
+  EXPECT_EQ(svg.find("nan"), std::string::npos);
+  EXPECT_EQ(svg.find("inf"), std::string::npos);
+}
+
+TEST(BenchPlot, ScatterParetoLinePassesThroughExactlyTheFrontPoints) {
+  for (const bool higher_is_better : {true, false}) {
+    auto chart = sample_scatter();
+    chart.y_higher_is_better = higher_is_better;
+    const std::string svg = plot::scatter_svg(chart);
+    const auto circles = elements(svg, "circle", "point");
+    const auto pareto = elements(svg, "polyline", "pareto");
+    ASSERT_EQ(pareto.size(), 1u);
+    const auto line = polyline_points(pareto[0].attributes.at("points"));
+    const auto front = plot::pareto_front(chart.points, higher_is_better);
+    ASSERT_EQ(line.size(), front.size());
+    for (size_t k = 0; k < front.size(); ++k) {
+      // Written with the same rounding as the circle: equal to the printed digit.
+      EXPECT_EQ(line[k].first, number(circles[front[k]], "cx")) << k;
+      EXPECT_EQ(line[k].second, number(circles[front[k]], "cy")) << k;
+      if (k > 0) {
+        EXPECT_GT(line[k].first, line[k - 1].first);
+      }
+    }
+    for (size_t i = 0; i < circles.size(); ++i) {
+      const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
+      EXPECT_EQ(circles[i].attributes.at("data-pareto"), on_front ? "1" : "0") << chart.points[i].label;
+    }
+  }
+}
+
+TEST(BenchPlot, ScatterEscapesLabels) {
+  plot::ScatterChart chart;
+  chart.title = "<modes> & \"times\"";
+  chart.points = {{"sort <16 bits> & 'fast' \"mode\"", 3, 20}, {"exact", 4, 30}};
+  const std::string svg = plot::scatter_svg(chart);
+  expect_svg_document(svg);
+  const std::string escaped = "sort &lt;16 bits&gt; &amp; &apos;fast&apos; &quot;mode&quot;";
+  const auto circles = elements(svg, "circle", "point");
+  ASSERT_EQ(circles.size(), 2u);
+  EXPECT_EQ(circles[0].attributes.at("data-label"), escaped);
+  const auto labels = elements(svg, "text", "point-label");
+  ASSERT_EQ(labels.size(), 2u);
+  EXPECT_EQ(labels[0].text, escaped);
+  EXPECT_EQ(svg.find("<16"), std::string::npos);
+  EXPECT_EQ(svg.find("'fast'"), std::string::npos);
+  EXPECT_EQ(elements(svg, "text", "title").front().text, "&lt;modes&gt; &amp; &quot;times&quot;");
+}
+
+TEST(BenchPlot, ScatterClampsValuesWithoutAPlaceOnTheAxis) {
+  const double inf = std::numeric_limits<double>::infinity();
+  plot::ScatterChart chart = sample_scatter();
+  chart.points.push_back({"reference itself", 14, inf, 7});
+  chart.points.push_back({"broken", 6, NAN, 8});
+  chart.points.push_back({"no timing", NAN, 35, 9});  // no place on x: left out
+  const std::string svg = plot::scatter_svg(chart);
+  expect_svg_document(svg);
+  const auto circles = elements(svg, "circle", "point");
+  ASSERT_EQ(circles.size(), chart.points.size() - 1);
+  const auto& identical = circles[7];
+  const auto& broken = circles[8];
+  EXPECT_EQ(identical.attributes.at("data-label"), "reference itself");
+  EXPECT_EQ(identical.attributes.at("data-y"), "inf");
+  EXPECT_EQ(broken.attributes.at("data-y"), "nan");
+  EXPECT_EQ(svg.find("no timing"), std::string::npos);
+  double highest = 1e300;
+  double lowest = -1e300;
+  for (size_t i = 0; i < 7; ++i) {
+    highest = std::min(highest, number(circles[i], "cy"));
+    lowest = std::max(lowest, number(circles[i], "cy"));
+  }
+  EXPECT_LT(number(identical, "cy"), highest);  // above every finite point, on the band past the top tick
+  EXPECT_GT(number(broken, "cy"), lowest);
+  EXPECT_TRUE(std::isfinite(number(identical, "cy")));
+
+  std::map<std::string, std::string> label_text;
+  for (const auto& e : elements(svg, "text", "point-label")) label_text[e.attributes.at("data-label")] = e.text;
+  EXPECT_EQ(label_text["reference itself"], "reference itself (identical)");
+  EXPECT_EQ(label_text["broken"], "broken (y = nan)");
+  EXPECT_EQ(label_text["exact"], "exact");
+
+  // +inf is the best PSNR: the slowest point, but on the front; NaN is not.
+  EXPECT_EQ(identical.attributes.at("data-pareto"), "1");
+  EXPECT_EQ(broken.attributes.at("data-pareto"), "0");
+  const auto line = polyline_points(elements(svg, "polyline", "pareto").at(0).attributes.at("points"));
+  ASSERT_FALSE(line.empty());
+  EXPECT_EQ(line.back().first, number(identical, "cx"));
+  EXPECT_EQ(line.back().second, number(identical, "cy"));
+
+  // Where higher is not better, +inf is not "identical", only clamped.
+  chart.y_higher_is_better = false;
+  const std::string lower = plot::scatter_svg(chart);
+  label_text.clear();
+  for (const auto& e : elements(lower, "text", "point-label")) label_text[e.attributes.at("data-label")] = e.text;
+  EXPECT_EQ(label_text["reference itself"], "reference itself (y = inf)");
+
+  // Every y unusable, and on a log axis a zero: still a chart, points at the ends of the axis.
+  plot::ScatterChart degenerate;
+  degenerate.y_scale = plot::Scale::kLog10;
+  degenerate.points = {{"zero error", 2, 0}, {"inf", 3, inf}};
+  const std::string svg2 = plot::scatter_svg(degenerate);
+  expect_svg_document(svg2);
+  const auto circles2 = elements(svg2, "circle", "point");
+  ASSERT_EQ(circles2.size(), 2u);
+  EXPECT_GT(number(circles2[0], "cy"), number(circles2[1], "cy"));
+  EXPECT_EQ(svg2.find("nan\""), std::string::npos);  // no coordinate is NaN
+}
+
+TEST(BenchPlot, EmptyScatterIsStillADocument) {
+  plot::ScatterChart chart;
+  chart.title = "nothing";
+  const std::string svg = plot::scatter_svg(chart);
+  expect_svg_document(svg);
+  EXPECT_TRUE(elements(svg, "circle", "point").empty());
+  EXPECT_EQ(elements(svg, "polyline", "pareto").size(), 1u);
 }
 
 // ---------------------------------------------------------------------------------------------

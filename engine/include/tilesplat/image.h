@@ -46,4 +46,40 @@ struct ImageDifference {
 // Compares the RGB(A) of two images of the same size. Throws std::invalid_argument otherwise.
 ImageDifference compare_images(const RenderImage& a, const RenderImage& b);
 
+// Structural similarity (Wang, Bovik, Sheikh and Simoncelli 2004) of the RGB channels, in the
+// convention of scikit-image (gaussian_weights=True, use_sample_covariance=False, data_range=1) and
+// pytorch-msssim: an 11x11 Gaussian window of sigma 1.5 (weights normalised to sum 1), K1 = 0.01,
+// K2 = 0.03, dynamic range L = 1, population (not sample) variances, the SSIM map computed only where
+// the whole window fits inside the image ("valid"), and the result the mean of that map over its
+// pixels and the three channels. 1 for identical images (exactly), and symmetric in a and b.
+// An image narrower or lower than 11 pixels gets, in that dimension, the window clipped to the image:
+// as many taps as the image has pixels, placed around the image's centre with the same sigma and
+// renormalised, so that the map has one column (or row) there; two empty images score 1.
+// The same sizes and layout as compare_images are required (std::invalid_argument otherwise); a NaN
+// or an infinity in any channel of either image, alpha included, makes the result NaN: it means the
+// renderer is broken, and NaN cannot pass for a score in any comparison.
+double ssim(const RenderImage& a, const RenderImage& b);
+
+// Temporal stability along a camera path. An image metric of each frame alone misses "popping": a
+// splat that appears, vanishes or jumps between two nearby views (a sort order flip, a culling or
+// tile-rect decision) can cost little error in either frame but is what the eye notices in motion.
+// Camera motion itself changes the image too, so the change of the tested sequence (a0 -> a1) is
+// measured against the change the reference has between the same two views (r0 -> r1): per pixel
+// and RGB channel e = |(a1 - a0) - (r1 - r0)|. Popping is change that the reference does not have;
+// change that the reference has too cancels out, whatever its size.
+struct TemporalDifference {
+  double mean_abs = 0;          // mean of e over pixels and RGB channels
+  double flicker_fraction = 0;  // fraction of pixels whose largest e over RGB exceeds the threshold
+};
+// All four images must have one size and the layout of compare_images (std::invalid_argument
+// otherwise, and for a threshold that is negative or not finite). A NaN or an infinity in any channel
+// of any of them makes both fields NaN, as in ssim. Empty images give {0, 0}.
+TemporalDifference temporal_excess(const RenderImage& a0, const RenderImage& a1, const RenderImage& r0,
+                                   const RenderImage& r1, double threshold = 0.05);
+
+// The raw frame-to-frame change of one sequence: the mean over pixels and RGB channels of
+// |a1 - a0|. The scale for temporal_excess (how much of the change is excess), and what
+// temporal_excess would report against a perfectly still reference. Errors as temporal_excess.
+double frame_change(const RenderImage& a0, const RenderImage& a1);
+
 }  // namespace tilesplat

@@ -1,8 +1,11 @@
 // Differences between two RenderImages, as used by the tests and the reference comparisons.
+#include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "tilesplat/image.h"
 
@@ -13,14 +16,56 @@ std::string size_text(const RenderImage& image) {
   return std::to_string(image.width) + "x" + std::to_string(image.height);
 }
 
-void check_comparable(const RenderImage& image, const char* which) {
+void check_comparable(const RenderImage& image, const char* function, const char* which) {
   if (image.width < 0 || image.height < 0)
-    throw std::invalid_argument(std::string("compare_images: image ") + which + " has a negative size " +
+    throw std::invalid_argument(std::string(function) + ": image " + which + " has a negative size " +
                                 size_text(image));
   if (image.rgba.size() != 4 * image.pixels())
-    throw std::invalid_argument(std::string("compare_images: image ") + which + " (" + size_text(image) +
+    throw std::invalid_argument(std::string(function) + ": image " + which + " (" + size_text(image) +
                                 ") holds " + std::to_string(image.rgba.size()) + " rgba values, expected " +
                                 std::to_string(4 * image.pixels()));
+}
+
+// Checks a sequence of images for a function that compares them value by value: one size, the rgba
+// layout. names[i] names images[i] in the messages.
+void check_same_size(const char* function, std::initializer_list<const RenderImage*> images,
+                     std::initializer_list<const char*> names) {
+  const RenderImage& first = **images.begin();
+  auto name = names.begin();
+  for (const RenderImage* image : images) {
+    if (image->width != first.width || image->height != first.height)
+      throw std::invalid_argument(std::string(function) + ": sizes differ: " + *names.begin() + " is " +
+                                  size_text(first) + ", " + *name + " is " + size_text(*image));
+    ++name;
+  }
+  name = names.begin();
+  for (const RenderImage* image : images) check_comparable(*image, function, *name++);
+}
+
+bool all_finite(const RenderImage& image) {
+  for (const float value : image.rgba)
+    if (!std::isfinite(value)) return false;
+  return true;
+}
+
+// The SSIM window along one dimension of n pixels: the Gaussian of sigma 1.5 sampled at 11 taps
+// around the centre one, normalised to sum 1. Where n < 11 the window is clipped to the image: n taps
+// placed symmetrically around the image's centre (a half-pixel offset when n is even), renormalised,
+// so that the whole dimension is one window position rather than no SSIM at all.
+std::vector<double> ssim_window(int n) {
+  constexpr int kTaps = 11;
+  constexpr double kSigma = 1.5;
+  const int taps = std::min(n, kTaps);
+  std::vector<double> weights(static_cast<size_t>(taps));
+  const double centre = 0.5 * (taps - 1);
+  double sum = 0;
+  for (int i = 0; i < taps; ++i) {
+    const double offset = i - centre;
+    weights[static_cast<size_t>(i)] = std::exp(-offset * offset / (2 * kSigma * kSigma));
+    sum += weights[static_cast<size_t>(i)];
+  }
+  for (double& weight : weights) weight /= sum;
+  return weights;
 }
 
 }  // namespace
@@ -28,8 +73,8 @@ void check_comparable(const RenderImage& image, const char* which) {
 ImageDifference compare_images(const RenderImage& a, const RenderImage& b) {
   if (a.width != b.width || a.height != b.height)
     throw std::invalid_argument("compare_images: sizes differ: " + size_text(a) + " vs " + size_text(b));
-  check_comparable(a, "a");
-  check_comparable(b, "b");
+  check_comparable(a, "compare_images", "a");
+  check_comparable(b, "compare_images", "b");
 
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   ImageDifference difference;
@@ -79,6 +124,151 @@ ImageDifference compare_images(const RenderImage& a, const RenderImage& b) {
   difference.rmse = std::sqrt(mean_squared_error);
   difference.psnr_db = mean_squared_error == 0.0 ? kInfinity : 10.0 * std::log10(1.0 / mean_squared_error);
   return difference;
+}
+
+double ssim(const RenderImage& a, const RenderImage& b) {
+  check_same_size("ssim", {&a, &b}, {"a", "b"});
+  if (!all_finite(a) || !all_finite(b)) return std::numeric_limits<double>::quiet_NaN();
+  if (a.pixels() == 0) return 1.0;
+
+  constexpr double kC1 = 0.01 * 0.01;  // (K1 L)^2 with L = 1
+  constexpr double kC2 = 0.03 * 0.03;  // (K2 L)^2
+  // The window's weighted means of five quantities: x, y, x^2, y^2 and (x - y)^2. The last one
+  // instead of xy, because SSIM's two factors are 1 minus a difference term,
+  //   (2 mx my + C1) / (mx^2 + my^2 + C1) = 1 - (mx - my)^2 / (mx^2 + my^2 + C1),
+  //   (2 sxy + C2) / (sx^2 + sy^2 + C2)   = 1 - var(x - y) / (sx^2 + sy^2 + C2),
+  // and computing those differences from x - y directly keeps them exact where the images agree:
+  // identical images score exactly 1, and nearly identical ones (the accurate modes that matter
+  // most) do not lose their small differences to the cancellation of 2 sxy against sx^2 + sy^2.
+  constexpr size_t kQuantities = 5;
+  const size_t width = static_cast<size_t>(a.width);
+  const size_t height = static_cast<size_t>(a.height);
+  const std::vector<double> window_x = ssim_window(a.width);
+  const std::vector<double> window_y = ssim_window(a.height);
+  const size_t taps_x = window_x.size();
+  const size_t taps_y = window_y.size();
+  const size_t out_width = width - taps_x + 1;  // the 'valid' region: where the whole window fits
+  const size_t out_height = height - taps_y + 1;
+
+  // Separable: each row is filtered horizontally once into a ring of the last taps_y rows, and
+  // each output row filters that ring vertically. Loops run along rows so that they vectorise.
+  std::vector<double> row(kQuantities * width);
+  std::vector<double> ring(taps_y * kQuantities * out_width);
+  std::vector<double> filtered(kQuantities * out_width);
+  double sum = 0;
+  for (size_t channel = 0; channel < 3; ++channel) {
+    for (size_t y = 0; y < height; ++y) {
+      for (size_t x = 0; x < width; ++x) {
+        const double value_a = a.rgba[4 * (y * width + x) + channel];
+        const double value_b = b.rgba[4 * (y * width + x) + channel];
+        const double difference = value_a - value_b;
+        row[x] = value_a;
+        row[width + x] = value_b;
+        row[2 * width + x] = value_a * value_a;
+        row[3 * width + x] = value_b * value_b;
+        row[4 * width + x] = difference * difference;
+      }
+      double* const slot = &ring[(y % taps_y) * kQuantities * out_width];
+      for (size_t q = 0; q < kQuantities; ++q) {
+        double* const out = slot + q * out_width;
+        const double* const in = &row[q * width];
+        // The window is symmetric: pairs of taps share a multiply.
+        const double centre_weight = window_x[taps_x / 2];
+        if (taps_x % 2 == 1)
+          for (size_t x = 0; x < out_width; ++x) out[x] = centre_weight * in[x + taps_x / 2];
+        else
+          std::fill(out, out + out_width, 0.0);
+        for (size_t t = 0; t < taps_x / 2; ++t) {
+          const double weight = window_x[t];
+          const double* const mirrored = in + (taps_x - 1 - t);
+          for (size_t x = 0; x < out_width; ++x) out[x] += weight * (in[x + t] + mirrored[x]);
+        }
+      }
+      if (y + 1 < taps_y) continue;
+
+      const size_t out_y = y + 1 - taps_y;
+      const size_t row_size = kQuantities * out_width;
+      auto ring_row = [&](size_t t) { return &ring[((out_y + t) % taps_y) * row_size]; };
+      if (taps_y % 2 == 1) {
+        const double centre_weight = window_y[taps_y / 2];
+        const double* const in = ring_row(taps_y / 2);
+        for (size_t i = 0; i < row_size; ++i) filtered[i] = centre_weight * in[i];
+      } else {
+        std::fill(filtered.begin(), filtered.end(), 0.0);
+      }
+      for (size_t t = 0; t < taps_y / 2; ++t) {
+        const double weight = window_y[t];
+        const double* const in = ring_row(t);
+        const double* const mirrored = ring_row(taps_y - 1 - t);
+        for (size_t i = 0; i < row_size; ++i) filtered[i] += weight * (in[i] + mirrored[i]);
+      }
+      double row_sum = 0;
+      for (size_t x = 0; x < out_width; ++x) {
+        const double mean_a = filtered[x];
+        const double mean_b = filtered[out_width + x];
+        const double variance_sum =
+            (filtered[2 * out_width + x] - mean_a * mean_a) + (filtered[3 * out_width + x] - mean_b * mean_b);
+        const double mean_difference = mean_a - mean_b;
+        const double squared_mean_difference = mean_difference * mean_difference;
+        // var(x - y) >= 0; only rounding takes it below, and then SSIM would exceed 1.
+        const double difference_variance = std::max(0.0, filtered[4 * out_width + x] - squared_mean_difference);
+        const double luminance = 1.0 - squared_mean_difference / (mean_a * mean_a + mean_b * mean_b + kC1);
+        const double contrast_structure = 1.0 - difference_variance / (variance_sum + kC2);
+        row_sum += luminance * contrast_structure;
+      }
+      sum += row_sum;
+    }
+  }
+  return sum / (3.0 * static_cast<double>(out_width) * static_cast<double>(out_height));
+}
+
+namespace {
+
+// e = |(a1 - a0) - (r1 - r0)| over RGB, or |a1 - a0| without a reference; NaN results for a
+// non-finite value, as the header promises.
+TemporalDifference temporal_difference(const RenderImage& a0, const RenderImage& a1, const RenderImage* r0,
+                                       const RenderImage* r1, double threshold) {
+  TemporalDifference result;
+  if (!all_finite(a0) || !all_finite(a1) || (r0 && (!all_finite(*r0) || !all_finite(*r1)))) {
+    result.mean_abs = std::numeric_limits<double>::quiet_NaN();
+    result.flicker_fraction = std::numeric_limits<double>::quiet_NaN();
+    return result;
+  }
+  const size_t pixels = a0.pixels();
+  if (pixels == 0) return result;
+  double sum = 0;
+  size_t flickering = 0;
+  for (size_t pixel = 0; pixel < pixels; ++pixel) {
+    double largest = 0;
+    for (size_t c = 0; c < 3; ++c) {
+      const size_t index = 4 * pixel + c;
+      double change = double{a1.rgba[index]} - double{a0.rgba[index]};
+      if (r0) change -= double{r1->rgba[index]} - double{r0->rgba[index]};
+      const double excess = std::fabs(change);
+      sum += excess;
+      largest = std::max(largest, excess);
+    }
+    if (largest > threshold) ++flickering;
+  }
+  result.mean_abs = sum / (3.0 * static_cast<double>(pixels));
+  result.flicker_fraction = static_cast<double>(flickering) / static_cast<double>(pixels);
+  return result;
+}
+
+}  // namespace
+
+TemporalDifference temporal_excess(const RenderImage& a0, const RenderImage& a1, const RenderImage& r0,
+                                   const RenderImage& r1, double threshold) {
+  check_same_size("temporal_excess", {&a0, &a1, &r0, &r1}, {"a0", "a1", "r0", "r1"});
+  if (!std::isfinite(threshold) || threshold < 0)
+    throw std::invalid_argument("temporal_excess: the threshold must be finite and >= 0, got " +
+                                std::to_string(threshold));
+  return temporal_difference(a0, a1, &r0, &r1, threshold);
+}
+
+double frame_change(const RenderImage& a0, const RenderImage& a1) {
+  check_same_size("frame_change", {&a0, &a1}, {"a0", "a1"});
+  return temporal_difference(a0, a1, nullptr, nullptr, 0).mean_abs;
 }
 
 }  // namespace tilesplat
