@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "accuracy_report.h"
 #include "bench_plot.h"
 #include "cli.h"
 #include "tilesplat/camera.h"
@@ -42,6 +43,9 @@ struct BenchOptions {
   bool all_views = false;
   int orbit = 0;  // --orbit N: N orbit cameras; 0: the one at --azimuth
   bool sort_bench = false;
+  bool accuracy = false;  // --accuracy: the error/time report
+  std::string markdown;
+  int path_frames = 6;
   std::vector<int> sort_sizes{10, 12, 14, 16, 18, 20, 22, 24};  // log2 of the key counts
   std::vector<int> key_bits{32, 64};
 };
@@ -689,6 +693,19 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     "size and sort; with --sort-bench, Mkeys/s against key count per sort and key width",
                     &options.plot);
 
+  parser.section("accuracy report");
+  parser.add_switch("--accuracy",
+                    "measure what each accuracy mode costs: per --mode combination (default: each approximation "
+                    "alone and the combinations that matter), the GPU time per pass and frame and the error "
+                    "against the float64 CPU reference (PSNR, SSIM, max abs) at each view, and the popping "
+                    "along a short dolly from the first view; --plot draws one Pareto chart per scene",
+                    &options.accuracy);
+  parser.add_string("--markdown", "FILE.md", "with --accuracy: also write the report as Markdown tables",
+                    &options.markdown);
+  parser.add_int("--path-frames", "N",
+                 "with --accuracy: frames of the dolly path the popping is measured on (default 6; 0: none)",
+                 &options.path_frames, 0, 1000);
+
   parser.section("sort micro-benchmark");
   parser.add_switch("--sort-bench",
                     "time the sort strategies alone on random keys (no SCENE), with std::sort and a CPU "
@@ -707,7 +724,7 @@ void check_outputs(const BenchOptions& options, const std::vector<std::pair<std:
   if (!options.plot.empty() && !cli::has_extension(options.plot, ".svg"))
     throw cli::UsageError("--plot writes SVG: its file name must end in .svg, got '" + options.plot + "'");
   const std::vector<std::pair<std::string, fs::path>> outputs = {
-      {"--csv", options.csv}, {"--json", options.json}, {"--plot", options.plot}};
+      {"--csv", options.csv}, {"--json", options.json}, {"--plot", options.plot}, {"--markdown", options.markdown}};
   cli::check_distinct_paths(outputs);
   // Inputs may repeat (one cameras.json for every scene); only an output may not be one of them.
   for (const auto& input : inputs) {
@@ -986,12 +1003,108 @@ int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// The accuracy report (accuracy_report.h): every mode against the float64 reference, per scene.
+
+// --plot FILE.svg with several scenes: FILE_<scene>.svg for each.
+fs::path scene_plot_path(const std::string& plot, const std::string& scene_file, size_t scenes) {
+  if (scenes == 1) return plot;
+  fs::path path(plot);
+  return path.parent_path() / (path.stem().string() + "_" + fs::path(scene_file).stem().string() + ".svg");
+}
+
+int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& options, int argc, char** argv) {
+  for (const char* flag : {"--resolutions", "--orbit", "--json"})
+    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");
+  if (options.common.sorts.size() > 1)
+    throw cli::UsageError("--accuracy measures with one --sort strategy (the modes do not depend on it)");
+  std::vector<std::pair<std::string, fs::path>> inputs;
+  for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
+  for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
+  check_outputs(options, inputs);
+
+  std::string command = "tilesplat-bench";
+  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+
+  // Every scene and camera first: a bad file or view fails now, not after an hour of measuring.
+  struct Planned {
+    BenchScene scene;
+    tilesplat::accuracy::Options options;
+  };
+  std::vector<Planned> planned;
+  const cli::ImageSize size{options.common.width, options.common.height};
+  for (size_t s = 0; s < options.common.scenes.size(); ++s) {
+    Planned p;
+    p.scene.loaded = cli::load_scene_file(options.common.scenes[s], options.common.strict, kProgram);
+    p.scene.name = p.scene.loaded.path.filename().string();
+    p.scene.description = cli::describe_scene(p.scene.loaded.scene);
+    p.scene.sh_degree = p.scene.loaded.scene.sh_degree;
+    const auto& cameras = options.common.cameras_files;
+    if (!cameras.empty()) p.scene.cameras = cameras.size() == 1 ? cameras.front() : cameras[s];
+    for (const Case& c : plan_cases(options, p.scene, s, {size})) {
+      p.options.views.push_back(c.camera.camera);
+      p.options.view_names.push_back(c.view_label);
+    }
+    p.options.modes = options.common.modes;
+    p.options.warmup = options.warmup;
+    p.options.repeat = options.repeat;
+    p.options.path_frames = options.path_frames;
+    if (!options.common.sorts.empty()) p.options.sort = options.common.sorts.front();
+    planned.push_back(std::move(p));
+  }
+
+  const auto renderer = tilesplat::Renderer::create(cli::renderer_options(options.common));
+  const tilesplat::DeviceInfo device = renderer->device_info();
+  std::printf("device  %s (driver %s)\n", device.name.c_str(), device.driver.c_str());
+  std::fflush(stdout);
+  int total = 0;
+  for (const auto& p : planned) total += tilesplat::accuracy::work_units(p.options, p.scene.sh_degree);
+  Progress progress(total, cli::stderr_is_terminal(), "renders");
+  int done_before = 0;
+  std::vector<tilesplat::accuracy::SceneReport> reports;
+  for (auto& p : planned) {
+    auto report = tilesplat::accuracy::measure_scene(
+        *renderer, p.scene.loaded.scene, p.options,
+        [&](int done, int, const std::string& what) { progress.update(done_before + done, p.scene.name + ": " + what); });
+    done_before += tilesplat::accuracy::work_units(p.options, p.scene.sh_degree);
+    report.scene = p.scene.name;
+    report.description = p.scene.description;
+    std::string views;
+    for (const auto& name : p.options.view_names) views += (views.empty() ? "" : ", ") + name;
+    report.views = views + " at " + cli::format_size(p.options.views.front().width, p.options.views.front().height);
+    p.scene.loaded.scene = {};  // measured: release its memory
+    progress.finish();
+    std::printf("\n%s", tilesplat::accuracy::text_table(report).c_str());
+    std::fflush(stdout);
+    reports.push_back(std::move(report));
+  }
+
+  std::vector<std::pair<std::string, std::function<std::string()>>> files = {
+      {options.markdown, [&] { return tilesplat::accuracy::markdown(reports, device, command); }},
+      {options.csv, [&] { return tilesplat::accuracy::csv(reports, device); }}};
+  std::vector<std::string> plot_paths;
+  if (!options.plot.empty())
+    for (const auto& report : reports) {
+      plot_paths.push_back(scene_plot_path(options.plot, report.scene, reports.size()).string());
+      files.emplace_back(plot_paths.back(), [&report, &device] { return tilesplat::accuracy::pareto_svg(report, device); });
+    }
+  const std::string written = write_outputs(files, *renderer);
+  std::fprintf(stderr, "%s: accuracy report, %d renders%s\n", kProgram, total, written.c_str());
+  return cli::kExitOk;
+}
+
+// ---------------------------------------------------------------------------------------------
 // The frame benchmark
 
 // What the parser cannot check flag by flag. Throws UsageError.
 void check_frame_options(const cli::ArgParser& parser, const BenchOptions& options) {
   for (const char* flag : {"--sort-sizes", "--key-bits"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --sort-bench");
+  if (!options.accuracy) {
+    for (const char* flag : {"--markdown", "--path-frames"})
+      if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --accuracy");
+    if (options.common.modes.size() > 1)
+      throw cli::UsageError("several --mode combinations are compared by --accuracy; the frame benchmark takes one");
+  }
   cli::check_common_options(parser, options.common);
   const size_t cameras = options.common.cameras_files.size();
   const size_t scenes = options.common.scenes.size();
@@ -1025,6 +1138,7 @@ int run(int argc, char** argv) {
   if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
   if (options.sort_bench) return run_sort_bench(parser, options);
   check_frame_options(parser, options);
+  if (options.accuracy) return run_accuracy_report(parser, options, argc, argv);
   std::vector<std::pair<std::string, fs::path>> inputs;
   for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
   for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
@@ -1082,6 +1196,7 @@ int run(int argc, char** argv) {
       for (const auto& sort : sorts) {
         tilesplat::RenderSettings settings;
         settings.sort = sort;
+        if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
         Collector collector(sort);
         for (int frame = 0; frame < frames_per_row; ++frame) {
           // Rendering reads the image back, which is part of cpu frame; the first measured image of

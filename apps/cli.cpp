@@ -513,6 +513,32 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                        }
                      });
   }
+
+  const std::string modes_help =
+      "reference, depth24, depth16, opacity-extent, square-tiles, sh0..sh3, fp16-sh, fp16-cov, t-cutoff=X, "
+      "alpha-cutoff=X (X a number or 1/64), resortN (2-16); combine with '+'";
+  auto parse_modes = [](const std::string& text) {
+    try {
+      return parse_accuracy_modes(std::string(trim(text)));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--mode: ") + e.what());
+    }
+  };
+  if (sort_choice == SortChoice::kOne) {
+    parser.add_value("--mode", "MODES", "accuracy modes (default reference): " + modes_help,
+                     [&options, parse_modes](const std::string& text) { options.modes = {parse_modes(text)}; });
+  } else {
+    parser.add_value("--mode", "MODES[,MODES...]",
+                     "accuracy mode combinations to measure, comma-separated (default reference): " + modes_help,
+                     [&options, parse_modes](const std::string& text) {
+                       options.modes.clear();
+                       for (const auto& part : split(text, ',')) {
+                         const AccuracyModes modes = parse_modes(part);
+                         if (std::find(options.modes.begin(), options.modes.end(), modes) == options.modes.end())
+                           options.modes.push_back(modes);
+                       }
+                     });
+  }
 }
 
 void check_common_options(const ArgParser& parser, const CommonOptions& options) {

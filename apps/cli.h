@@ -133,6 +133,8 @@ struct CommonOptions {
   bool list_devices = false;
   bool validation = false;
   std::vector<std::string> sorts;  // validated against sort_strategies(); empty = the app's default
+  // --mode: accuracy mode combinations (parse_accuracy_modes); empty = the reference alone.
+  std::vector<AccuracyModes> modes;
 };
 
 inline constexpr int kOrbitDefaultWidth = 1920;
@@ -143,7 +145,8 @@ enum class SortChoice { kOne, kList };
 enum class SceneChoice { kOne, kList };
 
 // Registers SCENE, --cameras, --view, --width, --height, the orbit flags, --strict, --device,
-// --list-devices, --validation and --sort (one name, or a comma list / "all" for kList).
+// --list-devices, --validation, --sort (one name, or a comma list / "all" for kList) and --mode
+// (one accuracy mode combination, or a comma list of them for kList).
 void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice,
                         SceneChoice scene_choice = SceneChoice::kOne);
 

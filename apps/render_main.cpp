@@ -119,7 +119,7 @@ int run(int argc, char** argv) {
                              {"-o", options.output},
                              {"--png", options.png}});
   if (options.reference) {
-    for (const char* gpu_flag : {"--device", "--validation", "--sort"})
+    for (const char* gpu_flag : {"--device", "--validation", "--sort", "--mode"})
       if (parser.seen(gpu_flag))
         cli::print_warning(kProgram, std::string(gpu_flag) + " has no effect with --reference (CPU renderer)");
   }
@@ -134,6 +134,7 @@ int run(int argc, char** argv) {
   if (!options.common.sorts.empty()) settings.sort = options.common.sorts.front();
   settings.depth = !options.no_depth;
   settings.splat_count = !options.no_count;
+  if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
 
   tilesplat::RenderImage image;
   std::string timing;

@@ -19,6 +19,8 @@ const uint COUNTER_VISIBLE = 3;        // Gaussians that touch at least one tile
 const uint COUNTER_RANGES_ARGS = 4;    // 3 uints: indirect dispatch of the tile-range pass
 const uint COUNTER_DEPTH_SORT = 8;     // SORT_STATE_UINTS: the sort of the Gaussians by depth
 const uint COUNTER_TILE_SORT = 16;     // SORT_STATE_UINTS: the sort of the (tile, Gaussian) pairs
+const uint COUNTER_DEPTH_MIN = 24;     // float bits of the nearest and farthest visible depths, for
+const uint COUNTER_DEPTH_MAX = 25;     // 16-bit depth keys (AccuracyModes::depth_key_bits)
 
 // A sort's state block: the key count it sorts (set before the sort runs) and what the sort derives
 // from it on the GPU (its block count and the indirect dispatch of its per-block passes).
@@ -37,6 +39,10 @@ const uint COUNTER_SORT_COUNT = COUNTER_TILE_SORT + SORT_COUNT;
 //   [2] colour r, g, b, mean.y lo part
 //   [3] dilated 2D covariance a, b, c and its determinant (for the exact tile coverage)
 const uint SPLAT_VEC4S = 4;
+
+// Per-pixel re-sorting data (AccuracyModes::resort_window), written by the projection only in that
+// mode: see write_ray_depth in projection.comp.
+const uint RAY_DEPTH_VEC4S = 3;
 
 // Popcount of a subgroup ballot, valid for any subgroup size up to 128.
 uint ballot_count(uvec4 b) { return bitCount(b.x) + bitCount(b.y) + bitCount(b.z) + bitCount(b.w); }

@@ -1,7 +1,7 @@
 #version 460
 // Composite: one workgroup per 16x16 tile. The tile's depth-sorted splats are staged through shared
-// memory in batches of 256; each pixel blends them front to back, stops at T < 1e-4, and the whole
-// tile stops once every pixel has.
+// memory in batches of 256; each pixel blends them front to back, stops at T < 1e-4 (the reference's
+// cut-off; a mode), and the whole tile stops once every pixel has.
 //
 // Each invocation owns a column of PIXELS_PER_INVOCATION pixels. GPUs use 1 (256 invocations, one
 // per pixel). CPU drivers such as lavapipe use 16: there a shared-memory read costs a scalar load per
@@ -21,6 +21,10 @@ layout(local_size_x = 16, local_size_y_id = 3) in;  // local_size_y = 16 / PIXEL
 layout(constant_id = 0) const bool WRITE_DEPTH = true;
 layout(constant_id = 1) const bool WRITE_COUNT = true;
 layout(constant_id = 2) const uint PIXELS_PER_INVOCATION = 1;  // 1, 2, 4, 8 or 16
+// The cut-offs (AccuracyModes); the defaults are the reference's.
+layout(constant_id = 4) const float ALPHA_MIN = 1.0 / 255.0;
+layout(constant_id = 5) const float ALPHA_INV = 255.0;  // 1 / ALPHA_MIN, as the tile coverage uses it
+layout(constant_id = 6) const float T_MIN = 1e-4;
 
 layout(push_constant) uniform Push {
   Vec4Array splats;
@@ -70,7 +74,7 @@ ivec2 pixel_span(float lo, float hi) {
 // and within rows 8-15 (bits 16-31): the ellipse cut to a band of rows is convex, so per band it
 // is one x-range (ellipse_x_range, shared with the tile coverage).
 uint splat_reach(vec2 centre, float opacity, vec4 cov_det) {
-  float tau = coverage_tau(opacity);
+  float tau = coverage_tau(opacity, ALPHA_INV);
   uint reach = 0u;
   for (uint band = 0; band < 2; ++band) {
     float band_top = float(band * 8) + 0.5 - centre.y;
@@ -108,9 +112,9 @@ uint blend_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
     float dy = mean_a_b.y - (float(local_y0 + p) + 0.5);
     float power = k0 + dy * (k1 + c_opacity_depth_r.x * dy);
     float alpha = min(0.99, c_opacity_depth_r.y * exp(power));
-    bool hit = T[p] > 0.0 && alpha >= 1.0 / 255.0;
+    bool hit = T[p] > 0.0 && alpha >= ALPHA_MIN;
     float next_T = T[p] * (1.0 - alpha);
-    bool finish = hit && next_T < 1e-4;  // done, and this splat is NOT blended (reference)
+    bool finish = hit && next_T < T_MIN;  // done, and this splat is NOT blended (reference)
     bool blend = hit && !finish;
     float w = blend ? alpha * T[p] : 0.0;
     colour[p] += rgb * w;

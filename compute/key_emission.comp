@@ -5,12 +5,15 @@
 // Gaussian index, and the stable tile sort that follows leaves each tile's run in exactly the
 // (tile, depth, index) order of the reference, with only the tile bits to sort.
 // With 64-bit keys (a strategy that sorts (tile, depth) pairs itself, FrameSortPlan::kTileDepthPairs)
-// the offsets are in Gaussian order and the key is tile << 32 | view depth bits.
+// the offsets are in Gaussian order and the key is tile << 32 | the Gaussian's depth key (the view
+// depth's float bits, or fewer bits in an accuracy mode).
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "tile_coverage.glsl"
 
 layout(constant_id = 0) const bool WIDE_KEYS = false;
+layout(constant_id = 1) const bool SQUARE_TILES = false;  // every tile of the rect (projection.comp)
+layout(constant_id = 2) const float ALPHA_INV = 255.0;     // 1 / the alpha cut-off
 #include "sort_keys.glsl"
 
 layout(local_size_x = 256) in;
@@ -22,11 +25,11 @@ layout(push_constant) uniform Push {
   UintArray offsets;  // per Gaussian: where its pairs start (scatter_offsets.comp)
   uint64_t keys;  // see sort_keys.glsl
   UintArray values;
+  UintArray depth_keys;  // WIDE_KEYS: per Gaussian, written by the projection
   uint count;
   uint tiles_x;
   uint capacity;
   uint tiles;
-  uint pad;
 } pc;
 
 void main() {
@@ -41,11 +44,11 @@ void main() {
   uvec2 hi = uvec2(rect.y & 0xffffu, rect.y >> 16);
   vec4 mdo = pc.splats.v[SPLAT_VEC4S * i];
   vec4 cov_det = pc.splats.v[SPLAT_VEC4S * i + 3];
-  float tau = coverage_tau(mdo.w);
+  float tau = coverage_tau(mdo.w, ALPHA_INV);
   uint end = offset + n;
-  uint64_t depth_bits = WIDE_KEYS ? uint64_t(floatBitsToUint(mdo.z)) : uint64_t(0);
+  uint64_t depth_bits = WIDE_KEYS ? uint64_t(pc.depth_keys.v[i]) : uint64_t(0);
   for (uint ty = lo.y; ty < hi.y; ++ty) {
-    uvec2 span = row_span(mdo.xy, cov_det, tau, ty, lo, hi);
+    uvec2 span = SQUARE_TILES ? uvec2(lo.x, hi.x) : row_span(mdo.xy, cov_det, tau, ty, lo, hi);
     for (uint tx = span.x; tx < span.y && offset < end; ++tx) {
       store_key(pc.keys, offset, uint64_t(ty * pc.tiles_x + tx) << (WIDE_KEYS ? 32 : 0) | depth_bits);
       pc.values.v[offset] = i;

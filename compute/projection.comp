@@ -11,7 +11,6 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #include "common.glsl"
-#include "sh.glsl"
 #include "tile_coverage.glsl"
 
 #ifdef TS_FP32_PROJECTION
@@ -30,7 +29,18 @@
 #endif
 
 layout(local_size_x = 256) in;
-layout(constant_id = 0) const int SH_DEGREE = 0;
+// The accuracy modes (AccuracyModes), each a specialization constant so that a mode that is off
+// costs nothing: its code compiles away.
+layout(constant_id = 0) const int SH_DEGREE = 0;       // evaluated: min(scene degree, cap)
+layout(constant_id = 1) const int SH_COEFFS = 1;       // stored per Gaussian: (scene degree + 1)^2
+layout(constant_id = 2) const bool SH_HALF = false;    // SH stored as 16-bit floats
+layout(constant_id = 3) const bool COV_HALF = false;   // 3D covariance read as six 16-bit floats
+layout(constant_id = 4) const bool OPACITY_EXTENT = false;  // sqrt(2 ln(o / alpha cut-off)) sigma, not 3
+layout(constant_id = 5) const bool SQUARE_TILES = false;    // every tile of the rect, no ellipse test
+layout(constant_id = 6) const float ALPHA_INV = 255.0;      // 1 / the alpha cut-off
+layout(constant_id = 7) const uint DEPTH_KEY_BITS = 32;     // 32: float bits; 24: their top 24; 16: see below
+layout(constant_id = 8) const bool RAY_DEPTH = false;       // write the per-pixel re-sorting data
+#include "sh.glsl"
 
 // Camera, written by the host each frame. Doubles are stored as bit pairs so that the float32
 // variant's SPIR-V needs no Float64 capability.
@@ -47,7 +57,7 @@ layout(push_constant) uniform Push {
   FloatArray log_scales;
   FloatArray rotations;
   FloatArray opacity_logits;
-  FloatArray sh;
+  uint64_t sh;  // floats, or packed halves (SH_HALF)
   CameraParams camera;
   Vec4Array splats;
   Uvec2Array rects;
@@ -55,6 +65,8 @@ layout(push_constant) uniform Push {
   UintArray depth_keys;  // the depth sort's input (32-bit keys): view depth bits, culled last
   UintArray depth_values;
   UintArray counters;
+  UintArray covariances;  // COV_HALF: 3 uints (xx xy, xz yy, yz zz as halves) per Gaussian
+  Vec4Array ray_depth;    // RAY_DEPTH: RAY_DEPTH_VEC4S per Gaussian (composite_resort.comp)
   uint count;
 } pc;
 
@@ -63,6 +75,27 @@ real to_real(uvec2 bits) { return packDouble2x32(bits); }
 #endif
 
 bool is_finite(real v) { return !isnan(v) && !isinf(v); }
+
+// For the per-pixel re-sorting (composite_resort.comp): the depth of a Gaussian's density maximum
+// along the camera ray d = (x, y, 1) is t(d) = (d . Q mu) / (d . Q d) with Q = Sigma^-1 in camera
+// space. Any multiple of Q gives the same t, so the adjugate is stored, scaled to its largest entry:
+// no inverse, no overflow for needles, and a flat splat (singular Sigma) becomes the exact ray-plane
+// intersection. [0] = Q mu, Q_xx; [1] = Q_xy, Q_xz, Q_yy, Q_yz; [2] = Q_zz, mean depth.
+void write_ray_depth(uint i, real3 mu, realmat3 S) {
+  real qxx = S[1][1] * S[2][2] - S[2][1] * S[2][1];
+  real qxy = S[2][1] * S[2][0] - S[1][0] * S[2][2];
+  real qxz = S[1][0] * S[2][1] - S[1][1] * S[2][0];
+  real qyy = S[0][0] * S[2][2] - S[2][0] * S[2][0];
+  real qyz = S[1][0] * S[2][0] - S[0][0] * S[2][1];
+  real qzz = S[0][0] * S[1][1] - S[1][0] * S[1][0];
+  real scale = max(max(max(abs(qxx), abs(qxy)), max(abs(qxz), abs(qyy))), max(abs(qyz), abs(qzz)));
+  scale = scale > 0.0 && is_finite(scale) ? 1.0 / scale : 0.0;
+  realmat3 Q = realmat3(qxx, qxy, qxz, qxy, qyy, qyz, qxz, qyz, qzz) * scale;
+  vec3 qmu = vec3(Q * mu);
+  pc.ray_depth.v[RAY_DEPTH_VEC4S * i + 0] = vec4(qmu, float(Q[0][0]));
+  pc.ray_depth.v[RAY_DEPTH_VEC4S * i + 1] = vec4(float(Q[0][1]), float(Q[0][2]), float(Q[1][1]), float(Q[1][2]));
+  pc.ray_depth.v[RAY_DEPTH_VEC4S * i + 2] = vec4(float(Q[2][2]), float(mu.z), 0.0, 0.0);
+}
 
 // Returns the tiles touched (0 = culled) and fills the splat record.
 uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
@@ -75,16 +108,28 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   real3 t = W * rel;
   if (!(t.z > real(cam.clip.z)) || !is_finite(t.x) || !is_finite(t.y) || !is_finite(t.z)) return 0;
 
-  // exp has no float64 overload in GLSL; its float32 rounding is far below what changes a decision.
-  real3 s = real3(exp(vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2])));
-  real4 q = real4(pc.rotations.v[4 * i], pc.rotations.v[4 * i + 1], pc.rotations.v[4 * i + 2],
-                  pc.rotations.v[4 * i + 3]);  // w x y z
-  real qn = dot(q, q);
-  q = qn > 0.0 ? q / sqrt(qn) : real4(1, 0, 0, 0);
-  real w = q.x, x = q.y, y = q.z, z = q.w;
-  realmat3 R = realmat3(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y),
-                        2.0 * (x * y - w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + w * x),
-                        2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y));
+  // The 3D shape: R S from the log scales and quaternion (reference), or the covariance itself,
+  // precomputed on the host and stored in 16 bits (COV_HALF, as web viewers do).
+  realmat3 RS;
+  realmat3 sigma;
+  if (COV_HALF) {
+    vec2 xx_xy = unpackHalf2x16(pc.covariances.v[3 * i]);
+    vec2 xz_yy = unpackHalf2x16(pc.covariances.v[3 * i + 1]);
+    vec2 yz_zz = unpackHalf2x16(pc.covariances.v[3 * i + 2]);
+    sigma = realmat3(xx_xy.x, xx_xy.y, xz_yy.x, xx_xy.y, xz_yy.y, yz_zz.x, xz_yy.x, yz_zz.x, yz_zz.y);
+  } else {
+    // exp has no float64 overload in GLSL; its float32 rounding is far below what changes a decision.
+    real3 s = real3(exp(vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2])));
+    real4 q = real4(pc.rotations.v[4 * i], pc.rotations.v[4 * i + 1], pc.rotations.v[4 * i + 2],
+                    pc.rotations.v[4 * i + 3]);  // w x y z
+    real qn = dot(q, q);
+    q = qn > 0.0 ? q / sqrt(qn) : real4(1, 0, 0, 0);
+    real w = q.x, x = q.y, y = q.z, z = q.w;
+    realmat3 R = realmat3(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y),
+                          2.0 * (x * y - w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + w * x),
+                          2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y));
+    RS = R * realmat3(s.x, 0, 0, 0, s.y, 0, 0, 0, s.z);
+  }
 
   real fx = to_real(cam.focal_principal[0]), fy = to_real(cam.focal_principal[1]);
   real cx = to_real(cam.focal_principal[2]), cy = to_real(cam.focal_principal[3]);
@@ -95,24 +140,38 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   // cov2d = (J W R S)(J W R S)^T, never forming the 3D covariance (better conditioned).
   real3 j0 = real3(fx * inv_z, 0.0, -fx * tx * inv_z * inv_z);
   real3 j1 = real3(0.0, fy * inv_z, -fy * ty * inv_z * inv_z);
-  realmat3 RS = R * realmat3(s.x, 0, 0, 0, s.y, 0, 0, 0, s.z);
-  realmat3 WRS = W * RS;
-  real3 u = j0 * WRS;  // row 0 of J W R S
-  real3 v = j1 * WRS;  // row 1
-  real a = dot(u, u) + 0.3;
-  real b = dot(u, v);
-  real c = dot(v, v) + 0.3;
-  // det(uu^T + vv^T + 0.3 I) without cancellation: |u x v|^2 + 0.3 (|u|^2 + |v|^2) + 0.09.
-  real3 uxv = cross(u, v);
-  real det = dot(uxv, uxv) + 0.3 * (dot(u, u) + dot(v, v)) + 0.09;
+  real a, b, c, det;
+  if (COV_HALF) {
+    real3 u = j0 * W;  // rows of J W
+    real3 v = j1 * W;
+    real3 su = sigma * u;
+    real3 sv = sigma * v;
+    a = dot(u, su) + 0.3;
+    b = dot(u, sv);
+    c = dot(v, sv) + 0.3;
+    det = a * c - b * b;
+  } else {
+    realmat3 WRS = W * RS;
+    real3 u = j0 * WRS;  // row 0 of J W R S
+    real3 v = j1 * WRS;  // row 1
+    a = dot(u, u) + 0.3;
+    b = dot(u, v);
+    c = dot(v, v) + 0.3;
+    // det(uu^T + vv^T + 0.3 I) without cancellation: |u x v|^2 + 0.3 (|u|^2 + |v|^2) + 0.09.
+    real3 uxv = cross(u, v);
+    det = dot(uxv, uxv) + 0.3 * (dot(u, u) + dot(v, v)) + 0.09;
+  }
   real2 mean = real2(fx * t.x * inv_z + cx, fy * t.y * inv_z + cy);
   if (!(det > 0.0) || !is_finite(a) || !is_finite(b) || !is_finite(c) || !is_finite(det) ||
       !is_finite(mean.x) || !is_finite(mean.y))
     return 0;
 
+  float opacity = 1.0 / (1.0 + exp(-pc.opacity_logits.v[i]));
   real mid = 0.5 * (a + c);
   real lambda = mid + sqrt(max(real(0.1), mid * mid - det));
-  real radius = ceil(3.0 * sqrt(lambda));
+  // Where alpha = o exp(-k^2 / 2) falls to the cut-off along the major axis: k = sqrt(2 ln(o / cut-off)).
+  real sigmas = OPACITY_EXTENT ? real(min(sqrt(max(2.0 * log(ALPHA_INV * opacity), 0.0)), 3.33)) : 3.0;
+  real radius = ceil(sigmas * sqrt(lambda));
   if (!is_finite(radius)) return 0;
   real2 grid = real2(cam.grid.xy);
   // Clamp before converting: a huge radius must not overflow the integer rect.
@@ -122,15 +181,18 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   uvec2 hi = uvec2(rect_max);
   if ((hi.x - lo.x) * (hi.y - lo.y) == 0) return 0;
 
-  // Of the reference rect, only the tiles the alpha >= 1/255 ellipse reaches (tile_coverage.glsl).
-  float opacity = 1.0 / (1.0 + exp(-pc.opacity_logits.v[i]));
+  // Of the rect, only the tiles the alpha >= cut-off ellipse reaches (tile_coverage.glsl).
   vec2 mean_hi = vec2(mean);
   vec4 cov_det = vec4(a, b, c, det);
-  float tau = coverage_tau(opacity);
   uint touched = 0;
-  for (uint ty = lo.y; ty < hi.y; ++ty) {
-    uvec2 span = row_span(mean_hi, cov_det, tau, ty, lo, hi);
-    touched += span.y - span.x;
+  if (SQUARE_TILES) {
+    touched = (hi.x - lo.x) * (hi.y - lo.y);
+  } else {
+    float tau = coverage_tau(opacity, ALPHA_INV);
+    for (uint ty = lo.y; ty < hi.y; ++ty) {
+      uvec2 span = row_span(mean_hi, cov_det, tau, ty, lo, hi);
+      touched += span.y - span.x;
+    }
   }
   if (touched == 0) return 0;
 
@@ -143,12 +205,14 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   record[2] = vec4(colour, mean_lo.y);
   record[3] = cov_det;
   rect = uvec2(lo.x | (lo.y << 16), hi.x | (hi.y << 16));
+  if (RAY_DEPTH) write_ray_depth(i, t, COV_HALF ? W * sigma * transpose(W) : (W * RS) * transpose(W * RS));
   return touched;
 }
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
   uint touched = 0;
+  uint depth_near = 0xffffffffu, depth_far = 0u;
   if (i < pc.count) {
     vec4 record[SPLAT_VEC4S];
     uvec2 rect;
@@ -158,11 +222,24 @@ void main() {
       pc.rects.v[i] = rect;
     }
     pc.tile_counts.v[i] = touched;
-    // View depth > near > 0, so its IEEE bits order like unsigned integers. Culled Gaussians touch
-    // no tile; they sort last only to keep the visible ones together.
-    pc.depth_keys.v[i] = touched > 0 ? floatBitsToUint(record[0].z) : 0xffffffffu;
+    // View depth > near > 0, so its IEEE bits order like unsigned integers; their top 24 bits too.
+    // 16-bit keys are made by depth_quantize.comp once the visible range is known: here the float
+    // bits. Culled Gaussians touch no tile; they sort last only to keep the visible ones together.
+    uint depth_bits = floatBitsToUint(record[0].z);
+    uint key = DEPTH_KEY_BITS == 24 ? depth_bits >> 8 : depth_bits;
+    pc.depth_keys.v[i] = touched > 0 ? key : (DEPTH_KEY_BITS == 24 ? 0xffffffu : 0xffffffffu);
     pc.depth_values.v[i] = i;
+    depth_near = touched > 0 ? depth_bits : 0xffffffffu;
+    depth_far = touched > 0 ? depth_bits : 0u;
   }
   uint visible = subgroupAdd(touched > 0 ? 1u : 0u);
   if (subgroupElect() && visible > 0) atomicAdd(pc.counters.v[COUNTER_VISIBLE], visible);
+  if (DEPTH_KEY_BITS == 16) {  // the visible depth range the 16-bit keys are quantized over
+    depth_near = subgroupMin(depth_near);
+    depth_far = subgroupMax(depth_far);
+    if (subgroupElect() && visible > 0) {
+      atomicMin(pc.counters.v[COUNTER_DEPTH_MIN], depth_near);
+      atomicMax(pc.counters.v[COUNTER_DEPTH_MAX], depth_far);
+    }
+  }
 }

@@ -9,15 +9,24 @@ const float SH_C3[7] = float[7](-0.5900435899266435, 2.890611442640554, -0.45704
                                 0.3731763325901154, -0.4570457994644658, 1.445305721320277,
                                 -0.5900435899266435);
 
-vec3 sh_coeff(FloatArray sh, uint base, uint k) {
+// The including shader declares SH_COEFFS (coefficients stored per Gaussian: the scene's, which may
+// be more than the evaluated degree uses) and SH_HALF (stored as packed 16-bit floats, two a uint).
+vec3 sh_coeff(uint64_t sh, uint base, uint k) {
   uint o = base + 3 * k;
-  return vec3(sh.v[o], sh.v[o + 1], sh.v[o + 2]);
+  if (SH_HALF) {
+    UintArray words = UintArray(sh);
+    // Three consecutive halves start on either half of a word.
+    vec2 w0 = unpackHalf2x16(words.v[o >> 1]);
+    vec2 w1 = unpackHalf2x16(words.v[(o >> 1) + 1]);
+    return (o & 1u) == 0u ? vec3(w0, w1.x) : vec3(w0.y, w1);
+  }
+  FloatArray values = FloatArray(sh);
+  return vec3(values.v[o], values.v[o + 1], values.v[o + 2]);
 }
 
 // degree is a specialization constant at every call site, so the unused bands compile away.
-vec3 eval_sh(int degree, FloatArray sh, uint gaussian, vec3 dir) {
-  uint K = uint((degree + 1) * (degree + 1));
-  uint base = gaussian * K * 3;
+vec3 eval_sh(int degree, uint64_t sh, uint gaussian, vec3 dir) {
+  uint base = gaussian * uint(SH_COEFFS) * 3;
   vec3 result = SH_C0 * sh_coeff(sh, base, 0);
   if (degree > 0) {
     float x = dir.x, y = dir.y, z = dir.z;

@@ -1,17 +1,18 @@
 // Which tiles of a splat's reference rect can receive any of it.
 //
-// The reference blends a splat into a pixel only where alpha = o exp(-q/2) >= 1/255, i.e. where
-// q = d^T cov^-1 d <= tau = 2 ln(255 o). A tile none of whose pixel centres lies in that ellipse gets
-// nothing from the splat, so leaving it out of the tile's list changes no pixel; it only saves sort
-// and composite work. tau carries a margin so float rounding can never drop a contributing tile.
+// The reference blends a splat into a pixel only where alpha = o exp(-q/2) >= 1/255 (the alpha
+// cut-off, a mode), i.e. where q = d^T cov^-1 d <= tau = 2 ln(255 o). A tile none of whose pixel
+// centres lies in that ellipse gets nothing from the splat, so leaving it out of the tile's list
+// changes no pixel; it only saves sort and composite work. tau carries a margin so float rounding can never drop a contributing tile.
 //
 // The projection counts with row_span() and the key emission emits with it, from the same stored
 // float inputs; `precise` keeps the two pipelines' arithmetic identical (no contraction). The
 // composite uses ellipse_x_range() for the columns of a tile a splat reaches.
 
-float coverage_tau(float opacity) {
-  precise float tau = 2.0 * log(255.0 * opacity);
-  return tau > 0.0 ? tau * 1.001 + 0.01 : -1.0;  // <= 0: alpha never reaches 1/255
+// alpha_inv = 1 / the alpha cut-off (255 in the reference; AccuracyModes::alpha_cutoff).
+float coverage_tau(float opacity, float alpha_inv) {
+  precise float tau = 2.0 * log(alpha_inv * opacity);
+  return tau > 0.0 ? tau * 1.001 + 0.01 : -1.0;  // <= 0: alpha never reaches the cut-off
 }
 
 // x-range [left, right], relative to the mean, of the ellipse {d : d^T cov^-1 d <= tau} over the

@@ -18,6 +18,8 @@
 #include <string>
 
 #include "passes/composite_pass.h"
+#include "passes/composite_resort_pass.h"
+#include "passes/depth_quantize_pass.h"
 #include "passes/frame_counters.h"
 #include "passes/key_emission_pass.h"
 #include "passes/prefix_sum_pass.h"
@@ -81,10 +83,12 @@ struct Renderer::Impl {
         ctx(source),
         timer(ctx),
         projection(ctx),
+        depth_quantize(ctx),
         prefix_sum(ctx),
         key_emission(ctx),
         tile_ranges(ctx),
         composite(ctx),
+        composite_resort(ctx),
         counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "frame counters") {}
 
   SortStrategy& sort(const std::string& name) {
@@ -114,15 +118,31 @@ struct Renderer::Impl {
 
   uint64_t device_bytes() const {
     uint64_t bytes = 0;
-    for (const vk::Buffer* b : {&scene.positions, &scene.log_scales, &scene.rotations, &scene.opacity_logits,
-                                &scene.sh, &projected.splats, &projected.rects, &projected.tile_counts,
-                                &projected.offsets, &projected.depth_offsets, &ranges, &outputs.rgba,
-                                &outputs.depth, &outputs.count, &counters})
+    for (const vk::Buffer* b :
+         {&scene.positions, &scene.log_scales, &scene.rotations, &scene.opacity_logits, &scene.sh, &scene.sh_half,
+          &scene.covariances_half, &projected.splats, &projected.rects, &projected.tile_counts, &projected.offsets,
+          &projected.depth_offsets, &projected.ray_depth, &ranges, &outputs.rgba, &outputs.depth, &outputs.count,
+          &counters})
       bytes += b->size();
     bytes += projected.depth_order.bytes() + keys.bytes();
     bytes += prefix_sum.device_bytes();
     for (const auto& [name, s] : sorts) bytes += s->device_bytes();
     return bytes;
+  }
+
+  // The projection a frame's accuracy modes call for.
+  ProjectionVariant projection_variant(const AccuracyModes& modes) const {
+    ProjectionVariant v;
+    v.stored_sh_degree = scene.sh_degree;
+    v.sh_degree = std::min(scene.sh_degree, modes.sh_degree_cap);
+    v.sh_half = modes.fp16_sh;
+    v.covariance_half = modes.fp16_covariance;
+    v.opacity_extent = modes.extent == AccuracyModes::Extent::kOpacityAware;
+    v.square_tiles = modes.tile_test == AccuracyModes::TileTest::kSquare;
+    v.alpha_inv = float(1.0 / double(modes.alpha_cutoff));
+    v.depth_key_bits = uint32_t(modes.depth_key_bits);
+    v.ray_depth = modes.resort_window > 0;
+    return v;
   }
 
   // Records and runs one frame. Returns the counters the GPU wrote.
@@ -132,8 +152,15 @@ struct Renderer::Impl {
     const uint32_t tiles = tiles_x * tiles_y;
     // Tile ids run to `tiles` inclusive: the key emission's padding uses that id (never in practice).
     const uint32_t tile_bits = uint32_t(std::bit_width(tiles));
-    constexpr uint32_t kDepthBits = 32;  // the float bits of the view depth
+    const AccuracyModes& modes = settings.accuracy;
+    const ProjectionVariant variant = projection_variant(modes);
+    // The per-Gaussian depth key: the view depth's float bits, or fewer (AccuracyModes::depth_key_bits).
+    const uint32_t depth_bits = variant.depth_key_bits;
     const uint32_t n = scene.count;
+    projection.prepare(scene, variant);
+    if (variant.ray_depth && projected.ray_depth.size() < VkDeviceSize(n) * kRayDepthBytes)
+      projected.ray_depth = vk::Buffer(ctx, std::max<VkDeviceSize>(kRayDepthBytes, VkDeviceSize(n) * kRayDepthBytes),
+                                       vk::MemoryUse::Device, "ray depth (re-sorting)");
     const bool depth_first = sorter.frame_plan() == FrameSortPlan::kDepthThenTile;
     ensure_key_capacity(keys.capacity, /*wide=*/!depth_first);
 
@@ -144,17 +171,24 @@ struct Renderer::Impl {
     vkCmdFillBuffer(cmd, counters.handle(), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, ranges.handle(), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, counters.handle(), kDepthSortOffset + offsetof(SortState, count), sizeof(uint32_t), n);
+    // The nearest visible depth is a minimum over the Gaussians: it starts at the largest value.
+    vkCmdFillBuffer(cmd, counters.handle(), kDepthRangeOffset, sizeof(uint32_t), 0xffffffffu);
     vk::barrier(cmd);
 
-    projection.record(cmd, scene, projected, counters.address());
+    projection.record(cmd, scene, projected, counters.address(), variant);
     vk::barrier(cmd);
     timer.mark(cmd, "projection");
+    if (depth_bits == 16) {
+      depth_quantize.record(cmd, projected, n, counters.address());
+      vk::barrier(cmd);
+      timer.mark(cmd, "depth_quantize");
+    }
 
     // Depth first: sort the Gaussians by depth, then emit the pairs front to back, so that the
     // pair sort only needs the tile bits. Otherwise the strategy sorts (tile, depth) pairs itself.
     const vk::Buffer* depth_order = nullptr;
     if (depth_first) {
-      SortInput depth_input{projected.depth_order, counters, kDepthSortOffset, kDepthBits, true};
+      SortInput depth_input{projected.depth_order, counters, kDepthSortOffset, depth_bits, true};
       depth_order = sorter.record(stream, depth_input) ? &projected.depth_order.values_alt
                                                        : &projected.depth_order.values;
       timer.mark(stream.cmd(), "depth_sort");
@@ -166,12 +200,13 @@ struct Renderer::Impl {
     }
     timer.mark(stream.cmd(), "prefix_sum");
 
-    key_emission.record(stream.cmd(), projected, depth_order, keys, n, tiles_x, tiles, counters.address());
+    key_emission.record(stream.cmd(), projected, depth_order, keys, n, tiles_x, tiles, counters.address(),
+                        variant.square_tiles, variant.alpha_inv);
     vk::barrier(stream.cmd());
     timer.mark(stream.cmd(), "key_emission");
 
-    SortInput tile_input{keys, counters, kTileSortOffset, depth_first ? tile_bits : kDepthBits + tile_bits,
-                         !depth_first};
+    // In 64-bit keys the tile id sits above bit 32 whatever the depth key's width.
+    SortInput tile_input{keys, counters, kTileSortOffset, depth_first ? tile_bits : 32 + tile_bits, !depth_first};
     const bool sorted_in_alt = sorter.record(stream, tile_input);
     timer.mark(stream.cmd(), "tile_sort");
 
@@ -181,14 +216,20 @@ struct Renderer::Impl {
     vk::barrier(stream.cmd());
     timer.mark(stream.cmd(), "tile_ranges");
 
-    composite.record(stream.cmd(), projected.splats, sorted_values, ranges, outputs, settings.background,
-                     settings.depth, settings.splat_count);
+    const CompositePass::Cutoffs cutoffs{modes.alpha_cutoff, modes.transmittance_cutoff};
+    if (variant.ray_depth)
+      composite_resort.record(stream.cmd(), projected.splats, projected.ray_depth, sorted_values, ranges, outputs,
+                              camera, settings.background, settings.depth, settings.splat_count, cutoffs,
+                              uint32_t(modes.resort_window));
+    else
+      composite.record(stream.cmd(), projected.splats, sorted_values, ranges, outputs, settings.background,
+                       settings.depth, settings.splat_count, cutoffs);
     timer.mark(stream.cmd(), "composite");
     stream.finish();
 
     FrameCounters result;
     std::memcpy(&result, counters.mapped(), sizeof(result));
-    stats.sort_bits = kDepthBits + tile_bits;
+    stats.sort_bits = depth_bits + tile_bits;
     stats.submissions = stream.submissions();
     return result;
   }
@@ -197,6 +238,7 @@ struct Renderer::Impl {
   // fills the frame statistics (all but cpu_ms).
   void render_frame(const Camera& camera, const RenderSettings& settings) {
     check_camera(camera, ctx.limits());
+    validate(settings.accuracy);
     SortStrategy& sorter = sort(settings.sort);
     ensure_outputs(uint32_t(camera.width), uint32_t(camera.height));
     projection.set_camera(camera);
@@ -241,10 +283,12 @@ struct Renderer::Impl {
   vk::Context ctx;
   vk::GpuTimer timer;
   ProjectionPass projection;
+  DepthQuantizePass depth_quantize;
   PrefixSumPass prefix_sum;
   KeyEmissionPass key_emission;
   TileRangesPass tile_ranges;
   CompositePass composite;
+  CompositeResortPass composite_resort;
   std::map<std::string, std::unique_ptr<SortStrategy>> sorts;
 
   SceneBuffers scene;
@@ -281,6 +325,8 @@ void Renderer::set_scene(const GaussianScene& scene) {
   upload(s.rotations, scene.rotations, "rotations");
   upload(s.opacity_logits, scene.opacity_logits, "opacity logits");
   upload(s.sh, scene.sh, "spherical harmonics");
+  s.sh_half.reset();  // the previous scene's half-precision copies (made again on first use)
+  s.covariances_half.reset();
   s.count = uint32_t(n);
   s.sh_degree = scene.sh_degree;
 

@@ -25,12 +25,56 @@ struct RendererOptions {
   bool timestamps = true;
 };
 
+// The approximations of the reference a frame may make, each a named mode. The defaults are the
+// reference behaviour (DESIGN-NOTES section 1). `tilesplat-bench --accuracy` measures what each mode
+// costs in error against the float64 reference and what it saves in time (docs/accuracy.md).
+struct AccuracyModes {
+  // Bits of the per-Gaussian depth key the depth sort orders by: 32 = the float bits of the view
+  // depth (reference); 24 = their top 24 bits (one radix digit fewer); 16 = the depth quantized
+  // linearly over the frame's visible depth range (two digits fewer; near-coincident splats tie
+  // and fall back to index order, which pops).
+  int depth_key_bits = 32;
+  // How far from its mean a splat reaches, in standard deviations of its major axis.
+  enum class Extent {
+    kSigma3,        // 3 sigma (reference)
+    kOpacityAware,  // sqrt(2 ln(opacity / alpha_cutoff)) sigma, at most 3.33: where alpha falls below the cut-off
+  };
+  Extent extent = Extent::kSigma3;
+  // Which tiles of the extent's square get the splat.
+  enum class TileTest {
+    kEllipse,  // only those the alpha >= alpha_cutoff ellipse reaches: the same image as kSquare, fewer pairs
+    kSquare,   // every tile of the square (the reference as written; shows what the ellipse test saves)
+  };
+  TileTest tile_test = TileTest::kEllipse;
+  int sh_degree_cap = 3;          // 0..3: evaluate SH only to min(scene degree, cap)
+  bool fp16_sh = false;           // SH coefficients stored as 16-bit floats on the GPU
+  bool fp16_covariance = false;   // the 3D covariance precomputed and stored as six 16-bit floats
+  float transmittance_cutoff = 1e-4f;    // a pixel stops blending when T would fall below this
+  float alpha_cutoff = 1.0f / 255.0f;    // splats fainter than this at a pixel are skipped
+  // Higher accuracy than the reference: each pixel re-sorts a window of this many splats by the
+  // depth of their density maximum along the pixel's ray (in the spirit of StopThePop), instead of
+  // blending in the order of the splats' centre depths. 0 = off (reference). 2 to 16.
+  int resort_window = 0;
+
+  bool operator==(const AccuracyModes&) const = default;
+};
+
+// "reference", or the modes that differ from it joined by '+', e.g. "depth16+sh1+t-cutoff=0.001".
+std::string to_string(const AccuracyModes& modes);
+// The inverse of to_string. Tokens: reference, depth24, depth16, opacity-extent, square-tiles,
+// sh0..sh3, fp16-sh, fp16-cov, t-cutoff=X, alpha-cutoff=X (X a number or a fraction like 1/64),
+// resortN or resort=N. Throws std::invalid_argument naming the bad token.
+AccuracyModes parse_accuracy_modes(const std::string& text);
+// Throws std::invalid_argument when a value is out of range (naming it).
+void validate(const AccuracyModes& modes);
+
 // Everything that changes how one frame is rendered.
 struct RenderSettings {
   std::array<float, 3> background = {0, 0, 0};
   std::string sort = "radix";  // the key sort strategy (see sort_strategies())
   bool depth = true;           // produce the expected-depth channel
   bool splat_count = true;     // produce the per-pixel blended-splat count
+  AccuracyModes accuracy;      // approximations (default: none, the reference)
 };
 
 struct PassTiming {

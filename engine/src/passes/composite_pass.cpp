@@ -1,5 +1,6 @@
 #include "passes/composite_pass.h"
 
+#include <bit>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
@@ -33,17 +34,23 @@ CompositePass::CompositePass(vk::Context& ctx)
 
 void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
                            const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
-                           bool write_depth, bool write_count) {
-  auto key = std::make_pair(write_depth, write_count);
+                           bool write_depth, bool write_count, const Cutoffs& cutoffs) {
+  auto key = std::make_tuple(write_depth, write_count, cutoffs);
   auto it = pipelines_.find(key);
-  if (it == pipelines_.end())
+  if (it == pipelines_.end()) {
+    // 1 / alpha rounded once on the host, as the projection's tile coverage uses it (255 exactly).
+    const float alpha_inv = float(1.0 / double(cutoffs.alpha));
     it = pipelines_
              .emplace(key, vk::ComputePipeline(ctx_, "composite", sizeof(CompositePush),
                                                {{0, write_depth ? 1u : 0u},
                                                 {1, write_count ? 1u : 0u},
                                                 {2, pixels_per_invocation_},
-                                                {3, kTileSize / pixels_per_invocation_}}))
+                                                {3, kTileSize / pixels_per_invocation_},
+                                                {4, std::bit_cast<uint32_t>(cutoffs.alpha)},
+                                                {5, std::bit_cast<uint32_t>(alpha_inv)},
+                                                {6, std::bit_cast<uint32_t>(cutoffs.transmittance)}}))
              .first;
+  }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
   CompositePush push{splats.address(),

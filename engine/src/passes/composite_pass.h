@@ -2,7 +2,9 @@
 #pragma once
 
 #include <array>
+#include <compare>
 #include <map>
+#include <tuple>
 
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
@@ -19,14 +21,20 @@ struct OutputBuffers {
 class CompositePass {
  public:
   explicit CompositePass(vk::Context& ctx);
+  // The cut-offs as in AccuracyModes (reference: 1/255 and 1e-4).
+  struct Cutoffs {
+    float alpha = 1.0f / 255.0f;
+    float transmittance = 1e-4f;
+    auto operator<=>(const Cutoffs&) const = default;
+  };
   void record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
               const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
-              bool write_depth, bool write_count);
+              bool write_depth, bool write_count, const Cutoffs& cutoffs);
 
  private:
   vk::Context& ctx_;
   uint32_t pixels_per_invocation_;
-  std::map<std::pair<bool, bool>, vk::ComputePipeline> pipelines_;  // by (depth, count) outputs
+  std::map<std::tuple<bool, bool, Cutoffs>, vk::ComputePipeline> pipelines_;  // by outputs and cut-offs
 };
 
 }  // namespace tilesplat

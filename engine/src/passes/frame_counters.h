@@ -25,12 +25,14 @@ struct FrameCounters {
   uint32_t ranges_args[4];  // indirect dispatch of the tile-range pass (+ padding)
   SortState depth_sort;     // the Gaussians by view depth
   SortState tile_sort;      // the (tile, Gaussian) pairs by tile; count = pairs sorted (0 on overflow)
+  uint32_t depth_range[2];  // float bits of the nearest and farthest visible depth (16-bit depth keys only)
 };
-static_assert(sizeof(FrameCounters) == 96);
+static_assert(sizeof(FrameCounters) == 104);
 
 constexpr uint32_t kRangesArgsOffset = offsetof(FrameCounters, ranges_args);
 constexpr uint32_t kDepthSortOffset = offsetof(FrameCounters, depth_sort);
 constexpr uint32_t kTileSortOffset = offsetof(FrameCounters, tile_sort);
+constexpr uint32_t kDepthRangeOffset = offsetof(FrameCounters, depth_range);
 constexpr uint32_t kSortArgsOffset = offsetof(SortState, args);  // within a SortState
 
 }  // namespace tilesplat

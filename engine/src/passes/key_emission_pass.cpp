@@ -1,5 +1,7 @@
 #include "passes/key_emission_pass.h"
 
+#include <bit>
+
 namespace tilesplat {
 
 namespace {
@@ -12,20 +14,19 @@ struct ScatterPush {
   uint32_t count, pad;
 };
 struct EmitPush {
-  VkDeviceAddress splats, rects, tile_counts, offsets, keys, values;
-  uint32_t count, tiles_x, capacity, tiles, pad[2];
+  VkDeviceAddress splats, rects, tile_counts, offsets, keys, values, depth_keys;
+  uint32_t count, tiles_x, capacity, tiles;
 };
 }  // namespace
 
 KeyEmissionPass::KeyEmissionPass(vk::Context& ctx)
-    : frame_setup_(ctx, "frame_setup", sizeof(SetupPush)),
-      scatter_offsets_(ctx, "scatter_offsets", sizeof(ScatterPush)) {
-  for (uint32_t wide : {0u, 1u}) emit_keys_[wide] = vk::ComputePipeline(ctx, "key_emission", sizeof(EmitPush), {{0, wide}});
-}
+    : ctx_(ctx),
+      frame_setup_(ctx, "frame_setup", sizeof(SetupPush)),
+      scatter_offsets_(ctx, "scatter_offsets", sizeof(ScatterPush)) {}
 
 void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer* depth_order,
                              KeyBuffers& keys, uint32_t gaussians, uint32_t tiles_x, uint32_t tiles,
-                             VkDeviceAddress counters) {
+                             VkDeviceAddress counters, bool square_tiles, float alpha_inv) {
   frame_setup_.bind(cmd, SetupPush{counters, keys.capacity, 0});
   frame_setup_.dispatch(cmd, 1);
   if (depth_order) {
@@ -34,10 +35,19 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
     scatter_offsets_.dispatch(cmd, vk::div_ceil(gaussians, 256));
   }
   vk::barrier(cmd);
-  const vk::ComputePipeline& emit_keys = emit_keys_[keys.wide_keys ? 1 : 0];
+  const auto variant = std::make_tuple(keys.wide_keys, square_tiles, alpha_inv);
+  auto it = emit_keys_.find(variant);
+  if (it == emit_keys_.end())
+    it = emit_keys_
+             .emplace(variant, vk::ComputePipeline(ctx_, "key_emission", sizeof(EmitPush),
+                                                   {{0, keys.wide_keys}, {1, square_tiles},
+                                                    {2, std::bit_cast<uint32_t>(alpha_inv)}}))
+             .first;
+  const vk::ComputePipeline& emit_keys = it->second;
   emit_keys.bind(cmd, EmitPush{projected.splats.address(), projected.rects.address(),
                                 projected.tile_counts.address(), projected.offsets.address(), keys.keys.address(),
-                                keys.values.address(), gaussians, tiles_x, keys.capacity, tiles, {0, 0}});
+                                keys.values.address(), projected.depth_order.keys.address(), gaussians, tiles_x,
+                                keys.capacity, tiles});
   emit_keys.dispatch(cmd, vk::div_ceil(gaussians, 256));
 }
 

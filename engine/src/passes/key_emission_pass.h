@@ -5,6 +5,9 @@
 // 64-bit tile << 32 | depth bits.
 #pragma once
 
+#include <map>
+#include <tuple>
+
 #include "passes/key_buffers.h"
 #include "passes/projection_pass.h"
 #include "vulkan/buffer.h"
@@ -18,13 +21,16 @@ class KeyEmissionPass {
   // depth_order: the Gaussian indices front to back (the depth sort's values), with
   // projected.depth_offsets the prefix sum of the tile counts taken in that order; or null, with
   // projected.offsets the prefix sum in Gaussian order and keys.wide_keys.
+  // square_tiles and alpha_inv must be the projection's (ProjectionVariant): both count the same tiles.
   void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer* depth_order, KeyBuffers& keys,
-              uint32_t gaussians, uint32_t tiles_x, uint32_t tiles, VkDeviceAddress counters);
+              uint32_t gaussians, uint32_t tiles_x, uint32_t tiles, VkDeviceAddress counters, bool square_tiles,
+              float alpha_inv);
 
  private:
+  vk::Context& ctx_;
   vk::ComputePipeline frame_setup_;
   vk::ComputePipeline scatter_offsets_;
-  vk::ComputePipeline emit_keys_[2];  // [wide keys]
+  std::map<std::tuple<bool, bool, float>, vk::ComputePipeline> emit_keys_;  // by (wide keys, square, alpha_inv)
 };
 
 }  // namespace tilesplat

@@ -1,6 +1,7 @@
 #include "passes/projection_pass.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "tilesplat/camera.h"
@@ -23,8 +24,19 @@ static_assert(sizeof(CameraParams) == 160);
 struct ProjectionPush {
   VkDeviceAddress positions, log_scales, rotations, opacity_logits, sh, camera;
   VkDeviceAddress splats, rects, tile_counts, depth_keys, depth_values, counters;
+  VkDeviceAddress covariances, ray_depth;
   uint32_t count;
   uint32_t pad;
+};
+
+struct PackShPush {
+  VkDeviceAddress sh, sh_half;
+  uint32_t values, pad;
+};
+
+struct PackCovariancePush {
+  VkDeviceAddress log_scales, rotations, covariances;
+  uint32_t count, pad;
 };
 
 constexpr double kNearPlane = 0.2;
@@ -32,7 +44,10 @@ constexpr double kNearPlane = 0.2;
 }  // namespace
 
 ProjectionPass::ProjectionPass(vk::Context& ctx)
-    : ctx_(ctx), camera_params_(ctx, sizeof(CameraParams), vk::MemoryUse::Upload, "camera params") {}
+    : ctx_(ctx),
+      camera_params_(ctx, sizeof(CameraParams), vk::MemoryUse::Upload, "camera params"),
+      pack_sh_half_(ctx, "pack_sh_half", sizeof(PackShPush)),
+      pack_covariance_half_(ctx, "pack_covariance_half", sizeof(PackCovariancePush)) {}
 
 void ProjectionPass::set_camera(const Camera& camera) {
   CameraParams p{};
@@ -52,26 +67,66 @@ void ProjectionPass::set_camera(const Camera& camera) {
   vk::upload(ctx_, camera_params_, &p, sizeof(p));
 }
 
-const vk::ComputePipeline& ProjectionPass::pipeline_for(int sh_degree) {
-  auto it = pipelines_.find(sh_degree);
-  if (it == pipelines_.end())
-    it = pipelines_
-             .emplace(sh_degree, vk::ComputePipeline(ctx_, ctx_.features().shader_float64 ? "projection"
-                                                                                           : "projection_fp32",
-                                                     sizeof(ProjectionPush),
-                                                     {{0, uint32_t(sh_degree)}}))
-             .first;
+const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant& v) {
+  auto it = pipelines_.find(v);
+  if (it == pipelines_.end()) {
+    const uint32_t stored_coeffs = uint32_t((v.stored_sh_degree + 1) * (v.stored_sh_degree + 1));
+    const std::vector<vk::SpecConstant> spec = {
+        {0, uint32_t(v.sh_degree)},         {1, stored_coeffs},
+        {2, v.sh_half},                     {3, v.covariance_half},
+        {4, v.opacity_extent},              {5, v.square_tiles},
+        {6, std::bit_cast<uint32_t>(v.alpha_inv)}, {7, v.depth_key_bits},
+        {8, v.ray_depth}};
+    const char* shader = ctx_.features().shader_float64 ? "projection" : "projection_fp32";
+    it = pipelines_.emplace(v, vk::ComputePipeline(ctx_, shader, sizeof(ProjectionPush), spec)).first;
+  }
   return it->second;
 }
 
+void ProjectionPass::prepare(SceneBuffers& scene, const ProjectionVariant& variant) {
+  const bool pack_sh = variant.sh_half && !scene.sh_half;
+  const bool pack_covariance = variant.covariance_half && !scene.covariances_half;
+  if (!pack_sh && !pack_covariance) return;
+  const uint32_t sh_values = uint32_t(scene.sh.size() / sizeof(float));
+  if (pack_sh)
+    scene.sh_half = vk::Buffer(ctx_, std::max<VkDeviceSize>(4, VkDeviceSize(vk::div_ceil(sh_values, 2)) * 4),
+                               vk::MemoryUse::Device, "spherical harmonics (fp16)");
+  if (pack_covariance)
+    scene.covariances_half = vk::Buffer(ctx_, std::max<VkDeviceSize>(4, VkDeviceSize(scene.count) * 12),
+                                        vk::MemoryUse::Device, "covariances (fp16)");
+  ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
+    if (pack_sh && sh_values > 0) {
+      pack_sh_half_.bind(cmd, PackShPush{scene.sh.address(), scene.sh_half.address(), sh_values, 0});
+      pack_sh_half_.dispatch(cmd, vk::div_ceil(vk::div_ceil(sh_values, 2), 256));
+    }
+    if (pack_covariance && scene.count > 0) {
+      pack_covariance_half_.bind(cmd, PackCovariancePush{scene.log_scales.address(), scene.rotations.address(),
+                                                         scene.covariances_half.address(), scene.count, 0});
+      pack_covariance_half_.dispatch(cmd, vk::div_ceil(scene.count, 256));
+    }
+  });
+}
+
 void ProjectionPass::record(VkCommandBuffer cmd, const SceneBuffers& scene, ProjectedBuffers& out,
-                            VkDeviceAddress counters) {
-  ProjectionPush push{scene.positions.address(), scene.log_scales.address(), scene.rotations.address(),
-                      scene.opacity_logits.address(), scene.sh.address(), camera_params_.address(),
-                      out.splats.address(), out.rects.address(), out.tile_counts.address(),
-                      out.depth_order.keys.address(), out.depth_order.values.address(), counters,
-                      scene.count, 0};
-  const auto& pipeline = pipeline_for(scene.sh_degree);
+                            VkDeviceAddress counters, const ProjectionVariant& variant) {
+  const vk::Buffer& sh = variant.sh_half ? scene.sh_half : scene.sh;
+  ProjectionPush push{scene.positions.address(),
+                      scene.log_scales.address(),
+                      scene.rotations.address(),
+                      scene.opacity_logits.address(),
+                      sh.address(),
+                      camera_params_.address(),
+                      out.splats.address(),
+                      out.rects.address(),
+                      out.tile_counts.address(),
+                      out.depth_order.keys.address(),
+                      out.depth_order.values.address(),
+                      counters,
+                      variant.covariance_half ? scene.covariances_half.address() : 0,
+                      variant.ray_depth ? out.ray_depth.address() : 0,
+                      scene.count,
+                      0};
+  const auto& pipeline = pipeline_for(variant);
   pipeline.bind(cmd, push);
   pipeline.dispatch(cmd, vk::div_ceil(scene.count, 256));
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <map>
+#include <tuple>
 
 #include "passes/key_buffers.h"
 #include "vulkan/buffer.h"
@@ -14,8 +15,29 @@ struct Camera;
 // The scene's attributes on the GPU, as the loader produced them (raw log scales and logits).
 struct SceneBuffers {
   vk::Buffer positions, log_scales, rotations, opacity_logits, sh;
+  // Made from the above on the first frame of an accuracy mode that reads them (fp16 SH, fp16
+  // covariance); never allocated otherwise.
+  vk::Buffer sh_half, covariances_half;
   uint32_t count = 0;
   int sh_degree = 0;
+};
+
+// Which projection a frame runs: the accuracy modes it specializes for (AccuracyModes).
+struct ProjectionVariant {
+  int sh_degree = 0;         // evaluated degree: min(scene degree, cap)
+  int stored_sh_degree = 0;  // the scene's
+  bool sh_half = false;
+  bool covariance_half = false;
+  bool opacity_extent = false;
+  bool square_tiles = false;
+  float alpha_inv = 255.0f;
+  uint32_t depth_key_bits = 32;
+  bool ray_depth = false;  // write ProjectedBuffers::ray_depth
+  auto tie() const {
+    return std::tie(sh_degree, stored_sh_degree, sh_half, covariance_half, opacity_extent, square_tiles, alpha_inv,
+                    depth_key_bits, ray_depth);
+  }
+  bool operator<(const ProjectionVariant& o) const { return tie() < o.tie(); }
 };
 
 // Bytes of one projected splat record (SPLAT_VEC4S vec4 in compute/common.glsl).
@@ -29,20 +51,29 @@ struct ProjectedBuffers {
   vk::Buffer depth_offsets;  // uint per depth position: exclusive prefix sum of tile_counts in depth order
   vk::Buffer offsets;        // uint per Gaussian: where its (tile, Gaussian) pairs start (the same sums)
   KeyBuffers depth_order;  // the depth sort's pairs: view depth bits (culled: last), Gaussian index
+  vk::Buffer ray_depth;    // RAY_DEPTH_VEC4S vec4 per Gaussian, only for per-pixel re-sorting
 };
+
+// Bytes of one Gaussian's per-pixel re-sorting data (RAY_DEPTH_VEC4S in compute/common.glsl).
+constexpr uint32_t kRayDepthBytes = 3 * 16;
 
 class ProjectionPass {
  public:
   explicit ProjectionPass(vk::Context& ctx);
   // Writes this frame's camera; must be called before record(), outside the command buffer.
   void set_camera(const Camera& camera);
-  void record(VkCommandBuffer cmd, const SceneBuffers& scene, ProjectedBuffers& out, VkDeviceAddress counters);
+  // Makes the half-precision copies the variant reads, once per scene (outside any command buffer).
+  void prepare(SceneBuffers& scene, const ProjectionVariant& variant);
+  void record(VkCommandBuffer cmd, const SceneBuffers& scene, ProjectedBuffers& out, VkDeviceAddress counters,
+              const ProjectionVariant& variant);
 
  private:
-  const vk::ComputePipeline& pipeline_for(int sh_degree);
+  const vk::ComputePipeline& pipeline_for(const ProjectionVariant& variant);
   vk::Context& ctx_;
   vk::Buffer camera_params_;
-  std::map<int, vk::ComputePipeline> pipelines_;  // one per SH degree (specialization constant)
+  std::map<ProjectionVariant, vk::ComputePipeline> pipelines_;  // specialization constants per variant
+  vk::ComputePipeline pack_sh_half_;
+  vk::ComputePipeline pack_covariance_half_;
 };
 
 }  // namespace tilesplat

@@ -1,0 +1,294 @@
+#include "accuracy_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "bench_plot.h"
+#include "cli.h"
+#include "tilesplat/image.h"
+#include "tilesplat/reference.h"
+
+namespace tilesplat::accuracy {
+
+namespace {
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+std::string fixed(double value, int decimals) {
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  if (std::isnan(value)) return "nan";
+  return cli::format_fixed(value, decimals);
+}
+
+std::string csv_quote(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+AccuracyModes with(std::initializer_list<const char*> tokens) {
+  std::string text;
+  for (const char* token : tokens) {
+    if (!text.empty()) text += '+';
+    text += token;
+  }
+  return parse_accuracy_modes(text);
+}
+
+}  // namespace
+
+std::vector<AccuracyModes> default_modes() {
+  return {with({"reference"}),
+          with({"depth24"}),
+          with({"depth16"}),
+          with({"square-tiles"}),
+          with({"opacity-extent"}),
+          with({"opacity-extent", "square-tiles"}),
+          with({"sh0"}),
+          with({"sh1"}),
+          with({"sh2"}),
+          with({"fp16-sh"}),
+          with({"fp16-cov"}),
+          with({"t-cutoff=1e-3"}),
+          with({"t-cutoff=1e-2"}),
+          with({"alpha-cutoff=1/128"}),
+          with({"alpha-cutoff=1/64"}),
+          with({"resort4"}),
+          with({"resort8"}),
+          // What a web viewer does: 16-bit depths, fp16 attributes, opacity-aware squares.
+          with({"depth16", "opacity-extent", "fp16-sh", "fp16-cov"}),
+          // ... and looser cut-offs on top.
+          with({"depth16", "opacity-extent", "fp16-sh", "fp16-cov", "t-cutoff=1e-3", "alpha-cutoff=1/64"})};
+}
+
+bool applies_to(const AccuracyModes& modes, int scene_sh_degree) {
+  return modes.sh_degree_cap >= 3 || modes.sh_degree_cap < scene_sh_degree;
+}
+
+std::vector<Camera> dolly_path(const Camera& start, const std::array<double, 3>& centre, int frames,
+                               double step_fraction) {
+  double distance = 0;
+  for (int k = 0; k < 3; ++k) distance += (centre[k] - start.position[k]) * (centre[k] - start.position[k]);
+  const double step = step_fraction * std::sqrt(distance);
+  std::vector<Camera> path;
+  for (int f = 0; f < frames; ++f) {
+    Camera camera = start;
+    // The rows of the world-to-camera rotation are the camera's axes in world space; row 0 is x.
+    for (int k = 0; k < 3; ++k) camera.position[k] += f * step * start.rotation[k];
+    path.push_back(camera);
+  }
+  return path;
+}
+
+int work_units(const Options& options, int scene_sh_degree) {
+  const auto modes = options.modes.empty() ? default_modes() : options.modes;
+  int applicable = 0;
+  for (const auto& m : modes) applicable += applies_to(m, scene_sh_degree) ? 1 : 0;
+  const int views = int(options.views.size());
+  // References: each view and each path frame; renders: per mode, per view the timed frames, and the path.
+  return views + options.path_frames + applicable * (views * (options.warmup + options.repeat) + options.path_frames);
+}
+
+SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const Options& options,
+                          const std::function<void(int, int, const std::string&)>& progress) {
+  if (options.views.empty()) throw std::invalid_argument("accuracy report: no views");
+  const auto modes = options.modes.empty() ? default_modes() : options.modes;
+  const int total = work_units(options, scene.sh_degree);
+  int done = 0;
+  auto step = [&](const std::string& what) { progress(++done, total, what); };
+
+  SceneReport report;
+  report.path_frames = options.path_frames;
+  RenderSettings reference_settings;
+  reference_settings.depth = false;
+  reference_settings.splat_count = false;
+
+  std::vector<RenderImage> references;
+  for (size_t v = 0; v < options.views.size(); ++v) {
+    references.push_back(render_reference(scene, options.views[v], reference_settings));
+    step("float64 reference, " + options.view_names[v]);
+  }
+  const Bounds bounds = compute_bounds(scene);
+  const std::vector<Camera> path =
+      dolly_path(options.views.front(), {bounds.center[0], bounds.center[1], bounds.center[2]},
+                 options.path_frames, options.path_step);
+  std::vector<RenderImage> path_references;
+  for (size_t f = 0; f < path.size(); ++f) {
+    path_references.push_back(render_reference(scene, path[f], reference_settings));
+    step("float64 reference, path frame " + std::to_string(f));
+  }
+  // Raw change between two frames: the excess over a sequence that stands still.
+  auto flicker_of = [](const RenderImage& a0, const RenderImage& a1) {
+    return temporal_excess(a0, a1, a0, a0, kFlickerThreshold).flicker_fraction;
+  };
+  for (size_t f = 1; f < path_references.size(); ++f) {
+    const double pairs = double(path.size() - 1);
+    report.reference_change += frame_change(path_references[f - 1], path_references[f]) / pairs;
+    report.reference_flicker += flicker_of(path_references[f - 1], path_references[f]) / pairs;
+  }
+
+  renderer.set_scene(scene);
+  for (const AccuracyModes& m : modes) {
+    if (!applies_to(m, scene.sh_degree)) continue;
+    ModeResult result;
+    result.modes = m;
+    result.name = to_string(m);
+    RenderSettings settings;
+    settings.sort = options.sort;
+    settings.depth = false;
+    settings.splat_count = false;
+    settings.accuracy = m;
+
+    std::vector<double> frame_ms_per_view;
+    std::map<std::string, std::vector<double>> pass_ms_per_view;
+    std::vector<std::string> pass_order;
+    double psnr_sum = 0, ssim_sum = 0;
+    for (size_t v = 0; v < options.views.size(); ++v) {
+      RenderImage image;
+      std::vector<double> frames;
+      std::map<std::string, std::vector<double>> passes;
+      for (int r = 0; r < options.warmup + options.repeat; ++r) {
+        image = renderer.render(options.views[v], settings);
+        const FrameStats& stats = renderer.last_frame_stats();
+        if (r >= options.warmup) {
+          frames.push_back(stats.gpu_ms);
+          // A pass recorded several times a frame counts once, with its total.
+          std::map<std::string, double> frame_passes;
+          for (const auto& pass : stats.passes) {
+            if (std::find(pass_order.begin(), pass_order.end(), pass.name) == pass_order.end())
+              pass_order.push_back(pass.name);
+            frame_passes[pass.name] += pass.gpu_ms;
+          }
+          for (const auto& [name, ms] : frame_passes) passes[name].push_back(ms);
+        }
+        if (v == 0) result.intersections = stats.intersections;
+        step(result.name + ", " + options.view_names[v]);
+      }
+      frame_ms_per_view.push_back(median(frames));
+      for (const auto& [name, samples] : passes) pass_ms_per_view[name].push_back(median(samples));
+      const ImageDifference difference = compare_images(image, references[v]);
+      psnr_sum += difference.psnr_db;
+      ssim_sum += ssim(image, references[v]);
+      result.max_abs = std::max(result.max_abs, difference.max_abs);
+    }
+    result.frame_ms = median(frame_ms_per_view);
+    for (const auto& name : pass_order) result.passes.push_back({name, median(pass_ms_per_view[name])});
+    result.psnr_db = psnr_sum / double(options.views.size());
+    result.ssim = ssim_sum / double(options.views.size());
+
+    std::vector<RenderImage> frames;
+    for (size_t f = 0; f < path.size(); ++f) {
+      frames.push_back(renderer.render(path[f], settings));
+      step(result.name + ", path frame " + std::to_string(f));
+    }
+    for (size_t f = 1; f < frames.size(); ++f) {
+      const double pairs = double(frames.size() - 1);
+      result.frame_change += frame_change(frames[f - 1], frames[f]) / pairs;
+      result.flicker += flicker_of(frames[f - 1], frames[f]) / pairs;
+      result.excess +=
+          temporal_excess(frames[f - 1], frames[f], path_references[f - 1], path_references[f]).mean_abs / pairs;
+    }
+    report.modes.push_back(std::move(result));
+  }
+  return report;
+}
+
+std::string text_table(const SceneReport& report) {
+  std::string text = "  " + report.scene + ", " + report.description + ", " + report.views +
+                     "; float64 reference on the dolly: " + fixed(100.0 * report.reference_flicker, 3) +
+                     "% flicker\n";
+  char line[512];
+  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s\n", "mode", "GPU ms", "vs ref",
+                "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess");
+  text += line;
+  const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
+  for (const auto& m : report.modes) {
+    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s\n", m.name.c_str(),
+                  fixed(m.frame_ms, 2).c_str(), fixed(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2).c_str(),
+                  fixed(m.psnr_db, 2).c_str(), fixed(m.ssim, 5).c_str(), fixed(m.max_abs, 4).c_str(),
+                  static_cast<unsigned long long>(m.intersections), fixed(100.0 * m.flicker, 3).c_str(),
+                  fixed(m.excess, 5).c_str());
+    text += line;
+  }
+  return text;
+}
+
+std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& device, const std::string& command) {
+  std::string md = "Device: " + device.name + " (" + device.driver + "). Command:\n\n```\n" + command + "\n```\n";
+  for (const auto& report : reports) {
+    md += "\n### " + report.scene + "\n\n" + report.description + "; " + report.views + ". Popping over a " +
+          std::to_string(report.path_frames) + "-frame dolly: the float64 reference itself changes " +
+          fixed(report.reference_change, 5) + " per frame on average, with " +
+          fixed(100.0 * report.reference_flicker, 3) + "% of pixels changing by more than " +
+          fixed(kFlickerThreshold, 2) + " (flicker).\n\n";
+    md += "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change |\n";
+    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
+    for (const auto& m : report.modes)
+      md += "| " + m.name + " | " + fixed(m.frame_ms, 2) + " | " +
+            fixed(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2) + "x | " + fixed(m.psnr_db, 2) + " | " +
+            fixed(m.ssim, 5) + " | " + fixed(m.max_abs, 4) + " | " + std::to_string(m.intersections) + " | " +
+            fixed(100.0 * m.flicker, 3) + " | " + fixed(m.excess, 5) + " |\n";
+    // Per-pass times: a column per mode would not fit; the passes whose time a mode changes.
+    md += "\nPer-pass median GPU ms:\n\n| mode |";
+    std::vector<std::string> names;
+    for (const auto& m : report.modes)
+      for (const auto& p : m.passes)
+        if (std::find(names.begin(), names.end(), p.name) == names.end()) names.push_back(p.name);
+    for (const auto& name : names) md += " " + name + " |";
+    md += "\n|---|";
+    for (size_t i = 0; i < names.size(); ++i) md += "---:|";
+    md += "\n";
+    for (const auto& m : report.modes) {
+      md += "| " + m.name + " |";
+      for (const auto& name : names) {
+        auto it = std::find_if(m.passes.begin(), m.passes.end(), [&](const PassTime& p) { return p.name == name; });
+        md += ' ';
+        md += it == m.passes.end() ? std::string("-") : fixed(it->ms, 2);
+        md += " |";
+      }
+      md += "\n";
+    }
+  }
+  return md;
+}
+
+std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& device) {
+  std::string out =
+      "device,scene,mode,gpu_frame_ms,psnr_db,ssim,max_abs,intersections,frame_change,flicker_fraction,"
+      "excess_change,passes\n";
+  for (const auto& report : reports)
+    for (const auto& m : report.modes) {
+      std::string passes;
+      for (const auto& p : m.passes) passes += (passes.empty() ? "" : ";") + p.name + "=" + fixed(p.ms, 4);
+      out += csv_quote(device.name) + "," + csv_quote(report.scene) + "," + csv_quote(m.name) + "," +
+             fixed(m.frame_ms, 4) + "," + fixed(m.psnr_db, 4) + "," + fixed(m.ssim, 6) + "," + fixed(m.max_abs, 6) +
+             "," + std::to_string(m.intersections) + "," + fixed(m.frame_change, 6) + "," + fixed(m.flicker, 6) +
+             "," + fixed(m.excess, 6) + "," + csv_quote(passes) + "\n";
+    }
+  return out;
+}
+
+std::string pareto_svg(const SceneReport& report, const DeviceInfo& device) {
+  plot::ScatterChart chart;
+  chart.title = "Accuracy against time: " + report.scene;
+  chart.subtitle = report.description + ", " + report.views + "; " + device.name;
+  chart.x_label = "median GPU frame time (ms)";
+  chart.y_label = "PSNR against the float64 reference (dB)";
+  chart.y_higher_is_better = true;
+  for (size_t i = 0; i < report.modes.size(); ++i) {
+    const auto& m = report.modes[i];
+    chart.points.push_back({m.name, m.frame_ms, m.psnr_db, i});
+  }
+  return plot::scatter_svg(chart);
+}
+
+}  // namespace tilesplat::accuracy

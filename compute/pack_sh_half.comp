@@ -1,0 +1,22 @@
+#version 460
+// fp16 SH storage (AccuracyModes::fp16_sh), made once per scene on first use: one invocation per
+// output word packs two consecutive float coefficients into 16-bit halves. Halving the SH bytes is
+// what the mode buys: SH are most of a scene's memory and of the projection's reads.
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(push_constant) uniform Push {
+  FloatArray sh;
+  UintArray sh_half;
+  uint values;  // floats in sh
+} pc;
+
+void main() {
+  uint w = gl_GlobalInvocationID.x;
+  if (2 * w >= pc.values) return;
+  float lo = pc.sh.v[2 * w];
+  float hi = 2 * w + 1 < pc.values ? pc.sh.v[2 * w + 1] : 0.0;
+  pc.sh_half.v[w] = packHalf2x16(vec2(lo, hi));
+}

@@ -1,0 +1,29 @@
+// Composite with per-pixel re-sorting of a window of splats by their depth along each pixel's ray
+// (AccuracyModes::resort_window). Runs instead of CompositePass in that mode.
+#pragma once
+
+#include <map>
+#include <tuple>
+
+#include "passes/composite_pass.h"
+
+namespace tilesplat {
+
+struct Camera;
+
+class CompositeResortPass {
+ public:
+  explicit CompositeResortPass(vk::Context& ctx);
+  // ray_depth: the projection's per-Gaussian re-sorting data (ProjectedBuffers::ray_depth).
+  void record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& ray_depth,
+              const vk::Buffer& sorted_indices, const vk::Buffer& ranges, OutputBuffers& out, const Camera& camera,
+              const std::array<float, 3>& background, bool write_depth, bool write_count,
+              const CompositePass::Cutoffs& cutoffs, uint32_t window);
+
+ private:
+  vk::Context& ctx_;
+  uint32_t pixels_per_invocation_;
+  std::map<std::tuple<bool, bool, CompositePass::Cutoffs, uint32_t>, vk::ComputePipeline> pipelines_;
+};
+
+}  // namespace tilesplat
