@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages tilesplat builds and tests with, only when one is missing.
 # Safe to run repeatedly; needs root (or sudo) only when something must be installed.
+# --fuzz adds clang and its compiler-rt (libFuzzer) for tests/fuzz/run.sh; the normal build needs neither.
 set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build pkg-config
@@ -9,6 +10,9 @@ pkgs=(
   libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev
   libgtest-dev googletest
 )
+if [ "${1:-}" = "--fuzz" ]; then
+  pkgs+=(clang libclang-rt-dev)
+fi
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -4,8 +4,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace tilesplat {
@@ -61,6 +63,10 @@ struct LoadReport {
 // Reads a 3DGS PLY (binary little/big endian or ASCII). Throws SceneError.
 GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& options = {},
                        LoadReport* report = nullptr);
+
+// The same reader on a PLY already in memory; `name` stands for the file in error messages.
+GaussianScene parse_ply(std::span<const std::byte> data, std::string_view name, const LoadOptions& options = {},
+                        LoadReport* report = nullptr);
 
 // Picks the reader by extension (only .ply for now). Throws SceneError.
 GaussianScene load_scene(const std::filesystem::path& path, const LoadOptions& options = {},

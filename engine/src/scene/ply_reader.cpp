@@ -1,6 +1,7 @@
 // Reader for 3DGS PLY files: binary (little or big endian) and ASCII.
 //
-// The whole file is mapped (or read with one call) and decoded in place. Properties are found by name;
+// The whole file is mapped (or read with one call) and decoded in place; parse_ply decodes a buffer
+// the caller holds (the fuzz harness in tests/fuzz uses it). Properties are found by name;
 // every value is converted to float. Structure (element sizes, truncation, trailing bytes) is
 // validated before the output arrays are allocated, so a malformed header can never trigger a
 // huge allocation.
@@ -15,6 +16,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -298,12 +300,26 @@ class FileContents {
   std::unique_ptr<unsigned char[]> buffer_;
 };
 
+// Checks that `path` names a readable regular file and maps or reads it; throws SceneError.
+void open_scene_file(const std::filesystem::path& path, FileContents& contents) {
+  const auto fail = [&](const std::string& what) { throw SceneError(path.string() + ": " + what); };
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec && status.type() != std::filesystem::file_type::not_found) fail("cannot open: " + ec.message());
+  if (!std::filesystem::exists(status)) fail("cannot open: no such file");
+  if (std::filesystem::is_directory(status)) fail("cannot open: is a directory, not a file");
+  if (!std::filesystem::is_regular_file(status)) fail("cannot open: not a regular file");
+  if (const std::string error = contents.open(path); !error.empty()) fail(error);
+}
+
+// Decodes a PLY held in memory. `name` (the file's path, for load_ply) prefixes every error.
 class PlyReader {
  public:
-  PlyReader(const std::filesystem::path& path, const LoadOptions& options) : path_(path), options_(options) {}
+  PlyReader(std::string_view name, const unsigned char* bytes, size_t size, const LoadOptions& options)
+      : name_(name), options_(options), bytes_(bytes), size_(size) {}
 
   GaussianScene read(LoadReport* report) {
-    read_file();
+    if (size_ == 0) fail("empty file, not a PLY file");
     parse_header();
     plan_vertex_columns();
 
@@ -329,22 +345,9 @@ class PlyReader {
   }
 
  private:
-  [[noreturn]] void fail(const std::string& what) const { throw SceneError(path_.string() + ": " + what); }
+  [[noreturn]] void fail(const std::string& what) const { throw SceneError(std::string(name_) + ": " + what); }
 
   const PlyElement& vertex() const { return header_.elements[header_.vertex_element]; }
-
-  void read_file() {
-    std::error_code ec;
-    const auto status = std::filesystem::status(path_, ec);
-    if (ec && status.type() != std::filesystem::file_type::not_found) fail("cannot open: " + ec.message());
-    if (!std::filesystem::exists(status)) fail("cannot open: no such file");
-    if (std::filesystem::is_directory(status)) fail("cannot open: is a directory, not a file");
-    if (!std::filesystem::is_regular_file(status)) fail("cannot open: not a regular file");
-    if (const std::string error = contents_.open(path_); !error.empty()) fail(error);
-    bytes_ = contents_.data();
-    size_ = contents_.size();
-    if (size_ == 0) fail("empty file, not a PLY file");
-  }
 
   std::string_view text(size_t begin, size_t end) const {
     return {reinterpret_cast<const char*>(bytes_) + begin, end - begin};
@@ -954,9 +957,8 @@ class PlyReader {
     }
   }
 
-  const std::filesystem::path& path_;
+  std::string_view name_;
   const LoadOptions& options_;
-  FileContents contents_;
   const unsigned char* bytes_ = nullptr;
   size_t size_ = 0;
   PlyHeader header_;
@@ -970,9 +972,16 @@ class PlyReader {
 
 }  // namespace
 
-GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report) {
-  PlyReader reader(path, options);
+GaussianScene parse_ply(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
+                        LoadReport* report) {
+  PlyReader reader(name, reinterpret_cast<const unsigned char*>(data.data()), data.size(), options);
   return reader.read(report);
+}
+
+GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report) {
+  FileContents contents;
+  open_scene_file(path, contents);
+  return parse_ply(std::as_bytes(std::span(contents.data(), contents.size())), path.string(), options, report);
 }
 
 }  // namespace tilesplat

@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# Fuzzes the scene readers: builds the libFuzzer harnesses with clang + ASan + UBSan in build-fuzz/,
+# replays every committed regression input (tests/fuzz/regressions/READER/), then fuzzes each reader
+# for SECONDS, seeded with a few Gaussians cut from every PLY in the shared scenes and scenes/.
+#
+#   bash tests/fuzz/run.sh [SECONDS]     (default 60; env: TILESPLAT_SHARED_SCENES, FUZZ_BUILD_DIR, FUZZ_CXX)
+#
+# libFuzzer's output goes to BUILD/fuzz_READER.log. On a finding (crash, sanitizer report, an
+# exception other than SceneError, a timeout, more than 2 GB of memory) it prints the log's tail and
+# the input, saved under BUILD/artifacts/READER/, and fails. Fix it, then keep the input as a
+# regression: copy it to tests/fuzz/regressions/READER/ under a name that says what it was.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+seconds="${1:-60}"
+build="${FUZZ_BUILD_DIR:-build-fuzz}"
+scenes="${TILESPLAT_SHARED_SCENES:-$(cd .. && pwd)/shared/scenes}"
+readers=(ply)
+fuzz_flags=(-timeout=10 -rss_limit_mb=2048 -max_len=16384)
+
+mkdir -p "$build"
+findings() {  # the end of a libFuzzer log without its progress lines
+  grep -v -E '^#[0-9]+[[:space:]]+(NEW|REDUCE|pulse|INITED|RELOAD)|^Executed ' "$1" | tail -n 50
+}
+quiet() {  # quiet LOG COMMAND...: runs COMMAND with its output in LOG, shown only when it fails
+  local log="$1"
+  shift
+  "$@" >"$log" 2>&1 || { tail -n 40 "$log"; echo "fuzz: failed: $* (log: $log)"; return 1; }
+}
+quiet "$build/setup.log" bash cmake/setup-deps.sh --fuzz
+echo "fuzz: $(head -n 1 "$build/setup.log" | cut -c1-100); $("${FUZZ_CXX:-clang++}" --version | head -n 1)"
+quiet "$build/configure.log" env CXX="${FUZZ_CXX:-clang++}" \
+  cmake -S . -B "$build" -G Ninja -DTILESPLAT_FUZZ=ON
+quiet "$build/build.log" cmake --build "$build" -j2
+
+seed_dirs=(scenes)
+[ -d "$scenes" ] && seed_dirs=("$scenes" scenes) || echo "fuzz: $scenes not found, seeding from scenes/ only"
+rm -rf "$build/seeds"
+quiet "$build/seeds.log" "$build/tests/fuzz/make_ply_seeds" "$build/seeds/ply" "${seed_dirs[@]}"
+echo "fuzz: $(tail -n 1 "$build/seeds.log")"
+
+# libFuzzer's timeout is wall-clock: a process the machine stops or starves for a while reports
+# one on whatever input it was running. Such a "timeout" that replays in time is not a finding.
+stalled() {  # stalled FUZZER ARTIFACT_DIR
+  local found=("$2"*)
+  [ ${#found[@]} -eq 1 ] && [[ "$(basename "${found[0]}")" == timeout-* ]] &&
+    "$1" -timeout=10 -rss_limit_mb=2048 "${found[0]}" >/dev/null 2>&1
+}
+
+status=0
+for reader in "${readers[@]}"; do
+  fuzzer="$build/tests/fuzz/fuzz_$reader"
+  regressions="tests/fuzz/regressions/$reader"
+  log="$build/fuzz_$reader.log"
+  artifacts="$build/artifacts/$reader/"
+  rm -rf "$artifacts"
+  mkdir -p "$regressions" "$build/corpus/$reader" "$artifacts"
+  # Each regression input once, whole (no -max_len), no mutation.
+  mapfile -t inputs < <(find "$regressions" -type f | sort)
+  if [ ${#inputs[@]} -gt 0 ] &&
+     ! "$fuzzer" -timeout=10 -rss_limit_mb=2048 "${inputs[@]}" >"$build/regressions_$reader.log" 2>&1; then
+    findings "$build/regressions_$reader.log"
+    echo "fuzz: FAILED: a regression input of $regressions crashes fuzz_$reader again"
+    status=1
+    continue
+  fi
+  echo "fuzz: $reader: ${#inputs[@]} regression inputs replay cleanly"
+  # New inputs go to the first directory (BUILD/corpus, kept between local runs), never to the seeds
+  # or the committed regressions.
+  if "$fuzzer" "${fuzz_flags[@]}" -max_total_time="$seconds" -print_final_stats=1 \
+       -dict="tests/fuzz/$reader.dict" -artifact_prefix="$artifacts" \
+       "$build/corpus/$reader" "$build/seeds/$reader" "$regressions" >"$log" 2>&1; then
+    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+    cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1)
+    echo "fuzz: $reader: ${seconds}s, ${runs:-?} inputs, $cov, no findings (log: $log)"
+  elif stalled "$fuzzer" "$artifacts"; then
+    echo "fuzz: $reader: a timeout that does not reproduce (the process was stalled, not the input slow): ignored"
+  else
+    findings "$log"
+    echo "fuzz: FAILED: fuzz_$reader found a problem; the input is in $artifacts:"
+    ls -l "$artifacts"
+    echo "fuzz: reproduce with: $fuzzer ${artifacts}FILE ; once fixed, copy the file to $regressions/"
+    status=1
+  fi
+done
+exit $status
