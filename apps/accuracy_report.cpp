@@ -93,8 +93,10 @@ int work_units(const Options& options, int scene_sh_degree) {
   int applicable = 0;
   for (const auto& m : modes) applicable += applies_to(m, scene_sh_degree) ? 1 : 0;
   const int views = int(options.views.size());
-  // References: each view and each path frame; renders: per mode, per view the timed frames, and the path.
-  return views + options.path_frames + applicable * (views * (options.warmup + options.repeat) + options.path_frames);
+  // The path starts at the first view, whose reference and render it reuses. References: each view and
+  // each later path frame; renders: per mode, per view the timed frames, and the later path frames.
+  const int later_path_frames = std::max(options.path_frames - 1, 0);
+  return views + later_path_frames + applicable * (views * (options.warmup + options.repeat) + later_path_frames);
 }
 
 SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const Options& options,
@@ -120,8 +122,13 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
   const std::vector<Camera> path =
       dolly_path(options.views.front(), {bounds.center[0], bounds.center[1], bounds.center[2]},
                  options.path_frames, options.path_step);
+  // path[0] is the first view: its reference is already made.
   std::vector<RenderImage> path_references;
   for (size_t f = 0; f < path.size(); ++f) {
+    if (f == 0) {
+      path_references.push_back(references.front());
+      continue;
+    }
     path_references.push_back(render_reference(scene, path[f], reference_settings));
     step("float64 reference, path frame " + std::to_string(f));
   }
@@ -151,6 +158,7 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     std::map<std::string, std::vector<double>> pass_ms_per_view;
     std::vector<std::string> pass_order;
     double psnr_sum = 0, ssim_sum = 0;
+    RenderImage first_view;  // also the path's first frame
     for (size_t v = 0; v < options.views.size(); ++v) {
       RenderImage image;
       std::vector<double> frames;
@@ -178,6 +186,7 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
       psnr_sum += difference.psnr_db;
       ssim_sum += ssim(image, references[v]);
       result.max_abs = std::max(result.max_abs, difference.max_abs);
+      if (v == 0) first_view = std::move(image);
     }
     result.frame_ms = median(frame_ms_per_view);
     for (const auto& name : pass_order) result.passes.push_back({name, median(pass_ms_per_view[name])});
@@ -186,6 +195,10 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
 
     std::vector<RenderImage> frames;
     for (size_t f = 0; f < path.size(); ++f) {
+      if (f == 0) {
+        frames.push_back(std::move(first_view));
+        continue;
+      }
       frames.push_back(renderer.render(path[f], settings));
       step(result.name + ", path frame " + std::to_string(f));
     }

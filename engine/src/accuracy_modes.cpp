@@ -12,9 +12,6 @@ namespace tilesplat {
 
 namespace {
 
-constexpr float kReferenceTransmittanceCutoff = 1e-4f;
-constexpr float kReferenceAlphaCutoff = 1.0f / 255.0f;
-
 [[noreturn]] void bad(const std::string& token, const std::string& why) {
   throw std::invalid_argument("accuracy mode '" + token + "': " + why);
 }
@@ -75,17 +72,18 @@ void validate(const AccuracyModes& m) {
 }
 
 std::string to_string(const AccuracyModes& m) {
+  const AccuracyModes reference;
   std::vector<std::string> parts;
-  if (m.depth_key_bits != 32) parts.push_back("depth" + std::to_string(m.depth_key_bits));
+  if (m.depth_key_bits != reference.depth_key_bits) parts.push_back("depth" + std::to_string(m.depth_key_bits));
   if (m.extent == AccuracyModes::Extent::kOpacityAware) parts.push_back("opacity-extent");
   if (m.tile_test == AccuracyModes::TileTest::kSquare) parts.push_back("square-tiles");
-  if (m.sh_degree_cap != 3) parts.push_back("sh" + std::to_string(m.sh_degree_cap));
+  if (m.sh_degree_cap != reference.sh_degree_cap) parts.push_back("sh" + std::to_string(m.sh_degree_cap));
   if (m.fp16_sh) parts.push_back("fp16-sh");
   if (m.fp16_covariance) parts.push_back("fp16-cov");
-  if (m.transmittance_cutoff != kReferenceTransmittanceCutoff)
+  if (m.transmittance_cutoff != reference.transmittance_cutoff)
     parts.push_back("t-cutoff=" + format_value(m.transmittance_cutoff));
-  if (m.alpha_cutoff != kReferenceAlphaCutoff) parts.push_back("alpha-cutoff=" + format_value(m.alpha_cutoff));
-  if (m.resort_window != 0) parts.push_back("resort" + std::to_string(m.resort_window));
+  if (m.alpha_cutoff != reference.alpha_cutoff) parts.push_back("alpha-cutoff=" + format_value(m.alpha_cutoff));
+  if (m.resort_window != reference.resort_window) parts.push_back("resort" + std::to_string(m.resort_window));
   if (parts.empty()) return "reference";
   std::string text = parts[0];
   for (size_t i = 1; i < parts.size(); ++i) text += "+" + parts[i];

@@ -24,6 +24,7 @@
 #include "passes/key_emission_pass.h"
 #include "passes/prefix_sum_pass.h"
 #include "passes/projection_pass.h"
+#include "passes/tile_coverage.h"
 #include "passes/tile_ranges_pass.h"
 #include "sort/sort_strategy.h"
 #include "tilesplat/reference.h"
@@ -139,7 +140,7 @@ struct Renderer::Impl {
     v.covariance_half = modes.fp16_covariance;
     v.opacity_extent = modes.extent == AccuracyModes::Extent::kOpacityAware;
     v.square_tiles = modes.tile_test == AccuracyModes::TileTest::kSquare;
-    v.alpha_inv = float(1.0 / double(modes.alpha_cutoff));
+    v.alpha_inv = coverage_alpha_inv(modes.alpha_cutoff);
     v.depth_key_bits = uint32_t(modes.depth_key_bits);
     v.ray_depth = modes.resort_window > 0;
     return v;

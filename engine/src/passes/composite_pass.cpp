@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "passes/tile_coverage.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
@@ -38,8 +39,7 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
   auto key = std::make_tuple(write_depth, write_count, cutoffs);
   auto it = pipelines_.find(key);
   if (it == pipelines_.end()) {
-    // 1 / alpha rounded once on the host, as the projection's tile coverage uses it (255 exactly).
-    const float alpha_inv = float(1.0 / double(cutoffs.alpha));
+    const float alpha_inv = coverage_alpha_inv(cutoffs.alpha);
     it = pipelines_
              .emplace(key, vk::ComputePipeline(ctx_, "composite", sizeof(CompositePush),
                                                {{0, write_depth ? 1u : 0u},
