@@ -13,6 +13,12 @@
 // branch on it. CPU drivers execute both sides of every branch under a lane mask and only leave a
 // loop for real, so there each invocation first lists the splats that reach its column and then
 // loops over just those.
+//
+// A tile's list is blended in chunks of at most `chunk_size` splats, one dispatch per chunk, with the
+// pixels' state carried through a buffer between them. llvmpipe silently cuts a shader short after
+// 65535 loop iterations, which a tile of ~60k faint splats reaches: there the host sets a chunk size
+// that stays within the limit (GPUs use one chunk). Chunk 0 records the longest list that did not
+// fit, and the host re-renders the frame with enough chunks.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "tile_coverage.glsl"
@@ -33,10 +39,15 @@ layout(push_constant) uniform Push {
   Vec4Array out_rgba;
   FloatArray out_depth;
   UintArray out_count;
+  Vec4Array state;     // 2 vec4 per pixel between chunks: (colour, T), (depth sum, weight sum, blended, 0)
+  UintArray counters;  // COUNTER_MAX_TILE_PAIRS
   vec4 background;
   uint width;
   uint height;
   uint tiles_x;
+  uint chunk_start;  // position in each tile's list where this dispatch starts
+  uint chunk_size;   // splats per tile this dispatch blends at most
+  uint last_chunk;   // 1: write the outputs whatever is left
 } pc;
 
 const uint P = PIXELS_PER_INVOCATION;
@@ -137,6 +148,16 @@ void main() {
   uint px = tile.x * TILE_SIZE + local_x;
   uint py0 = tile.y * TILE_SIZE + local_y0;
 
+  uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
+  uint list_length = range.y - range.x;
+  bool resume = pc.chunk_start > 0;
+  if (resume && list_length <= pc.chunk_start) return;  // an earlier chunk finished this tile
+  if (!resume && list_length > pc.chunk_size && thread == 0)
+    atomicMax(pc.counters.v[COUNTER_MAX_TILE_PAIRS], list_length);
+  uint list_begin = range.x + pc.chunk_start;
+  uint list_end = list_length - pc.chunk_start <= pc.chunk_size ? range.y : list_begin + pc.chunk_size;
+  bool write_outputs = list_end == range.y || pc.last_chunk != 0;
+
   for (uint p = 0; p < P; ++p) {
     bool outside = px >= pc.width || py0 + p >= pc.height;
     T[p] = outside ? -1.0 : 1.0;
@@ -144,7 +165,17 @@ void main() {
     depth_sum[p] = 0.0;
     weight_sum[p] = 0.0;
     blended[p] = 0;
-    my_done += outside ? 1u : 0u;
+    if (resume && !outside) {
+      uint i = (py0 + p) * pc.width + px;
+      vec4 colour_T = pc.state.v[2 * i];
+      vec4 sums = pc.state.v[2 * i + 1];
+      colour[p] = colour_T.rgb;
+      T[p] = colour_T.a;
+      depth_sum[p] = sums.x;
+      weight_sum[p] = sums.y;
+      blended[p] = floatBitsToUint(sums.z);
+    }
+    my_done += T[p] < 0.0 ? 1u : 0u;
   }
 
   if (thread == 0) s_done_pixels = 0;
@@ -158,11 +189,10 @@ void main() {
     else bottom_done += T[p] < 0.0 ? 1u : 0u;
   }
 
-  uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
-  for (uint batch_start = range.x; batch_start < range.y; batch_start += BATCH) {
+  for (uint batch_start = list_begin; batch_start < list_end; batch_start += BATCH) {
     barrier();  // previous batch fully consumed; s_done_pixels up to date
     if (s_done_pixels == TILE_PIXELS) break;
-    uint batch_size = min(BATCH, range.y - batch_start);
+    uint batch_size = min(BATCH, list_end - batch_start);
     for (uint k = thread; k < batch_size; k += threads) {
       uint g = pc.sorted_indices.v[batch_start + k];
       vec4 mdo = pc.splats.v[SPLAT_VEC4S * g + 0];
@@ -215,6 +245,11 @@ void main() {
     uint py = py0 + p;
     if (px >= pc.width || py >= pc.height) continue;
     uint i = py * pc.width + px;
+    if (!write_outputs) {
+      pc.state.v[2 * i] = vec4(colour[p], T[p]);
+      pc.state.v[2 * i + 1] = vec4(depth_sum[p], weight_sum[p], uintBitsToFloat(blended[p]), 0.0);
+      continue;
+    }
     float transmittance = abs(T[p]);
     pc.out_rgba.v[i] = vec4(colour[p] + transmittance * pc.background.rgb, 1.0 - transmittance);
     if (WRITE_DEPTH) pc.out_depth.v[i] = weight_sum[p] > 0.0 ? depth_sum[p] / weight_sum[p] : 0.0;

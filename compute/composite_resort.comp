@@ -34,6 +34,8 @@ layout(push_constant) uniform Push {
   vec4 background;
   vec4 intrinsics;  // fx, fy, cx, cy
   uint tiles_x;
+  uint max_splats;     // the longest list a tile may have (llvmpipe's loop limit; see composite.comp)
+  UintArray counters;  // COUNTER_MAX_TILE_PAIRS: a longer list, which the host reports as an error
 } pc;
 
 const uint P = PIXELS_PER_INVOCATION;
@@ -154,6 +156,7 @@ void main() {
   uint published_done = my_done;
 
   uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
+  if (range.y - range.x > pc.max_splats && thread == 0) atomicMax(pc.counters.v[COUNTER_MAX_TILE_PAIRS], range.y - range.x);
   for (uint batch_start = range.x; batch_start < range.y; batch_start += BATCH) {
     barrier();
     if (s_done_pixels == TILE_PIXELS) break;

@@ -14,12 +14,13 @@ layout(push_constant) uniform Push {
 
 void main() {
   uint total = pc.counters.v[COUNTER_INTERSECTIONS];
+  bool overflow = total > pc.capacity || pc.counters.v[COUNTER_PAIRS_HIGH] != 0;  // 2^32 pairs or more
   // An overflowing frame is thrown away and re-rendered with larger buffers, so it sorts and
   // composites nothing: the key emission leaves the slots of the Gaussian that straddles the
   // capacity unwritten, and sorting them would feed stale tile ids and indices to the composite.
-  uint sorted = total > pc.capacity ? 0u : total;
+  uint sorted = overflow ? 0u : total;
   pc.counters.v[COUNTER_SORT_COUNT] = sorted;
-  pc.counters.v[COUNTER_OVERFLOW] = total > pc.capacity ? 1u : 0u;
+  pc.counters.v[COUNTER_OVERFLOW] = overflow ? 1u : 0u;
   pc.counters.v[COUNTER_RANGES_ARGS + 0] = (sorted + 255) / 256;
   pc.counters.v[COUNTER_RANGES_ARGS + 1] = 1;
   pc.counters.v[COUNTER_RANGES_ARGS + 2] = 1;

@@ -26,6 +26,8 @@ layout(push_constant) uniform Push {
   uint64_t keys;  // see sort_keys.glsl
   UintArray values;
   UintArray depth_keys;  // WIDE_KEYS: per Gaussian, written by the projection
+  UintArray big_splats;  // Gaussians with more than BIG_SPLAT_PAIRS pairs, for key_emission_big.comp
+  UintArray counters;
   uint count;
   uint tiles_x;
   uint capacity;
@@ -39,6 +41,13 @@ void main() {
   if (n == 0) return;
   uint offset = pc.offsets.v[i];
   if (uint64_t(offset) + n > pc.capacity) return;  // overflow: the frame is re-run with larger buffers
+  // A splat over thousands of tiles would keep one invocation busy while its neighbours idle, and
+  // on llvmpipe a loop past 65535 iterations is silently cut short: such splats are handed to a
+  // workgroup each (key_emission_big.comp). The count is that pass's indirect dispatch size.
+  if (n > BIG_SPLAT_PAIRS) {
+    pc.big_splats.v[atomicAdd(pc.counters.v[COUNTER_BIG_SPLATS], 1u)] = i;
+    return;
+  }
   uvec2 rect = pc.rects.v[i];
   uvec2 lo = uvec2(rect.x & 0xffffu, rect.x >> 16);
   uvec2 hi = uvec2(rect.y & 0xffffu, rect.y >> 16);

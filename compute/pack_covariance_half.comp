@@ -21,8 +21,10 @@ void main() {
   if (i >= pc.count) return;
   vec3 s = exp(vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2]));
   vec4 q = vec4(pc.rotations.v[4 * i], pc.rotations.v[4 * i + 1], pc.rotations.v[4 * i + 2], pc.rotations.v[4 * i + 3]);
-  float qn = dot(q, q);
-  q = qn > 0.0 ? q / sqrt(qn) : vec4(1, 0, 0, 0);
+  // Zeros and denormals are the zero quaternion, the identity (as in projection.comp). Dividing by
+  // the largest component first keeps the dot product from overflowing for components near 1e20.
+  float largest = max(max(abs(q.x), abs(q.y)), max(abs(q.z), abs(q.w)));
+  q = largest >= FLT_MIN ? normalize(q / largest) : vec4(1, 0, 0, 0);
   float w = q.x, x = q.y, y = q.z, z = q.w;
   mat3 R = mat3(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y),
                 2.0 * (x * y - w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + w * x),

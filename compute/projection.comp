@@ -48,7 +48,9 @@ layout(buffer_reference, std430, buffer_reference_align = 8) buffer CameraParams
   uvec2 rotation[9];         // world-to-camera rotation, row-major, as doubles
   uvec2 centre[3];           // camera centre (world), as doubles
   uvec2 focal_principal[4];  // fx, fy, cx, cy, as doubles
-  vec4 clip;                 // 1.3 tan(fov_x/2), 1.3 tan(fov_y/2), near, unused
+  // 1.3 tan(fov_x/2), 1.3 tan(fov_y/2), the near plane, as doubles: the reference compares in
+  // double, and a float 0.2 would cull a splat on the plane that the reference keeps.
+  uvec2 clip[4];
   uvec4 grid;                // tiles x, tiles y, width, height
 };
 
@@ -106,7 +108,7 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) W[c][r] = to_real(cam.rotation[3 * r + c]);
   real3 t = W * rel;
-  if (!(t.z > real(cam.clip.z)) || !is_finite(t.x) || !is_finite(t.y) || !is_finite(t.z)) return 0;
+  if (!(t.z > to_real(cam.clip[2])) || !is_finite(t.x) || !is_finite(t.y) || !is_finite(t.z)) return 0;
 
   // The 3D shape: R S from the log scales and quaternion (reference), or the covariance itself,
   // precomputed on the host and stored in 16 bits (COV_HALF, as web viewers do).
@@ -122,8 +124,10 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
     real3 s = real3(exp(vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2])));
     real4 q = real4(pc.rotations.v[4 * i], pc.rotations.v[4 * i + 1], pc.rotations.v[4 * i + 2],
                     pc.rotations.v[4 * i + 3]);  // w x y z
-    real qn = dot(q, q);
-    q = qn > 0.0 ? q / sqrt(qn) : real4(1, 0, 0, 0);
+    // Zeros and float denormals are the zero quaternion, the identity (whether or not the device
+    // flushes denormals on load: the reference decides the same way).
+    real largest = max(max(abs(q.x), abs(q.y)), max(abs(q.z), abs(q.w)));
+    q = largest >= real(FLT_MIN) ? q / sqrt(dot(q, q)) : real4(1, 0, 0, 0);  // doubles: no overflow
     real w = q.x, x = q.y, y = q.z, z = q.w;
     realmat3 R = realmat3(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y),
                           2.0 * (x * y - w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + w * x),
@@ -134,8 +138,9 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   real fx = to_real(cam.focal_principal[0]), fy = to_real(cam.focal_principal[1]);
   real cx = to_real(cam.focal_principal[2]), cy = to_real(cam.focal_principal[3]);
   real inv_z = 1.0 / t.z;
-  real tx = clamp(t.x * inv_z, -real(cam.clip.x), real(cam.clip.x)) * t.z;
-  real ty = clamp(t.y * inv_z, -real(cam.clip.y), real(cam.clip.y)) * t.z;
+  real limit_x = to_real(cam.clip[0]), limit_y = to_real(cam.clip[1]);
+  real tx = clamp(t.x * inv_z, -limit_x, limit_x) * t.z;
+  real ty = clamp(t.y * inv_z, -limit_y, limit_y) * t.z;
   // The 2x3 Jacobian's rows, applied to the world-to-camera rotation and then to R S:
   // cov2d = (J W R S)(J W R S)^T, never forming the 3D covariance (better conditioned).
   real3 j0 = real3(fx * inv_z, 0.0, -fx * tx * inv_z * inv_z);
@@ -162,11 +167,15 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
     det = dot(uxv, uxv) + 0.3 * (dot(u, u) + dot(v, v)) + 0.09;
   }
   real2 mean = real2(fx * t.x * inv_z + cx, fy * t.y * inv_z + cy);
+  // The composite works in float32 relative to the mean, so the mean must be a finite float.
   if (!(det > 0.0) || !is_finite(a) || !is_finite(b) || !is_finite(c) || !is_finite(det) ||
-      !is_finite(mean.x) || !is_finite(mean.y))
+      !(abs(mean.x) <= real(FLT_MAX)) || !(abs(mean.y) <= real(FLT_MAX)))
     return 0;
 
-  float opacity = 1.0 / (1.0 + exp(-pc.opacity_logits.v[i]));
+  // A NaN logit has no opacity (min(0.99, NaN) would draw it opaque): culled. +-inf are 1 and 0.
+  float logit = pc.opacity_logits.v[i];
+  if (isnan(logit)) return 0;
+  float opacity = 1.0 / (1.0 + exp(-logit));
   real mid = 0.5 * (a + c);
   real lambda = mid + sqrt(max(real(0.1), mid * mid - det));
   // Where alpha = o exp(-k^2 / 2) falls to the cut-off along the major axis: k = sqrt(2 ln(o / cut-off)).
@@ -197,7 +206,9 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   if (touched == 0) return 0;
 
   vec3 dir = vec3(normalize(rel));
-  vec3 colour = max(eval_sh(SH_DEGREE, pc.sh, i, dir) + 0.5, vec3(0.0));
+  vec3 colour = eval_sh(SH_DEGREE, pc.sh, i, dir) + 0.5;
+  if (any(isnan(colour)) || any(isinf(colour))) return 0;  // NaN or Inf coefficients: culled
+  colour = max(colour, vec3(0.0));
   // The mean is stored as float hi + lo so that (pixel - mean) in the composite stays accurate.
   vec2 mean_lo = vec2(mean - real2(mean_hi));
   record[0] = vec4(mean_hi, float(t.z), opacity);
@@ -207,6 +218,21 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   rect = uvec2(lo.x | (lo.y << 16), hi.x | (hi.y << 16));
   if (RAY_DEPTH) write_ray_depth(i, t, COV_HALF ? W * sigma * transpose(W) : (W * RS) * transpose(W * RS));
   return touched;
+}
+
+// The frame's (Gaussian, tile) pair count in 64 bits. The prefix sum over the 32-bit tile counts
+// wraps past 2^32 pairs (100k splats covering a 4K frame want 6.5e9), so the projection also counts
+// them exactly: the low word's carries go to COUNTER_PAIRS_HIGH, which the frame setup and the host
+// read to refuse a frame they cannot hold instead of rendering a wrapped count.
+void count_pairs(uint touched) {
+  // Halves of 16 bits: a subgroup's sum of each fits 32 bits for any subgroup size up to 65536.
+  uint64_t sum = (uint64_t(subgroupAdd(touched >> 16)) << 16) + subgroupAdd(touched & 0xffffu);
+  if (!subgroupElect() || sum == 0) return;
+  uint low = uint(sum);
+  uint high = uint(sum >> 32);
+  uint before = atomicAdd(pc.counters.v[COUNTER_PAIRS_LOW], low);
+  high += before + low < before ? 1u : 0u;  // this add carried out of the low word
+  if (high > 0) atomicAdd(pc.counters.v[COUNTER_PAIRS_HIGH], high);
 }
 
 void main() {
@@ -234,6 +260,7 @@ void main() {
   }
   uint visible = subgroupAdd(touched > 0 ? 1u : 0u);
   if (subgroupElect() && visible > 0) atomicAdd(pc.counters.v[COUNTER_VISIBLE], visible);
+  count_pairs(touched);
   if (DEPTH_KEY_BITS == 16) {  // the visible depth range the 16-bit keys are quantized over
     depth_near = subgroupMin(depth_near);
     depth_far = subgroupMax(depth_far);

@@ -38,11 +38,13 @@ namespace {
 
 constexpr uint32_t kMinKeyCapacity = 1u << 16;
 constexpr int kMaxRetries = 4;
+// Pairs a frame may sort: key buffer positions and the prefix sum's offsets are 32-bit.
+constexpr uint64_t kMaxKeyCapacity = 1ull << 31;
 
 uint32_t grow_capacity(uint64_t needed) {
   // Headroom so that a moving camera does not re-grow every frame.
   uint64_t target = std::max<uint64_t>(kMinKeyCapacity, needed + needed / 4);
-  return uint32_t(std::min<uint64_t>(std::bit_ceil(target), 1ull << 31));
+  return uint32_t(std::min<uint64_t>(std::bit_ceil(target), kMaxKeyCapacity));
 }
 
 void check_camera(const Camera& camera, const vk::DeviceLimits& limits) {
@@ -122,7 +124,7 @@ struct Renderer::Impl {
     for (const vk::Buffer* b :
          {&scene.positions, &scene.log_scales, &scene.rotations, &scene.opacity_logits, &scene.sh, &scene.sh_half,
           &scene.covariances_half, &projected.splats, &projected.rects, &projected.tile_counts, &projected.offsets,
-          &projected.depth_offsets, &projected.ray_depth, &ranges, &outputs.rgba, &outputs.depth, &outputs.count,
+          &projected.depth_offsets, &projected.big_splats, &projected.ray_depth, &ranges, &composite_state, &outputs.rgba, &outputs.depth, &outputs.count,
           &counters})
       bytes += b->size();
     bytes += projected.depth_order.bytes() + keys.bytes();
@@ -162,6 +164,10 @@ struct Renderer::Impl {
     if (variant.ray_depth && projected.ray_depth.size() < VkDeviceSize(n) * kRayDepthBytes)
       projected.ray_depth = vk::Buffer(ctx, std::max<VkDeviceSize>(kRayDepthBytes, VkDeviceSize(n) * kRayDepthBytes),
                                        vk::MemoryUse::Device, "ray depth (re-sorting)");
+    if (composite_chunks > 1 &&
+        composite_state.size() < CompositePass::state_bytes(uint32_t(camera.width), uint32_t(camera.height)))
+      composite_state = vk::Buffer(ctx, CompositePass::state_bytes(uint32_t(camera.width), uint32_t(camera.height)),
+                                   vk::MemoryUse::Device, "composite chunk state");
     const bool depth_first = sorter.frame_plan() == FrameSortPlan::kDepthThenTile;
     ensure_key_capacity(keys.capacity, /*wide=*/!depth_first);
 
@@ -174,6 +180,8 @@ struct Renderer::Impl {
     vkCmdFillBuffer(cmd, counters.handle(), kDepthSortOffset + offsetof(SortState, count), sizeof(uint32_t), n);
     // The nearest visible depth is a minimum over the Gaussians: it starts at the largest value.
     vkCmdFillBuffer(cmd, counters.handle(), kDepthRangeOffset, sizeof(uint32_t), 0xffffffffu);
+    // The big-splat key emission's dispatch is (listed splats, 1, 1).
+    vkCmdFillBuffer(cmd, counters.handle(), kBigSplatsOffset + sizeof(uint32_t), 2 * sizeof(uint32_t), 1);
     vk::barrier(cmd);
 
     projection.record(cmd, scene, projected, counters.address(), variant);
@@ -201,7 +209,7 @@ struct Renderer::Impl {
     }
     timer.mark(stream.cmd(), "prefix_sum");
 
-    key_emission.record(stream.cmd(), projected, depth_order, keys, n, tiles_x, tiles, counters.address(),
+    key_emission.record(stream.cmd(), projected, depth_order, keys, n, tiles_x, tiles, counters,
                         variant.square_tiles, variant.alpha_inv);
     vk::barrier(stream.cmd());
     timer.mark(stream.cmd(), "key_emission");
@@ -221,10 +229,11 @@ struct Renderer::Impl {
     if (variant.ray_depth)
       composite_resort.record(stream.cmd(), projected.splats, projected.ray_depth, sorted_values, ranges, outputs,
                               camera, settings.background, settings.depth, settings.splat_count, cutoffs,
-                              uint32_t(modes.resort_window));
+                              uint32_t(modes.resort_window), counters.address());
     else
       composite.record(stream.cmd(), projected.splats, sorted_values, ranges, outputs, settings.background,
-                       settings.depth, settings.splat_count, cutoffs);
+                       settings.depth, settings.splat_count, cutoffs,
+                       {composite_chunks, composite_state, counters.address()});
     timer.mark(stream.cmd(), "composite");
     stream.finish();
 
@@ -233,6 +242,12 @@ struct Renderer::Impl {
     stats.sort_bits = depth_bits + tile_bits;
     stats.submissions = stream.submissions();
     return result;
+  }
+
+  std::string too_many_intersections(const FrameCounters& frame, const Camera& camera) const {
+    return "frame needs " + std::to_string(frame.wanted_intersections()) + " tile intersections (pairs of " +
+           std::to_string(frame.visible) + " visible Gaussians and the " + std::to_string(camera.width) + "x" +
+           std::to_string(camera.height) + " image's 16x16 tiles)";
   }
 
   // Renders into the output buffers, growing the key buffers and re-rendering on overflow, and
@@ -246,15 +261,34 @@ struct Renderer::Impl {
 
     stats = {};
     const uint64_t fallbacks_before = sorter.stall_fallbacks();
-    FrameCounters frame{};
-    for (int attempt = 0;; ++attempt) {
-      frame = run_frame(camera, settings, sorter);
-      if (!frame.overflow) break;
-      if (attempt == kMaxRetries || keys.capacity >= (1u << 31))
-        throw std::runtime_error("frame needs " + std::to_string(frame.intersections) +
-                                 " tile intersections, more than the key buffers can hold");
-      ensure_key_capacity(grow_capacity(frame.intersections), keys.wide_keys);
-      stats.retries = attempt + 1;
+    // A frame re-renders when it wanted more (tile, Gaussian) pairs than the key buffers hold, which
+    // grow, or when a tile's list needs more composite chunks than it had (CPU drivers only).
+    FrameCounters frame = run_frame(camera, settings, sorter);
+    for (int retry = 1;; ++retry) {
+      if (frame.overflow) {
+        if (frame.wanted_intersections() > kMaxKeyCapacity || retry > kMaxRetries)
+          throw std::runtime_error(too_many_intersections(frame, camera) + ", more than the renderer's limit of " +
+                                   std::to_string(kMaxKeyCapacity) + " (2^31)");
+        try {  // larger key and sort buffers, which the device may not have room for
+          ensure_key_capacity(grow_capacity(frame.wanted_intersections()), keys.wide_keys);
+          frame = run_frame(camera, settings, sorter);
+        } catch (const std::runtime_error& e) {
+          throw std::runtime_error(too_many_intersections(frame, camera) + ": " + e.what());
+        }
+      } else if (settings.accuracy.resort_window > 0 && frame.max_tile_pairs > 0) {
+        throw std::runtime_error("per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
+                                 "): a tile lists " + std::to_string(frame.max_tile_pairs) +
+                                 " splats, more than this device's limit of " +
+                                 std::to_string(composite_resort.max_tile_splats()) +
+                                 " for that mode (render without resortN)");
+      } else if (composite.chunks_for(frame.max_tile_pairs) > composite_chunks) {
+        if (retry > kMaxRetries) throw std::logic_error("composite chunks did not converge");  // one retry suffices
+        composite_chunks = composite.chunks_for(frame.max_tile_pairs);
+        frame = run_frame(camera, settings, sorter);
+      } else {
+        break;
+      }
+      stats.retries = retry;
     }
     for (const auto& section : timer.read(&stats.gpu_ms)) stats.passes.push_back({section.name, section.ms});
     stats.gaussians = scene.count;
@@ -298,6 +332,9 @@ struct Renderer::Impl {
   vk::Buffer ranges;
   OutputBuffers outputs;
   vk::Buffer counters;
+  // Dispatches per composite (CompositePass::Chunks), kept for later frames once a scene needed more.
+  uint32_t composite_chunks = 1;
+  vk::Buffer composite_state;
   FrameStats stats;
 };
 
@@ -337,6 +374,7 @@ void Renderer::set_scene(const GaussianScene& scene) {
   p.tile_counts = make_buffer<uint32_t>(r.ctx, n, "tile counts");
   p.depth_offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets (depth order)");
   p.offsets = make_buffer<uint32_t>(r.ctx, n, "tile offsets");
+  p.big_splats = make_buffer<uint32_t>(r.ctx, n, "big splats");
   p.depth_order = KeyBuffers::allocate(r.ctx, uint32_t(n), 32, "depth");
   r.ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)), /*wide=*/false);
 }

@@ -1,7 +1,9 @@
 #include "passes/composite_pass.h"
 
 #include <bit>
+#include <algorithm>
 #include <cstdlib>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -12,10 +14,15 @@ namespace tilesplat {
 
 namespace {
 struct CompositePush {
-  VkDeviceAddress splats, sorted_indices, ranges, out_rgba, out_depth, out_count;
+  VkDeviceAddress splats, sorted_indices, ranges, out_rgba, out_depth, out_count, state, counters;
   float background[4];
-  uint32_t width, height, tiles_x, pad;
+  uint32_t width, height, tiles_x, chunk_start, chunk_size, last_chunk;
 };
+
+// llvmpipe ends any shader invocation after 65535 loop iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS),
+// silently. A 16-pixel column spends at most ~800 per batch of 256 splats (staging, listing, two
+// bands), so 8192 splats (32 batches, ~26k iterations) leave a wide margin.
+constexpr uint32_t kCpuDriverChunkSplats = 8192;
 }  // namespace
 
 // On CPU drivers every shared-memory read is a scalar load per SIMD lane: there one invocation
@@ -24,7 +31,9 @@ struct CompositePush {
 // TILESPLAT_COMPOSITE_PIXELS (1, 2, 4, 8 or 16) overrides the choice, so that the tests run the
 // GPU layout on lavapipe too.
 CompositePass::CompositePass(vk::Context& ctx)
-    : ctx_(ctx), pixels_per_invocation_(ctx.is_cpu_device() ? kTileSize : 1) {
+    : ctx_(ctx),
+      pixels_per_invocation_(ctx.is_cpu_device() ? kTileSize : 1),
+      chunk_splats_(ctx.is_cpu_device() ? kCpuDriverChunkSplats : std::numeric_limits<uint32_t>::max()) {
   if (const char* env = std::getenv("TILESPLAT_COMPOSITE_PIXELS"); env && *env) {
     const std::string value = env;
     if (value != "1" && value != "2" && value != "4" && value != "8" && value != "16")
@@ -35,7 +44,7 @@ CompositePass::CompositePass(vk::Context& ctx)
 
 void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
                            const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
-                           bool write_depth, bool write_count, const Cutoffs& cutoffs) {
+                           bool write_depth, bool write_count, const Cutoffs& cutoffs, const Chunks& chunks) {
   auto key = std::make_tuple(write_depth, write_count, cutoffs);
   auto it = pipelines_.find(key);
   if (it == pipelines_.end()) {
@@ -53,19 +62,32 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
-  CompositePush push{splats.address(),
-                     sorted_indices.address(),
-                     ranges.address(),
-                     out.rgba.address(),
-                     write_depth ? out.depth.address() : 0,
-                     write_count ? out.count.address() : 0,
-                     {background[0], background[1], background[2], 0.0f},
-                     out.width,
-                     out.height,
-                     tiles_x,
-                     0};
-  it->second.bind(cmd, push);
-  it->second.dispatch(cmd, tiles_x, tiles_y);
+  if (chunks.count > 1 && chunks.state.size() < state_bytes(out.width, out.height))
+    throw std::logic_error("composite: the chunk state buffer is smaller than the image");
+  for (uint32_t chunk = 0; chunk < chunks.count; ++chunk) {
+    if (chunk > 0) vk::barrier(cmd);
+    CompositePush push{splats.address(),
+                       sorted_indices.address(),
+                       ranges.address(),
+                       out.rgba.address(),
+                       write_depth ? out.depth.address() : 0,
+                       write_count ? out.count.address() : 0,
+                       chunks.count > 1 ? chunks.state.address() : 0,
+                       chunks.counters,
+                       {background[0], background[1], background[2], 0.0f},
+                       out.width,
+                       out.height,
+                       tiles_x,
+                       chunk * chunk_splats_,
+                       chunk_splats_,
+                       chunk + 1 == chunks.count ? 1u : 0u};
+    it->second.bind(cmd, push);
+    it->second.dispatch(cmd, tiles_x, tiles_y);
+  }
+}
+
+uint32_t CompositePass::chunks_for(uint64_t longest_tile_list) const {
+  return uint32_t(std::max<uint64_t>(1, (longest_tile_list + chunk_splats_ - 1) / chunk_splats_));
 }
 
 }  // namespace tilesplat

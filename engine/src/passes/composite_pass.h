@@ -27,13 +27,25 @@ class CompositePass {
     float transmittance = 1e-4f;
     auto operator<=>(const Cutoffs&) const = default;
   };
+  // How many dispatches blend each tile's list (see composite.comp): 1, or more on a driver that
+  // limits loop iterations, with the pixels' state in `state` (state_bytes) between them. Chunk 0
+  // writes the longest list over one chunk to FrameCounters::max_tile_pairs; chunks_for() turns it
+  // into the count a re-render needs.
+  struct Chunks {
+    uint32_t count = 1;
+    const vk::Buffer& state;
+    VkDeviceAddress counters = 0;
+  };
   void record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
               const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
-              bool write_depth, bool write_count, const Cutoffs& cutoffs);
+              bool write_depth, bool write_count, const Cutoffs& cutoffs, const Chunks& chunks);
+  uint32_t chunks_for(uint64_t longest_tile_list) const;
+  static VkDeviceSize state_bytes(uint32_t width, uint32_t height) { return VkDeviceSize(width) * height * 32; }
 
  private:
   vk::Context& ctx_;
   uint32_t pixels_per_invocation_;
+  uint32_t chunk_splats_;  // splats per tile and dispatch
   std::map<std::tuple<bool, bool, Cutoffs>, vk::ComputePipeline> pipelines_;  // by outputs and cut-offs
 };
 

@@ -13,7 +13,8 @@ struct CompositeResortPush {
   uint32_t width, height;
   float background[4];
   float intrinsics[4];  // fx, fy, cx, cy
-  uint32_t tiles_x, pad;
+  uint32_t tiles_x, max_splats;
+  VkDeviceAddress counters;
 };
 static_assert(offsetof(CompositeResortPush, background) == 64);
 }  // namespace
@@ -26,7 +27,8 @@ CompositeResortPass::CompositeResortPass(vk::Context& ctx) : ctx_(ctx), pixels_p
 void CompositeResortPass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& ray_depth,
                                  const vk::Buffer& sorted_indices, const vk::Buffer& ranges, OutputBuffers& out,
                                  const Camera& camera, const std::array<float, 3>& background, bool write_depth,
-                                 bool write_count, const CompositePass::Cutoffs& cutoffs, uint32_t window) {
+                                 bool write_count, const CompositePass::Cutoffs& cutoffs, uint32_t window,
+                                 VkDeviceAddress counters) {
   auto key = std::make_tuple(write_depth, write_count, cutoffs, window);
   auto it = pipelines_.find(key);
   if (it == pipelines_.end())
@@ -54,7 +56,8 @@ void CompositeResortPass::record(VkCommandBuffer cmd, const vk::Buffer& splats, 
                            {background[0], background[1], background[2], 0.0f},
                            {float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy)},
                            tiles_x,
-                           0};
+                           max_tile_splats(),
+                           counters};
   it->second.bind(cmd, push);
   it->second.dispatch(cmd, tiles_x, tiles_y);
 }

@@ -18,7 +18,11 @@ class CompositeResortPass {
   void record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& ray_depth,
               const vk::Buffer& sorted_indices, const vk::Buffer& ranges, OutputBuffers& out, const Camera& camera,
               const std::array<float, 3>& background, bool write_depth, bool write_count,
-              const CompositePass::Cutoffs& cutoffs, uint32_t window);
+              const CompositePass::Cutoffs& cutoffs, uint32_t window, VkDeviceAddress counters);
+  // The longest tile list this pass blends on this device; a longer one is written to
+  // FrameCounters::max_tile_pairs (and the frame is refused). Unlimited except on CPU drivers,
+  // where llvmpipe cuts a shader short after 65535 loop iterations (~130 per batch of 128 here).
+  uint32_t max_tile_splats() const { return ctx_.is_cpu_device() ? 32768u : 0xffffffffu; }
 
  private:
   vk::Context& ctx_;

@@ -18,21 +18,31 @@ struct SortState {
 static_assert(sizeof(SortState) == 32);
 
 struct FrameCounters {
-  uint32_t intersections;   // (Gaussian, tile) pairs wanted
-  uint32_t reserved0;
+  uint32_t intersections;       // (Gaussian, tile) pairs wanted, modulo 2^32
+  uint32_t intersections_high;  // the high 32 bits of that total
   uint32_t overflow;        // 1 when the key buffers were too small
   uint32_t visible;         // Gaussians touching at least one tile
   uint32_t ranges_args[4];  // indirect dispatch of the tile-range pass (+ padding)
   SortState depth_sort;     // the Gaussians by view depth
   SortState tile_sort;      // the (tile, Gaussian) pairs by tile; count = pairs sorted (0 on overflow)
   uint32_t depth_range[2];  // float bits of the nearest and farthest visible depth (16-bit depth keys only)
+  uint32_t pairs_low;       // the projection's running low word of the total (for its carries)
+  uint32_t max_tile_pairs;  // the longest tile list, when longer than the composite's chunk (else 0)
+  uint32_t big_splats[3];   // indirect dispatch of key_emission_big.comp: splats listed, 1, 1
+  uint32_t reserved;
+
+  uint64_t wanted_intersections() const { return uint64_t(intersections_high) << 32 | intersections; }
 };
-static_assert(sizeof(FrameCounters) == 104);
+static_assert(sizeof(FrameCounters) == 128);
+static_assert(offsetof(FrameCounters, intersections_high) == 1 * 4 && offsetof(FrameCounters, pairs_low) == 26 * 4 &&
+                  offsetof(FrameCounters, max_tile_pairs) == 27 * 4 && offsetof(FrameCounters, big_splats) == 28 * 4,
+              "must match the COUNTER_* constants in compute/common.glsl");
 
 constexpr uint32_t kRangesArgsOffset = offsetof(FrameCounters, ranges_args);
 constexpr uint32_t kDepthSortOffset = offsetof(FrameCounters, depth_sort);
 constexpr uint32_t kTileSortOffset = offsetof(FrameCounters, tile_sort);
 constexpr uint32_t kDepthRangeOffset = offsetof(FrameCounters, depth_range);
+constexpr uint32_t kBigSplatsOffset = offsetof(FrameCounters, big_splats);
 constexpr uint32_t kSortArgsOffset = offsetof(SortState, args);  // within a SortState
 
 }  // namespace tilesplat

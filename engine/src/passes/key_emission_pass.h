@@ -7,6 +7,7 @@
 
 #include <map>
 #include <tuple>
+#include <utility>
 
 #include "passes/key_buffers.h"
 #include "passes/projection_pass.h"
@@ -23,14 +24,15 @@ class KeyEmissionPass {
   // projected.offsets the prefix sum in Gaussian order and keys.wide_keys.
   // square_tiles and alpha_inv must be the projection's (ProjectionVariant): both count the same tiles.
   void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer* depth_order, KeyBuffers& keys,
-              uint32_t gaussians, uint32_t tiles_x, uint32_t tiles, VkDeviceAddress counters, bool square_tiles,
+              uint32_t gaussians, uint32_t tiles_x, uint32_t tiles, const vk::Buffer& counters, bool square_tiles,
               float alpha_inv);
 
  private:
   vk::Context& ctx_;
   vk::ComputePipeline frame_setup_;
   vk::ComputePipeline scatter_offsets_;
-  std::map<std::tuple<bool, bool, float>, vk::ComputePipeline> emit_keys_;  // by (wide keys, square, alpha_inv)
+  // key_emission and key_emission_big, by (wide keys, square, alpha_inv).
+  std::map<std::tuple<bool, bool, float>, std::pair<vk::ComputePipeline, vk::ComputePipeline>> emit_keys_;
 };
 
 }  // namespace tilesplat

@@ -16,10 +16,10 @@ struct CameraParams {
   double rotation[9];  // world to camera, row-major
   double centre[3];
   double focal_principal[4];
-  float clip[4];
+  double clip[4];  // 1.3 tan(fov_x / 2), 1.3 tan(fov_y / 2), near, unused
   uint32_t grid[4];
 };
-static_assert(sizeof(CameraParams) == 160);
+static_assert(sizeof(CameraParams) == 176);
 
 struct ProjectionPush {
   VkDeviceAddress positions, log_scales, rotations, opacity_logits, sh, camera;
@@ -57,9 +57,9 @@ void ProjectionPass::set_camera(const Camera& camera) {
   p.focal_principal[1] = camera.fy;
   p.focal_principal[2] = camera.cx;
   p.focal_principal[3] = camera.cy;
-  p.clip[0] = float(1.3 * camera.tan_half_fov_x());
-  p.clip[1] = float(1.3 * camera.tan_half_fov_y());
-  p.clip[2] = float(kNearPlane);
+  p.clip[0] = 1.3 * camera.tan_half_fov_x();
+  p.clip[1] = 1.3 * camera.tan_half_fov_y();
+  p.clip[2] = kNearPlane;
   p.grid[0] = uint32_t((camera.width + kTileSize - 1) / kTileSize);
   p.grid[1] = uint32_t((camera.height + kTileSize - 1) / kTileSize);
   p.grid[2] = uint32_t(camera.width);

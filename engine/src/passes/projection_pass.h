@@ -52,6 +52,7 @@ struct ProjectedBuffers {
   vk::Buffer offsets;        // uint per Gaussian: where its (tile, Gaussian) pairs start (the same sums)
   KeyBuffers depth_order;  // the depth sort's pairs: view depth bits (culled: last), Gaussian index
   vk::Buffer ray_depth;    // RAY_DEPTH_VEC4S vec4 per Gaussian, only for per-pixel re-sorting
+  vk::Buffer big_splats;   // uint per Gaussian: the splats whose keys key_emission_big.comp writes
 };
 
 // Bytes of one Gaussian's per-pixel re-sorting data (RAY_DEPTH_VEC4S in compute/common.glsl).

@@ -34,6 +34,7 @@ constexpr double kMinEigenGap = 0.1;
 constexpr double kMaxAlpha = 0.99;
 constexpr double kMinAlpha = 1.0 / 255.0;
 constexpr double kMinTransmittance = 1e-4;
+constexpr double kFloatMax = std::numeric_limits<float>::max();
 
 double sigmoid(double logit) {
   // exp of a large positive argument overflows; use the form whose exponent is never positive.
@@ -84,6 +85,12 @@ void check_camera(const Camera& camera) {
                                 std::to_string(camera.width) + "x" + std::to_string(camera.height));
   if (!(camera.fx > 0) || !(camera.fy > 0) || !std::isfinite(camera.fx) || !std::isfinite(camera.fy))
     throw std::invalid_argument("render_reference: camera focal lengths must be positive and finite");
+  auto all_finite_in = [](const auto& values) {
+    return std::all_of(std::begin(values), std::end(values), [](double v) { return std::isfinite(v); });
+  };
+  if (!std::isfinite(camera.cx) || !std::isfinite(camera.cy) || !all_finite_in(camera.rotation) ||
+      !all_finite_in(camera.position))
+    throw std::invalid_argument("render_reference: camera principal point, rotation and position must be finite");
 }
 
 void check_scene(const GaussianScene& scene) {
@@ -114,7 +121,10 @@ std::array<double, 9> covariance3d(const float log_scale[3], const float quat_wx
 
   double w = quat_wxyz[0], x = quat_wxyz[1], y = quat_wxyz[2], z = quat_wxyz[3];
   const double norm = std::sqrt(w * w + x * x + y * y + z * z);
-  if (norm == 0) {
+  // A quaternion of zeros and float denormals is the zero quaternion: GPUs may flush denormals to
+  // zero on load, and every renderer must agree on which rotation the splat has.
+  const double largest = std::max({std::abs(w), std::abs(x), std::abs(y), std::abs(z)});
+  if (largest < double(std::numeric_limits<float>::min())) {
     w = 1;
     x = y = z = 0;
   } else {
@@ -176,6 +186,10 @@ ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const C
   // Written as a negated comparison so that a NaN depth is culled too.
   if (!(t[2] > kNearPlane) || !all_finite({t[0], t[1], t[2]})) return out;
 
+  // Scales are float32 values: a log scale whose exp overflows a float is an infinite scale (the GPU
+  // evaluates exp in float32), and an infinite scale has no usable covariance.
+  for (int axis = 0; axis < 3; ++axis)
+    if (!(std::exp(double(scene.log_scales[3 * i + size_t(axis)])) <= kFloatMax)) return out;
   const std::array<double, 9> sigma = covariance3d(&scene.log_scales[3 * i], &scene.rotations[4 * i]);
 
   // The Jacobian is evaluated at a point clamped to 1.3x the field of view so that splats far
@@ -207,7 +221,10 @@ ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const C
   out.mean[1] = camera.fy * t[1] / tz + camera.cy;
 
   const double det = a * c - b * b;
-  if (!all_finite({a, b, c, det, out.mean[0], out.mean[1]}) || !(det > 0)) return out;
+  // The composite works in float32 relative to the mean: a mean beyond the float range is culled.
+  if (!all_finite({a, b, c, det, out.mean[0], out.mean[1]}) || !(det > 0) || !(std::abs(out.mean[0]) <= kFloatMax) ||
+      !(std::abs(out.mean[1]) <= kFloatMax))
+    return out;
   out.conic[0] = c / det;
   out.conic[1] = -b / det;
   out.conic[2] = a / det;
@@ -228,6 +245,9 @@ ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const C
                                   static_cast<long long>(out.tile_max[1] - out.tile_min[1]);
   if (tiles_touched <= 0) return out;
 
+  // A NaN opacity or a non-finite colour has no meaning: the splat is culled rather than blended
+  // (std::min(0.99, NaN) would draw it opaque). +-inf logits are opacities 1 and 0 and stay.
+  if (std::isnan(scene.opacity_logits[i])) return out;
   out.opacity = sigmoid(scene.opacity_logits[i]);
   std::array<double, 3> dir = {mean[0] - camera.position[0], mean[1] - camera.position[1],
                                mean[2] - camera.position[2]};
@@ -236,7 +256,10 @@ ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const C
     for (double& d : dir) d /= dir_length;
   const size_t k = static_cast<size_t>(scene.sh_coefficients());
   const std::array<double, 3> sh = eval_sh(scene.sh_degree, &scene.sh[i * k * 3], dir);
-  for (size_t ch = 0; ch < 3; ++ch) out.color[ch] = std::max(sh[ch] + 0.5, 0.0);
+  for (size_t ch = 0; ch < 3; ++ch) {
+    if (!(std::abs(sh[ch] + 0.5) <= kFloatMax)) return out;  // the colour must be a finite float
+    out.color[ch] = std::max(sh[ch] + 0.5, 0.0);
+  }
   out.visible = true;
   return out;
 }
