@@ -47,16 +47,19 @@ uint32_t grow_capacity(uint64_t needed) {
   return uint32_t(std::min<uint64_t>(std::bit_ceil(target), kMaxKeyCapacity));
 }
 
-void check_camera(const Camera& camera, const vk::DeviceLimits& limits) {
+void check_camera(const Camera& camera, const vk::DeviceLimits& limits, bool cpu_driver) {
   auto fail = [](const std::string& why) { throw std::runtime_error("invalid camera: " + why); };
   if (camera.width <= 0 || camera.height <= 0)
     fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + " is not positive");
   // Tile rects pack each coordinate in 16 bits, and the composite dispatches one workgroup per tile.
+  // On CPU drivers a shader invocation may loop over a row or column of tiles, and llvmpipe cuts
+  // loops short after 65535 iterations (key_emission_big.comp): there 16384 tiles per axis.
+  const uint64_t max_tiles = cpu_driver ? 16384 : std::min<uint64_t>(0xffff, limits.max_workgroup_count_x);
   const uint64_t tiles_x = (uint64_t(camera.width) + kTileSize - 1) / kTileSize;
   const uint64_t tiles_y = (uint64_t(camera.height) + kTileSize - 1) / kTileSize;
-  if (tiles_x > std::min<uint64_t>(0xffff, limits.max_workgroup_count_x) || tiles_y > 0xffff)
+  if (tiles_x > max_tiles || tiles_y > std::min<uint64_t>(max_tiles, 0xffff))
     fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-         " exceeds the renderer's limit of 65535 tiles per axis");
+         " exceeds the renderer's limit of " + std::to_string(max_tiles) + " tiles (of 16 pixels) per axis");
   const uint64_t rgba_bytes = uint64_t(camera.width) * uint64_t(camera.height) * 16;
   if (rgba_bytes > limits.max_allocation_size)
     fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + " needs " +
@@ -253,7 +256,7 @@ struct Renderer::Impl {
   // Renders into the output buffers, growing the key buffers and re-rendering on overflow, and
   // fills the frame statistics (all but cpu_ms).
   void render_frame(const Camera& camera, const RenderSettings& settings) {
-    check_camera(camera, ctx.limits());
+    check_camera(camera, ctx.limits(), ctx.is_cpu_device());
     validate(settings.accuracy);
     SortStrategy& sorter = sort(settings.sort);
     ensure_outputs(uint32_t(camera.width), uint32_t(camera.height));
