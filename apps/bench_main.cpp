@@ -21,6 +21,7 @@
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/scene_description.h"
 #include "tilesplat/sort.h"
 
 namespace {
@@ -248,8 +249,15 @@ struct BenchScene {
   std::string description;  // "31,000 Gaussians (SH2)"
   uint64_t gaussians = 0;   // kept apart from loaded.scene, which is released once the scene is measured
   int sh_degree = 0;
-  std::string cameras;      // the scene's cameras.json; empty when its cameras orbit it
+  std::string cameras;      // --cameras for this scene; empty: the scene file's cameras, else an orbit
 };
+
+// Where the scene's cameras come from, for the JSON: --cameras, the scene file's own, or null (orbit).
+std::string cameras_source(const BenchScene& scene) {
+  if (!scene.cameras.empty()) return scene.cameras;
+  const cli::SceneViews own = cli::scene_views(scene.loaded);
+  return own.views.empty() ? std::string() : own.file.string();
+}
 
 // One camera of the run, a row of the results per sort strategy.
 struct Case {
@@ -288,8 +296,13 @@ std::vector<Case> plan_cases(const BenchOptions& options, const BenchScene& scen
   auto add = [&](size_t size_index, std::string label, cli::NamedCamera camera) {
     cases.push_back({scene_index, size_index, std::move(label), std::move(camera), {}});
   };
-  if (!scene.cameras.empty()) {
-    const auto file_views = cli::load_camera_views(scene.cameras);
+  const cli::SceneViews own = cli::scene_views(scene.loaded);
+  if (!scene.cameras.empty() || !own.views.empty()) {
+    const auto file_views = scene.cameras.empty() ? own.views : cli::load_camera_views(scene.cameras);
+    const fs::path views_file = scene.cameras.empty() ? own.file : fs::path(scene.cameras);
+    if (scene.cameras.empty() && (options.orbit > 0 || options.common.orbit_given))
+      throw cli::UsageError("--orbit, --azimuth, --elevation, --fov and --distance apply only to orbit cameras, and '" +
+                            scene.loaded.path.string() + "' has cameras of its own (pick them with --view or --views)");
     std::vector<int> indices = options.views;
     if (options.all_views) {
       indices.resize(file_views.size());
@@ -301,8 +314,12 @@ std::vector<Case> plan_cases(const BenchOptions& options, const BenchScene& scen
     for (size_t s = 0; s < sizes.size(); ++s)
       for (const int index : indices)
         add(s, "view " + std::to_string(index),
-            cli::view_camera(file_views, index, scene.cameras, sizes[s].width, sizes[s].height, flag));
+            cli::view_camera(file_views, index, views_file, sizes[s].width, sizes[s].height, flag));
   } else {
+    if (!options.views.empty() || options.all_views || options.common.view_given)
+      throw cli::UsageError(std::string(options.common.view_given ? "--view" : "--views") + " needs cameras: '" +
+                            scene.loaded.path.string() +
+                            "' has none, and no --cameras FILE.json was given (without them the cameras orbit it)");
     const int count = std::max(1, options.orbit);
     for (size_t s = 0; s < sizes.size(); ++s) {
       for (int v = 0; v < count; ++v) {
@@ -547,7 +564,8 @@ std::string make_json(const std::vector<Group>& groups, const std::vector<BenchS
     json += std::string(s ? ",\n" : "\n") + "    {\"path\": " + json_string(scenes[s].loaded.path.string()) +
             ", \"gaussians\": " + json_number(double(scenes[s].gaussians)) +
             ", \"sh_degree\": " + std::to_string(scenes[s].sh_degree) +
-            ", \"cameras\": " + (scenes[s].cameras.empty() ? "null" : json_string(scenes[s].cameras)) + "}";
+            ", \"cameras\": " +
+            (cameras_source(scenes[s]).empty() ? "null" : json_string(cameras_source(scenes[s]))) + "}";
   json += "\n  ],\n  \"results\": [";
   bool first = true;
   for (const auto& group : groups) {
@@ -1012,6 +1030,15 @@ fs::path scene_plot_path(const std::string& plot, const std::string& scene_file,
   return path.parent_path() / (path.stem().string() + "_" + fs::path(scene_file).stem().string() + ".svg");
 }
 
+// The report renders every mode against the reference itself, so a scene file's sh_degree effect is
+// applied to the scene (dropping the bands it excludes gives the same images as the cap) rather than
+// to the modes, whose SH cap is one of the things measured.
+void apply_scene_sh_degree(cli::LoadedScene& loaded) {
+  if (!loaded.description || !loaded.description->effects.sh_degree) return;
+  const int degree = std::min(loaded.scene.sh_degree, *loaded.description->effects.sh_degree);
+  loaded.scene = tilesplat::with_sh_degree(loaded.scene, degree);
+}
+
 int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& options, int argc, char** argv) {
   for (const char* flag : {"--resolutions", "--orbit", "--json"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");
@@ -1035,6 +1062,7 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
   for (size_t s = 0; s < options.common.scenes.size(); ++s) {
     Planned p;
     p.scene.loaded = cli::load_scene_file(options.common.scenes[s], options.common.strict, kProgram);
+    apply_scene_sh_degree(p.scene.loaded);
     p.scene.name = p.scene.loaded.path.filename().string();
     p.scene.description = cli::describe_scene(p.scene.loaded.scene);
     p.scene.sh_degree = p.scene.loaded.scene.sh_degree;
@@ -1113,7 +1141,7 @@ void check_frame_options(const cli::ArgParser& parser, const BenchOptions& optio
                           std::to_string(scenes) + " scenes: give it once for every scene, or once per scene in "
                           "the order of the scenes");
   if (parser.seen("--views")) {
-    if (cameras == 0)
+    if (cameras == 0 && !cli::any_scene_file(options.common))
       throw cli::UsageError("--views needs --cameras FILE.json (without it the cameras orbit the scene: see --orbit)");
     if (parser.seen("--view")) throw cli::UsageError("--view and --views cannot be combined");
   }
@@ -1128,7 +1156,7 @@ void check_frame_options(const cli::ArgParser& parser, const BenchOptions& optio
 
 int run(int argc, char** argv) {
   BenchOptions options;
-  cli::ArgParser parser(kProgram, "tilesplat-bench SCENE.ply [SCENE.ply...] [options]",
+  cli::ArgParser parser(kProgram, "tilesplat-bench SCENE.ply|SCENE.json [SCENE...] [options]",
                         "Renders 3D Gaussian Splatting scenes repeatedly and prints the GPU time of every pass "
                         "(median, min, max over the measured frames) for each sort strategy, with the frame's "
                         "CPU time, visible Gaussians, intersections and device memory. Every scene is measured "
@@ -1197,6 +1225,7 @@ int run(int argc, char** argv) {
         tilesplat::RenderSettings settings;
         settings.sort = sort;
         if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
+        cli::apply_scene_settings(scene.loaded, settings);
         Collector collector(sort);
         for (int frame = 0; frame < frames_per_row; ++frame) {
           // Rendering reads the image back, which is part of cpu frame; the first measured image of

@@ -408,12 +408,15 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
   const std::string cameras_help =
       "take the camera from the trainer's cameras.json (default: an orbit camera framing the scene, see --azimuth)";
   if (scene_choice == SceneChoice::kOne) {
-    parser.add_positional("SCENE.ply", "the scene: a 3D Gaussian Splatting .ply as the trainer writes it",
+    parser.add_positional("SCENE.ply",
+                          "the scene: a 3D Gaussian Splatting .ply as the trainer writes it, or a scene file "
+                          "(.json, docs/scene-format.md) that places several of them and brings cameras, "
+                          "background and outputs",
                           &options.scene);
   } else {
     parser.add_positional_list("SCENE.ply",
-                               "the scenes: 3D Gaussian Splatting .ply files as the trainer writes them, each "
-                               "loaded once",
+                               "the scenes: 3D Gaussian Splatting .ply files as the trainer writes them, or scene "
+                               "files (.json, docs/scene-format.md), each loaded once",
                                &options.scenes);
   }
 
@@ -428,8 +431,11 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                        options.cameras_files.push_back(text);
                      });
   }
-  parser.add_int("--view", "N", "which view of --cameras, counting from 0 (default 0)", &options.view, 0,
-                 std::numeric_limits<int>::max());
+  parser.add_value("--view", "N", "which view of --cameras (or of a scene file's cameras), counting from 0 (default 0)",
+                   [&options](const std::string& text) {
+                     options.view = parse_int("--view", text, 0, std::numeric_limits<int>::max());
+                     options.view_given = true;
+                   });
   parser.add_int("--width", "W",
                  "image width in pixels; given alone, the height follows the view's aspect ratio (default: "
                  "the view's size, or 1920x1080 for the orbit camera)",
@@ -441,6 +447,7 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                        ")",
                    [&options](const std::string& text) {
                      options.orbit.azimuth_deg = parse_double("--azimuth", text);
+                     options.orbit_given = true;
                    });
   parser.add_value("--elevation", "DEG",
                    "orbit camera: angle above the horizon, between -90 and 90 (default " +
@@ -450,6 +457,7 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                      if (!(degrees > -90 && degrees < 90))
                        throw UsageError("--elevation must be strictly between -90 and 90, got " + single_quoted(text));
                      options.orbit.elevation_deg = degrees;
+                     options.orbit_given = true;
                    });
   parser.add_value("--fov", "DEG",
                    "orbit camera: vertical field of view (default " +
@@ -459,6 +467,7 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                      if (!(degrees > 0 && degrees < 180))
                        throw UsageError("--fov must be strictly between 0 and 180 degrees, got " + single_quoted(text));
                      options.orbit.vertical_fov_deg = degrees;
+                     options.orbit_given = true;
                    });
   parser.add_value("--distance", "SCALE",
                    "orbit camera: multiply the distance that frames the scene (default 1)",
@@ -466,6 +475,7 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                      const double scale = parse_double("--distance", text);
                      if (!(scale > 0)) throw UsageError("--distance must be positive, got " + single_quoted(text));
                      options.orbit.distance_scale = scale;
+                     options.orbit_given = true;
                    });
 
   parser.section("scene and device");
@@ -542,13 +552,15 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
 }
 
 void check_common_options(const ArgParser& parser, const CommonOptions& options) {
-  if (options.scene.empty() && options.scenes.empty()) throw UsageError("missing the SCENE.ply argument (see --help)");
+  if (options.scene.empty() && options.scenes.empty())
+    throw UsageError("missing the SCENE.ply (or scene file .json) argument (see --help)");
   if (!options.cameras.empty() || !options.cameras_files.empty()) {
     for (const char* orbit_flag : {"--azimuth", "--elevation", "--fov", "--distance"})
       if (parser.seen(orbit_flag))
         throw UsageError(std::string(orbit_flag) +
                          " applies only to the orbit camera and cannot be combined with --cameras");
-  } else if (parser.seen("--view")) {
+  } else if (parser.seen("--view") && !any_scene_file(options)) {
+    // A scene file may bring cameras of its own: whether it does is known once it is read.
     throw UsageError("--view needs --cameras FILE.json (without it the camera is an orbit)");
   }
 }
@@ -568,7 +580,13 @@ LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view 
   LoadOptions load_options;
   load_options.strict = strict;
   try {
-    loaded.scene = load_scene(loaded.path, load_options, &loaded.report);
+    if (is_scene_description(loaded.path)) {
+      loaded.description = load_scene_description(loaded.path);
+      require_supported_effects(*loaded.description);
+      loaded.scene = load_described_scene(*loaded.description, load_options, &loaded.report);
+    } else {
+      loaded.scene = load_scene(loaded.path, load_options, &loaded.report);
+    }
   } catch (const std::bad_alloc&) {
     throw std::runtime_error(loaded.path.string() + ": out of memory while loading the scene");
   } catch (const std::exception& error) {
@@ -582,6 +600,43 @@ LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view 
     print_warning(program, naming_file(loaded.path, summary));
   }
   return loaded;
+}
+
+SceneViews scene_views(const LoadedScene& loaded) {
+  SceneViews out;
+  if (!loaded.description) return out;
+  out.views = loaded.description->cameras;
+  out.file = loaded.description->cameras_file.empty() ? loaded.path : loaded.description->cameras_file;
+  return out;
+}
+
+void require_supported_effects(const SceneDescription& description) {
+  const SceneEffects& effects = description.effects;
+  auto refuse = [&](const std::string& path, const std::string& what) {
+    throw std::runtime_error(description.file.string() + ": effects." + path + ": " + what +
+                             " is not implemented yet");
+  };
+  if (effects.antialiasing == Antialiasing::kAntialiased) refuse("antialiasing", "'antialiased' antialiasing");
+  if (effects.antialiasing == Antialiasing::kMip) refuse("antialiasing", "'mip' (Mip-Splatting) antialiasing");
+  if (!effects.lights.empty()) refuse("lights", "relighting");
+  if (effects.tone_map != ToneMap::kNone) refuse("tone_map", "tone mapping");
+  if (effects.exposure_stops != 0) refuse("exposure", "exposure");
+}
+
+void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings) {
+  if (!loaded.description) return;
+  const SceneDescription& description = *loaded.description;
+  settings.background = description.background;
+  settings.depth = description.outputs.depth;
+  settings.splat_count = description.outputs.splat_count;
+  if (description.effects.sh_degree)
+    settings.accuracy.sh_degree_cap = std::min(settings.accuracy.sh_degree_cap, *description.effects.sh_degree);
+}
+
+bool any_scene_file(const CommonOptions& options) {
+  if (!options.scene.empty() && is_scene_description(options.scene)) return true;
+  return std::any_of(options.scenes.begin(), options.scenes.end(),
+                     [](const std::string& scene) { return is_scene_description(scene); });
 }
 
 std::vector<CameraView> load_camera_views(const fs::path& path) {
@@ -636,11 +691,22 @@ NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const O
 
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program) {
   LoadedScene loaded = load_scene_file(options.scene, options.strict, program);
-  const NamedCamera named =
-      options.cameras.empty()
-          ? orbit_view(loaded, options.width, options.height, options.orbit)
-          : view_camera(load_camera_views(options.cameras), options.view, options.cameras, options.width,
+  const SceneViews own = scene_views(loaded);
+  NamedCamera named;
+  if (!options.cameras.empty()) {
+    named = view_camera(load_camera_views(options.cameras), options.view, options.cameras, options.width,
                         options.height);
+  } else if (!own.views.empty()) {
+    if (options.orbit_given)
+      throw UsageError("--azimuth, --elevation, --fov and --distance apply only to the orbit camera, and " +
+                       single_quoted(loaded.path.string()) + " has cameras of its own (pick one with --view)");
+    named = view_camera(own.views, options.view, own.file, options.width, options.height);
+  } else {
+    if (options.view_given)
+      throw UsageError("--view needs cameras: " + single_quoted(loaded.path.string()) +
+                       " has none, and no --cameras FILE.json was given (without them the camera is an orbit)");
+    named = orbit_view(loaded, options.width, options.height, options.orbit);
+  }
   loaded.camera = named.camera;
   loaded.camera_description = named.description;
   return loaded;

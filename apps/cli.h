@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -16,6 +17,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/scene_description.h"
 
 namespace tilesplat::cli {
 
@@ -125,9 +127,11 @@ struct CommonOptions {
   std::vector<std::string> scenes;
   std::vector<std::string> cameras_files;
   int view = 0;
+  bool view_given = false;   // --view appeared (a scene file's cameras make it valid without --cameras)
   int width = 0;   // 0: the view's size (or kOrbitDefaultWidth), keeping the aspect when one is given
   int height = 0;
   OrbitParams orbit;
+  bool orbit_given = false;  // an orbit flag (--azimuth, --elevation, --fov, --distance) appeared
   bool strict = false;
   std::string device;
   bool list_devices = false;
@@ -151,7 +155,7 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                         SceneChoice scene_choice = SceneChoice::kOne);
 
 // Checks what the parser cannot check flag by flag (a SCENE was given, orbit flags are not
-// mixed with --cameras, ...). Throws UsageError.
+// mixed with --cameras, --view has cameras to pick from, ...). Throws UsageError.
 void check_common_options(const ArgParser& parser, const CommonOptions& options);
 
 // Prints list_devices() with the indices --device accepts.
@@ -165,6 +169,9 @@ bool parse_and_handle_info_flags(ArgParser& parser, int argc, const char* const*
 struct LoadedScene {
   std::filesystem::path path;
   GaussianScene scene;
+  // Set when the SCENE is a scene file (.json, docs/scene-format.md): its cameras, background,
+  // effects and outputs. Its models are already loaded, transformed and merged into `scene`.
+  std::optional<SceneDescription> description;
   LoadReport report;
   Camera camera;
   std::string camera_description;  // "view 0 of cams.json" or "orbit azimuth 0 elevation 20 fov 50"
@@ -172,14 +179,35 @@ struct LoadedScene {
 };
 
 // Loads the scene (printing LoadReport::summary() to stderr as a warning when Gaussians were
-// dropped) and builds the camera at the requested size. A missing or unreadable file throws
-// std::runtime_error naming it; an out-of-range --view throws UsageError naming the file and
-// its number of views.
+// dropped) and builds the camera at the requested size: --cameras, else the scene file's cameras,
+// else the orbit. A missing or unreadable file throws std::runtime_error naming it; an
+// out-of-range --view throws UsageError naming the file and its number of views.
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program);
 
 // The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
-// load_scene_file fills path, scene, report and load_ms only.
+// load_scene_file fills path, scene, description, report and load_ms only. A scene file (.json)
+// asking for an effect the renderer does not implement yet fails before any splat file is read
+// (require_supported_effects).
 LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program);
+
+// The views a scene file brings ("cameras") and the file that names them (the cameras.json it
+// refers to, else the scene file). No views for a .ply, or a scene file without cameras.
+struct SceneViews {
+  std::vector<CameraView> views;
+  std::filesystem::path file;
+};
+SceneViews scene_views(const LoadedScene& loaded);
+
+// Throws std::runtime_error naming the scene file and the JSON path, e.g.
+// "scene.json: effects.lights: relighting is not implemented yet", for the first effect the
+// renderer cannot do yet: antialiasing other than classic, lights, tone_map, exposure.
+void require_supported_effects(const SceneDescription& description);
+
+// What a scene file asks of every frame: its background, its outputs (depth, splat_count) and its
+// sh_degree effect (accuracy.sh_degree_cap: the smaller of it and the --mode's cap). A .ply
+// leaves the settings as they are. Flags that override the scene file are applied after this.
+void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings);
+
 // The views of a cameras.json; throws std::runtime_error naming the file when it is missing,
 // malformed or has no views.
 std::vector<CameraView> load_camera_views(const std::filesystem::path& path);
@@ -196,6 +224,9 @@ NamedCamera view_camera(const std::vector<CameraView>& views, int index, const s
 NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const OrbitParams& orbit);
 
 RendererOptions renderer_options(const CommonOptions& options);
+
+// Whether any SCENE of the options is a scene file (.json).
+bool any_scene_file(const CommonOptions& options);
 
 // "SH3" style summary of the scene: "64 Gaussians (SH3)".
 std::string describe_scene(const GaussianScene& scene);

@@ -69,7 +69,7 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
   parser.section("output");
   parser.add_string("--output", "OUT.exr",
                     "the EXR to write (required): R G B A, plus Z (expected depth) and 'splats' (blended "
-                    "splats per pixel) unless turned off",
+                    "splats per pixel) unless turned off; for a scene file, the channels its \"outputs\" list",
                     &options.output, "-o");
   parser.add_string("--png", "FILE.png", "also write an 8-bit sRGB preview of the colours", &options.png);
   parser.add_value("--exposure", "X", "multiply the colours of the --png preview (default 1)",
@@ -84,7 +84,7 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
   parser.add_switch("--no-count", "do not compute or store the per-pixel splat count", &options.no_count);
 
   parser.section("rendering");
-  parser.add_value("--background", "R,G,B", "linear background colour (default 0,0,0)",
+  parser.add_value("--background", "R,G,B", "linear background colour (default: the scene file's, else 0,0,0)",
                    [&options](const std::string& text) {
                      options.background = cli::parse_rgb("--background", text);
                    });
@@ -99,10 +99,12 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
 
 int run(int argc, char** argv) {
   RenderOptions options;
-  cli::ArgParser parser(kProgram, "tilesplat-render SCENE.ply -o OUT.exr [options]",
+  cli::ArgParser parser(kProgram, "tilesplat-render SCENE.ply|SCENE.json -o OUT.exr [options]",
                         "Renders one view of a 3D Gaussian Splatting scene with the Vulkan compute renderer "
                         "and writes it as an EXR. The camera comes from the trainer's cameras.json "
-                        "(--cameras, --view) or orbits the scene (--azimuth, --elevation, --fov).");
+                        "(--cameras, --view), from the scene file's cameras (--view), or orbits the scene "
+                        "(--azimuth, --elevation, --fov). A scene file's background and outputs apply unless "
+                        "--background, --no-depth or --no-count say otherwise.");
   add_render_options(parser, options);
   if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
   cli::check_common_options(parser, options.common);
@@ -130,11 +132,13 @@ int run(int argc, char** argv) {
   const cli::LoadedScene loaded = cli::load_scene_and_camera(options.common, kProgram);
 
   tilesplat::RenderSettings settings;
-  settings.background = options.background;
   if (!options.common.sorts.empty()) settings.sort = options.common.sorts.front();
-  settings.depth = !options.no_depth;
-  settings.splat_count = !options.no_count;
   if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
+  cli::apply_scene_settings(loaded, settings);
+  // The flags override the scene file.
+  if (parser.seen("--background") || !loaded.description) settings.background = options.background;
+  if (options.no_depth) settings.depth = false;
+  if (options.no_count) settings.splat_count = false;
 
   tilesplat::RenderImage image;
   std::string timing;
@@ -164,12 +168,13 @@ int run(int argc, char** argv) {
     throw std::runtime_error("the renderer returned a " + std::to_string(image.width) + "x" +
                              std::to_string(image.height) + " image for a " + std::to_string(loaded.camera.width) +
                              "x" + std::to_string(loaded.camera.height) + " camera");
-  if (options.no_depth) image.depth.clear();
-  if (options.no_count) image.splat_count.clear();
+  if (!settings.depth) image.depth.clear();
+  if (!settings.splat_count) image.splat_count.clear();
 
   // The EXR first: a preview must never exist without the image it previews.
   tilesplat::ExrWriteOptions exr_options;
   exr_options.half = options.half;
+  exr_options.alpha = !loaded.description || loaded.description->outputs.alpha;
   try {
     tilesplat::write_exr(options.output, image, exr_options);
   } catch (const std::exception& error) {

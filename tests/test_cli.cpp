@@ -11,6 +11,9 @@
 #include <vector>
 
 #include "test_support.h"
+#include "tilesplat/image.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene_description.h"
 
 namespace {
 
@@ -481,6 +484,125 @@ TEST(CliBench, SortBenchDrawsThroughputLines) {
     EXPECT_TRUE(contains(svg_text, "<polyline class=\"series\" data-series=\"" + std::string(series) + "\""))
         << series << "\n" << svg_text;
   EXPECT_TRUE(contains(svg_text, "Mkeys/s")) << svg_text;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene files (docs/scene-format.md) in place of a .ply
+
+// Two bundled scenes composed, two cameras of its own, a blue background, colour and depth only.
+fs::path write_scene_file(const std::string& effects = "") {
+  const fs::path path = temp_dir() / "scene.json";
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      << R"({"models": [{"path": ")" << bundled_playbot().string() << R"("},
+                   {"path": ")" << bundled_sh3().string() << R"(", "translation": [0.5, 0, 0], "scale": 0.5,
+                    "rotation_deg": [0, 30, 0]}],
+        "cameras": [{"name": "front", "width": 64, "height": 36,
+                     "look_at": {"eye": [0, -0.5, 2.5], "target": [0, 0, 0], "fov_deg": 45}},
+                    {"name": "side", "width": 64, "height": 36, "look_at": {"eye": [2.5, -0.5, 0], "target": [0, 0, 0]}}],
+        "background": [0, 0, 1],
+        "outputs": ["color", "depth"])"
+      << (effects.empty() ? "" : ", \"effects\": " + effects) << "}";
+  return path;
+}
+
+TEST(CliRender, RendersSceneFileToExr) {
+  const auto out = fresh_output_dir();
+  const fs::path scene_file = write_scene_file();
+  const fs::path exr = out / "scene.exr";
+  const auto result = run_exe(kRenderExe, {scene_file.string(), "-o", exr.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(contains(result.err, "view 0 (front) of scene.json")) << result.err;
+  EXPECT_TRUE(contains(result.err, "31,064 Gaussians (SH3)")) << result.err;
+  EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+
+  // The same scene, camera and settings through the library: the app must have used them all.
+  const tilesplat::SceneDescription description = tilesplat::load_scene_description(scene_file);
+  tilesplat::RenderSettings settings;
+  settings.background = {0, 0, 1};
+  settings.splat_count = false;
+  tilesplat::Renderer& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(tilesplat::load_described_scene(description));
+  const tilesplat::RenderImage expected = renderer.render(description.cameras[0].camera, settings);
+
+  const tilesplat::RenderImage image = tilesplat::read_exr(exr);
+  ASSERT_EQ(image.width, 64);
+  ASSERT_EQ(image.height, 36);
+  EXPECT_EQ(image.depth.size(), image.pixels());  // "depth" is listed
+  EXPECT_TRUE(image.splat_count.empty());         // "splat_count" is not
+  EXPECT_EQ(tilesplat::compare_images(image, expected).max_abs, 0.0);
+  // "alpha" is not listed: the EXR has no A channel, which reads back as opaque everywhere, even
+  // where the render saw only background.
+  bool background_seen = false;
+  for (size_t i = 0; i < image.pixels(); ++i) {
+    EXPECT_EQ(image.rgba[4 * i + 3], 1.0f);
+    background_seen = background_seen || expected.rgba[4 * i + 3] == 0.0f;
+  }
+  EXPECT_TRUE(background_seen);
+  EXPECT_EQ(image.rgba[2], 1.0f);  // the top-left corner shows the scene file's blue background
+
+  // --view picks the file's second camera; --background overrides the file's.
+  const fs::path side = out / "side.exr";
+  const auto side_result =
+      run_exe(kRenderExe, {scene_file.string(), "--view", "1", "--background", "0,0,0", "-o", side.string()});
+  ASSERT_EQ(side_result.exit_code, 0) << side_result.err;
+  EXPECT_TRUE(contains(side_result.err, "view 1 (side) of scene.json")) << side_result.err;
+  EXPECT_EQ(tilesplat::read_exr(side).rgba[2], 0.0f);
+}
+
+TEST(CliRender, SceneFileEffectNotImplementedYetFails) {
+  const auto out = fresh_output_dir();
+  const fs::path scene_file =
+      write_scene_file(R"({"lights": [{"type": "directional", "direction": [0, 1, 0]}]})");
+  const auto result = run_exe(kRenderExe, {scene_file.string(), "-o", (out / "x.exr").string()});
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_TRUE(contains(result.err, "scene.json: effects.lights: relighting is not implemented yet")) << result.err;
+  expect_one_error_line(result, "tilesplat-render");
+  EXPECT_TRUE(entries(out).empty());
+
+  const fs::path mip = write_scene_file(R"({"antialiasing": "mip"})");
+  const auto mip_result = run_exe(kRenderExe, {mip.string(), "-o", (out / "x.exr").string()});
+  EXPECT_EQ(mip_result.exit_code, 1) << mip_result.err;
+  EXPECT_TRUE(contains(mip_result.err, "scene.json: effects.antialiasing: 'mip'")) << mip_result.err;
+}
+
+TEST(CliRender, SceneFileMistakesAndViews) {
+  const auto out = fresh_output_dir();
+  const fs::path exr = out / "x.exr";
+  const fs::path typo = write_scene_file(R"({"antialias": "classic"})");
+  const auto typo_result = run_exe(kRenderExe, {typo.string(), "-o", exr.string()});
+  EXPECT_EQ(typo_result.exit_code, 1) << typo_result.err;
+  EXPECT_TRUE(contains(typo_result.err, "scene.json: effects.antialias: unknown key; did you mean 'antialiasing'?"))
+      << typo_result.err;
+  expect_one_error_line(typo_result, "tilesplat-render");
+
+  const fs::path scene_file = write_scene_file();
+  const auto out_of_range = run_exe(kRenderExe, {scene_file.string(), "--view", "2", "-o", exr.string()});
+  EXPECT_EQ(out_of_range.exit_code, 2) << out_of_range.err;
+  EXPECT_TRUE(contains(out_of_range.err, "has 2 views")) << out_of_range.err;
+
+  const auto orbit = run_exe(kRenderExe, {scene_file.string(), "--azimuth", "30", "-o", exr.string()});
+  EXPECT_EQ(orbit.exit_code, 2) << orbit.err;
+  EXPECT_TRUE(contains(orbit.err, "has cameras of its own")) << orbit.err;
+
+  const fs::path no_cameras = temp_dir() / "no_cameras.json";
+  std::ofstream(no_cameras, std::ios::trunc) << R"({"models": [{"path": ")" << bundled_sh3().string() << R"("}]})";
+  const auto no_views = run_exe(kRenderExe, {no_cameras.string(), "--view", "0", "-o", exr.string()});
+  EXPECT_EQ(no_views.exit_code, 2) << no_views.err;
+  EXPECT_TRUE(contains(no_views.err, "--view needs cameras")) << no_views.err;
+  EXPECT_TRUE(entries(out).empty());
+}
+
+TEST(CliBench, MeasuresSceneFileAtItsOwnCameras) {
+  const auto out = fresh_output_dir();
+  const fs::path json = out / "j.json";
+  const fs::path scene_file = write_scene_file();
+  const auto result = run_exe(kBenchExe, {scene_file.string(), "--views", "all", "--sort", "radix", "--warmup", "0",
+                                          "--repeat", "1", "--json", json.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(contains(result.err, "2 frames")) << result.err;
+  const std::string json_text = read_file(json);
+  EXPECT_TRUE(contains(json_text, "\"cameras\": \"" + scene_file.string() + "\"")) << json_text;
+  EXPECT_TRUE(contains(json_text, "\"sh_degree\": 3")) << json_text;
 }
 
 TEST(CliRender, ListsDevices) {

@@ -20,10 +20,12 @@ struct RenderImage {
 };
 
 struct ExrWriteOptions {
-  bool half = false;  // store HALF instead of FLOAT channels
+  bool half = false;   // store HALF instead of FLOAT channels
+  bool alpha = true;   // write the A channel (false: R G B only, which readers take as opaque)
 };
 
-// Writes channels R G B A (and Z when depth is present, and "splats" when counts are present).
+// Writes channels R G B A (A unless options.alpha is false), Z when depth is present, and "splats"
+// when counts are present.
 // Atomic: the image goes to a temporary file beside `path` that is renamed over it only once
 // complete, so a failure never leaves a partial file. Throws std::runtime_error naming the file.
 void write_exr(const std::filesystem::path& path, const RenderImage& image, const ExrWriteOptions& options = {});

@@ -144,6 +144,7 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
     Imf::FrameBuffer frame;
     const size_t colour_pixel_bytes = 4 * colour_value_bytes;
     for (size_t c = 0; c < kColourChannels.size(); ++c) {
+      if (c == 3 && !options.alpha) continue;
       header.channels().insert(kColourChannels[c], Imf::Channel(colour_type));
       frame.insert(kColourChannels[c],
                    Imf::Slice::Make(colour_type, colour_data + c * colour_value_bytes, data_window,

@@ -1,0 +1,147 @@
+// Scene descriptions: a JSON file that composes several splat files into one scene, each placed by a
+// model transform, with the cameras, background, effects and outputs to render it with.
+// The format is documented in docs/scene-format.md (JSON Schema: docs/scene.schema.json).
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "tilesplat/camera.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat {
+
+// Places one splat file in the scene: p' = s R p + t, applied after the optional z_up conversion.
+struct ModelTransform {
+  std::array<double, 3> translation = {0, 0, 0};
+  // Unit quaternion w x y z. In JSON, "quaternion": [w, x, y, z] or "rotation_deg": [rx, ry, rz].
+  std::array<double, 4> rotation = {1, 0, 0, 0};
+  // Must be uniform (all three equal, positive): transform_scene rejects anything else. Three values
+  // so that a non-uniform scale can be written down, and refused with the reason, not truncated.
+  std::array<double, 3> scale = {1, 1, 1};
+  // The capture's up axis is +Z (Blender, many photogrammetry tools). The engine's world follows the
+  // trainer's OpenCV/COLMAP convention, whose up is -Y (cameras: x right, y down, z forward), so z_up
+  // first rotates the capture by +90 degrees about +X: (x, y, z) -> (x, -z, y), taking +Z to -Y.
+  bool z_up = false;
+
+  bool is_identity() const;
+};
+
+// The rotation z_up applies: +90 degrees about +X, as a w x y z quaternion.
+std::array<double, 4> z_up_rotation();
+
+// Euler angles in degrees, extrinsic X then Y then Z (about the world axes): R = Rz Ry Rx.
+std::array<double, 4> quaternion_from_euler_xyz_deg(const std::array<double, 3>& degrees);
+
+// Row-major 3x3 matrix of a unit quaternion w x y z (the convention of the scene's rotations).
+std::array<double, 9> rotation_matrix(const std::array<double, 4>& quaternion);
+
+// Everything the transform rotates by, z_up included: rotation * z_up_rotation() when z_up.
+std::array<double, 4> total_rotation(const ModelTransform& transform);
+
+// Throws std::invalid_argument when the transform cannot be applied exactly: a non-finite value, a
+// quaternion whose norm is not 1 (within 1e-3), a scale that is not positive, or a non-uniform scale.
+void validate(const ModelTransform& transform);
+
+// Exact rotation of real spherical harmonics, in the basis and signs of eval_sh (tilesplat/reference.h):
+// coefficients c' with eval_sh(c', R d) == eval_sh(c, d) for every direction d. Band l's (2l+1)x(2l+1)
+// matrix is fitted once per rotation from eval_sh itself, so it cannot drift from the renderers' basis.
+class ShRotation {
+ public:
+  explicit ShRotation(const std::array<double, 9>& rotation);  // row-major, a proper rotation
+  // One Gaussian's coefficients: (degree + 1)^2 * 3 floats, coefficient-major, RGB innermost.
+  void apply(int degree, float* coefficients) const;
+  // Band l (1..3), row-major: the band's new coefficients are this matrix times the old ones.
+  std::span<const double> band(int l) const;
+
+ private:
+  std::array<std::vector<double>, 4> bands_;
+};
+
+// The scene placed by the transform: positions p' = s R p + t; rotations q' = q_R q (normalised);
+// log scales + log s; SH bands 1..3 rotated exactly (ShRotation); normals rotated. A transform
+// without rotation leaves rotations, SH and normals bit-identical; the identity leaves everything so.
+// Throws std::invalid_argument for an invalid transform (validate), above all a non-uniform scale,
+// or when a transformed value overflows float.
+GaussianScene transform_scene(const GaussianScene& scene, const ModelTransform& transform);
+
+// The camera that sees transform_scene(scene, transform) as `camera` sees `scene`: centre moved by
+// the transform, axes rotated with it. The images agree (depths scale by s). Throws
+// std::invalid_argument for an invalid transform (validate).
+Camera transform_camera(const Camera& camera, const ModelTransform& transform);
+
+// The same Gaussians with `degree` (0..3) SH bands: higher bands dropped, missing ones zero.
+GaussianScene with_sh_degree(const GaussianScene& scene, int degree);
+
+// All Gaussians of all scenes, in order. The result's SH degree is the largest; scenes of lower
+// degree get zero coefficients (the same colours). Normals are kept when any scene has them (zero
+// for those without). Throws std::invalid_argument for a scene whose arrays disagree in size.
+GaussianScene merge_scenes(std::span<const GaussianScene> scenes);
+
+struct SceneModel {
+  std::filesystem::path path;  // resolved: relative paths in the file are relative to its directory
+  ModelTransform transform;
+};
+
+enum class Antialiasing { kClassic, kAntialiased, kMip };
+enum class ToneMap { kNone, kAces, kReinhard };
+
+struct SceneLight {
+  enum class Type { kDirectional, kPoint };
+  Type type = Type::kDirectional;
+  std::array<double, 3> direction = {0, 1, 0};  // directional: where the light travels (unit length)
+  std::array<double, 3> position = {0, 0, 0};   // point
+  std::array<double, 3> color = {1, 1, 1};      // linear RGB
+  double intensity = 1;
+};
+
+// Each effect is off unless the file asks for it.
+struct SceneEffects {
+  // Cap on the SH degree evaluated (0..3); none: every band the files have. "view_dependent": false
+  // in the file means 0 (the DC colour alone).
+  std::optional<int> sh_degree;
+  Antialiasing antialiasing = Antialiasing::kClassic;
+  std::vector<SceneLight> lights;
+  double exposure_stops = 0;  // PNG previews: colours times 2^exposure
+  ToneMap tone_map = ToneMap::kNone;
+};
+
+// What a render writes. Colour is always written; the rest as listed in the file's "outputs".
+struct SceneOutputs {
+  bool color = true;
+  bool alpha = true;
+  bool depth = false;
+  bool splat_count = false;
+};
+
+struct SceneDescription {
+  std::filesystem::path file;  // the description itself (names it in error messages)
+  std::vector<SceneModel> models;
+  std::vector<CameraView> cameras;     // empty when the file has none
+  std::filesystem::path cameras_file;  // resolved cameras.json when "cameras" names one, else empty
+  std::array<float, 3> background = {0, 0, 0};
+  SceneEffects effects;
+  SceneOutputs outputs;
+};
+
+// Reads a scene description. Throws SceneError for every mistake, as
+// "FILE: JSON.PATH: what is wrong, what is allowed" (e.g. "scene.json: effects.lights[1].type: ..."),
+// or "FILE: line L, column C: malformed JSON: ..." for a syntax error. Referenced files must exist.
+SceneDescription load_scene_description(const std::filesystem::path& path);
+
+// The same on text already in memory; `file` names it in messages and anchors relative paths.
+SceneDescription parse_scene_description(std::string_view text, const std::filesystem::path& file);
+
+// Loads every model (load_scene), transforms and merges them. Throws SceneError naming the description,
+// the model and the problem. The report sums the files' reports.
+GaussianScene load_described_scene(const SceneDescription& description, const LoadOptions& options = {},
+                                   LoadReport* report = nullptr);
+
+// Whether the path names a scene description (a .json file) rather than a splat file.
+bool is_scene_description(const std::filesystem::path& path);
+
+}  // namespace tilesplat

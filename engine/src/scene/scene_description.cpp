@@ -1,0 +1,700 @@
+// Reads scene descriptions (docs/scene-format.md): every mistake is a SceneError naming the file, the
+// JSON path of the bad value, what is wrong and what is allowed.
+#include "tilesplat/scene_description.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace tilesplat {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Limits that catch typos and unit mistakes; anything beyond them cannot be meant.
+constexpr double kMaxCoordinate = 1e9;      // translations, camera and light positions
+constexpr double kMinScale = 1e-6, kMaxScale = 1e6;
+constexpr double kMaxAngleDeg = 360;
+constexpr double kMaxFocal = 1e9;           // pixels
+constexpr int kMaxImageSide = 65536;
+constexpr double kMaxRadiance = 1e6;        // background and light colours, light intensity
+constexpr double kMaxExposureStops = 20;
+constexpr double kOrthonormalTolerance = 1e-3;
+constexpr double kDefaultFovDeg = 50;
+constexpr int kFormatVersion = 1;
+
+constexpr auto kTopKeys = std::to_array<std::string_view>({"$schema", "version", "models", "cameras",
+                                                      "background", "effects", "outputs"});
+constexpr auto kModelKeys = std::to_array<std::string_view>({"path", "translation", "rotation_deg",
+                                                        "quaternion", "scale", "z_up"});
+constexpr auto kCameraKeys = std::to_array<std::string_view>({"name", "width", "height", "fx", "fy",
+                                                          "cx", "cy", "position", "rotation", "look_at"});
+constexpr auto kLookAtKeys = std::to_array<std::string_view>({"eye", "target", "up", "fov_deg"});
+constexpr auto kEffectKeys = std::to_array<std::string_view>({"sh_degree", "view_dependent", "antialiasing",
+                                                         "lights", "exposure", "tone_map"});
+constexpr auto kLightKeys = std::to_array<std::string_view>({"type", "direction", "position", "color",
+                                                        "colour", "intensity"});
+constexpr auto kAntialiasing = std::to_array<std::string_view>({"classic", "antialiased", "mip"});
+constexpr auto kToneMaps = std::to_array<std::string_view>({"none", "aces", "reinhard"});
+constexpr auto kLightTypes = std::to_array<std::string_view>({"directional", "point"});
+constexpr auto kOutputs = std::to_array<std::string_view>({"color", "alpha", "depth", "splat_count"});
+
+std::string single_quoted(std::string_view text) { return "'" + std::string(text) + "'"; }
+
+template <size_t N>
+std::string quoted_list(const std::array<std::string_view, N>& items) {
+  std::string out;
+  for (size_t i = 0; i < N; ++i) out += (i ? ", " : "") + single_quoted(items[i]);
+  return out;
+}
+
+std::string format_number(double value) {
+  std::ostringstream out;
+  out.precision(10);
+  out << value;
+  return out.str();
+}
+
+std::string child_path(const std::string& parent, std::string_view key) {
+  return parent.empty() ? std::string(key) : parent + "." + std::string(key);
+}
+
+std::string element_path(const std::string& parent, size_t index) {
+  return parent + "[" + std::to_string(index) + "]";
+}
+
+std::string lowercase(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<size_t> previous(b.size() + 1), current(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    current[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j)
+      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (a[i - 1] != b[j - 1])});
+    std::swap(previous, current);
+  }
+  return previous[b.size()];
+}
+
+// "; did you mean 'x'?" for the closest candidate when it is close enough to be a typo, else "".
+template <size_t N>
+std::string did_you_mean(std::string_view given, const std::array<std::string_view, N>& candidates) {
+  const std::string lower = lowercase(given);
+  std::string_view best;
+  size_t best_distance = std::string::npos;
+  for (const auto candidate : candidates) {
+    const size_t distance = edit_distance(lower, lowercase(candidate));
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = candidate;
+    }
+  }
+  const size_t allowed = std::max<size_t>(2, std::max(given.size(), best.size()) / 3);
+  if (best.empty() || best_distance > allowed) return {};
+  return "; did you mean " + single_quoted(best) + "?";
+}
+
+std::string type_name(const json& value) {
+  switch (value.type()) {
+    case json::value_t::object: return "an object";
+    case json::value_t::array: return "an array";
+    case json::value_t::string: return "a string";
+    case json::value_t::boolean: return value.get<bool>() ? "true" : "false";
+    case json::value_t::null: return "null";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+    case json::value_t::number_float: return format_number(value.get<double>());
+    default: return "an unsupported value";
+  }
+}
+
+// Line and column (both from 1) of the character at 1-based byte `offset`, as nlohmann reports it.
+std::pair<size_t, size_t> line_and_column(std::string_view text, size_t offset) {
+  const size_t index = std::min(offset > 0 ? offset - 1 : 0, text.size());
+  const std::string_view before = text.substr(0, index);
+  const size_t line = 1 + size_t(std::count(before.begin(), before.end(), '\n'));
+  const size_t line_start = before.rfind('\n');
+  const size_t column = line_start == std::string_view::npos ? index + 1 : index - line_start;
+  return {line, column};
+}
+
+// The explanation of a nlohmann parse error without its "[json.exception...] parse error at ...: " prefix.
+std::string parse_explanation(const std::string& what) {
+  const size_t start = what.find("parse error");
+  if (start == std::string::npos) return what;
+  const size_t colon = what.find(": ", start);
+  return colon == std::string::npos ? what : what.substr(colon + 2);
+}
+
+// A JSON value and where it sits in the file.
+struct Node {
+  const json& value;
+  std::string path;
+};
+
+// Tracks the JSON path during parsing, to report duplicate keys (which nlohmann would silently
+// resolve to the last one: a mistake the author should hear about).
+class DuplicateKeyCheck {
+ public:
+  // Returns the path of a duplicated key, or nothing.
+  std::optional<std::string> on_event(json::parse_event_t event, const json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        frames_.push_back({event == json::parse_event_t::array_start, 0, next_path(), {}, {}});
+        return std::nullopt;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        if (!frames_.empty()) frames_.pop_back();
+        return std::nullopt;
+      case json::parse_event_t::key: {
+        Frame& frame = frames_.back();
+        frame.key = parsed.get<std::string>();
+        if (!frame.keys.insert(frame.key).second) return child_path(frame.path, frame.key);
+        return std::nullopt;
+      }
+      case json::parse_event_t::value:
+        next_path();
+        return std::nullopt;
+    }
+    return std::nullopt;
+  }
+
+ private:
+  struct Frame {
+    bool array = false;
+    size_t next_index = 0;
+    std::string path;
+    std::set<std::string> keys;
+    std::string key;
+  };
+
+  // The path of the value that starts now (advancing the enclosing array's index).
+  std::string next_path() {
+    if (frames_.empty()) return {};
+    Frame& frame = frames_.back();
+    if (frame.array) return element_path(frame.path, frame.next_index++);
+    return child_path(frame.path, frame.key);
+  }
+
+  std::vector<Frame> frames_;
+};
+
+class Reader {
+ public:
+  explicit Reader(const fs::path& file) : file_(file.string()), directory_(file.parent_path()) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& message) const {
+    throw SceneError(file_ + ": " + (path.empty() ? std::string("top level") : path) + ": " + message);
+  }
+
+  json parse(std::string_view text) const {
+    DuplicateKeyCheck duplicates;
+    std::optional<std::string> duplicate;
+    json document;
+    try {
+      document = json::parse(text.begin(), text.end(), [&](int, json::parse_event_t event, json& parsed) {
+        if (!duplicate) duplicate = duplicates.on_event(event, parsed);
+        return true;
+      });
+    } catch (const json::parse_error& error) {
+      const auto [line, column] = line_and_column(text, error.byte);
+      throw SceneError(file_ + ": line " + std::to_string(line) + ", column " + std::to_string(column) +
+                       ": malformed JSON: " + parse_explanation(error.what()));
+    } catch (const json::out_of_range& error) {
+      throw SceneError(number_overflow_message(text, error.what()));
+    }
+    if (duplicate)
+      fail(*duplicate, "duplicate key: the object has it twice and only one can count; remove the other");
+    return document;
+  }
+
+  // --- structure
+
+  template <size_t N>
+  void expect_object(const Node& node, const std::array<std::string_view, N>& keys) const {
+    if (!node.value.is_object())
+      fail(node.path, "must be an object with the keys " + quoted_list(keys) + ", got " + type_name(node.value));
+    for (const auto& [key, value] : node.value.items()) {
+      if (std::find(keys.begin(), keys.end(), key) != keys.end()) continue;
+      fail(child_path(node.path, key),
+           "unknown key" + did_you_mean(key, keys) + " (allowed: " + quoted_list(keys) + ")");
+    }
+  }
+
+  std::optional<Node> optional_child(const Node& node, std::string_view key) const {
+    const auto it = node.value.find(std::string(key));
+    if (it == node.value.end()) return std::nullopt;
+    return Node{*it, child_path(node.path, key)};
+  }
+
+  Node required_child(const Node& node, std::string_view key, const std::string& what) const {
+    auto child = optional_child(node, key);
+    if (!child) fail(node.path, "missing " + single_quoted(key) + ": " + what);
+    return *child;
+  }
+
+  const json& array(const Node& node, const std::string& what) const {
+    if (!node.value.is_array()) fail(node.path, "must be " + what + ", got " + type_name(node.value));
+    return node.value;
+  }
+
+  // --- values
+
+  double number(const Node& node, double min, double max) const {
+    const std::string range = "from " + format_number(min) + " to " + format_number(max);
+    if (!node.value.is_number()) fail(node.path, "must be a number " + range + ", got " + type_name(node.value));
+    const double value = node.value.get<double>();
+    if (!(value >= min && value <= max)) fail(node.path, "must be " + range + ", got " + format_number(value));
+    return value;
+  }
+
+  double positive(const Node& node, double max) const {
+    const std::string range = "greater than 0 and at most " + format_number(max);
+    if (!node.value.is_number()) fail(node.path, "must be a number " + range + ", got " + type_name(node.value));
+    const double value = node.value.get<double>();
+    if (!(value > 0 && value <= max)) fail(node.path, "must be " + range + ", got " + format_number(value));
+    return value;
+  }
+
+  int integer(const Node& node, int min, int max) const {
+    const std::string range = "from " + std::to_string(min) + " to " + std::to_string(max);
+    // 1920.0 is as good as 1920: some writers store every number as a float.
+    const bool integral = node.value.is_number() && std::floor(node.value.get<double>()) == node.value.get<double>();
+    if (!integral) fail(node.path, "must be an integer " + range + ", got " + type_name(node.value));
+    const double value = node.value.get<double>();
+    if (!(value >= min && value <= max)) fail(node.path, "must be " + range + ", got " + format_number(value));
+    return static_cast<int>(value);
+  }
+
+  bool boolean(const Node& node) const {
+    if (!node.value.is_boolean()) fail(node.path, "must be true or false, got " + type_name(node.value));
+    return node.value.get<bool>();
+  }
+
+  std::string string(const Node& node) const {
+    if (!node.value.is_string()) fail(node.path, "must be a string, got " + type_name(node.value));
+    return node.value.get<std::string>();
+  }
+
+  template <size_t N>
+  std::array<double, N> numbers(const Node& node, double min, double max) const {
+    if (!node.value.is_array() || node.value.size() != N)
+      fail(node.path, "must be an array of " + std::to_string(N) + " numbers, got " +
+                          (node.value.is_array() ? std::to_string(node.value.size()) + " values"
+                                                 : type_name(node.value)));
+    std::array<double, N> out{};
+    for (size_t i = 0; i < N; ++i) out[i] = number(Node{node.value[i], element_path(node.path, i)}, min, max);
+    return out;
+  }
+
+  std::array<double, 3> nonzero_vector(const Node& node) const {
+    const auto v = numbers<3>(node, -kMaxCoordinate, kMaxCoordinate);
+    if (!(std::hypot(v[0], v[1], v[2]) > 1e-12)) fail(node.path, "must not be the zero vector");
+    return v;
+  }
+
+  template <size_t N>
+  std::string_view choice(const Node& node, const std::array<std::string_view, N>& allowed) const {
+    const std::string text = string(node);
+    for (const auto option : allowed)
+      if (option == text) return option;
+    fail(node.path, "unknown value " + single_quoted(text) + did_you_mean(text, allowed) +
+                        " (allowed: " + quoted_list(allowed) + ")");
+  }
+
+  // A file the description names: relative to the description's directory, and it must exist.
+  fs::path existing_file(const Node& node, std::string_view what) const {
+    const std::string text = string(node);
+    if (text.empty()) fail(node.path, "must name " + std::string(what) + ", got an empty string");
+    const fs::path resolved = (directory_ / fs::path(text)).lexically_normal();
+    std::error_code error;
+    const auto status = fs::status(resolved, error);
+    const std::string named = single_quoted(resolved.string());
+    if (!fs::exists(status)) fail(node.path, std::string(what) + " " + named + " does not exist");
+    if (fs::is_directory(status)) fail(node.path, named + " is a directory, not " + std::string(what));
+    return resolved;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  // nlohmann reports a number too large for a double without a position: find the literal.
+  std::string number_overflow_message(std::string_view text, const std::string& what) const {
+    const size_t open = what.find('\'');
+    const size_t close = what.rfind('\'');
+    if (open == std::string::npos || close <= open) return file_ + ": malformed JSON: " + what;
+    const std::string literal = what.substr(open + 1, close - open - 1);
+    std::string where;
+    if (const size_t at = text.find(literal); at != std::string_view::npos) {
+      const auto [line, column] = line_and_column(text, at + 1);
+      where = ": line " + std::to_string(line) + ", column " + std::to_string(column);
+    }
+    return file_ + where + ": the number " + literal + " is too large for a 64-bit float";
+  }
+
+  std::string file_;
+  fs::path directory_;
+};
+
+// --- models
+
+ModelTransform read_rotation(const Reader& reader, const Node& model, ModelTransform transform) {
+  const auto euler = reader.optional_child(model, "rotation_deg");
+  const auto quaternion = reader.optional_child(model, "quaternion");
+  if (euler && quaternion)
+    reader.fail(model.path, "give either 'rotation_deg' or 'quaternion', not both");
+  if (euler) transform.rotation = quaternion_from_euler_xyz_deg(reader.numbers<3>(*euler, -kMaxAngleDeg, kMaxAngleDeg));
+  if (quaternion) {
+    const auto q = reader.numbers<4>(*quaternion, -2, 2);
+    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!(std::abs(norm - 1) <= 1e-3))
+      reader.fail(quaternion->path, "must be a unit quaternion [w, x, y, z] (norm 1 within 0.001), its norm is " +
+                                        format_number(norm));
+    transform.rotation = {q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm};
+  }
+  return transform;
+}
+
+std::array<double, 3> read_scale(const Reader& reader, const Node& node) {
+  std::array<double, 3> scale{};
+  if (node.value.is_number()) {
+    const double s = reader.number(node, kMinScale, kMaxScale);
+    scale = {s, s, s};
+  } else if (node.value.is_array()) {
+    scale = reader.numbers<3>(node, kMinScale, kMaxScale);
+  } else {
+    reader.fail(node.path, "must be a number from " + format_number(kMinScale) + " to " + format_number(kMaxScale) +
+                               " (one uniform scale), got " + type_name(node.value));
+  }
+  ModelTransform probe;
+  probe.scale = scale;
+  try {
+    validate(probe);
+  } catch (const std::invalid_argument& error) {
+    reader.fail(node.path, error.what());
+  }
+  return scale;
+}
+
+SceneModel read_model(const Reader& reader, const Node& model) {
+  reader.expect_object(model, kModelKeys);
+  SceneModel out;
+  out.path = reader.existing_file(reader.required_child(model, "path", "the splat file (.ply) to load"), "splat file");
+  if (const auto t = reader.optional_child(model, "translation"))
+    out.transform.translation = reader.numbers<3>(*t, -kMaxCoordinate, kMaxCoordinate);
+  out.transform = read_rotation(reader, model, out.transform);
+  if (const auto s = reader.optional_child(model, "scale")) out.transform.scale = read_scale(reader, *s);
+  if (const auto z_up = reader.optional_child(model, "z_up")) out.transform.z_up = reader.boolean(*z_up);
+  return out;
+}
+
+std::vector<SceneModel> read_models(const Reader& reader, const Node& root) {
+  const Node models = reader.required_child(root, "models", "a list of {\"path\": \"file.ply\", ...}");
+  const json& list = reader.array(models, "a non-empty list of models");
+  if (list.empty()) reader.fail(models.path, "must list at least one model");
+  std::vector<SceneModel> out;
+  for (size_t i = 0; i < list.size(); ++i)
+    out.push_back(read_model(reader, Node{list[i], element_path(models.path, i)}));
+  return out;
+}
+
+// --- cameras
+
+// A world-to-camera matrix given as three rows; it must be a rotation.
+std::array<double, 9> read_camera_rotation(const Reader& reader, const Node& node) {
+  if (!node.value.is_array() || node.value.size() != 3)
+    reader.fail(node.path, "must be a 3x3 world-to-camera rotation given as 3 rows of 3 numbers, got " +
+                               type_name(node.value));
+  std::array<double, 9> m{};
+  for (size_t r = 0; r < 3; ++r) {
+    const auto row = reader.numbers<3>(Node{node.value[r], element_path(node.path, r)}, -1.001, 1.001);
+    std::copy(row.begin(), row.end(), m.begin() + static_cast<std::ptrdiff_t>(r * 3));
+  }
+  double worst = 0;
+  for (size_t i = 0; i < 3; ++i)
+    for (size_t j = 0; j < 3; ++j) {
+      double dot = 0;
+      for (size_t k = 0; k < 3; ++k) dot += m[i * 3 + k] * m[j * 3 + k];
+      worst = std::max(worst, std::abs(dot - (i == j ? 1.0 : 0.0)));
+    }
+  if (!(worst <= kOrthonormalTolerance))
+    reader.fail(node.path, "must be a rotation: its rows are not orthonormal (|R R^T - I| = " + format_number(worst) +
+                               ", tolerance " + format_number(kOrthonormalTolerance) + ")");
+  const double det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+                     m[2] * (m[3] * m[7] - m[4] * m[6]);
+  if (det < 0) reader.fail(node.path, "is a reflection (determinant -1), not a rotation");
+  return m;
+}
+
+Camera read_look_at(const Reader& reader, const Node& node, int width, int height) {
+  reader.expect_object(node, kLookAtKeys);
+  const auto eye = reader.numbers<3>(reader.required_child(node, "eye", "the camera centre [x, y, z]"),
+                                     -kMaxCoordinate, kMaxCoordinate);
+  const Node target_node = reader.required_child(node, "target", "the point looked at [x, y, z]");
+  const auto target = reader.numbers<3>(target_node, -kMaxCoordinate, kMaxCoordinate);
+  std::array<double, 3> up = {0, -1, 0};  // the engine's world up (OpenCV/COLMAP captures)
+  const auto up_node = reader.optional_child(node, "up");
+  if (up_node) up = reader.nonzero_vector(*up_node);
+  double fov = kDefaultFovDeg;
+  if (const auto fov_node = reader.optional_child(node, "fov_deg")) {
+    fov = reader.number(*fov_node, 0, 180);
+    if (!(fov > 0 && fov < 180))
+      reader.fail(fov_node->path, "must be strictly between 0 and 180 degrees, got " + format_number(fov));
+  }
+  const std::array<double, 3> forward = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
+  const double distance = std::hypot(forward[0], forward[1], forward[2]);
+  if (!(distance > 0)) reader.fail(target_node.path, "must differ from 'eye'");
+  const std::array<double, 3> side = {up[1] * forward[2] - up[2] * forward[1], up[2] * forward[0] - up[0] * forward[2],
+                                      up[0] * forward[1] - up[1] * forward[0]};
+  const double up_length = std::hypot(up[0], up[1], up[2]);
+  if (std::hypot(side[0], side[1], side[2]) <= 1e-6 * up_length * distance)
+    reader.fail(up_node ? up_node->path : node.path, "'up' is parallel to the view direction (eye to target): "
+                                                     "the camera's roll is undefined");
+  return look_at_camera(eye, target, up, width, height, fov);
+}
+
+Camera read_pinhole(const Reader& reader, const Node& node, int width, int height) {
+  Camera camera;
+  camera.width = width;
+  camera.height = height;
+  const std::string focal = "the focal length in pixels (or use 'look_at')";
+  camera.fx = reader.positive(reader.required_child(node, "fx", focal), kMaxFocal);
+  camera.fy = reader.positive(reader.required_child(node, "fy", focal), kMaxFocal);
+  camera.cx = width / 2.0;
+  camera.cy = height / 2.0;
+  if (const auto cx = reader.optional_child(node, "cx")) camera.cx = reader.number(*cx, -kMaxFocal, kMaxFocal);
+  if (const auto cy = reader.optional_child(node, "cy")) camera.cy = reader.number(*cy, -kMaxFocal, kMaxFocal);
+  camera.position = reader.numbers<3>(reader.required_child(node, "position", "the camera centre [x, y, z]"),
+                                      -kMaxCoordinate, kMaxCoordinate);
+  camera.rotation = read_camera_rotation(
+      reader, reader.required_child(node, "rotation", "the world-to-camera rotation, 3 rows of 3 numbers"));
+  return camera;
+}
+
+CameraView read_camera(const Reader& reader, const Node& node, size_t index) {
+  reader.expect_object(node, kCameraKeys);
+  CameraView view;
+  view.id = static_cast<int>(index);
+  if (const auto name = reader.optional_child(node, "name")) view.name = reader.string(*name);
+  const int width = reader.integer(reader.required_child(node, "width", "the image width in pixels"), 1, kMaxImageSide);
+  const int height =
+      reader.integer(reader.required_child(node, "height", "the image height in pixels"), 1, kMaxImageSide);
+  if (const auto look_at = reader.optional_child(node, "look_at")) {
+    for (const char* key : {"fx", "fy", "cx", "cy", "position", "rotation"})
+      if (const auto conflict = reader.optional_child(node, key))
+        reader.fail(conflict->path, "not allowed with 'look_at', which sets the pose and the focal length");
+    view.camera = read_look_at(reader, *look_at, width, height);
+  } else {
+    view.camera = read_pinhole(reader, node, width, height);
+  }
+  return view;
+}
+
+void read_cameras(const Reader& reader, const Node& node, SceneDescription& out) {
+  if (node.value.is_string()) {
+    out.cameras_file = reader.existing_file(node, "cameras file");
+    try {
+      out.cameras = load_cameras_json(out.cameras_file);
+    } catch (const SceneError& error) {
+      reader.fail(node.path, error.what());
+    }
+    return;
+  }
+  const json& list = reader.array(node, "a cameras.json path or a list of cameras");
+  if (list.empty()) reader.fail(node.path, "must list at least one camera (leave 'cameras' out for none)");
+  for (size_t i = 0; i < list.size(); ++i)
+    out.cameras.push_back(read_camera(reader, Node{list[i], element_path(node.path, i)}, i));
+}
+
+// --- effects and outputs
+
+SceneLight read_light(const Reader& reader, const Node& node) {
+  reader.expect_object(node, kLightKeys);
+  SceneLight light;
+  const Node type = reader.required_child(node, "type", "'directional' or 'point'");
+  light.type = reader.choice(type, kLightTypes) == "point" ? SceneLight::Type::kPoint : SceneLight::Type::kDirectional;
+  const auto direction = reader.optional_child(node, "direction");
+  const auto position = reader.optional_child(node, "position");
+  if (light.type == SceneLight::Type::kDirectional) {
+    if (position) reader.fail(position->path, "a directional light has a 'direction', not a 'position'");
+    const auto d = reader.nonzero_vector(reader.required_child(node, "direction", "where the light travels [x, y, z]"));
+    const double length = std::hypot(d[0], d[1], d[2]);
+    light.direction = {d[0] / length, d[1] / length, d[2] / length};
+  } else {
+    if (direction) reader.fail(direction->path, "a point light has a 'position', not a 'direction'");
+    light.position = reader.numbers<3>(reader.required_child(node, "position", "the light's position [x, y, z]"),
+                                       -kMaxCoordinate, kMaxCoordinate);
+  }
+  const auto color = reader.optional_child(node, "color");
+  const auto colour = reader.optional_child(node, "colour");
+  if (color && colour) reader.fail(colour->path, "give 'color' or 'colour' (the same thing), not both");
+  if (color || colour) light.color = reader.numbers<3>(color ? *color : *colour, 0, kMaxRadiance);
+  if (const auto intensity = reader.optional_child(node, "intensity"))
+    light.intensity = reader.number(*intensity, 0, kMaxRadiance);
+  return light;
+}
+
+std::optional<int> read_sh_degree(const Reader& reader, const Node& effects) {
+  const auto degree_node = reader.optional_child(effects, "sh_degree");
+  const auto view_dependent_node = reader.optional_child(effects, "view_dependent");
+  std::optional<int> degree;
+  if (degree_node) degree = reader.integer(*degree_node, 0, 3);
+  if (!view_dependent_node) return degree;
+  const bool view_dependent = reader.boolean(*view_dependent_node);
+  if (degree && view_dependent != (*degree > 0))
+    reader.fail(view_dependent_node->path, std::string("contradicts 'sh_degree': ") + std::to_string(*degree) +
+                                               (view_dependent ? " is the DC colour alone, not view-dependent"
+                                                               : " keeps view-dependent bands") +
+                                               "; give one of the two");
+  if (!view_dependent) return 0;
+  return degree;
+}
+
+SceneEffects read_effects(const Reader& reader, const Node& node) {
+  reader.expect_object(node, kEffectKeys);
+  SceneEffects effects;
+  effects.sh_degree = read_sh_degree(reader, node);
+  if (const auto aa = reader.optional_child(node, "antialiasing")) {
+    const auto mode = reader.choice(*aa, kAntialiasing);
+    effects.antialiasing = mode == "mip"           ? Antialiasing::kMip
+                           : mode == "antialiased" ? Antialiasing::kAntialiased
+                                                   : Antialiasing::kClassic;
+  }
+  if (const auto lights = reader.optional_child(node, "lights")) {
+    const json& list = reader.array(*lights, "a list of lights");
+    for (size_t i = 0; i < list.size(); ++i)
+      effects.lights.push_back(read_light(reader, Node{list[i], element_path(lights->path, i)}));
+  }
+  if (const auto exposure = reader.optional_child(node, "exposure"))
+    effects.exposure_stops = reader.number(*exposure, -kMaxExposureStops, kMaxExposureStops);
+  if (const auto tone_map = reader.optional_child(node, "tone_map")) {
+    const auto mode = reader.choice(*tone_map, kToneMaps);
+    effects.tone_map = mode == "aces" ? ToneMap::kAces : mode == "reinhard" ? ToneMap::kReinhard : ToneMap::kNone;
+  }
+  return effects;
+}
+
+SceneOutputs read_outputs(const Reader& reader, const Node& node) {
+  const json& list = reader.array(node, "a list of outputs from " + quoted_list(kOutputs));
+  SceneOutputs outputs{false, false, false, false};
+  std::set<std::string_view> seen;
+  for (size_t i = 0; i < list.size(); ++i) {
+    const Node item{list[i], element_path(node.path, i)};
+    const std::string_view output = reader.choice(item, kOutputs);
+    if (!seen.insert(output).second) reader.fail(item.path, single_quoted(output) + " is listed twice");
+    outputs.color |= output == "color";
+    outputs.alpha |= output == "alpha";
+    outputs.depth |= output == "depth";
+    outputs.splat_count |= output == "splat_count";
+  }
+  if (!outputs.color) reader.fail(node.path, "must include 'color': every render writes the colour channels");
+  return outputs;
+}
+
+void read_version(const Reader& reader, const Node& root) {
+  const auto version = reader.optional_child(root, "version");
+  if (version && reader.integer(*version, 1, 1000000) != kFormatVersion)
+    reader.fail(version->path, "this reader knows format version " + std::to_string(kFormatVersion) + " only");
+  if (const auto schema = reader.optional_child(root, "$schema")) reader.string(*schema);
+}
+
+std::string read_text(const fs::path& path) {
+  std::error_code error;
+  const auto status = fs::status(path, error);
+  if (!fs::exists(status)) throw SceneError(path.string() + ": the scene description does not exist");
+  if (fs::is_directory(status)) throw SceneError(path.string() + ": is a directory, not a scene description");
+  std::ifstream stream(path, std::ios::binary);
+  if (!stream) throw SceneError(path.string() + ": cannot open the scene description");
+  return {std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>()};
+}
+
+// The models' load reports as one: counts summed, properties named with their file.
+void add_report(LoadReport& total, const LoadReport& part, const fs::path& file) {
+  total.gaussians_in_file += part.gaussians_in_file;
+  total.dropped += part.dropped;
+  for (DroppedProperty dropped : part.dropped_by_property) {
+    dropped.property = file.filename().string() + " " + dropped.property;
+    total.dropped_by_property.push_back(std::move(dropped));
+  }
+  for (const auto& property : part.ignored_properties)
+    if (std::find(total.ignored_properties.begin(), total.ignored_properties.end(), property) ==
+        total.ignored_properties.end())
+      total.ignored_properties.push_back(property);
+  if (total.format.find(part.format) == std::string::npos)
+    total.format += (total.format.back() == '(' ? "" : ", ") + part.format;
+}
+
+}  // namespace
+
+SceneDescription parse_scene_description(std::string_view text, const fs::path& file) {
+  const Reader reader(file);
+  const json document = reader.parse(text);
+  const Node root{document, ""};
+  if (document.is_array())
+    reader.fail(root.path, "must be an object {\"models\": [...], ...}, got an array (a trainer cameras.json? "
+                           "name it in \"cameras\", or pass it to the apps with --cameras)");
+  reader.expect_object(root, kTopKeys);
+  read_version(reader, root);
+
+  SceneDescription description;
+  description.file = file;
+  description.models = read_models(reader, root);
+  if (const auto cameras = reader.optional_child(root, "cameras")) read_cameras(reader, *cameras, description);
+  if (const auto background = reader.optional_child(root, "background")) {
+    const auto rgb = reader.numbers<3>(*background, 0, kMaxRadiance);
+    description.background = {float(rgb[0]), float(rgb[1]), float(rgb[2])};
+  }
+  if (const auto effects = reader.optional_child(root, "effects")) description.effects = read_effects(reader, *effects);
+  if (const auto outputs = reader.optional_child(root, "outputs")) description.outputs = read_outputs(reader, *outputs);
+  return description;
+}
+
+SceneDescription load_scene_description(const fs::path& path) { return parse_scene_description(read_text(path), path); }
+
+GaussianScene load_described_scene(const SceneDescription& description, const LoadOptions& options,
+                                   LoadReport* report) {
+  LoadReport total;
+  total.format = "scene description (";
+  std::vector<GaussianScene> scenes;
+  scenes.reserve(description.models.size());
+  for (size_t i = 0; i < description.models.size(); ++i) {
+    const SceneModel& model = description.models[i];
+    const std::string where = description.file.string() + ": models[" + std::to_string(i) + "]: ";
+    LoadReport part;
+    try {
+      scenes.push_back(transform_scene(load_scene(model.path, options, &part), model.transform));
+    } catch (const SceneError& error) {
+      throw SceneError(where + error.what());
+    } catch (const std::invalid_argument& error) {
+      throw SceneError(where + model.path.string() + ": " + error.what());
+    }
+    add_report(total, part, model.path);
+  }
+  total.format += ")";
+  GaussianScene merged = merge_scenes(scenes);
+  if (report) *report = std::move(total);
+  return merged;
+}
+
+bool is_scene_description(const fs::path& path) { return lowercase(path.extension().string()) == ".json"; }
+
+}  // namespace tilesplat
