@@ -616,8 +616,6 @@ void require_supported_effects(const SceneDescription& description) {
     throw std::runtime_error(description.file.string() + ": effects." + path + ": " + what +
                              " is not implemented yet");
   };
-  if (effects.antialiasing == Antialiasing::kAntialiased) refuse("antialiasing", "'antialiased' antialiasing");
-  if (effects.antialiasing == Antialiasing::kMip) refuse("antialiasing", "'mip' (Mip-Splatting) antialiasing");
   if (!effects.lights.empty()) refuse("lights", "relighting");
   if (effects.tone_map != ToneMap::kNone) refuse("tone_map", "tone mapping");
   if (effects.exposure_stops != 0) refuse("exposure", "exposure");
@@ -629,6 +627,7 @@ void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings) {
   settings.background = description.background;
   settings.depth = description.outputs.depth;
   settings.splat_count = description.outputs.splat_count;
+  settings.antialiasing = description.effects.antialiasing;
   if (description.effects.sh_degree)
     settings.accuracy.sh_degree_cap = std::min(settings.accuracy.sh_degree_cap, *description.effects.sh_degree);
 }

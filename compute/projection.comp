@@ -40,6 +40,11 @@ layout(constant_id = 5) const bool SQUARE_TILES = false;    // every tile of the
 layout(constant_id = 6) const float ALPHA_INV = 255.0;      // 1 / the alpha cut-off
 layout(constant_id = 7) const uint DEPTH_KEY_BITS = 32;     // 32: float bits; 24: their top 24; 16: see below
 layout(constant_id = 8) const bool RAY_DEPTH = false;       // write the per-pixel re-sorting data
+// The antialiasing mode (tilesplat::Antialiasing), a scene effect: the low-pass filter added to the
+// 2D covariance, and whether opacity is scaled by sqrt(det before / det after) to keep the
+// footprint's integral (gsplat's "antialiased" and Mip-Splatting's 2D filter).
+layout(constant_id = 9) const uint DILATION_TENTHS = 3;  // 0.3 px^2 (classic, antialiased) or 0.1 (mip)
+layout(constant_id = 10) const bool COMPENSATE_OPACITY = false;
 #include "sh.glsl"
 
 // Camera, written by the host each frame. Doubles are stored as bit pairs so that the float32
@@ -146,25 +151,29 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   real3 j0 = real3(fx * inv_z, 0.0, -fx * tx * inv_z * inv_z);
   real3 j1 = real3(0.0, fy * inv_z, -fy * ty * inv_z * inv_z);
   real a, b, c, det;
+  real det_unfiltered;  // of the 2D covariance before the low-pass filter
+  const real d = real(DILATION_TENTHS) / 10.0;  // the double nearest 0.3 or 0.1, as the reference's
   if (COV_HALF) {
     real3 u = j0 * W;  // rows of J W
     real3 v = j1 * W;
     real3 su = sigma * u;
     real3 sv = sigma * v;
-    a = dot(u, su) + 0.3;
+    a = dot(u, su) + d;
     b = dot(u, sv);
-    c = dot(v, sv) + 0.3;
+    c = dot(v, sv) + d;
     det = a * c - b * b;
+    det_unfiltered = (a - d) * (c - d) - b * b;
   } else {
     realmat3 WRS = W * RS;
     real3 u = j0 * WRS;  // row 0 of J W R S
     real3 v = j1 * WRS;  // row 1
-    a = dot(u, u) + 0.3;
+    a = dot(u, u) + d;
     b = dot(u, v);
-    c = dot(v, v) + 0.3;
-    // det(uu^T + vv^T + 0.3 I) without cancellation: |u x v|^2 + 0.3 (|u|^2 + |v|^2) + 0.09.
+    c = dot(v, v) + d;
+    // det(uu^T + vv^T + d I) without cancellation: |u x v|^2 + d (|u|^2 + |v|^2) + d^2.
     real3 uxv = cross(u, v);
-    det = dot(uxv, uxv) + 0.3 * (dot(u, u) + dot(v, v)) + 0.09;
+    det_unfiltered = dot(uxv, uxv);
+    det = det_unfiltered + d * (dot(u, u) + dot(v, v)) + d * d;
   }
   real2 mean = real2(fx * t.x * inv_z + cx, fy * t.y * inv_z + cy);
   // The composite works in float32 relative to the mean, so the mean must be a finite float.
@@ -176,6 +185,7 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   float logit = pc.opacity_logits.v[i];
   if (isnan(logit)) return 0;
   float opacity = 1.0 / (1.0 + exp(-logit));
+  if (COMPENSATE_OPACITY) opacity *= float(sqrt(max(real(2.5e-5), max(det_unfiltered, real(0.0)) / det)));
   real mid = 0.5 * (a + c);
   real lambda = mid + sqrt(max(real(0.1), mid * mid - det));
   // Where alpha = o exp(-k^2 / 2) falls to the cut-off along the major axis: k = sqrt(2 ln(o / cut-off)).

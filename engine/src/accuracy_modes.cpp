@@ -10,6 +10,15 @@
 
 namespace tilesplat {
 
+std::string to_string(Antialiasing mode) {
+  switch (mode) {
+    case Antialiasing::kClassic: return "classic";
+    case Antialiasing::kAntialiased: return "antialiased";
+    case Antialiasing::kMip: return "mip";
+  }
+  return "unknown";
+}
+
 namespace {
 
 [[noreturn]] void bad(const std::string& token, const std::string& why) {

@@ -137,8 +137,11 @@ struct Renderer::Impl {
   }
 
   // The projection a frame's accuracy modes call for.
-  ProjectionVariant projection_variant(const AccuracyModes& modes) const {
+  ProjectionVariant projection_variant(const RenderSettings& settings) const {
+    const AccuracyModes& modes = settings.accuracy;
     ProjectionVariant v;
+    v.dilation_tenths = settings.antialiasing == Antialiasing::kMip ? 1 : 3;
+    v.compensate_opacity = settings.antialiasing != Antialiasing::kClassic;
     v.stored_sh_degree = scene.sh_degree;
     v.sh_degree = std::min(scene.sh_degree, modes.sh_degree_cap);
     v.sh_half = modes.fp16_sh;
@@ -159,7 +162,7 @@ struct Renderer::Impl {
     // Tile ids run to `tiles` inclusive: the key emission's padding uses that id (never in practice).
     const uint32_t tile_bits = uint32_t(std::bit_width(tiles));
     const AccuracyModes& modes = settings.accuracy;
-    const ProjectionVariant variant = projection_variant(modes);
+    const ProjectionVariant variant = projection_variant(settings);
     // The per-Gaussian depth key: the view depth's float bits, or fewer (AccuracyModes::depth_key_bits).
     const uint32_t depth_bits = variant.depth_key_bits;
     const uint32_t n = scene.count;

@@ -29,7 +29,8 @@ struct ProjectedGaussian {
 constexpr int kTileSize = 16;
 
 // Projects Gaussian i of the scene with the reference math.
-ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera);
+ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
+                                   Antialiasing antialiasing = Antialiasing::kClassic);
 
 // Evaluates real spherical harmonics up to `degree` for the (normalized) direction dir.
 // coeffs: K * 3 values, coefficient-major RGB innermost. Returns the raw sum (no +0.5, no clamp).

@@ -68,6 +68,15 @@ AccuracyModes parse_accuracy_modes(const std::string& text);
 // Throws std::invalid_argument when a value is out of range (naming it).
 void validate(const AccuracyModes& modes);
 
+// How a splat's 2D footprint is filtered (DESIGN-NOTES section 1). An asset is trained for one mode
+// and renders correctly only in that mode.
+enum class Antialiasing {
+  kClassic,      // the original 3DGS: 0.3 px^2 added to the 2D covariance
+  kAntialiased,  // gsplat's "antialiased": the same dilation, opacity * sqrt(det before / det after)
+  kMip,          // Mip-Splatting's 2D filter: 0.1 px^2 and the same opacity compensation
+};
+std::string to_string(Antialiasing mode);  // "classic", "antialiased", "mip"
+
 // Everything that changes how one frame is rendered.
 struct RenderSettings {
   std::array<float, 3> background = {0, 0, 0};
@@ -75,6 +84,7 @@ struct RenderSettings {
   bool depth = true;           // produce the expected-depth channel
   bool splat_count = true;     // produce the per-pixel blended-splat count
   AccuracyModes accuracy;      // approximations (default: none, the reference)
+  Antialiasing antialiasing = Antialiasing::kClassic;
 };
 
 struct PassTiming {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tilesplat/camera.h"
+#include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 
 namespace tilesplat {
@@ -87,7 +88,6 @@ struct SceneModel {
   ModelTransform transform;
 };
 
-enum class Antialiasing { kClassic, kAntialiased, kMip };
 enum class ToneMap { kNone, kAces, kReinhard };
 
 struct SceneLight {

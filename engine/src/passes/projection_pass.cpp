@@ -76,7 +76,8 @@ const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant&
         {2, v.sh_half},                     {3, v.covariance_half},
         {4, v.opacity_extent},              {5, v.square_tiles},
         {6, std::bit_cast<uint32_t>(v.alpha_inv)}, {7, v.depth_key_bits},
-        {8, v.ray_depth}};
+        {8, v.ray_depth},                   {9, v.dilation_tenths},
+        {10, v.compensate_opacity}};
     const char* shader = ctx_.features().shader_float64 ? "projection" : "projection_fp32";
     it = pipelines_.emplace(v, vk::ComputePipeline(ctx_, shader, sizeof(ProjectionPush), spec)).first;
   }

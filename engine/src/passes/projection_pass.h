@@ -33,9 +33,11 @@ struct ProjectionVariant {
   float alpha_inv = 255.0f;
   uint32_t depth_key_bits = 32;
   bool ray_depth = false;  // write ProjectedBuffers::ray_depth
+  uint32_t dilation_tenths = 3;  // the antialiasing mode's low-pass filter, in 0.1 px^2
+  bool compensate_opacity = false;
   auto tie() const {
     return std::tie(sh_degree, stored_sh_degree, sh_half, covariance_half, opacity_extent, square_tiles, alpha_inv,
-                    depth_key_bits, ray_depth);
+                    depth_key_bits, ray_depth, dilation_tenths, compensate_opacity);
   }
   bool operator<(const ProjectionVariant& o) const { return tie() < o.tie(); }
 };

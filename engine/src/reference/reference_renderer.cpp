@@ -29,7 +29,8 @@ constexpr double kShC3[7] = {-0.5900435899266435, 2.890611442640554, -0.45704579
 
 constexpr double kNearPlane = 0.2;
 constexpr double kFrustumClampFactor = 1.3;  // x/z, y/z clamp before the Jacobian, in units of tan(fov/2)
-constexpr double kLowPassDilation = 0.3;
+// The low-pass filter added to every 2D covariance, per antialiasing mode.
+double low_pass_dilation(Antialiasing mode) { return mode == Antialiasing::kMip ? 0.1 : 0.3; }
 constexpr double kMinEigenGap = 0.1;
 constexpr double kMaxAlpha = 0.99;
 constexpr double kMinAlpha = 1.0 / 255.0;
@@ -177,7 +178,8 @@ std::array<double, 3> eval_sh(int degree, const float* coeffs, const std::array<
   return result;
 }
 
-ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera) {
+ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
+                                   Antialiasing antialiasing) {
   if (i >= scene.size()) throw std::out_of_range("project_gaussian: index out of range");
   ProjectedGaussian out;
   const std::array<double, 3> mean = {scene.positions[3 * i], scene.positions[3 * i + 1], scene.positions[3 * i + 2]};
@@ -211,9 +213,12 @@ ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const C
     sigma_t0[r] = sigma[r * 3] * t0[0] + sigma[r * 3 + 1] * t0[1] + sigma[r * 3 + 2] * t0[2];
     sigma_t1[r] = sigma[r * 3] * t1[0] + sigma[r * 3 + 1] * t1[1] + sigma[r * 3 + 2] * t1[2];
   }
-  const double a = t0[0] * sigma_t0[0] + t0[1] * sigma_t0[1] + t0[2] * sigma_t0[2] + kLowPassDilation;
+  const double dilation = low_pass_dilation(antialiasing);
+  const double a0 = t0[0] * sigma_t0[0] + t0[1] * sigma_t0[1] + t0[2] * sigma_t0[2];
   const double b = t0[0] * sigma_t1[0] + t0[1] * sigma_t1[1] + t0[2] * sigma_t1[2];
-  const double c = t1[0] * sigma_t1[0] + t1[1] * sigma_t1[1] + t1[2] * sigma_t1[2] + kLowPassDilation;
+  const double c0 = t1[0] * sigma_t1[0] + t1[1] * sigma_t1[1] + t1[2] * sigma_t1[2];
+  const double a = a0 + dilation;
+  const double c = c0 + dilation;
   out.cov2d[0] = a;
   out.cov2d[1] = b;
   out.cov2d[2] = c;
@@ -249,6 +254,9 @@ ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const C
   // (std::min(0.99, NaN) would draw it opaque). +-inf logits are opacities 1 and 0 and stay.
   if (std::isnan(scene.opacity_logits[i])) return out;
   out.opacity = sigmoid(scene.opacity_logits[i]);
+  // The filtered footprint is larger than the splat; these modes keep its integral (its energy).
+  if (antialiasing != Antialiasing::kClassic)
+    out.opacity *= std::sqrt(std::max(2.5e-5, std::max(0.0, a0 * c0 - b * b) / det));
   std::array<double, 3> dir = {mean[0] - camera.position[0], mean[1] - camera.position[1],
                                mean[2] - camera.position[2]};
   const double dir_length = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
@@ -271,7 +279,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
 
   std::vector<ProjectedGaussian> projected(n);
   parallel_chunks(n, 4096, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) projected[i] = project_gaussian(scene, i, camera);
+    for (size_t i = begin; i < end; ++i) projected[i] = project_gaussian(scene, i, camera, settings.antialiasing);
   });
 
   // Front to back by the float32 depth the GPU sorts on, ties by Gaussian index.
