@@ -22,6 +22,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "tile_coverage.glsl"
+#include "composite_reach.glsl"
 
 layout(local_size_x = 16, local_size_y_id = 3) in;  // local_size_y = 16 / PIXELS_PER_INVOCATION
 layout(constant_id = 0) const bool WRITE_DEPTH = true;
@@ -59,7 +60,7 @@ const uint TILE_PIXELS = TILE_SIZE * TILE_SIZE;
 // power = A' dx^2 + B' dx dy + C' dy^2), opacity, view depth and colour.
 shared u64vec4 s_packed_a[BATCH];  // (mean x, mean y), (A', B'), (C', opacity), (depth, red)
 shared uint64_t s_packed_b[BATCH];  // (green, blue)
-shared uint s_reach[BATCH];  // bit 16 h + x: the splat reaches column x in rows [8 h, 8 h + 7]
+shared uint s_reach[BATCH];  // bit 16 h + x: the splat reaches column x in rows [8 h, 8 h + 7] (composite_reach.glsl)
 shared uint s_done_pixels;
 
 // The invocation's pixels, front to back state. A pixel that is done keeps its final transmittance
@@ -70,38 +71,6 @@ float depth_sum[P];
 float weight_sum[P];
 uint blended[P];
 uint my_done = 0;  // pixels of this invocation that are done
-
-// Inclusive range of tile-local pixel indices i whose centres i + 0.5 lie in [lo, hi] (relative to
-// the tile origin), clamped to the tile; x > y when there is none. 1e-3 px of slack on top of
-// coverage_tau's margin: the range may only ever be too large.
-ivec2 pixel_span(float lo, float hi) {
-  float first = ceil(lo - 0.5 - 1e-3);
-  float last = floor(hi - 0.5 + 1e-3);
-  if (!(last >= 0.0 && first <= float(TILE_SIZE - 1) && first <= last)) return ivec2(1, 0);
-  return ivec2(clamp(first, 0.0, float(TILE_SIZE - 1)), clamp(last, 0.0, float(TILE_SIZE - 1)));
-}
-
-// Which columns of the tile the splat's alpha >= 1/255 ellipse reaches within rows 0-7 (bits 0-15)
-// and within rows 8-15 (bits 16-31): the ellipse cut to a band of rows is convex, so per band it
-// is one x-range (ellipse_x_range, shared with the tile coverage).
-uint splat_reach(vec2 centre, float opacity, vec4 cov_det) {
-  float tau = coverage_tau(opacity, ALPHA_INV);
-  uint reach = 0u;
-  for (uint band = 0; band < 2; ++band) {
-    float band_top = float(band * 8) + 0.5 - centre.y;
-    vec2 x = ellipse_x_range(cov_det, tau, band_top, band_top + 7.0);
-    ivec2 columns = pixel_span(centre.x + x.x, centre.x + x.y);
-    if (columns.x <= columns.y)  // an empty x-range gives an empty span
-      reach |= ((2u << columns.y) - (1u << columns.x)) << (16 * band);
-  }
-  return reach;
-}
-
-// This invocation's bits in a splat's reach mask (see splat_reach).
-uint my_reach_bits(uint local_x, uint local_y0) {
-  uint bands = P > 8 ? 0x10001u : 1u << (16 * (local_y0 / 8));
-  return bands << local_x;
-}
 
 // Blends staged splat j into the invocation's pixels first .. first + count - 1 (indices into its
 // column; the call sites pass constants, so the register arrays stay statically indexed) and
@@ -182,7 +151,7 @@ void main() {
   barrier();
   if (my_done > 0) atomicAdd(s_done_pixels, my_done);
   uint published_done = my_done;  // pixels finishing in a batch are added to s_done_pixels after it
-  uint my_bits = my_reach_bits(local_x, local_y0);
+  uint my_bits = my_reach_bits(local_x, local_y0, P);
   uint top_done = 0, bottom_done = 0;  // P == 16: done pixels among rows 0-7 and rows 8-15
   for (uint p = 0; p < P; ++p) {
     if (p < 8) top_done += T[p] < 0.0 ? 1u : 0u;
@@ -202,7 +171,7 @@ void main() {
       s_packed_a[k] = u64vec4(pack64(floatBitsToUint(local_mean)), pack64(floatBitsToUint(vec2(-0.5 * conic.x, -conic.y))),
                               pack64(floatBitsToUint(vec2(-0.5 * conic.z, mdo.w))), pack64(floatBitsToUint(vec2(mdo.z, colour_lo.r))));
       s_packed_b[k] = pack64(floatBitsToUint(colour_lo.gb));
-      s_reach[k] = splat_reach(local_mean, mdo.w, pc.splats.v[SPLAT_VEC4S * g + 3]);
+      s_reach[k] = splat_reach(local_mean, mdo.w, pc.splats.v[SPLAT_VEC4S * g + 3], ALPHA_INV);
     }
     barrier();
     if (P == 1) {

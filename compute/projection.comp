@@ -45,6 +45,12 @@ layout(constant_id = 8) const bool RAY_DEPTH = false;       // write the per-pix
 // footprint's integral (gsplat's "antialiased" and Mip-Splatting's 2D filter).
 layout(constant_id = 9) const uint DILATION_TENTHS = 3;  // 0.3 px^2 (classic, antialiased) or 0.1 (mip)
 layout(constant_id = 10) const bool COMPENSATE_OPACITY = false;
+// Relighting (tilesplat::Lighting, a scene effect; the model is written there): LIGHTING multiplies
+// the SH colour by the light factor of the lights in pc.lighting. Off, its code compiles away and no
+// normal is read. FILE_NORMALS: the scene has a normal buffer (pc.lighting.normals); without one every
+// splat uses its shortest axis. The lights are data, not constants: changing them rebuilds nothing.
+layout(constant_id = 11) const bool LIGHTING = false;
+layout(constant_id = 12) const bool FILE_NORMALS = false;
 #include "sh.glsl"
 
 // Camera, written by the host each frame. Doubles are stored as bit pairs so that the float32
@@ -59,6 +65,23 @@ layout(buffer_reference, std430, buffer_reference_align = 8) buffer CameraParams
   uvec4 grid;                // tiles x, tiles y, width, height
 };
 
+// The frame's lights, written by the host (ProjectionPass::set_lighting) in float64 from the same
+// prepared values as the reference's (engine/src/lighting.h). Doubles as bit pairs, as above.
+struct LightRecord {
+  uvec2 vector[3];    // directional: the unit vector toward the light; point: its position
+  uvec2 radiance[3];  // colour * intensity
+  uint point;         // 1: a point light
+  uint pad;
+};
+layout(buffer_reference, std430, buffer_reference_align = 8) buffer LightParams {
+  uint64_t normals;   // FILE_NORMALS: 3 floats per Gaussian (the PLY's nx ny nz, possibly zero)
+  uvec2 ambient[3];
+  uint count;
+  uint pad;
+  LightRecord lights[];
+};
+
+// 128 bytes: the most every Vulkan device must accept.
 layout(push_constant) uniform Push {
   FloatArray positions;
   FloatArray log_scales;
@@ -74,6 +97,7 @@ layout(push_constant) uniform Push {
   UintArray counters;
   UintArray covariances;  // COV_HALF: 3 uints (xx xy, xz yy, yz zz as halves) per Gaussian
   Vec4Array ray_depth;    // RAY_DEPTH: RAY_DEPTH_VEC4S per Gaussian (composite_resort.comp)
+  LightParams lighting;   // LIGHTING
   uint count;
 } pc;
 
@@ -82,6 +106,72 @@ real to_real(uvec2 bits) { return packDouble2x32(bits); }
 #endif
 
 bool is_finite(real v) { return !isnan(v) && !isinf(v); }
+
+// Gaussian i's rotation from its stored quaternion (w x y z). Zeros and float denormals are the zero
+// quaternion, the identity (whether or not the device flushes denormals on load: the reference
+// decides the same way).
+realmat3 rotation_of(uint i) {
+  real4 q = real4(pc.rotations.v[4 * i], pc.rotations.v[4 * i + 1], pc.rotations.v[4 * i + 2],
+                  pc.rotations.v[4 * i + 3]);
+  real largest = max(max(abs(q.x), abs(q.y)), max(abs(q.z), abs(q.w)));
+  q = largest >= real(FLT_MIN) ? q / sqrt(dot(q, q)) : real4(1, 0, 0, 0);  // doubles: no overflow
+  real w = q.x, x = q.y, y = q.z, z = q.w;
+  return realmat3(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y),
+                  2.0 * (x * y - w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + w * x),
+                  2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y));
+}
+
+// Relighting's normal: the file's when finite and non-zero (zeros and denormals are none, as for the
+// quaternion), else the shortest axis (the rotation's column of the smallest stored log scale, the
+// first on ties). Turned toward the camera; rel = x - camera centre.
+real3 lighting_normal(uint i, real3 rel) {
+  real3 n;
+  bool from_file = false;
+  if (FILE_NORMALS) {
+    FloatArray normals = FloatArray(pc.lighting.normals);
+    vec3 f = vec3(normals.v[3 * i], normals.v[3 * i + 1], normals.v[3 * i + 2]);
+    float largest = max(max(abs(f.x), abs(f.y)), abs(f.z));
+    if (!any(isnan(f)) && !any(isinf(f)) && largest >= FLT_MIN) {
+      n = real3(f);
+      n /= sqrt(dot(n, n));
+      from_file = true;
+    }
+  }
+  if (!from_file) {
+    vec3 s = vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2]);
+    int axis = s.x <= s.y && s.x <= s.z ? 0 : (s.y <= s.z ? 1 : 2);
+    n = rotation_of(i)[axis];
+  }
+  // dot(n, camera centre - x) < 0, as -dot(n, rel) (negation is exact).
+  if (-dot(n, rel) < 0.0) n = -n;
+  return n;
+}
+
+// The factor the unlit colour is multiplied by: ambient + sum of radiance max(0, n . w) falloff, in the
+// operations and order of the reference's light_factor (engine/src/lighting.cpp).
+real3 light_factor(real3 world, real3 n) {
+  LightParams lp = pc.lighting;
+  real3 factor = real3(to_real(lp.ambient[0]), to_real(lp.ambient[1]), to_real(lp.ambient[2]));
+  for (uint l = 0; l < lp.count; ++l) {
+    real3 v = real3(to_real(lp.lights[l].vector[0]), to_real(lp.lights[l].vector[1]),
+                    to_real(lp.lights[l].vector[2]));
+    real3 radiance = real3(to_real(lp.lights[l].radiance[0]), to_real(lp.lights[l].radiance[1]),
+                           to_real(lp.lights[l].radiance[2]));
+    real3 w = v;
+    real falloff = 1.0;
+    if (lp.lights[l].point != 0) {
+      real3 d = v - world;
+      real distance2 = dot(d, d);
+      if (!(distance2 > 0.0)) continue;  // the splat is at the light: no direction, no light
+      real distance = sqrt(distance2);
+      w = real3(d.x / distance, d.y / distance, d.z / distance);
+      falloff = 1.0 / distance2;
+    }
+    real cosine = dot(n, w);
+    if (cosine > 0.0) factor += radiance * (cosine * falloff);
+  }
+  return factor;
+}
 
 // For the per-pixel re-sorting (composite_resort.comp): the depth of a Gaussian's density maximum
 // along the camera ray d = (x, y, 1) is t(d) = (d . Q mu) / (d . Q d) with Q = Sigma^-1 in camera
@@ -127,17 +217,7 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   } else {
     // exp has no float64 overload in GLSL; its float32 rounding is far below what changes a decision.
     real3 s = real3(exp(vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2])));
-    real4 q = real4(pc.rotations.v[4 * i], pc.rotations.v[4 * i + 1], pc.rotations.v[4 * i + 2],
-                    pc.rotations.v[4 * i + 3]);  // w x y z
-    // Zeros and float denormals are the zero quaternion, the identity (whether or not the device
-    // flushes denormals on load: the reference decides the same way).
-    real largest = max(max(abs(q.x), abs(q.y)), max(abs(q.z), abs(q.w)));
-    q = largest >= real(FLT_MIN) ? q / sqrt(dot(q, q)) : real4(1, 0, 0, 0);  // doubles: no overflow
-    real w = q.x, x = q.y, y = q.z, z = q.w;
-    realmat3 R = realmat3(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z), 2.0 * (x * z - w * y),
-                          2.0 * (x * y - w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + w * x),
-                          2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y));
-    RS = R * realmat3(s.x, 0, 0, 0, s.y, 0, 0, 0, s.z);
+    RS = rotation_of(i) * realmat3(s.x, 0, 0, 0, s.y, 0, 0, 0, s.z);
   }
 
   real fx = to_real(cam.focal_principal[0]), fy = to_real(cam.focal_principal[1]);
@@ -219,6 +299,12 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   vec3 colour = eval_sh(SH_DEGREE, pc.sh, i, dir) + 0.5;
   if (any(isnan(colour)) || any(isinf(colour))) return 0;  // NaN or Inf coefficients: culled
   colour = max(colour, vec3(0.0));
+  if (LIGHTING) {  // the unlit colour is the albedo
+    real3 lit = real3(colour) * light_factor(world, lighting_normal(i, rel));
+    // The lit colour must be a finite float too (the reference culls alike).
+    if (!(lit.x <= real(FLT_MAX)) || !(lit.y <= real(FLT_MAX)) || !(lit.z <= real(FLT_MAX))) return 0;
+    colour = vec3(lit);
+  }
   // The mean is stored as float hi + lo so that (pixel - mean) in the composite stays accurate.
   vec2 mean_lo = vec2(mean - real2(mean_hi));
   record[0] = vec4(mean_hi, float(t.z), opacity);

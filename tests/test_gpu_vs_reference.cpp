@@ -2,8 +2,10 @@
 // images in ../shared/scenes/reference, on real trained scenes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "test_support.h"
 #include "tilesplat/camera.h"
@@ -326,11 +328,12 @@ namespace {
 // llvmpipe ends a shader invocation after 65535 loop iterations, silently: one tile listing 70k faint
 // pixel-sized splats (none saturates a pixel, so every one is blended) lost its last ~15k splats
 // before the composite blended long lists in chunks (max abs 0.08). The GPU must blend them all.
-TEST(GpuRenderer, TileListsLongerThanTheCpuLoopLimitAreBlendedWhole) {
+// 70000 faint splats in front of a 16x16 camera: every one lands in its single tile.
+GaussianScene one_crowded_tile(Camera& camera) {
   GaussianScene scene;
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> unit(0.f, 1.f);
-  Camera camera;
+  camera = Camera{};
   camera.width = camera.height = 16;  // one tile
   camera.fx = camera.fy = 16;
   camera.cx = camera.cy = 8;
@@ -344,6 +347,12 @@ TEST(GpuRenderer, TileListsLongerThanTheCpuLoopLimitAreBlendedWhole) {
     scene.opacity_logits.push_back(std::log(0.02f / 0.98f));
     scene.sh.insert(scene.sh.end(), {unit(rng), unit(rng), unit(rng)});
   }
+  return scene;
+}
+
+TEST(GpuRenderer, TileListsLongerThanTheCpuLoopLimitAreBlendedWhole) {
+  Camera camera;
+  const GaussianScene scene = one_crowded_tile(camera);
   Renderer& renderer = testing::validated_renderer();
   renderer.set_scene(scene);
   RenderImage gpu = renderer.render(camera);
@@ -360,6 +369,48 @@ TEST(GpuRenderer, TileListsLongerThanTheCpuLoopLimitAreBlendedWhole) {
   EXPECT_GT(blended_ref, 200000u);  // the case really blends more than the limit's worth per invocation
   EXPECT_LE(compare_images(gpu, ref).max_abs, 1e-5);
   EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// The composite's chunks (CPU drivers) follow the previous frame's longest list: one crowded frame
+// must not leave every later sparse frame paying for its chunks and their per-pixel state (it once
+// cost sparse 8192^2 frames 9x the time and 2.3x the memory), and a chunk retry re-runs the
+// composite alone.
+TEST(GpuRenderer, CompositeChunksFollowEachFrameAndReleaseTheirState) {
+  Camera crowded_camera;
+  const GaussianScene scene = one_crowded_tile(crowded_camera);
+  RendererOptions options;
+  options.validation = true;
+  auto renderer = Renderer::create(options);
+  renderer->set_scene(scene);
+  RenderSettings settings;
+  settings.reuse_lists = false;
+  const RenderImage crowded = renderer->render(crowded_camera, settings);
+  const FrameStats first = renderer->last_frame_stats();
+  if (first.retries == 0) GTEST_SKIP() << "this device blends any list in one dispatch (no chunks)";
+  ASSERT_EQ(first.retries, 1);
+  // The retried frame reports every pass it ran, the first attempt's included.
+  const auto has_pass = [](const FrameStats& stats, const std::string& name) {
+    return std::any_of(stats.passes.begin(), stats.passes.end(), [&](const PassTiming& p) { return p.name == name; });
+  };
+  EXPECT_TRUE(has_pass(first, "projection"));
+  EXPECT_TRUE(has_pass(first, "tile_sort"));
+
+  // A frame starts with the chunks the previous one needed (the next view is usually alike): the
+  // first sparse frame still has them, the second not, nor their state.
+  Camera empty_camera = crowded_camera;
+  empty_camera.position = {1000, 0, 0};  // sees none of the splats
+  renderer->render(empty_camera, settings);
+  EXPECT_EQ(renderer->last_frame_stats().retries, 0);
+  EXPECT_EQ(renderer->last_frame_stats().device_bytes, first.device_bytes);
+  renderer->render(empty_camera, settings);
+  const FrameStats sparse = renderer->last_frame_stats();
+  EXPECT_EQ(sparse.retries, 0);
+  EXPECT_EQ(first.device_bytes - sparse.device_bytes, 16u * 16u * 32u);  // the chunk state, released
+
+  const RenderImage again = renderer->render(crowded_camera, settings);
+  EXPECT_EQ(renderer->last_frame_stats().retries, 1);  // the chunks grew again, for this frame
+  EXPECT_EQ(again.rgba, crowded.rgba);
+  EXPECT_EQ(renderer->validation_messages(), 0u);
 }
 
 }  // namespace

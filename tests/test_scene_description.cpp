@@ -259,7 +259,8 @@ TEST(SceneDescription, ParsesAValidDescription) {
     "background": [0.25, 0.5, 1],
     "effects": {"sh_degree": 1, "antialiasing": "mip", "exposure": -1.5, "tone_map": "aces",
                 "lights": [{"type": "directional", "direction": [0, 2, 0], "color": [1, 0.9, 0.8]},
-                           {"type": "point", "position": [1, -2, 0], "colour": [1, 1, 1], "intensity": 5}]},
+                           {"type": "point", "position": [1, -2, 0], "colour": [1, 1, 1], "intensity": 5}],
+                "ambient": [0.1, 0.2, 0.3]},
     "outputs": ["color", "depth", "splat_count"]
   })");
 
@@ -302,6 +303,7 @@ TEST(SceneDescription, ParsesAValidDescription) {
   EXPECT_EQ(d.effects.lights[1].type, SceneLight::Type::kPoint);
   EXPECT_EQ(d.effects.lights[1].position, (Vec3{1, -2, 0}));
   EXPECT_EQ(d.effects.lights[1].intensity, 5);
+  EXPECT_EQ(d.effects.ambient, (Vec3{0.1, 0.2, 0.3}));
   EXPECT_TRUE(d.outputs.color);
   EXPECT_FALSE(d.outputs.alpha);
   EXPECT_TRUE(d.outputs.depth);
@@ -324,6 +326,7 @@ TEST(SceneDescription, DefaultsAreOffAndViewDependentFalseMeansDegreeZero) {
   EXPECT_FALSE(plain.effects.sh_degree.has_value());
   EXPECT_EQ(plain.effects.antialiasing, Antialiasing::kClassic);
   EXPECT_TRUE(plain.effects.lights.empty());
+  EXPECT_EQ(plain.effects.ambient, (Vec3{0, 0, 0}));
   EXPECT_EQ(plain.effects.exposure_stops, 0);
   EXPECT_EQ(plain.effects.tone_map, ToneMap::kNone);
   EXPECT_TRUE(plain.outputs.color && plain.outputs.alpha);
@@ -397,6 +400,11 @@ TEST(SceneDescription, EveryMistakeNamesTheFileAndTheJsonPath) {
        "effects.lights[1].type", {"unknown value 'spot'", "'directional', 'point'"}},
       {R"({"models": [{"path": "$PLY"}], "effects": {"lights": [{"type": "directional", "position": [0, 0, 0]}]}})",
        "effects.lights[0].position", {"directional light has a 'direction'"}},
+      {R"({"models": [{"path": "$PLY"}], "effects": {"lights": [{"type": "point", "position": [0, 0, 0]}],
+          "ambient": [0.1, -0.1, 0]}})",
+       "effects.ambient[1]", {"from 0 to"}},
+      {R"({"models": [{"path": "$PLY"}], "effects": {"ambient": [0.1, 0.1, 0.1]}})", "effects.ambient",
+       {"applies only to relighting", "at least one light in 'lights'"}},
       {R"({"models": [{"path": "$PLY"}], "effects": {"exposure": 50}})", "effects.exposure", {"from -20 to 20"}},
       {R"({"models": [{"path": "$PLY"}], "effects": {"tone_map": "filmic"}})", "effects.tone_map",
        {"'none', 'aces', 'reinhard'"}},

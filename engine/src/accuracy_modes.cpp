@@ -19,6 +19,10 @@ std::string to_string(Antialiasing mode) {
   return "unknown";
 }
 
+std::string to_string(Compositor compositor) {
+  return compositor == Compositor::kStochastic ? "stochastic" : "sorted";
+}
+
 namespace {
 
 [[noreturn]] void bad(const std::string& token, const std::string& why) {

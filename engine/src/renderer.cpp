@@ -5,6 +5,13 @@
 // keys, for far fewer key bits times keys: on playbot_lod0 at 1080p, 4 digit passes over 0.5M
 // Gaussians plus 2 over 1.5M pairs instead of 6 over 1.5M.
 // Data flows one way; the only host read-back is the counters (and the image) after the fence.
+//
+// The stochastic compositor (Compositor::kStochastic) needs no depth order: its frame is
+//   projection -> prefix sum -> key emission -> tile binning -> tile ranges -> stochastic composite
+// with the pairs grouped by tile only, and one composite dispatch per averaged sample.
+// A frame whose tile lists would equal the previous frame's (same scene, camera, sort strategy,
+// accuracy modes, antialiasing, lighting and compositor) runs the composite alone on the lists left
+// in the buffers (FrameStats::reused_sorted_lists).
 #include "tilesplat/renderer.h"
 #include "tilesplat/vulkan_interop.h"
 
@@ -14,6 +21,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -24,6 +33,7 @@
 #include "passes/key_emission_pass.h"
 #include "passes/prefix_sum_pass.h"
 #include "passes/projection_pass.h"
+#include "passes/stochastic_composite_pass.h"
 #include "passes/tile_coverage.h"
 #include "passes/tile_ranges_pass.h"
 #include "sort/sort_strategy.h"
@@ -48,9 +58,12 @@ uint32_t grow_capacity(uint64_t needed) {
 }
 
 void check_camera(const Camera& camera, const vk::DeviceLimits& limits, bool cpu_driver) {
+  try {
+    validate(camera);  // size, intrinsics, pose; then what this device can hold
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(e.what());  // render() reports every camera it cannot render as a runtime_error
+  }
   auto fail = [](const std::string& why) { throw std::runtime_error("invalid camera: " + why); };
-  if (camera.width <= 0 || camera.height <= 0)
-    fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + " is not positive");
   // Tile rects pack each coordinate in 16 bits, and the composite dispatches one workgroup per tile.
   // On CPU drivers a shader invocation may loop over a row or column of tiles, and llvmpipe cuts
   // loops short after 65535 iterations (key_emission_big.comp): there 16384 tiles per axis.
@@ -65,13 +78,24 @@ void check_camera(const Camera& camera, const vk::DeviceLimits& limits, bool cpu
     fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + " needs " +
          std::to_string(rgba_bytes >> 20) + " MiB for its colour buffer, more than the device's largest allocation (" +
          std::to_string(limits.max_allocation_size >> 20) + " MiB)");
-  for (double v : {camera.fx, camera.fy, camera.cx, camera.cy})
-    if (!std::isfinite(v)) fail("non-finite intrinsics");
-  if (!(camera.fx > 0) || !(camera.fy > 0)) fail("focal lengths must be positive");
-  for (double v : camera.rotation)
-    if (!std::isfinite(v)) fail("non-finite rotation");
-  for (double v : camera.position)
-    if (!std::isfinite(v)) fail("non-finite position");
+}
+
+// Settings the stochastic compositor cannot honour. Throws std::invalid_argument.
+constexpr uint32_t kMaxStochasticFrames = 4096;
+void validate_compositor(const RenderSettings& settings) {
+  if (settings.compositor != Compositor::kStochastic) return;
+  auto fail = [](const std::string& why) { throw std::invalid_argument("stochastic compositor: " + why); };
+  const AccuracyModes& modes = settings.accuracy;
+  if (modes.resort_window > 0)
+    fail("per-pixel re-sorting (resort" + std::to_string(modes.resort_window) +
+         ") re-orders depth-sorted lists, and this compositor sorts nothing: use the sorted compositor");
+  if (modes.depth_key_bits != 32)
+    fail(std::to_string(modes.depth_key_bits) +
+         "-bit depth keys approximate the depth sort, which this compositor does not run (it compares full view "
+         "depths): use 32-bit depth keys");
+  if (settings.stochastic.frames < 1 || settings.stochastic.frames > kMaxStochasticFrames)
+    fail("stochastic.frames must be 1 to " + std::to_string(kMaxStochasticFrames) + ", not " +
+         std::to_string(settings.stochastic.frames));
 }
 
 template <typename T>
@@ -95,6 +119,7 @@ struct Renderer::Impl {
         tile_ranges(ctx),
         composite(ctx),
         composite_resort(ctx),
+        stochastic_composite(ctx),
         counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "frame counters") {}
 
   SortStrategy& sort(const std::string& name) {
@@ -126,7 +151,7 @@ struct Renderer::Impl {
     uint64_t bytes = 0;
     for (const vk::Buffer* b :
          {&scene.positions, &scene.log_scales, &scene.rotations, &scene.opacity_logits, &scene.sh, &scene.sh_half,
-          &scene.covariances_half, &projected.splats, &projected.rects, &projected.tile_counts, &projected.offsets,
+          &scene.covariances_half, &scene.normals, &projected.splats, &projected.rects, &projected.tile_counts, &projected.offsets,
           &projected.depth_offsets, &projected.big_splats, &projected.ray_depth, &ranges, &composite_state, &outputs.rgba, &outputs.depth, &outputs.count,
           &counters})
       bytes += b->size();
@@ -151,36 +176,105 @@ struct Renderer::Impl {
     v.alpha_inv = coverage_alpha_inv(modes.alpha_cutoff);
     v.depth_key_bits = uint32_t(modes.depth_key_bits);
     v.ray_depth = modes.resort_window > 0;
+    v.lighting = settings.lighting.enabled();
+    v.file_normals = v.lighting && scene.file_normals;
     return v;
   }
 
-  // Records and runs one frame. Returns the counters the GPU wrote.
-  FrameCounters run_frame(const Camera& camera, const RenderSettings& settings, SortStrategy& sorter) {
+  // Records and runs one frame: with build_lists, everything from the projection on; without, only
+  // the composite, over the tile lists the previous frame left in the buffers (FrameStats::
+  // reused_sorted_lists). Returns the counters the GPU wrote: a composite-only frame rewrites only
+  // max_tile_pairs, so the others still describe the lists it read.
+  FrameCounters run_frame(const Camera& camera, const RenderSettings& settings, SortStrategy& sorter,
+                          bool build_lists) {
+    const uint32_t width = uint32_t(camera.width), height = uint32_t(camera.height);
+    const bool stochastic = settings.compositor == Compositor::kStochastic;
+    const ProjectionVariant variant = projection_variant(settings);
+    const bool needs_state = stochastic
+                                 ? StochasticCompositePass::needs_state(settings.stochastic.frames, stochastic_chunks)
+                                 : composite_chunks > 1;
+    // One buffer serves both composites: the state they carry between their dispatches (chunks,
+    // samples) lives only within a frame.
+    const VkDeviceSize state_bytes = std::max(CompositePass::state_bytes(width, height),
+                                              StochasticCompositePass::state_bytes(width, height));
+    if (needs_state && composite_state.size() < state_bytes)
+      composite_state = vk::Buffer(ctx, state_bytes, vk::MemoryUse::Device, "composite state (chunks, samples)");
+    else if (!needs_state && composite_state.size() > 0)
+      composite_state = vk::Buffer();  // 32 bytes a pixel that a one-dispatch composite does not use
+    if (build_lists) {
+      projection.prepare(scene, variant);
+      if (variant.ray_depth && projected.ray_depth.size() < VkDeviceSize(scene.count) * kRayDepthBytes)
+        projected.ray_depth =
+            vk::Buffer(ctx, std::max<VkDeviceSize>(kRayDepthBytes, VkDeviceSize(scene.count) * kRayDepthBytes),
+                       vk::MemoryUse::Device, "ray depth (re-sorting)");
+      // Depth-sorted frames of a strategy that sorts (tile, depth) pairs itself use 64-bit keys; the
+      // stochastic frame only bins by tile, in 32-bit keys whatever the strategy.
+      const bool wide = !stochastic && sorter.frame_plan() == FrameSortPlan::kTileDepthPairs;
+      ensure_key_capacity(keys.capacity, wide);
+      sorter.reserve(std::max(scene.count, keys.capacity));
+    }
+
+    vk::CommandStream stream(ctx);
+    timer.begin_frame(stream.cmd());
+    if (build_lists) {
+      lists_in_alt = record_lists(stream, camera, settings, sorter);
+    } else {
+      // The composite's chunk 0 raises the longest-list counter: it starts from zero again.
+      vkCmdFillBuffer(stream.cmd(), counters.handle(), offsetof(FrameCounters, max_tile_pairs), sizeof(uint32_t), 0);
+      vk::barrier(stream.cmd());
+    }
+
+    const vk::Buffer& tile_lists = lists_in_alt ? keys.values_alt : keys.values;
+    const AccuracyModes& modes = settings.accuracy;
+    if (stochastic) {
+      stochastic_composite.record(stream, projected.splats, tile_lists, ranges, outputs, settings.background,
+                                  settings.depth, settings.splat_count, modes.alpha_cutoff,
+                                  {settings.stochastic.frames, settings.stochastic.seed},
+                                  {stochastic_chunks, composite_state, counters.address()});
+      timer.mark(stream.cmd(), "stochastic_composite");
+    } else {
+      const CompositePass::Cutoffs cutoffs{modes.alpha_cutoff, modes.transmittance_cutoff};
+      if (variant.ray_depth)
+        composite_resort.record(stream.cmd(), projected.splats, projected.ray_depth, tile_lists, ranges, outputs,
+                                camera, settings.background, settings.depth, settings.splat_count, cutoffs,
+                                uint32_t(modes.resort_window), counters.address());
+      else
+        composite.record(stream.cmd(), projected.splats, tile_lists, ranges, outputs, settings.background,
+                         settings.depth, settings.splat_count, cutoffs,
+                         {composite_chunks, composite_state, counters.address()});
+      timer.mark(stream.cmd(), "composite");
+    }
+    stream.finish();
+
+    FrameCounters result;
+    std::memcpy(&result, counters.mapped(), sizeof(result));
+    stats.submissions = stream.submissions();
+    return result;
+  }
+
+  // Records the passes that build each tile's list into the stream, from the projection to the tile
+  // ranges. Returns whether the lists ended in keys.values_alt (else keys.values).
+  //   sorted:     projection -> depth sort -> prefix sum (depth order) -> key emission -> tile sort
+  //               (stable, so each tile's run stays front to back) -> tile ranges
+  //   stochastic: projection -> prefix sum (index order) -> key emission -> tile binning -> tile ranges
+  // The stochastic frame never sorts by depth: its composite needs each tile's splats, in any order.
+  // Its tile binning is the strategy's sort over the tile bits of 32-bit keys, used only to group the
+  // pairs by tile (they come out in index order within a tile, being stable, which the composite
+  // does not rely on).
+  bool record_lists(vk::CommandStream& stream, const Camera& camera, const RenderSettings& settings,
+                    SortStrategy& sorter) {
     const uint32_t tiles_x = vk::div_ceil(uint32_t(camera.width), kTileSize);
     const uint32_t tiles_y = vk::div_ceil(uint32_t(camera.height), kTileSize);
     const uint32_t tiles = tiles_x * tiles_y;
     // Tile ids run to `tiles` inclusive: the key emission's padding uses that id (never in practice).
     const uint32_t tile_bits = uint32_t(std::bit_width(tiles));
-    const AccuracyModes& modes = settings.accuracy;
     const ProjectionVariant variant = projection_variant(settings);
     // The per-Gaussian depth key: the view depth's float bits, or fewer (AccuracyModes::depth_key_bits).
     const uint32_t depth_bits = variant.depth_key_bits;
     const uint32_t n = scene.count;
-    projection.prepare(scene, variant);
-    if (variant.ray_depth && projected.ray_depth.size() < VkDeviceSize(n) * kRayDepthBytes)
-      projected.ray_depth = vk::Buffer(ctx, std::max<VkDeviceSize>(kRayDepthBytes, VkDeviceSize(n) * kRayDepthBytes),
-                                       vk::MemoryUse::Device, "ray depth (re-sorting)");
-    if (composite_chunks > 1 &&
-        composite_state.size() < CompositePass::state_bytes(uint32_t(camera.width), uint32_t(camera.height)))
-      composite_state = vk::Buffer(ctx, CompositePass::state_bytes(uint32_t(camera.width), uint32_t(camera.height)),
-                                   vk::MemoryUse::Device, "composite chunk state");
-    const bool depth_first = sorter.frame_plan() == FrameSortPlan::kDepthThenTile;
-    ensure_key_capacity(keys.capacity, /*wide=*/!depth_first);
+    const bool stochastic = settings.compositor == Compositor::kStochastic;
 
-    sorter.reserve(std::max(n, keys.capacity));
-    vk::CommandStream stream(ctx);
     VkCommandBuffer cmd = stream.cmd();
-    timer.begin_frame(cmd);
     vkCmdFillBuffer(cmd, counters.handle(), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, ranges.handle(), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, counters.handle(), kDepthSortOffset + offsetof(SortState, count), sizeof(uint32_t), n);
@@ -199,8 +293,26 @@ struct Renderer::Impl {
       timer.mark(cmd, "depth_quantize");
     }
 
+    if (stochastic) {
+      // Offsets in index order; the key emission then writes each Gaussian's tile ids at its offset.
+      prefix_sum.record(stream.cmd(), projected.tile_counts.address(), projected.offsets.address(), n,
+                        counters.address());
+      timer.mark(stream.cmd(), "prefix_sum");
+      key_emission.record(stream.cmd(), projected, nullptr, keys, n, tiles_x, tiles, counters, variant.square_tiles,
+                          variant.alpha_inv);
+      vk::barrier(stream.cmd());
+      timer.mark(stream.cmd(), "key_emission");
+      SortInput binning{keys, counters, kTileSortOffset, tile_bits, false};
+      const bool in_alt = sorter.record(stream, binning);
+      timer.mark(stream.cmd(), "tile_binning");
+      record_tile_ranges(stream.cmd(), in_alt, tiles);
+      stats.sort_bits = tile_bits;
+      return in_alt;
+    }
+
     // Depth first: sort the Gaussians by depth, then emit the pairs front to back, so that the
     // pair sort only needs the tile bits. Otherwise the strategy sorts (tile, depth) pairs itself.
+    const bool depth_first = sorter.frame_plan() == FrameSortPlan::kDepthThenTile;
     const vk::Buffer* depth_order = nullptr;
     if (depth_first) {
       SortInput depth_input{projected.depth_order, counters, kDepthSortOffset, depth_bits, true};
@@ -224,30 +336,16 @@ struct Renderer::Impl {
     SortInput tile_input{keys, counters, kTileSortOffset, depth_first ? tile_bits : 32 + tile_bits, !depth_first};
     const bool sorted_in_alt = sorter.record(stream, tile_input);
     timer.mark(stream.cmd(), "tile_sort");
-
-    const vk::Buffer& sorted_keys = sorted_in_alt ? keys.keys_alt : keys.keys;
-    const vk::Buffer& sorted_values = sorted_in_alt ? keys.values_alt : keys.values;
-    tile_ranges.record(stream.cmd(), sorted_keys, keys.wide_keys, ranges, counters, kRangesArgsOffset, tiles);
-    vk::barrier(stream.cmd());
-    timer.mark(stream.cmd(), "tile_ranges");
-
-    const CompositePass::Cutoffs cutoffs{modes.alpha_cutoff, modes.transmittance_cutoff};
-    if (variant.ray_depth)
-      composite_resort.record(stream.cmd(), projected.splats, projected.ray_depth, sorted_values, ranges, outputs,
-                              camera, settings.background, settings.depth, settings.splat_count, cutoffs,
-                              uint32_t(modes.resort_window), counters.address());
-    else
-      composite.record(stream.cmd(), projected.splats, sorted_values, ranges, outputs, settings.background,
-                       settings.depth, settings.splat_count, cutoffs,
-                       {composite_chunks, composite_state, counters.address()});
-    timer.mark(stream.cmd(), "composite");
-    stream.finish();
-
-    FrameCounters result;
-    std::memcpy(&result, counters.mapped(), sizeof(result));
+    record_tile_ranges(stream.cmd(), sorted_in_alt, tiles);
     stats.sort_bits = depth_bits + tile_bits;
-    stats.submissions = stream.submissions();
-    return result;
+    return sorted_in_alt;
+  }
+
+  void record_tile_ranges(VkCommandBuffer cmd, bool in_alt, uint32_t tiles) {
+    tile_ranges.record(cmd, in_alt ? keys.keys_alt : keys.keys, keys.wide_keys, ranges, counters, kRangesArgsOffset,
+                       tiles);
+    vk::barrier(cmd);
+    timer.mark(cmd, "tile_ranges");
   }
 
   std::string too_many_intersections(const FrameCounters& frame, const Camera& camera) const {
@@ -256,52 +354,111 @@ struct Renderer::Impl {
            std::to_string(camera.height) + " image's 16x16 tiles)";
   }
 
+  // Everything a frame's tile lists depend on. When it equals the key of the lists in the buffers,
+  // a frame runs the composite alone: the background, the outputs requested, the stochastic frames
+  // and seed, and the transmittance cut-off change only the composite (the whole AccuracyModes is
+  // compared anyway, to keep this simple and safe).
+  struct ListKey {
+    uint64_t scene_generation = 0;
+    Camera camera;
+    std::string sort;
+    AccuracyModes accuracy;
+    Antialiasing antialiasing = Antialiasing::kClassic;
+    Lighting lighting;
+    Compositor compositor = Compositor::kSorted;  // sorted and binned-only lists differ
+
+    bool operator==(const ListKey& o) const {
+      const Camera& a = camera;
+      const Camera& b = o.camera;
+      return scene_generation == o.scene_generation && a.width == b.width && a.height == b.height && a.fx == b.fx &&
+             a.fy == b.fy && a.cx == b.cx && a.cy == b.cy && a.rotation == b.rotation && a.position == b.position &&
+             sort == o.sort && accuracy == o.accuracy && antialiasing == o.antialiasing && lighting == o.lighting &&
+             compositor == o.compositor;
+    }
+  };
+
   // Renders into the output buffers, growing the key buffers and re-rendering on overflow, and
   // fills the frame statistics (all but cpu_ms).
   void render_frame(const Camera& camera, const RenderSettings& settings) {
     check_camera(camera, ctx.limits(), ctx.is_cpu_device());
     validate(settings.accuracy);
+    validate_compositor(settings);
     SortStrategy& sorter = sort(settings.sort);
     ensure_outputs(uint32_t(camera.width), uint32_t(camera.height));
-    projection.set_camera(camera);
 
     stats = {};
+    const ListKey key{scene_generation, camera,   settings.sort,      settings.accuracy,
+                      settings.antialiasing, settings.lighting, settings.compositor};
+    const bool reuse = settings.reuse_lists && lists && *lists == key;
+    lists.reset();  // valid again once this frame's lists are complete (not if it throws)
+    // Reused lists were built with an equal camera and equal (validated) lights, which are in their
+    // buffers still: nothing to upload.
+    if (!reuse) {
+      projection.set_lighting(settings.lighting, scene);  // validates the lights; uploads normals on first use
+      projection.set_camera(camera);
+    }
+    const bool stochastic = settings.compositor == Compositor::kStochastic;
+    uint32_t& chunks = stochastic ? stochastic_chunks : composite_chunks;
+    auto chunks_for = [&](uint64_t longest) {
+      return stochastic ? stochastic_composite.chunks_for(longest) : composite.chunks_for(longest);
+    };
     const uint64_t fallbacks_before = sorter.stall_fallbacks();
+    // The GPU time of every attempt, summed per pass: a re-rendered frame cost all of them.
+    std::vector<PassTiming> passes;
+    auto add_timings = [&] {
+      double ms = 0;
+      for (const auto& section : timer.read(&ms)) {
+        auto it = std::find_if(passes.begin(), passes.end(), [&](const PassTiming& p) { return p.name == section.name; });
+        if (it == passes.end()) passes.push_back({section.name, section.ms});
+        else it->gpu_ms += section.ms;
+      }
+      stats.gpu_ms += ms;
+    };
     // A frame re-renders when it wanted more (tile, Gaussian) pairs than the key buffers hold, which
-    // grow, or when a tile's list needs more composite chunks than it had (CPU drivers only).
-    FrameCounters frame = run_frame(camera, settings, sorter);
+    // grow, or re-runs its composite when a tile's list needs more composite chunks than it had (CPU
+    // drivers only; the lists are complete then). A frame on reused lists cannot overflow.
+    FrameCounters frame = run_frame(camera, settings, sorter, !reuse);
     for (int retry = 1;; ++retry) {
+      add_timings();
       if (frame.overflow) {
         if (frame.wanted_intersections() > kMaxKeyCapacity || retry > kMaxRetries)
           throw std::runtime_error(too_many_intersections(frame, camera) + ", more than the renderer's limit of " +
                                    std::to_string(kMaxKeyCapacity) + " (2^31)");
         try {  // larger key and sort buffers, which the device may not have room for
           ensure_key_capacity(grow_capacity(frame.wanted_intersections()), keys.wide_keys);
-          frame = run_frame(camera, settings, sorter);
+          frame = run_frame(camera, settings, sorter, true);
         } catch (const std::runtime_error& e) {
           throw std::runtime_error(too_many_intersections(frame, camera) + ": " + e.what());
         }
-      } else if (settings.accuracy.resort_window > 0 && frame.max_tile_pairs > 0) {
+      } else if (!stochastic && settings.accuracy.resort_window > 0 && frame.max_tile_pairs > 0) {
         throw std::runtime_error("per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
                                  "): a tile lists " + std::to_string(frame.max_tile_pairs) +
                                  " splats, more than this device's limit of " +
                                  std::to_string(composite_resort.max_tile_splats()) +
                                  " for that mode (render without resortN)");
-      } else if (composite.chunks_for(frame.max_tile_pairs) > composite_chunks) {
+      } else if (chunks_for(frame.max_tile_pairs) > chunks) {
         if (retry > kMaxRetries) throw std::logic_error("composite chunks did not converge");  // one retry suffices
-        composite_chunks = composite.chunks_for(frame.max_tile_pairs);
-        frame = run_frame(camera, settings, sorter);
+        chunks = chunks_for(frame.max_tile_pairs);
+        frame = run_frame(camera, settings, sorter, /*build_lists=*/false);
       } else {
+        // The next frame starts with as many chunks as this one's longest list needed (views change
+        // little from frame to frame), no more: one crowded frame must not leave every later frame
+        // paying for its chunks and their per-pixel state.
+        chunks = chunks_for(frame.max_tile_pairs);
         break;
       }
       stats.retries = retry;
     }
-    for (const auto& section : timer.read(&stats.gpu_ms)) stats.passes.push_back({section.name, section.ms});
+    lists = key;
+    stats.passes = std::move(passes);
+    stats.reused_sorted_lists = reuse;
     stats.gaussians = scene.count;
     stats.visible = frame.visible;
     stats.intersections = frame.tile_sort.count;
     stats.sort_fallbacks = sorter.stall_fallbacks() - fallbacks_before;
     stats.device_bytes = device_bytes();
+    stats.uploaded_bytes = ctx.uploaded_bytes() - uploaded_bytes_reported;
+    uploaded_bytes_reported = ctx.uploaded_bytes();
   }
 
   template <typename T>
@@ -330,6 +487,7 @@ struct Renderer::Impl {
   TileRangesPass tile_ranges;
   CompositePass composite;
   CompositeResortPass composite_resort;
+  StochasticCompositePass stochastic_composite;
   std::map<std::string, std::unique_ptr<SortStrategy>> sorts;
 
   SceneBuffers scene;
@@ -340,8 +498,15 @@ struct Renderer::Impl {
   vk::Buffer counters;
   // Dispatches per composite (CompositePass::Chunks), kept for later frames once a scene needed more.
   uint32_t composite_chunks = 1;
-  vk::Buffer composite_state;
+  uint32_t stochastic_chunks = 1;  // the same for the stochastic composite
+  vk::Buffer composite_state;  // per-pixel state between a composite's dispatches (chunks, samples)
   FrameStats stats;
+  // The tile lists in the buffers: what they were built for (none after set_scene or a frame that
+  // failed), and where the tile sort or binning left them.
+  std::optional<ListKey> lists;
+  bool lists_in_alt = false;
+  uint64_t scene_generation = 0;  // counts set_scene calls
+  uint64_t uploaded_bytes_reported = 0;  // vk::Context::uploaded_bytes() at the last frame's statistics
 };
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -353,11 +518,13 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
 
 void Renderer::set_scene(const GaussianScene& scene) {
   Impl& r = *impl_;
+  ++r.scene_generation;  // the tile lists in the buffers are the previous scene's
   const size_t n = scene.size();
   if (n > (1u << 30)) throw std::runtime_error("scene has " + std::to_string(n) + " Gaussians; the limit is 2^30");
   const int k = scene.sh_coefficients();
   if (scene.positions.size() != 3 * n || scene.log_scales.size() != 3 * n || scene.rotations.size() != 4 * n ||
-      scene.sh.size() != n * size_t(k) * 3 || scene.sh_degree < 0 || scene.sh_degree > 3)
+      scene.sh.size() != n * size_t(k) * 3 || scene.sh_degree < 0 || scene.sh_degree > 3 ||
+      (scene.has_normals() && scene.normals.size() != 3 * n))
     throw std::invalid_argument("set_scene: inconsistent GaussianScene array sizes");
   SceneBuffers& s = r.scene;
   auto upload = [&](vk::Buffer& dst, const std::vector<float>& src, const char* name) {
@@ -371,6 +538,18 @@ void Renderer::set_scene(const GaussianScene& scene) {
   upload(s.sh, scene.sh, "spherical harmonics");
   s.sh_half.reset();  // the previous scene's half-precision copies (made again on first use)
   s.covariances_half.reset();
+  // Relighting's normals are uploaded on the first lit frame (ProjectionPass::set_lighting), never for a
+  // scene rendered unlit. Until then a host copy is kept, as the caller may drop its scene: 12 bytes a
+  // splat of host memory, freed on upload, instead of as much device memory held by every unlit
+  // scene. A file whose normals are all zero (the original trainer writes nx = ny = nz = 0) or
+  // unusable keeps nothing: every splat falls back to its shortest axis, with no buffer to read.
+  s.normals.reset();
+  s.pending_normals.clear();
+  s.pending_normals.shrink_to_fit();
+  s.file_normals = std::any_of(scene.normals.begin(), scene.normals.end(), [](float v) {
+    return std::isfinite(v) && std::abs(v) >= std::numeric_limits<float>::min();
+  });
+  if (s.file_normals) s.pending_normals = scene.normals;
   s.count = uint32_t(n);
   s.sh_degree = scene.sh_degree;
 

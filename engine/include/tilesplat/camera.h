@@ -25,6 +25,11 @@ struct Camera {
   double tan_half_fov_y() const { return height / (2.0 * fy); }
 };
 
+// Throws std::invalid_argument ("invalid camera: ...", saying what) for a camera no renderer can use:
+// a size that is not positive, focal lengths that are not positive and finite, or a non-finite
+// principal point, rotation or position. Both renderers call it; device limits are checked on top.
+void validate(const Camera& camera);
+
 // One entry of the trainer's cameras.json.
 struct CameraView {
   int id = 0;

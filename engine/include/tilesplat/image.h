@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace tilesplat {
@@ -34,9 +35,27 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
 // converted, any data window origin. Throws std::runtime_error naming the file.
 RenderImage read_exr(const std::filesystem::path& path);
 
-// An 8-bit sRGB PNG preview of the colour channels (clamped to [0, 1], alpha dropped).
-// Atomic like write_exr.
-void write_png_preview(const std::filesystem::path& path, const RenderImage& image, float exposure = 1.0f);
+// How a PNG preview maps linear radiance to display values: colour times 2^exposure_stops, then the
+// tone curve per channel, then a clamp to [0, 1] and the sRGB encoding. The EXR keeps the linear
+// values; only previews are tone mapped.
+enum class ToneMap {
+  kNone,      // clamp: values above 1 clip
+  kAces,      // Narkowicz's fit of the ACES filmic curve: x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)
+  kReinhard,  // x / (1 + x): never clips, compresses highlights
+};
+std::string to_string(ToneMap tone_map);  // "none", "aces", "reinhard"
+// The tone curve of one linear channel value (exposure already applied); NaN and negatives map to 0.
+double apply_tone_map(ToneMap tone_map, double linear);
+
+struct PreviewOptions {
+  double exposure_stops = 0;  // -20 to 20
+  ToneMap tone_map = ToneMap::kNone;
+};
+
+// An 8-bit sRGB PNG preview of the colour channels (alpha dropped). Atomic like write_exr. Throws
+// std::runtime_error naming the file for an empty image or an exposure out of range.
+void write_png_preview(const std::filesystem::path& path, const RenderImage& image,
+                       const PreviewOptions& options = {});
 
 struct ImageDifference {
   double psnr_db = 0;       // over RGB, peak 1.0; +inf when identical

@@ -20,7 +20,7 @@ struct ProjectedGaussian {
   double cov2d[3] = {0, 0, 0};  // a b c of the dilated 2D covariance [[a b] [b c]]
   double conic[3] = {0, 0, 0};  // inverse of cov2d: A B C
   double opacity = 0;           // sigmoid(logit)
-  double color[3] = {0, 0, 0};  // max(SH + 0.5, 0)
+  double color[3] = {0, 0, 0};  // max(SH + 0.5, 0), times the light factor when lit (tilesplat::Lighting)
   int radius = 0;               // pixels
   int tile_min[2] = {0, 0};     // tile rect, max exclusive
   int tile_max[2] = {0, 0};
@@ -28,9 +28,11 @@ struct ProjectedGaussian {
 
 constexpr int kTileSize = 16;
 
-// Projects Gaussian i of the scene with the reference math.
+// Projects Gaussian i of the scene with the reference math, lit when `lighting` has lights.
+// Throws std::invalid_argument for invalid lights (validate).
 ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
-                                   Antialiasing antialiasing = Antialiasing::kClassic);
+                                   Antialiasing antialiasing = Antialiasing::kClassic,
+                                   const Lighting& lighting = {});
 
 // Evaluates real spherical harmonics up to `degree` for the (normalized) direction dir.
 // coeffs: K * 3 values, coefficient-major RGB innermost. Returns the raw sum (no +0.5, no clamp).

@@ -77,6 +77,62 @@ enum class Antialiasing {
 };
 std::string to_string(Antialiasing mode);  // "classic", "antialiased", "mip"
 
+// Relighting (a scene effect): splats lit by lights through per-splat normals. Off when `lights`
+// is empty: the projection then never reads a normal and no normal buffer exists.
+//
+// The model, per splat, evaluated in the projection after the SH colour (the unlit colour acts as
+// the albedo; Lambert, no shadows, no occlusion between splats):
+//   colour_lit = colour * (ambient + sum_l color_l intensity_l max(0, n . w_l) falloff_l)
+// with colour = max(SH + 0.5, 0) and, per light, w_l the unit vector toward it:
+//   directional: w = -direction / |direction|, falloff 1;
+//   point: w = (position - x) / |position - x|, falloff 1 / |position - x|^2; a splat exactly at the
+//   light (|position - x| = 0) gets nothing from it.
+// The normal n: the scene's (GaussianScene::normals, the PLY's nx ny nz) when finite and non-zero, else
+// (files of the original trainer hold zeros) the Gaussian's shortest axis, the rotation's column of its
+// smallest scale (the first on ties). Either way turned toward the camera: a splat shows its lit side.
+// A lit colour beyond the float range culls the splat, as a non-finite SH colour does.
+struct Light {
+  enum class Type { kDirectional, kPoint };
+  Type type = Type::kDirectional;
+  std::array<float, 3> direction = {0, 1, 0};  // directional: where the light travels (any non-zero length)
+  std::array<float, 3> position = {0, 0, 0};   // point: world position
+  std::array<float, 3> color = {1, 1, 1};      // linear RGB, >= 0
+  float intensity = 1;                         // >= 0
+  bool operator==(const Light&) const = default;
+};
+struct Lighting {
+  std::vector<Light> lights;
+  std::array<float, 3> ambient = {0, 0, 0};  // light reaching every splat whatever its normal, >= 0
+  bool enabled() const { return !lights.empty(); }
+  bool operator==(const Lighting&) const = default;
+};
+// Throws std::invalid_argument naming the light and field ("lighting.lights[1].intensity: ...") for
+// a non-finite value, a negative colour, intensity or ambient, or a zero direction. The renderer and
+// the reference call it on every frame with lights.
+void validate(const Lighting& lighting);
+
+// How the sorted splats become pixels.
+enum class Compositor {
+  kSorted,      // front-to-back blending of each tile's depth-sorted list (the reference)
+  kStochastic,  // sort-free: each splat kept per pixel with probability alpha, nearest kept wins; averaged
+};
+std::string to_string(Compositor compositor);  // "sorted", "stochastic"
+// The stochastic compositor draws, per pixel and frame, each splat of its tile with probability
+// alpha (the sorted composite's alpha and cut-off) from a hash of (pixel, splat index, frame, seed)
+// and shows the nearest drawn splat (by view depth, then index), or the background. Its expectation
+// is the sorted front-to-back blend without the transmittance early-out, so the mean of `frames`
+// frames converges to the sorted image, with an error falling as 1/sqrt(frames). One render() runs
+// them all, with no depth sort, and writes their means: rgb; alpha = the fraction of frames that drew
+// a splat; depth = the mean depth of the drawn splats over those frames; splat_count = the splats
+// each pixel tested (its tile's list length). AccuracyModes::transmittance_cutoff does not apply; the
+// modes that change the depth order (resort_window, depth_key_bits != 32) and frames outside 1..4096
+// throw std::invalid_argument.
+struct StochasticSettings {
+  uint32_t frames = 16;  // frames averaged by one render() call, 1 to 4096
+  uint32_t seed = 1;     // the hashed thresholds' seed: equal seeds give bit-identical images
+  bool operator==(const StochasticSettings&) const = default;
+};
+
 // Everything that changes how one frame is rendered.
 struct RenderSettings {
   std::array<float, 3> background = {0, 0, 0};
@@ -85,6 +141,13 @@ struct RenderSettings {
   bool splat_count = true;     // produce the per-pixel blended-splat count
   AccuracyModes accuracy;      // approximations (default: none, the reference)
   Antialiasing antialiasing = Antialiasing::kClassic;
+  Lighting lighting;  // relighting; off (no lights) by default
+  Compositor compositor = Compositor::kSorted;
+  StochasticSettings stochastic;  // used by Compositor::kStochastic
+  // Run only the composite when the frame's tile lists would equal those the previous frame left in
+  // the buffers (FrameStats::reused_sorted_lists). false: always build them, as a benchmark timing
+  // whole frames of one camera needs.
+  bool reuse_lists = true;
 };
 
 struct PassTiming {
@@ -104,6 +167,18 @@ struct FrameStats {
   int submissions = 0;             // command buffers the frame took: 1, more for a strategy that sorts on the host
   uint64_t sort_fallbacks = 0;     // onesweep look-backs that gave up waiting and counted keys themselves
   uint64_t device_bytes = 0;       // device memory held by the renderer's buffers
+  // True when the frame ran only its composite, on the tile lists the previous frame left in the
+  // buffers: the scene (no set_scene since), the camera, the sort strategy, the accuracy modes, the
+  // antialiasing, the lighting and the compositor were all the previous frame's (the background, the
+  // outputs requested and the stochastic frames and seed may differ), and RenderSettings::reuse_lists
+  // was on. `passes` then lists the composite alone, sort_bits is 0, and visible and intersections
+  // describe the reused lists. (For the stochastic compositor the lists are binned, not sorted.)
+  bool reused_sorted_lists = false;
+  // Bytes the host transferred into device buffers since the previous frame's statistics: the camera
+  // and light parameters of this frame (a few hundred bytes, none when the lists are reused), the
+  // normals on a scene's first lit frame, and everything a set_scene() since the previous frame
+  // uploaded. A host sort strategy (cpu-radix) moves the pairs through host memory besides.
+  uint64_t uploaded_bytes = 0;
 };
 
 struct DeviceInfo {

@@ -88,8 +88,6 @@ struct SceneModel {
   ModelTransform transform;
 };
 
-enum class ToneMap { kNone, kAces, kReinhard };
-
 struct SceneLight {
   enum class Type { kDirectional, kPoint };
   Type type = Type::kDirectional;
@@ -105,9 +103,10 @@ struct SceneEffects {
   // in the file means 0 (the DC colour alone).
   std::optional<int> sh_degree;
   Antialiasing antialiasing = Antialiasing::kClassic;
-  std::vector<SceneLight> lights;
-  double exposure_stops = 0;  // PNG previews: colours times 2^exposure
-  ToneMap tone_map = ToneMap::kNone;
+  std::vector<SceneLight> lights;  // relighting (tilesplat::Lighting has the model); none: unlit
+  std::array<double, 3> ambient = {0, 0, 0};  // relighting's ambient light, linear RGB (only with lights)
+  double exposure_stops = 0;  // PNG previews: colours times 2^exposure (PreviewOptions)
+  ToneMap tone_map = ToneMap::kNone;  // PNG previews (PreviewOptions)
 };
 
 // What a render writes. Colour is always written; the rest as listed in the file's "outputs".

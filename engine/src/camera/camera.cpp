@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 #include "tilesplat/camera.h"
 #include "tilesplat/scene.h"
@@ -27,6 +28,18 @@ double degrees_to_radians(double degrees) { return degrees * std::numbers::pi / 
 int scaled_dimension(double value) { return std::max(1, static_cast<int>(std::lround(value))); }
 
 }  // namespace
+
+void validate(const Camera& camera) {
+  auto fail = [](const std::string& why) { throw std::invalid_argument("invalid camera: " + why); };
+  if (camera.width <= 0 || camera.height <= 0)
+    fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + " is not positive");
+  if (!std::isfinite(camera.fx) || !std::isfinite(camera.fy) || !(camera.fx > 0) || !(camera.fy > 0))
+    fail("focal lengths must be positive and finite");
+  if (!std::isfinite(camera.cx) || !std::isfinite(camera.cy)) fail("non-finite principal point");
+  auto finite = [](double v) { return std::isfinite(v); };
+  if (!std::all_of(camera.rotation.begin(), camera.rotation.end(), finite)) fail("non-finite rotation");
+  if (!std::all_of(camera.position.begin(), camera.position.end(), finite)) fail("non-finite position");
+}
 
 std::array<double, 3> Camera::to_camera(const std::array<double, 3>& world) const {
   // Evaluated as W x + t with t = -W c, the view-matrix form the trainer's rasterizer uses: equal

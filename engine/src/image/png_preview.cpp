@@ -1,6 +1,7 @@
 // 8-bit sRGB PNG previews of RenderImages, written with libpng's simplified API.
 #include <png.h>
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -20,17 +21,37 @@ double linear_to_srgb(double linear) {
   return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
 }
 
-std::uint8_t preview_byte(float colour, float exposure) {
-  double exposed = double{colour} * double{exposure};
-  // Written so that NaN, which fails every comparison, maps to black instead of reaching the cast.
-  if (!(exposed > 0.0)) exposed = 0.0;
-  if (exposed > 1.0) exposed = 1.0;
-  return static_cast<std::uint8_t>(std::lround(linear_to_srgb(exposed) * 255.0));
+// Exposure and tone curve, then the clamp and encoding; NaN, which fails every comparison, maps to black.
+std::uint8_t preview_byte(float colour, double scale, ToneMap tone_map) {
+  double mapped = apply_tone_map(tone_map, double{colour} * scale);
+  if (mapped > 1.0) mapped = 1.0;
+  return static_cast<std::uint8_t>(std::lround(linear_to_srgb(mapped) * 255.0));
 }
 
 }  // namespace
 
-void write_png_preview(const std::filesystem::path& path, const RenderImage& image, float exposure) {
+std::string to_string(ToneMap tone_map) {
+  switch (tone_map) {
+    case ToneMap::kNone: return "none";
+    case ToneMap::kAces: return "aces";
+    case ToneMap::kReinhard: return "reinhard";
+  }
+  return "unknown";
+}
+
+double apply_tone_map(ToneMap tone_map, double x) {
+  if (!(x > 0.0)) return 0.0;  // negatives and NaN
+  if (std::isinf(x)) return 1.0;
+  switch (tone_map) {
+    case ToneMap::kNone: return x;
+    // Both curves are monotonic, map 0 to 0 and approach 1 (ACES reaches it at x ~ 11.2, then clamps).
+    case ToneMap::kAces: return std::min(1.0, x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14));
+    case ToneMap::kReinhard: return x / (1.0 + x);
+  }
+  return x;
+}
+
+void write_png_preview(const std::filesystem::path& path, const RenderImage& image, const PreviewOptions& options) {
   const std::string prefix = "cannot write " + path.string() + ": ";
   if (image.width <= 0 || image.height <= 0)
     throw std::runtime_error(prefix + "image size " + std::to_string(image.width) + "x" +
@@ -43,13 +64,14 @@ void write_png_preview(const std::filesystem::path& path, const RenderImage& ima
     throw std::runtime_error(prefix + "rgba holds " + std::to_string(image.rgba.size()) + " values, a " +
                              std::to_string(image.width) + "x" + std::to_string(image.height) +
                              " image needs " + std::to_string(4 * pixels));
-  if (!std::isfinite(exposure) || exposure <= 0.0f)
-    throw std::runtime_error(prefix + "exposure " + std::to_string(exposure) +
-                             " is not a positive finite number");
+  if (!(std::abs(options.exposure_stops) <= 20.0))
+    throw std::runtime_error(prefix + "exposure " + std::to_string(options.exposure_stops) +
+                             " stops is not a number from -20 to 20");
+  const double scale = std::exp2(options.exposure_stops);
 
   std::vector<std::uint8_t> rgb(3 * pixels);
   for (size_t pixel = 0; pixel < pixels; ++pixel)
-    for (size_t c = 0; c < 3; ++c) rgb[3 * pixel + c] = preview_byte(image.rgba[4 * pixel + c], exposure);
+    for (size_t c = 0; c < 3; ++c) rgb[3 * pixel + c] = preview_byte(image.rgba[4 * pixel + c], scale, options.tone_map);
 
   detail::write_file_atomically(path, [&](const std::filesystem::path& temp) {
     png_image png{};

@@ -21,7 +21,8 @@ struct CompositePush {
 
 // llvmpipe ends any shader invocation after 65535 loop iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS),
 // silently. A 16-pixel column spends at most ~800 per batch of 256 splats (staging, listing, two
-// bands), so 8192 splats (32 batches, ~26k iterations) leave a wide margin.
+// bands; composite_stochastic.comp has the same loops), so 8192 splats (32 batches, ~26k iterations)
+// leave a wide margin.
 constexpr uint32_t kCpuDriverChunkSplats = 8192;
 }  // namespace
 
@@ -30,17 +31,24 @@ constexpr uint32_t kCpuDriverChunkSplats = 8192;
 // invocation per pixel.
 // TILESPLAT_COMPOSITE_PIXELS (1, 2, 4, 8 or 16) overrides the choice, so that the tests run the
 // GPU layout on lavapipe too.
-CompositePass::CompositePass(vk::Context& ctx)
-    : ctx_(ctx),
-      pixels_per_invocation_(ctx.is_cpu_device() ? kTileSize : 1),
-      chunk_splats_(ctx.is_cpu_device() ? kCpuDriverChunkSplats : std::numeric_limits<uint32_t>::max()) {
+uint32_t composite_pixels_per_invocation(const vk::Context& ctx) {
   if (const char* env = std::getenv("TILESPLAT_COMPOSITE_PIXELS"); env && *env) {
     const std::string value = env;
     if (value != "1" && value != "2" && value != "4" && value != "8" && value != "16")
       throw std::invalid_argument("TILESPLAT_COMPOSITE_PIXELS must be 1, 2, 4, 8 or 16, got '" + value + "'");
-    pixels_per_invocation_ = uint32_t(std::stoul(value));
+    return uint32_t(std::stoul(value));
   }
+  return ctx.is_cpu_device() ? kTileSize : 1;
 }
+
+uint32_t composite_chunk_splats(const vk::Context& ctx) {
+  return ctx.is_cpu_device() ? kCpuDriverChunkSplats : std::numeric_limits<uint32_t>::max();
+}
+
+CompositePass::CompositePass(vk::Context& ctx)
+    : ctx_(ctx),
+      pixels_per_invocation_(composite_pixels_per_invocation(ctx)),
+      chunk_splats_(composite_chunk_splats(ctx)) {}
 
 void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
                            const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,

@@ -18,6 +18,13 @@ struct OutputBuffers {
   uint32_t width = 0, height = 0;
 };
 
+// Shared by the composites that stage splats per tile (composite.comp, composite_stochastic.comp):
+// how many pixels of a column one invocation handles (16 on CPU drivers, 1 on GPUs, or
+// TILESPLAT_COMPOSITE_PIXELS), and how many splats of a tile's list one dispatch may take (llvmpipe's
+// loop limit; unlimited on GPUs).
+uint32_t composite_pixels_per_invocation(const vk::Context& ctx);
+uint32_t composite_chunk_splats(const vk::Context& ctx);
+
 class CompositePass {
  public:
   explicit CompositePass(vk::Context& ctx);

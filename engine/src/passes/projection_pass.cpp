@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 
+#include "lighting.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/reference.h"
 
@@ -24,10 +27,29 @@ static_assert(sizeof(CameraParams) == 176);
 struct ProjectionPush {
   VkDeviceAddress positions, log_scales, rotations, opacity_logits, sh, camera;
   VkDeviceAddress splats, rects, tile_counts, depth_keys, depth_values, counters;
-  VkDeviceAddress covariances, ray_depth;
+  VkDeviceAddress covariances, ray_depth, lighting;
   uint32_t count;
   uint32_t pad;
 };
+// maxPushConstantsSize is at least 128 on every Vulkan device: what does not fit goes in a buffer
+// (the normals' address sits in the light buffer for this reason).
+static_assert(sizeof(ProjectionPush) <= 128);
+
+// Mirrors LightParams and LightRecord in compute/projection.comp (std430).
+struct LightRecord {
+  double vector[3];
+  double radiance[3];
+  uint32_t point;
+  uint32_t pad;
+};
+static_assert(sizeof(LightRecord) == 56);
+struct LightParamsHeader {
+  VkDeviceAddress normals;
+  double ambient[3];
+  uint32_t count;
+  uint32_t pad;
+};
+static_assert(sizeof(LightParamsHeader) == 40);
 
 struct PackShPush {
   VkDeviceAddress sh, sh_half;
@@ -67,6 +89,33 @@ void ProjectionPass::set_camera(const Camera& camera) {
   vk::upload(ctx_, camera_params_, &p, sizeof(p));
 }
 
+void ProjectionPass::set_lighting(const Lighting& lighting, SceneBuffers& scene) {
+  const PreparedLighting prepared = prepare_lighting(lighting);  // validates, lit or not
+  if (!lighting.enabled()) return;
+  if (!scene.pending_normals.empty()) {
+    const VkDeviceSize normal_bytes = scene.pending_normals.size() * sizeof(float);
+    scene.normals = vk::Buffer(ctx_, normal_bytes, vk::MemoryUse::Device, "normals");
+    vk::upload(ctx_, scene.normals, scene.pending_normals.data(), normal_bytes);
+    scene.pending_normals = {};  // the device copy is the scene's now: free the host one
+  }
+  const VkDeviceSize bytes = sizeof(LightParamsHeader) + prepared.lights.size() * sizeof(LightRecord);
+  if (light_params_.size() < bytes) light_params_ = vk::Buffer(ctx_, bytes, vk::MemoryUse::Upload, "light params");
+  std::vector<std::byte> data(bytes);
+  LightParamsHeader header{};
+  header.normals = scene.normals ? scene.normals.address() : 0;
+  std::copy(prepared.ambient.begin(), prepared.ambient.end(), header.ambient);
+  header.count = uint32_t(prepared.lights.size());
+  std::memcpy(data.data(), &header, sizeof(header));
+  for (size_t l = 0; l < prepared.lights.size(); ++l) {
+    LightRecord record{};
+    std::copy(prepared.lights[l].vector.begin(), prepared.lights[l].vector.end(), record.vector);
+    std::copy(prepared.lights[l].radiance.begin(), prepared.lights[l].radiance.end(), record.radiance);
+    record.point = prepared.lights[l].point ? 1 : 0;
+    std::memcpy(data.data() + sizeof(header) + l * sizeof(LightRecord), &record, sizeof(record));
+  }
+  vk::upload(ctx_, light_params_, data.data(), bytes);
+}
+
 const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant& v) {
   auto it = pipelines_.find(v);
   if (it == pipelines_.end()) {
@@ -77,7 +126,8 @@ const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant&
         {4, v.opacity_extent},              {5, v.square_tiles},
         {6, std::bit_cast<uint32_t>(v.alpha_inv)}, {7, v.depth_key_bits},
         {8, v.ray_depth},                   {9, v.dilation_tenths},
-        {10, v.compensate_opacity}};
+        {10, v.compensate_opacity},         {11, v.lighting},
+        {12, v.file_normals}};
     const char* shader = ctx_.features().shader_float64 ? "projection" : "projection_fp32";
     it = pipelines_.emplace(v, vk::ComputePipeline(ctx_, shader, sizeof(ProjectionPush), spec)).first;
   }
@@ -125,6 +175,7 @@ void ProjectionPass::record(VkCommandBuffer cmd, const SceneBuffers& scene, Proj
                       counters,
                       variant.covariance_half ? scene.covariances_half.address() : 0,
                       variant.ray_depth ? out.ray_depth.address() : 0,
+                      variant.lighting ? light_params_.address() : 0,
                       scene.count,
                       0};
   const auto& pipeline = pipeline_for(variant);

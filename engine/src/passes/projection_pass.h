@@ -3,6 +3,7 @@
 
 #include <map>
 #include <tuple>
+#include <vector>
 
 #include "passes/key_buffers.h"
 #include "vulkan/buffer.h"
@@ -11,6 +12,7 @@
 namespace tilesplat {
 
 struct Camera;
+struct Lighting;
 
 // The scene's attributes on the GPU, as the loader produced them (raw log scales and logits).
 struct SceneBuffers {
@@ -18,6 +20,11 @@ struct SceneBuffers {
   // Made from the above on the first frame of an accuracy mode that reads them (fp16 SH, fp16
   // covariance); never allocated otherwise.
   vk::Buffer sh_half, covariances_half;
+  // Relighting's per-splat normals (3 floats each), uploaded on the first lit frame and never for a
+  // scene that is not lit. Until then their host copy waits in pending_normals (see set_scene).
+  vk::Buffer normals;
+  std::vector<float> pending_normals;
+  bool file_normals = false;  // the scene has a usable normal (finite, non-zero) somewhere
   uint32_t count = 0;
   int sh_degree = 0;
 };
@@ -35,9 +42,11 @@ struct ProjectionVariant {
   bool ray_depth = false;  // write ProjectedBuffers::ray_depth
   uint32_t dilation_tenths = 3;  // the antialiasing mode's low-pass filter, in 0.1 px^2
   bool compensate_opacity = false;
+  bool lighting = false;      // relighting on (the lights themselves are data: ProjectionPass::set_lighting)
+  bool file_normals = false;  // lit, with the scene's normal buffer (else every splat's shortest axis)
   auto tie() const {
     return std::tie(sh_degree, stored_sh_degree, sh_half, covariance_half, opacity_extent, square_tiles, alpha_inv,
-                    depth_key_bits, ray_depth, dilation_tenths, compensate_opacity);
+                    depth_key_bits, ray_depth, dilation_tenths, compensate_opacity, lighting, file_normals);
   }
   bool operator<(const ProjectionVariant& o) const { return tie() < o.tie(); }
 };
@@ -65,6 +74,10 @@ class ProjectionPass {
   explicit ProjectionPass(vk::Context& ctx);
   // Writes this frame's camera; must be called before record(), outside the command buffer.
   void set_camera(const Camera& camera);
+  // Validates this frame's lights (tilesplat::validate) and, when there are any, writes them and
+  // uploads the scene's pending normals (once per scene). Must be called before record(), outside the
+  // command buffer; record() of a lit variant reads what the last call wrote.
+  void set_lighting(const Lighting& lighting, SceneBuffers& scene);
   // Makes the half-precision copies the variant reads, once per scene (outside any command buffer).
   void prepare(SceneBuffers& scene, const ProjectionVariant& variant);
   void record(VkCommandBuffer cmd, const SceneBuffers& scene, ProjectedBuffers& out, VkDeviceAddress counters,
@@ -74,6 +87,7 @@ class ProjectionPass {
   const vk::ComputePipeline& pipeline_for(const ProjectionVariant& variant);
   vk::Context& ctx_;
   vk::Buffer camera_params_;
+  vk::Buffer light_params_;  // LightParams of compute/projection.comp; grown to the most lights seen
   std::map<ProjectionVariant, vk::ComputePipeline> pipelines_;  // specialization constants per variant
   vk::ComputePipeline pack_sh_half_;
   vk::ComputePipeline pack_covariance_half_;

@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "lighting.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
@@ -80,20 +81,6 @@ void parallel_chunks(size_t count, size_t chunk, const Body& body) {
   for (auto& thread : pool) thread.join();
 }
 
-void check_camera(const Camera& camera) {
-  if (camera.width <= 0 || camera.height <= 0)
-    throw std::invalid_argument("render_reference: camera size must be positive, got " +
-                                std::to_string(camera.width) + "x" + std::to_string(camera.height));
-  if (!(camera.fx > 0) || !(camera.fy > 0) || !std::isfinite(camera.fx) || !std::isfinite(camera.fy))
-    throw std::invalid_argument("render_reference: camera focal lengths must be positive and finite");
-  auto all_finite_in = [](const auto& values) {
-    return std::all_of(std::begin(values), std::end(values), [](double v) { return std::isfinite(v); });
-  };
-  if (!std::isfinite(camera.cx) || !std::isfinite(camera.cy) || !all_finite_in(camera.rotation) ||
-      !all_finite_in(camera.position))
-    throw std::invalid_argument("render_reference: camera principal point, rotation and position must be finite");
-}
-
 void check_scene(const GaussianScene& scene) {
   const size_t n = scene.size();
   if (scene.sh_degree < 0 || scene.sh_degree > 3)
@@ -102,6 +89,11 @@ void check_scene(const GaussianScene& scene) {
   if (scene.positions.size() != 3 * n || scene.log_scales.size() != 3 * n || scene.rotations.size() != 4 * n ||
       scene.sh.size() != n * k * 3)
     throw std::invalid_argument("render_reference: scene arrays have inconsistent sizes");
+}
+
+void check_normals(const GaussianScene& scene) {
+  if (scene.has_normals() && scene.normals.size() != 3 * scene.size())
+    throw std::invalid_argument("render_reference: scene normals must be empty or 3 per Gaussian");
 }
 
 // What the blending loop needs of a visible Gaussian, packed densely in front-to-back order.
@@ -115,11 +107,10 @@ struct Splat {
 
 }  // namespace
 
-std::array<double, 9> covariance3d(const float log_scale[3], const float quat_wxyz[4]) {
-  const double sx = std::exp(double(log_scale[0]));
-  const double sy = std::exp(double(log_scale[1]));
-  const double sz = std::exp(double(log_scale[2]));
+namespace {
 
+// Row-major rotation of a w x y z quaternion as the renderers read it (normalized; zero = identity).
+std::array<double, 9> rotation_of(const float quat_wxyz[4]) {
   double w = quat_wxyz[0], x = quat_wxyz[1], y = quat_wxyz[2], z = quat_wxyz[3];
   const double norm = std::sqrt(w * w + x * x + y * y + z * z);
   // A quaternion of zeros and float denormals is the zero quaternion: GPUs may flush denormals to
@@ -134,14 +125,56 @@ std::array<double, 9> covariance3d(const float log_scale[3], const float quat_wx
     y /= norm;
     z /= norm;
   }
-  const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-                       2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                       2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+}
+
+// The normal relighting uses (tilesplat::Lighting): the file's when finite and non-zero, else the
+// shortest axis; turned toward the camera.
+std::array<double, 3> lighting_normal(const GaussianScene& scene, size_t i, const std::array<double, 3>& x,
+                                      const Camera& camera) {
+  std::array<double, 3> n = {0, 0, 0};
+  bool from_file = false;
+  if (scene.has_normals()) {
+    const float* f = &scene.normals[3 * i];
+    // Zeros and float denormals are no normal: a GPU may flush denormals to zero on load, and
+    // both renderers must decide alike (as for the zero quaternion).
+    const float largest = std::max({std::abs(f[0]), std::abs(f[1]), std::abs(f[2])});
+    if (std::isfinite(f[0]) && std::isfinite(f[1]) && std::isfinite(f[2]) &&
+        largest >= std::numeric_limits<float>::min()) {
+      n = {f[0], f[1], f[2]};
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (double& v : n) v /= length;
+      from_file = true;
+    }
+  }
+  if (!from_file) {
+    // The axis of the smallest scale, compared as the stored floats (exp is monotonic), first on ties.
+    const float* s = &scene.log_scales[3 * i];
+    const size_t axis = s[0] <= s[1] && s[0] <= s[2] ? 0 : s[1] <= s[2] ? 1 : 2;
+    const std::array<double, 9> r = rotation_of(&scene.rotations[4 * i]);
+    n = {r[axis], r[3 + axis], r[6 + axis]};
+  }
+  const double toward_camera =
+      n[0] * (camera.position[0] - x[0]) + n[1] * (camera.position[1] - x[1]) + n[2] * (camera.position[2] - x[2]);
+  if (toward_camera < 0)
+    for (double& v : n) v = -v;
+  return n;
+}
+
+}  // namespace
+
+std::array<double, 9> covariance3d(const float log_scale[3], const float quat_wxyz[4]) {
+  const double sx = std::exp(double(log_scale[0]));
+  const double sy = std::exp(double(log_scale[1]));
+  const double sz = std::exp(double(log_scale[2]));
+  const std::array<double, 9> r = rotation_of(quat_wxyz);
   // M = R S scales the columns of R; Sigma = M M^T.
   const double scale[3] = {sx, sy, sz};
   double m[9];
   for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 3; ++col) m[row * 3 + col] = r[row * 3 + col] * scale[col];
+    for (int col = 0; col < 3; ++col) m[row * 3 + col] = r[size_t(row * 3 + col)] * scale[col];
   std::array<double, 9> sigma{};
   for (int row = 0; row < 3; ++row)
     for (int col = 0; col < 3; ++col)
@@ -178,9 +211,10 @@ std::array<double, 3> eval_sh(int degree, const float* coeffs, const std::array<
   return result;
 }
 
-ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
-                                   Antialiasing antialiasing) {
-  if (i >= scene.size()) throw std::out_of_range("project_gaussian: index out of range");
+namespace {
+
+ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& camera, Antialiasing antialiasing,
+                          const PreparedLighting& lighting) {
   ProjectedGaussian out;
   const std::array<double, 3> mean = {scene.positions[3 * i], scene.positions[3 * i + 1], scene.positions[3 * i + 2]};
   const std::array<double, 3> t = camera.to_camera(mean);
@@ -268,18 +302,37 @@ ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const C
     if (!(std::abs(sh[ch] + 0.5) <= kFloatMax)) return out;  // the colour must be a finite float
     out.color[ch] = std::max(sh[ch] + 0.5, 0.0);
   }
+  if (!lighting.lights.empty()) {  // relighting: the unlit colour is the albedo
+    const std::array<double, 3> factor = light_factor(lighting, mean, lighting_normal(scene, i, mean, camera));
+    for (size_t ch = 0; ch < 3; ++ch) {
+      out.color[ch] *= factor[ch];
+      if (!(out.color[ch] <= kFloatMax)) return out;  // the lit colour must be a finite float too
+    }
+  }
   out.visible = true;
   return out;
 }
 
+}  // namespace
+
+ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
+                                   Antialiasing antialiasing, const Lighting& lighting) {
+  if (i >= scene.size()) throw std::out_of_range("project_gaussian: index out of range");
+  if (lighting.enabled()) check_normals(scene);
+  return project(scene, i, camera, antialiasing, prepare_lighting(lighting));
+}
+
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings) {
-  check_camera(camera);
+  validate(camera);
   check_scene(scene);
   const size_t n = scene.size();
 
+  const PreparedLighting lighting = prepare_lighting(settings.lighting);  // validates
+  if (settings.lighting.enabled()) check_normals(scene);
+
   std::vector<ProjectedGaussian> projected(n);
   parallel_chunks(n, 4096, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) projected[i] = project_gaussian(scene, i, camera, settings.antialiasing);
+    for (size_t i = begin; i < end; ++i) projected[i] = project(scene, i, camera, settings.antialiasing, lighting);
   });
 
   // Front to back by the float32 depth the GPU sorts on, ties by Gaussian index.

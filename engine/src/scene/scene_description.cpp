@@ -44,7 +44,7 @@ constexpr auto kCameraKeys = std::to_array<std::string_view>({"name", "width", "
                                                           "cx", "cy", "position", "rotation", "look_at"});
 constexpr auto kLookAtKeys = std::to_array<std::string_view>({"eye", "target", "up", "fov_deg"});
 constexpr auto kEffectKeys = std::to_array<std::string_view>({"sh_degree", "view_dependent", "antialiasing",
-                                                         "lights", "exposure", "tone_map"});
+                                                         "lights", "ambient", "exposure", "tone_map"});
 constexpr auto kLightKeys = std::to_array<std::string_view>({"type", "direction", "position", "color",
                                                         "colour", "intensity"});
 constexpr auto kAntialiasing = std::to_array<std::string_view>({"classic", "antialiased", "mip"});
@@ -583,6 +583,13 @@ SceneEffects read_effects(const Reader& reader, const Node& node) {
     const json& list = reader.array(*lights, "a list of lights");
     for (size_t i = 0; i < list.size(); ++i)
       effects.lights.push_back(read_light(reader, Node{list[i], element_path(lights->path, i)}));
+  }
+  if (const auto ambient = reader.optional_child(node, "ambient")) {
+    effects.ambient = reader.numbers<3>(*ambient, 0, kMaxRadiance);
+    // Relighting is on only with lights: an ambient alone would be silently ignored.
+    if (effects.lights.empty())
+      reader.fail(ambient->path, "applies only to relighting: list at least one light in 'lights' (an ambient alone "
+                                 "would be ignored)");
   }
   if (const auto exposure = reader.optional_child(node, "exposure"))
     effects.exposure_stops = reader.number(*exposure, -kMaxExposureStops, kMaxExposureStops);

@@ -87,6 +87,7 @@ void Buffer::reset() {
 
 void upload(Context& ctx, Buffer& dst, const void* data, VkDeviceSize size, VkDeviceSize dst_offset) {
   if (size == 0) return;
+  ctx.count_upload(size);
   if (dst.mapped()) {
     std::memcpy(static_cast<char*>(dst.mapped()) + dst_offset, data, size);
     return;

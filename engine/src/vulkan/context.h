@@ -77,6 +77,11 @@ class Context {
 
   uint64_t validation_messages() const { return validation_messages_.load(); }
 
+  // Bytes the host has written into device buffers through vk::upload, over the context's life (the
+  // renderer reports them per frame: FrameStats::uploaded_bytes).
+  uint64_t uploaded_bytes() const { return uploaded_bytes_.load(); }
+  void count_upload(uint64_t bytes) { uploaded_bytes_ += bytes; }
+
   static std::vector<std::string> list_devices();
 
  private:
@@ -108,6 +113,7 @@ class Context {
   std::string driver_name_;
   bool is_cpu_ = false;
   std::atomic<uint64_t> validation_messages_{0};
+  std::atomic<uint64_t> uploaded_bytes_{0};
 };
 
 }  // namespace tilesplat::vk

@@ -1,0 +1,203 @@
+#version 460
+// Stochastic composite (Compositor::kStochastic): sort-free transparency. Each tile's list comes in
+// no particular order (the frame bins the pairs by tile but never sorts by depth). For one sample,
+// each pixel keeps every splat of its tile's list whose alpha reaches the cut-off with probability
+// alpha, deciding with a hashed threshold u(pixel, splat, sample, seed) < alpha, and the kept splat
+// nearest by (view depth, Gaussian index) -- the sorted order and its tie break -- gives the sample
+// its colour; no kept splat gives the background. The chance that splat i wins is
+// alpha_i * prod over the splats j before it of (1 - alpha_j): exactly its weight in the sorted
+// front-to-back blend without the transmittance early-out, so the mean over samples converges to the
+// sorted image (the early-out's T < 1e-4 leaves a difference below 1e-4 of a colour).
+//
+// One dispatch per sample: the host runs the samples back to back and this shader keeps the running
+// sums per pixel in `state`; the last sample writes the means. Alpha is the fraction of samples that
+// kept a splat, depth the mean of the winners' depths over those samples, and the count output is
+// the number of splats each pixel tested (its tile's list length).
+//
+// The layout is composite.comp's: one workgroup per tile, splats staged through shared memory in
+// batches of 256, PIXELS_PER_INVOCATION pixels of a column per invocation (16 on CPU drivers, 1 on
+// GPUs), per-invocation lists of the splats that reach its column (composite_reach.glsl), and long
+// lists split into chunks of `chunk_size` splats, one dispatch each, for llvmpipe's loop limit; the
+// nearest kept splat so far is carried through `state` between chunks.
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+#include "tile_coverage.glsl"
+#include "composite_reach.glsl"
+
+layout(local_size_x = 16, local_size_y_id = 3) in;  // local_size_y = 16 / PIXELS_PER_INVOCATION
+layout(constant_id = 0) const bool WRITE_DEPTH = true;
+layout(constant_id = 1) const bool WRITE_COUNT = true;
+layout(constant_id = 2) const uint PIXELS_PER_INVOCATION = 1;  // 1, 2, 4, 8 or 16
+layout(constant_id = 4) const float ALPHA_MIN = 1.0 / 255.0;   // the alpha cut-off (AccuracyModes)
+layout(constant_id = 5) const float ALPHA_INV = 255.0;         // 1 / ALPHA_MIN, as the tile coverage uses it
+
+layout(push_constant) uniform Push {
+  Vec4Array splats;
+  UintArray indices;  // each tile's Gaussians, binned by tile, in no depth order
+  Uvec2Array ranges;
+  Vec4Array out_rgba;
+  FloatArray out_depth;
+  UintArray out_count;
+  // 32 bytes per pixel: vec4 (sum of the winners' rgb, samples with a winner), float (sum of the
+  // winners' depths), float unused, uint64 (the nearest kept splat's order key, carried between
+  // chunks). Unused (0) with one sample in one chunk.
+  Vec4Array state;
+  UintArray counters;  // COUNTER_MAX_TILE_PAIRS
+  vec4 background;
+  uint width;
+  uint height;
+  uint tiles_x;
+  uint chunk_start;  // position in each tile's list where this dispatch starts
+  uint chunk_size;   // splats per tile this dispatch tests at most
+  uint last_chunk;   // 1: finish the sample whatever is left
+  uint sample_index; // this dispatch's sample, 0 .. samples - 1
+  uint samples;      // samples averaged: the last one writes the outputs
+  uint seed;
+} pc;
+
+const uint P = PIXELS_PER_INVOCATION;
+const uint BATCH = 256;
+const uint64_t NONE = 0xffffffffffffffffUL;  // no splat kept (above every (depth, index) key)
+
+// A staged splat: its mean relative to the tile origin, A' = -A/2, B' = -B, C' = -C/2 of its conic
+// (exact scalings, as composite.comp), opacity, and its order key: view depth bits << 32 | index
+// (depths are > 0, so their bits order like the floats).
+shared u64vec4 s_splat[BATCH];  // (mean x, mean y), (A', B'), (C', opacity), order key
+shared uint s_hash[BATCH];      // hash of the Gaussian index, the splat's half of the threshold hash
+shared uint s_reach[BATCH];     // composite_reach.glsl
+
+uint64_t best[P];    // the nearest kept splat of each pixel: its order key, NONE if none
+uint pixel_hash[P];  // each pixel's half of the threshold hash (pixel, sample, seed)
+
+// lowbias32 (Chris Wellons' hash prospector): a bijection on 32 bits with near-ideal avalanche.
+uint hash32(uint x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+
+// Tests staged splat j against the invocation's pixels first .. first + count - 1 (constants at the
+// call sites, so the register arrays stay statically indexed). alpha is composite.comp's, bit for
+// bit: the same staged values, the same arithmetic. Branch-free, like composite.comp's blend.
+void test_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
+  u64vec4 a = s_splat[j];
+  vec4 mean_a_b = vec4(uintBitsToFloat(unpack32(a.x)), uintBitsToFloat(unpack32(a.y)));
+  vec2 c_opacity = uintBitsToFloat(unpack32(a.z));
+  uint splat_hash = s_hash[j];
+  float dx = mean_a_b.x - (float(local_x) + 0.5);
+  float k0 = mean_a_b.z * dx * dx;
+  float k1 = mean_a_b.w * dx;
+  for (uint p = first; p < first + count; ++p) {
+    float dy = mean_a_b.y - (float(local_y0 + p) + 0.5);
+    float power = k0 + dy * (k1 + c_opacity.x * dy);
+    float alpha = min(0.99, c_opacity.y * exp(power));
+    // u in [0, 1) on a 2^-24 grid: kept with probability alpha (rounded up to that grid).
+    float u = float(hash32(pixel_hash[p] ^ splat_hash) >> 8) * (1.0 / 16777216.0);
+    bool keep = alpha >= ALPHA_MIN && u < alpha;
+    best[p] = keep ? min(best[p], a.w) : best[p];
+  }
+}
+
+void main() {
+  uvec2 tile = gl_WorkGroupID.xy;
+  uint thread = gl_LocalInvocationIndex;
+  uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+  uint local_x = gl_LocalInvocationID.x;
+  uint local_y0 = gl_LocalInvocationID.y * P;
+  vec2 tile_origin = vec2(tile * TILE_SIZE);
+  uint px = tile.x * TILE_SIZE + local_x;
+  uint py0 = tile.y * TILE_SIZE + local_y0;
+
+  uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
+  uint list_length = range.y - range.x;
+  bool resume = pc.chunk_start > 0;
+  if (resume && list_length <= pc.chunk_start) return;  // an earlier chunk finished this tile's sample
+  if (!resume && list_length > pc.chunk_size && thread == 0)
+    atomicMax(pc.counters.v[COUNTER_MAX_TILE_PAIRS], list_length);
+  uint list_begin = range.x + pc.chunk_start;
+  uint list_end = list_length - pc.chunk_start <= pc.chunk_size ? range.y : list_begin + pc.chunk_size;
+  bool finish_sample = list_end == range.y || pc.last_chunk != 0;
+
+  Uint64Array carried = Uint64Array(uint64_t(pc.state));  // the order keys in the state (see above)
+  uint sample_hash = hash32(hash32(pc.seed) ^ pc.sample_index);
+  for (uint p = 0; p < P; ++p) {
+    pixel_hash[p] = hash32(hash32(sample_hash ^ px) ^ (py0 + p));
+    best[p] = NONE;
+    if (resume && px < pc.width && py0 + p < pc.height) best[p] = carried.v[4 * ((py0 + p) * pc.width + px) + 3];
+  }
+
+  uint my_bits = my_reach_bits(local_x, local_y0, P);
+  for (uint batch_start = list_begin; batch_start < list_end; batch_start += BATCH) {
+    barrier();  // the previous batch is fully consumed
+    uint batch_size = min(BATCH, list_end - batch_start);
+    for (uint k = thread; k < batch_size; k += threads) {
+      uint g = pc.indices.v[batch_start + k];
+      vec4 mdo = pc.splats.v[SPLAT_VEC4S * g + 0];
+      vec4 conic = pc.splats.v[SPLAT_VEC4S * g + 1];
+      float mean_y_lo = pc.splats.v[SPLAT_VEC4S * g + 2].w;
+      vec2 local_mean = vec2((mdo.x - tile_origin.x) + conic.w, (mdo.y - tile_origin.y) + mean_y_lo);
+      s_splat[k] = u64vec4(pack64(floatBitsToUint(local_mean)),
+                           pack64(floatBitsToUint(vec2(-0.5 * conic.x, -conic.y))),
+                           pack64(floatBitsToUint(vec2(-0.5 * conic.z, mdo.w))),
+                           pack64(uvec2(g, floatBitsToUint(mdo.z))));  // depth bits << 32 | index
+      s_hash[k] = hash32(g);
+      s_reach[k] = splat_reach(local_mean, mdo.w, pc.splats.v[SPLAT_VEC4S * g + 3], ALPHA_INV);
+    }
+    barrier();
+    if (P == 1) {
+      for (uint j = 0; j < batch_size; ++j)
+        if ((s_reach[j] & my_bits) != 0) test_splat(j, local_x, local_y0, 0, P);
+    } else if (P < 16) {
+      uint list[BATCH];  // see composite.comp: only a loop that never reaches a splat skips it
+      uint n = 0;
+      for (uint j = 0; j < batch_size; ++j) {
+        list[n] = j;
+        n += (s_reach[j] & my_bits) != 0 ? 1u : 0u;
+      }
+      for (uint k = 0; k < n; ++k) test_splat(list[k], local_x, local_y0, 0, P);
+    } else {
+      uint top[BATCH], bottom[BATCH];  // one list per row band of the column, as composite.comp
+      uint n_top = 0, n_bottom = 0;
+      for (uint j = 0; j < batch_size; ++j) {
+        uint reach = s_reach[j] >> local_x;
+        top[n_top] = j;
+        bottom[n_bottom] = j;
+        n_top += reach & 1u;
+        n_bottom += (reach >> 16) & 1u;
+      }
+      for (uint k = 0; k < n_top; ++k) test_splat(top[k], local_x, local_y0, 0, 8);
+      for (uint k = 0; k < n_bottom; ++k) test_splat(bottom[k], local_x, local_y0, 8, 8);
+    }
+  }
+
+  bool first_sample = pc.sample_index == 0;
+  bool last_sample = pc.sample_index + 1 >= pc.samples;
+  for (uint p = 0; p < P; ++p) {
+    uint py = py0 + p;
+    if (px >= pc.width || py >= pc.height) continue;
+    uint i = py * pc.width + px;
+    if (!finish_sample) {  // a later chunk goes on with this sample
+      carried.v[4 * i + 3] = best[p];
+      continue;
+    }
+    vec4 sums = first_sample ? vec4(0.0) : pc.state.v[2 * i];
+    float depth_sum = first_sample ? 0.0 : pc.state.v[2 * i + 1].x;
+    if (best[p] != NONE) {
+      uint g = uint(best[p]);
+      sums += vec4(pc.splats.v[SPLAT_VEC4S * g + 2].rgb, 1.0);
+      depth_sum += uintBitsToFloat(uint(best[p] >> 32));
+    }
+    if (!last_sample) {
+      pc.state.v[2 * i] = sums;
+      pc.state.v[2 * i + 1].x = depth_sum;
+      continue;
+    }
+    float n = float(pc.samples);
+    pc.out_rgba.v[i] = vec4((sums.rgb + (n - sums.w) * pc.background.rgb) / n, sums.w / n);
+    if (WRITE_DEPTH) pc.out_depth.v[i] = sums.w > 0.0 ? depth_sum / sums.w : 0.0;
+    if (WRITE_COUNT) pc.out_count.v[i] = list_length;
+  }
+}

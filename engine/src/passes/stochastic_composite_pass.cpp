@@ -1,0 +1,85 @@
+#include "passes/stochastic_composite_pass.h"
+
+#include <algorithm>
+#include <bit>
+#include <stdexcept>
+
+#include "passes/tile_coverage.h"
+#include "tilesplat/reference.h"
+
+namespace tilesplat {
+
+namespace {
+// Mirrors the push constants of compute/composite_stochastic.comp.
+struct StochasticPush {
+  VkDeviceAddress splats, indices, ranges, out_rgba, out_depth, out_count, state, counters;
+  float background[4];
+  uint32_t width, height, tiles_x, chunk_start, chunk_size, last_chunk, sample_index, samples, seed, pad;
+};
+static_assert(sizeof(StochasticPush) == 120);
+}  // namespace
+
+StochasticCompositePass::StochasticCompositePass(vk::Context& ctx)
+    : ctx_(ctx),
+      pixels_per_invocation_(composite_pixels_per_invocation(ctx)),
+      chunk_splats_(composite_chunk_splats(ctx)) {}
+
+void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer& splats,
+                                     const vk::Buffer& binned_indices, const vk::Buffer& ranges, OutputBuffers& out,
+                                     const std::array<float, 3>& background, bool write_depth, bool write_count,
+                                     float alpha_cutoff, const Samples& samples,
+                                     const CompositePass::Chunks& chunks) {
+  if (samples.count == 0) throw std::logic_error("stochastic composite: no samples");
+  const bool with_state = needs_state(samples.count, chunks.count);
+  if (with_state && chunks.state.size() < state_bytes(out.width, out.height))
+    throw std::logic_error("stochastic composite: the state buffer is smaller than the image");
+  auto key = std::make_tuple(write_depth, write_count, alpha_cutoff);
+  auto it = pipelines_.find(key);
+  if (it == pipelines_.end()) {
+    it = pipelines_
+             .emplace(key, vk::ComputePipeline(ctx_, "composite_stochastic", sizeof(StochasticPush),
+                                               {{0, write_depth ? 1u : 0u},
+                                                {1, write_count ? 1u : 0u},
+                                                {2, pixels_per_invocation_},
+                                                {3, kTileSize / pixels_per_invocation_},
+                                                {4, std::bit_cast<uint32_t>(alpha_cutoff)},
+                                                {5, std::bit_cast<uint32_t>(coverage_alpha_inv(alpha_cutoff))}}))
+             .first;
+  }
+  const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
+  const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
+  for (uint32_t sample = 0; sample < samples.count; ++sample) {
+    if (sample > 0 && sample % kSamplesPerSubmission == 0) stream.flush();
+    for (uint32_t chunk = 0; chunk < chunks.count; ++chunk) {
+      // Each dispatch reads what the previous one left in the state buffer.
+      if (sample > 0 || chunk > 0) vk::barrier(stream.cmd());
+      StochasticPush push{splats.address(),
+                          binned_indices.address(),
+                          ranges.address(),
+                          out.rgba.address(),
+                          write_depth ? out.depth.address() : 0,
+                          write_count ? out.count.address() : 0,
+                          with_state ? chunks.state.address() : 0,
+                          chunks.counters,
+                          {background[0], background[1], background[2], 0.0f},
+                          out.width,
+                          out.height,
+                          tiles_x,
+                          chunk * chunk_splats_,
+                          chunk_splats_,
+                          chunk + 1 == chunks.count ? 1u : 0u,
+                          sample,
+                          samples.count,
+                          samples.seed,
+                          0};
+      it->second.bind(stream.cmd(), push);
+      it->second.dispatch(stream.cmd(), tiles_x, tiles_y);
+    }
+  }
+}
+
+uint32_t StochasticCompositePass::chunks_for(uint64_t longest_tile_list) const {
+  return uint32_t(std::max<uint64_t>(1, (longest_tile_list + chunk_splats_ - 1) / chunk_splats_));
+}
+
+}  // namespace tilesplat

@@ -1,0 +1,46 @@
+// Stochastic composite (Compositor::kStochastic): sort-free. Each pixel keeps each splat of its tile's
+// unordered list with probability alpha and shows the nearest kept one; the mean over samples
+// converges to the sorted front-to-back blend (compute/composite_stochastic.comp).
+#pragma once
+
+#include <array>
+#include <map>
+#include <tuple>
+
+#include "passes/composite_pass.h"
+#include "vulkan/buffer.h"
+#include "vulkan/command_stream.h"
+#include "vulkan/compute_pipeline.h"
+
+namespace tilesplat {
+
+class StochasticCompositePass {
+ public:
+  explicit StochasticCompositePass(vk::Context& ctx);
+  struct Samples {
+    uint32_t count = 1;  // samples averaged (StochasticSettings::frames)
+    uint32_t seed = 1;   // the hashed thresholds' seed
+  };
+  // Records every sample, each as chunks.count dispatches (as CompositePass::Chunks: chunk 0 writes
+  // the longest list over one chunk to FrameCounters::max_tile_pairs, chunks_for() turns it into the
+  // count a re-render needs). The per-pixel sums and the chunks' carried state live in chunks.state
+  // (state_bytes), which only one sample in one chunk does without. Flushes the stream after every
+  // kSamplesPerSubmission samples, so that no submission runs long enough for a GPU watchdog.
+  void record(vk::CommandStream& stream, const vk::Buffer& splats, const vk::Buffer& binned_indices,
+              const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
+              bool write_depth, bool write_count, float alpha_cutoff, const Samples& samples,
+              const CompositePass::Chunks& chunks);
+  uint32_t chunks_for(uint64_t longest_tile_list) const;
+  static bool needs_state(uint32_t samples, uint32_t chunks) { return samples > 1 || chunks > 1; }
+  static VkDeviceSize state_bytes(uint32_t width, uint32_t height) { return VkDeviceSize(width) * height * 32; }
+
+  static constexpr uint32_t kSamplesPerSubmission = 64;
+
+ private:
+  vk::Context& ctx_;
+  uint32_t pixels_per_invocation_;
+  uint32_t chunk_splats_;  // splats per tile and dispatch
+  std::map<std::tuple<bool, bool, float>, vk::ComputePipeline> pipelines_;  // by outputs and alpha cut-off
+};
+
+}  // namespace tilesplat

@@ -1,0 +1,308 @@
+// The stochastic (sort-free) compositor: its mean over frames converges to the sorted image at the
+// Monte Carlo rate, is deterministic per seed, runs no depth sort, and refuses what it cannot honour.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstdio>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "test_support.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/image.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat {
+namespace {
+
+RenderSettings stochastic(uint32_t frames, uint32_t seed = 1) {
+  RenderSettings settings;
+  settings.compositor = Compositor::kStochastic;
+  settings.stochastic.frames = frames;
+  settings.stochastic.seed = seed;
+  return settings;
+}
+
+// Overlapping splats of every opacity in front of the camera: many layers per pixel, so that the
+// nearest-kept choice matters, and some pixels uncovered.
+GaussianScene synthetic_scene() {
+  GaussianScene scene;
+  scene.sh_degree = 0;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  for (int i = 0; i < 3000; ++i) {
+    const float x = 2.4f * unit(rng) - 1.2f, y = 1.8f * unit(rng) - 0.9f, z = 2.f + 2.f * unit(rng);
+    scene.positions.insert(scene.positions.end(), {x, y, z});
+    scene.log_scales.insert(scene.log_scales.end(),
+                            {std::log(0.02f + 0.1f * unit(rng)), std::log(0.02f + 0.1f * unit(rng)), -3.f});
+    const float angle = 3.14159f * unit(rng);
+    scene.rotations.insert(scene.rotations.end(), {std::cos(angle), 0.f, 0.f, std::sin(angle)});
+    scene.opacity_logits.push_back(6.f * unit(rng) - 3.f);
+    scene.sh.insert(scene.sh.end(), {3.f * unit(rng) - 1.5f, 3.f * unit(rng) - 1.5f, 3.f * unit(rng) - 1.5f});
+  }
+  return scene;
+}
+
+struct Case {
+  std::string name;
+  GaussianScene scene;
+  Camera camera;
+  double psnr_bound_256;  // PSNR against the sorted image after 256 frames (measured, with margin)
+};
+
+// The bounds: 41.9 and 37.8 dB measured on lavapipe (deterministic hashes), less 3-4 dB.
+Case playbot_case() {
+  return {"playbot", load_scene(testing::bundled_playbot()),
+          resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, 160, 90), 38.0};
+}
+Case synthetic_case() {
+  return {"synthetic", synthetic_scene(), look_at_camera({0, 0, 0}, {0, 0, 1}, {0, -1, 0}, 128, 96, 50), 35.0};
+}
+
+class StochasticConvergence : public ::testing::TestWithParam<int> {};
+
+// The mean over N frames is an unbiased estimate of the sorted blend (up to its T < 1e-4 early-out):
+// PSNR rises with N and the RMS error falls as 1/sqrt(N).
+TEST_P(StochasticConvergence, ApproachesTheSortedImageAtTheMonteCarloRate) {
+  const Case c = GetParam() == 0 ? playbot_case() : synthetic_case();
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(c.scene);
+  RenderSettings sorted_settings;
+  sorted_settings.background = {0.2f, 0.3f, 0.4f};
+  const RenderImage sorted = renderer.render(c.camera, sorted_settings);
+
+  const std::vector<uint32_t> frames = {1, 4, 16, 64, 256};
+  std::vector<double> psnr, rmse, alpha_error;
+  for (uint32_t n : frames) {
+    RenderSettings settings = stochastic(n);
+    settings.background = sorted_settings.background;
+    const RenderImage image = renderer.render(c.camera, settings);
+    const ImageDifference d = compare_images(image, sorted);
+    psnr.push_back(d.psnr_db);
+    rmse.push_back(d.rmse);
+    double alpha_sq = 0;
+    for (size_t i = 0; i < image.pixels(); ++i) {
+      const double e = double(image.rgba[4 * i + 3]) - double(sorted.rgba[4 * i + 3]);
+      alpha_sq += e * e;
+    }
+    alpha_error.push_back(std::sqrt(alpha_sq / double(image.pixels())));
+    std::printf("[ measure  ] %s %dx%d: %4u frames: PSNR %.2f dB, RMSE %.5f, alpha RMSE %.5f, composite %.1f ms\n",
+                c.name.c_str(), c.camera.width, c.camera.height, n, d.psnr_db, d.rmse, alpha_error.back(),
+                renderer.last_frame_stats().passes.back().gpu_ms);
+  }
+  for (size_t k = 1; k < frames.size(); ++k) {
+    EXPECT_GT(psnr[k], psnr[k - 1] + 3.0) << c.name << ": " << frames[k] << " frames";  // 6 dB per 4x, ideally
+    EXPECT_LT(alpha_error[k], alpha_error[k - 1]) << c.name << ": " << frames[k] << " frames";
+  }
+  EXPECT_GE(psnr.back(), c.psnr_bound_256) << c.name;
+  // 1/sqrt(N): 16x the frames, 4x smaller error. Slack for the noise of the estimate itself.
+  for (size_t k = 0; k + 2 < frames.size(); ++k) {
+    const double ratio = rmse[k] / rmse[k + 2];
+    EXPECT_GT(ratio, 3.0) << c.name << ": RMSE " << frames[k] << " / " << frames[k + 2] << " frames";
+    EXPECT_LT(ratio, 5.3) << c.name << ": RMSE " << frames[k] << " / " << frames[k + 2] << " frames";
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, StochasticConvergence, ::testing::Values(0, 1),
+                         [](const ::testing::TestParamInfo<int>& scene) {
+                           return std::string(scene.param == 0 ? "PlaybotCrop" : "Synthetic");
+                         });
+
+TEST(Stochastic, SameSeedIsBitIdenticalAndOtherSeedsAreEquallyClose) {
+  const Case c = playbot_case();
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(c.scene);
+  const RenderImage sorted = renderer.render(c.camera);
+  const RenderImage a = renderer.render(c.camera, stochastic(16, 7));
+  renderer.set_scene(c.scene);  // the lists built anew: the same again
+  const RenderImage b = renderer.render(c.camera, stochastic(16, 7));
+  EXPECT_EQ(a.rgba, b.rgba);
+  EXPECT_EQ(a.depth, b.depth);
+  EXPECT_EQ(a.splat_count, b.splat_count);
+
+  const RenderImage other = renderer.render(c.camera, stochastic(16, 8));
+  EXPECT_NE(a.rgba, other.rgba);
+  const double psnr_a = compare_images(a, sorted).psnr_db;
+  const double psnr_other = compare_images(other, sorted).psnr_db;
+  const double psnr_between = compare_images(a, other).psnr_db;
+  std::printf("[ measure  ] 16 frames, seed 7: %.2f dB, seed 8: %.2f dB, seed 7 vs 8: %.2f dB\n", psnr_a, psnr_other,
+              psnr_between);
+  EXPECT_NEAR(psnr_a, psnr_other, 1.0);
+  // Independent estimates: their difference has twice the variance of either's error (-3 dB).
+  EXPECT_NEAR(psnr_between, psnr_a - 3.0, 1.5);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(Stochastic, FrameRunsNoDepthSortAndReportsItsPasses) {
+  const Case c = synthetic_case();
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(c.scene);
+  RenderImage first;
+  for (const std::string& sort : sort_strategies()) {
+    if (!sort_strategy_is_exact(sort)) continue;
+    RenderSettings settings = stochastic(2);
+    settings.sort = sort;
+    const RenderImage image = renderer.render(c.camera, settings);
+    const FrameStats& stats = renderer.last_frame_stats();
+    std::vector<std::string> names;
+    for (const PassTiming& pass : stats.passes) {
+      names.push_back(pass.name);
+      EXPECT_GE(pass.gpu_ms, 0.0);
+    }
+    EXPECT_EQ(names, (std::vector<std::string>{"projection", "prefix_sum", "key_emission", "tile_binning",
+                                               "tile_ranges", "stochastic_composite"}))
+        << sort;
+    EXPECT_FALSE(stats.reused_sorted_lists);
+    EXPECT_GT(stats.intersections, 3000u);
+    // Tile bits alone: the 8x6 tiles' ids need 6 bits.
+    EXPECT_EQ(stats.sort_bits, 6u) << sort;
+    // Every strategy bins the same pairs into the same lists, so the images agree bit for bit.
+    if (first.rgba.empty()) first = image;
+    EXPECT_EQ(image.rgba, first.rgba) << sort;
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// The outputs besides colour: alpha is the fraction of frames that kept a splat, depth the mean of
+// the winners' depths, the count the list length each pixel tested (at least the sorted blend's).
+TEST(Stochastic, AlphaDepthAndCountOutputs) {
+  const Case c = synthetic_case();
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(c.scene);
+  const RenderImage sorted = renderer.render(c.camera);
+  const uint32_t frames = 64;
+  const RenderImage image = renderer.render(c.camera, stochastic(frames));
+  double depth_error = 0;
+  size_t covered = 0, empty = 0;
+  for (size_t i = 0; i < image.pixels(); ++i) {
+    const float alpha = image.rgba[4 * i + 3];
+    // A fraction of the frames: a multiple of 1/64, exactly.
+    EXPECT_EQ(alpha * float(frames), std::round(alpha * float(frames))) << i;
+    EXPECT_GE(image.splat_count[i], sorted.splat_count[i]) << i;
+    if (image.splat_count[i] == 0) {
+      ++empty;
+      EXPECT_EQ(alpha, 0.f);
+      EXPECT_EQ(image.depth[i], 0.f);
+    }
+    if (alpha > 0.9f && sorted.rgba[4 * i + 3] > 0.9f) {
+      depth_error += std::abs(double(image.depth[i]) - double(sorted.depth[i]));
+      ++covered;
+    }
+  }
+  ASSERT_GT(covered, image.pixels() / 4);
+  depth_error /= double(covered);
+  std::printf("[ measure  ] 64 frames: mean |depth - sorted depth| %.4f over %zu covered pixels (%zu empty)\n",
+              depth_error, covered, empty);
+  EXPECT_LT(depth_error, 0.1);  // depths 2 to 4
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// llvmpipe cuts a shader invocation after 65535 loop iterations: a tile list of 70k splats is tested
+// in chunks, each sample carrying its nearest kept splat between them. The nearest, opaque splats
+// are the last 10k of the list (binned lists keep index order), so a truncated list would show the
+// far red ones instead of the near green ones.
+TEST(Stochastic, TileListsLongerThanTheCpuLoopLimitAreTestedWhole) {
+  GaussianScene scene;
+  scene.sh_degree = 0;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  Camera camera;
+  camera.width = camera.height = 16;  // one tile
+  camera.fx = camera.fy = 16;
+  camera.cx = camera.cy = 8;
+  for (int i = 0; i < 70000; ++i) {
+    const bool near = i >= 60000;
+    const float z = near ? 1.f + 0.1f * unit(rng) : 2.f + unit(rng);
+    const float px = 0.5f + 15.f * unit(rng), py = 0.5f + 15.f * unit(rng);
+    scene.positions.insert(scene.positions.end(), {(px - 8.f) * z / 16.f, (py - 8.f) * z / 16.f, z});
+    const float log_scale = std::log((near ? 0.5f : 0.05f) * z / 16.f);
+    scene.log_scales.insert(scene.log_scales.end(), {log_scale, log_scale, log_scale});
+    scene.rotations.insert(scene.rotations.end(), {1, 0, 0, 0});
+    scene.opacity_logits.push_back(near ? 0.f : -4.f);
+    scene.sh.insert(scene.sh.end(), {near ? -1.f : 1.f, near ? 1.f : -1.f, -1.f});
+  }
+  RendererOptions options;
+  options.validation = true;
+  const auto owned = Renderer::create(options);  // its own: the chunk count starts at one
+  Renderer& renderer = *owned;
+  renderer.set_scene(scene);
+  const RenderImage sorted = renderer.render(camera);
+  const RenderImage image = renderer.render(camera, stochastic(64));
+  const FrameStats& stats = renderer.last_frame_stats();
+  for (size_t i = 0; i < image.pixels(); ++i) EXPECT_EQ(image.splat_count[i], 70000u) << i;
+  const ImageDifference d = compare_images(image, sorted);
+  double green = 0;
+  for (size_t i = 0; i < image.pixels(); ++i) green += image.rgba[4 * i + 1] / double(image.pixels());
+  std::printf("[ measure  ] 70000 splats in one tile, 64 frames: PSNR %.2f dB against sorted, mean green %.3f, "
+              "%d re-render(s)\n",
+              d.psnr_db, green, stats.retries);
+  EXPECT_GE(stats.retries, 1);  // found the list too long for one chunk, and re-rendered with more
+  EXPECT_GT(green, 0.4);
+  EXPECT_GE(d.psnr_db, 25.0);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// As CompositeLayoutsGiveIdenticalImages: the GPU layouts (one pixel per invocation, or a few with
+// one list each) run on lavapipe and give the CPU layout's image bit for bit.
+TEST(Stochastic, CompositeLayoutsGiveIdenticalImages) {
+  const Case c = playbot_case();
+  std::vector<RenderImage> images;
+  for (const char* pixels : {"1", "4", "16"}) {
+    ::setenv("TILESPLAT_COMPOSITE_PIXELS", pixels, 1);
+    RendererOptions options;
+    options.validation = true;
+    auto renderer = Renderer::create(options);
+    ::unsetenv("TILESPLAT_COMPOSITE_PIXELS");
+    renderer->set_scene(c.scene);
+    images.push_back(renderer->render(c.camera, stochastic(3)));
+    EXPECT_EQ(renderer->validation_messages(), 0u);
+  }
+  for (size_t k = 1; k < images.size(); ++k) {
+    EXPECT_EQ(images[k].rgba, images[0].rgba) << "layout " << k;
+    EXPECT_EQ(images[k].depth, images[0].depth) << "layout " << k;
+    EXPECT_EQ(images[k].splat_count, images[0].splat_count) << "layout " << k;
+  }
+}
+
+TEST(Stochastic, RejectsSettingsItCannotHonour) {
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(synthetic_scene());
+  const Camera camera = look_at_camera({0, 0, 0}, {0, 0, 1}, {0, -1, 0}, 32, 32, 50);
+  auto message = [&](const RenderSettings& settings) -> std::string {
+    try {
+      renderer.render(camera, settings);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "(no exception)";
+  };
+  RenderSettings settings = stochastic(4);
+  settings.accuracy.resort_window = 8;
+  EXPECT_NE(message(settings).find("resort8"), std::string::npos) << message(settings);
+  settings = stochastic(4);
+  settings.accuracy.depth_key_bits = 16;
+  EXPECT_NE(message(settings).find("16-bit depth keys"), std::string::npos) << message(settings);
+  settings.accuracy.depth_key_bits = 24;
+  EXPECT_NE(message(settings).find("24-bit depth keys"), std::string::npos) << message(settings);
+  for (uint32_t frames : {0u, 4097u}) {
+    settings = stochastic(frames);
+    EXPECT_NE(message(settings).find("frames must be 1 to 4096"), std::string::npos) << message(settings);
+  }
+  // The limits themselves are fine, and the sorted compositor ignores the stochastic settings.
+  EXPECT_NO_THROW(renderer.render(camera, stochastic(1)));
+  settings = stochastic(0);
+  settings.compositor = Compositor::kSorted;
+  settings.accuracy.resort_window = 8;
+  EXPECT_NO_THROW(renderer.render(camera, settings));
+  EXPECT_EQ(to_string(Compositor::kStochastic), "stochastic");
+  EXPECT_EQ(to_string(Compositor::kSorted), "sorted");
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+}  // namespace
+}  // namespace tilesplat
