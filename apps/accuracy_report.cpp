@@ -153,6 +153,7 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     settings.depth = false;
     settings.splat_count = false;
     settings.accuracy = m;
+    settings.reuse_lists = false;  // the repeats time whole frames, not the composite on reused lists
 
     std::vector<double> frame_ms_per_view;
     std::map<std::string, std::vector<double>> pass_ms_per_view;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "accuracy_report.h"
+#include "effects_report.h"
 #include "bench_plot.h"
 #include "cli.h"
 #include "tilesplat/camera.h"
@@ -45,6 +46,7 @@ struct BenchOptions {
   int orbit = 0;  // --orbit N: N orbit cameras; 0: the one at --azimuth
   bool sort_bench = false;
   bool accuracy = false;  // --accuracy: the error/time report
+  bool effects = false;   // --effects: the per-effect cost table
   std::string markdown;
   int path_frames = 6;
   std::vector<int> sort_sizes{10, 12, 14, 16, 18, 20, 22, 24};  // log2 of the key counts
@@ -718,11 +720,19 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     "against the float64 CPU reference (PSNR, SSIM, max abs) at each view, and the popping "
                     "along a short dolly from the first view; --plot draws one Pareto chart per scene",
                     &options.accuracy);
-  parser.add_string("--markdown", "FILE.md", "with --accuracy: also write the report as Markdown tables",
+  parser.add_string("--markdown", "FILE.md", "with --accuracy or --effects: also write the report as Markdown tables",
                     &options.markdown);
   parser.add_int("--path-frames", "N",
                  "with --accuracy: frames of the dolly path the popping is measured on (default 6; 0: none)",
                  &options.path_frames, 0, 1000);
+
+  parser.section("effect costs");
+  parser.add_switch("--effects",
+                    "measure what each scene effect costs: GPU time per pass with one effect changed at a time "
+                    "from all off (SH degree 0..3, relighting, antialiasing modes, depth and splat-count outputs), "
+                    "and beside the 'off' rows a scene that never had the effect (SH stored at degree 0, no "
+                    "normals); one SCENE, --views or --orbit cameras; --markdown and --csv write the table",
+                    &options.effects);
 
   parser.section("sort micro-benchmark");
   parser.add_switch("--sort-bench",
@@ -1120,6 +1130,61 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
   return cli::kExitOk;
 }
 
+int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options, int argc, char** argv) {
+  for (const char* flag : {"--resolutions", "--json", "--plot"})
+    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --effects");
+  if (options.common.scenes.size() != 1) throw cli::UsageError("--effects measures one SCENE");
+  if (options.common.sorts.size() > 1) throw cli::UsageError("--effects measures with one --sort strategy");
+  if (parser.seen("--antialiasing"))
+    throw cli::UsageError("--antialiasing does not apply to --effects (it measures every mode)");
+  check_outputs(options, {{"SCENE", options.common.scenes.front()}});
+  std::string command = "tilesplat-bench";
+  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+
+  BenchScene scene;
+  scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
+  apply_scene_sh_degree(scene.loaded);
+  scene.name = scene.loaded.path.filename().string();
+  scene.description = cli::describe_scene(scene.loaded.scene);
+  scene.sh_degree = scene.loaded.scene.sh_degree;
+  if (!options.common.cameras_files.empty()) scene.cameras = options.common.cameras_files.front();
+  tilesplat::effects::Options effect_options;
+  for (const Case& c : plan_cases(options, scene, 0, {{options.common.width, options.common.height}}))
+    effect_options.views.push_back(c.camera.camera);
+  effect_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
+  effect_options.repeat = options.repeat;
+  if (!options.common.sorts.empty()) effect_options.sort = options.common.sorts.front();
+
+  tilesplat::RenderSettings base;
+  if (!options.common.modes.empty()) base.accuracy = options.common.modes.front();
+  cli::apply_scene_settings(scene.loaded, base);
+  std::vector<tilesplat::effects::Row> rows = tilesplat::effects::plan_rows(scene.loaded.scene, base);
+  std::printf("scene   %s: %s, %s\n", scene.name.c_str(), scene.description.c_str(),
+              cli::format_size(effect_options.views.front().width, effect_options.views.front().height).c_str());
+  std::fflush(stdout);
+  tilesplat::effects::Run run;
+  {
+    Progress progress(tilesplat::effects::work_units(rows, effect_options), cli::stderr_is_terminal());
+    run = tilesplat::effects::measure(cli::renderer_options(options.common), scene.loaded.scene, rows, effect_options,
+                                      [&](int done, int, const std::string& what) { progress.update(done, what); });
+  }
+  std::printf("device  %s (driver %s)\n\n%s", run.device.name.c_str(), run.device.driver.c_str(),
+              tilesplat::effects::text_table(rows).c_str());
+  std::fflush(stdout);
+  std::string written;
+  for (const auto& [path, make] : std::vector<std::pair<std::string, std::function<std::string()>>>{
+           {options.markdown, [&] { return tilesplat::effects::markdown(rows, scene.name, run.device, command); }},
+           {options.csv, [&] { return tilesplat::effects::csv(rows, scene.name, run.device); }}}) {
+    if (path.empty()) continue;
+    cli::write_file_atomic(path, make());
+    written += (written.empty() ? " -> " : ", ") + path;
+  }
+  if (run.validation_messages > 0)
+    cli::print_warning(kProgram, std::to_string(run.validation_messages) + " Vulkan validation messages (see above)");
+  std::fprintf(stderr, "%s: effect costs, %zu rows%s\n", kProgram, rows.size(), written.c_str());
+  return cli::kExitOk;
+}
+
 // ---------------------------------------------------------------------------------------------
 // The frame benchmark
 
@@ -1127,9 +1192,11 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
 void check_frame_options(const cli::ArgParser& parser, const BenchOptions& options) {
   for (const char* flag : {"--sort-sizes", "--key-bits"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --sort-bench");
+  if (options.accuracy && options.effects) throw cli::UsageError("--accuracy and --effects are separate runs");
   if (!options.accuracy) {
-    for (const char* flag : {"--markdown", "--path-frames"})
-      if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --accuracy");
+    if (parser.seen("--path-frames")) throw cli::UsageError("--path-frames applies only with --accuracy");
+    if (parser.seen("--markdown") && !options.effects)
+      throw cli::UsageError("--markdown applies only with --accuracy or --effects");
     if (options.common.modes.size() > 1)
       throw cli::UsageError("several --mode combinations are compared by --accuracy; the frame benchmark takes one");
   }
@@ -1167,6 +1234,7 @@ int run(int argc, char** argv) {
   if (options.sort_bench) return run_sort_bench(parser, options);
   check_frame_options(parser, options);
   if (options.accuracy) return run_accuracy_report(parser, options, argc, argv);
+  if (options.effects) return run_effects_report(parser, options, argc, argv);
   std::vector<std::pair<std::string, fs::path>> inputs;
   for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
   for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
@@ -1224,8 +1292,10 @@ int run(int argc, char** argv) {
       for (const auto& sort : sorts) {
         tilesplat::RenderSettings settings;
         settings.sort = sort;
+        settings.reuse_lists = false;  // every measured frame is a whole frame, not a composite on reused lists
         if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
         cli::apply_scene_settings(scene.loaded, settings);
+        if (options.common.antialiasing) settings.antialiasing = *options.common.antialiasing;
         Collector collector(sort);
         for (int frame = 0; frame < frames_per_row; ++frame) {
           // Rendering reads the image back, which is part of cpu frame; the first measured image of

@@ -549,6 +549,17 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                        }
                      });
   }
+  parser.add_value("--antialiasing", "MODE",
+                   "the footprint filter the splats were trained with: classic (3DGS), antialiased (gsplat) or "
+                   "mip (Mip-Splatting) (default: the scene file's, else classic)",
+                   [&options](const std::string& text) {
+                     for (Antialiasing mode : {Antialiasing::kClassic, Antialiasing::kAntialiased, Antialiasing::kMip})
+                       if (text == to_string(mode)) {
+                         options.antialiasing = mode;
+                         return;
+                       }
+                     throw UsageError("--antialiasing must be classic, antialiased or mip, got " + single_quoted(text));
+                   });
 }
 
 void check_common_options(const ArgParser& parser, const CommonOptions& options) {
@@ -610,15 +621,27 @@ SceneViews scene_views(const LoadedScene& loaded) {
   return out;
 }
 
-void require_supported_effects(const SceneDescription& description) {
-  const SceneEffects& effects = description.effects;
-  auto refuse = [&](const std::string& path, const std::string& what) {
-    throw std::runtime_error(description.file.string() + ": effects." + path + ": " + what +
-                             " is not implemented yet");
-  };
-  if (!effects.lights.empty()) refuse("lights", "relighting");
-  if (effects.tone_map != ToneMap::kNone) refuse("tone_map", "tone mapping");
-  if (effects.exposure_stops != 0) refuse("exposure", "exposure");
+void require_supported_effects(const SceneDescription&) {
+  // Every effect of the format is implemented (relighting was the last). An effect the format gains
+  // before the renderer does is refused here, as "FILE: effects.KEY: WHAT is not implemented yet",
+  // rather than ignored.
+}
+
+Lighting scene_lighting(const SceneEffects& effects) {
+  Lighting lighting;
+  for (const SceneLight& source : effects.lights) {
+    Light light;
+    light.type = source.type == SceneLight::Type::kPoint ? Light::Type::kPoint : Light::Type::kDirectional;
+    for (size_t c = 0; c < 3; ++c) {
+      light.direction[c] = float(source.direction[c]);
+      light.position[c] = float(source.position[c]);
+      light.color[c] = float(source.color[c]);
+    }
+    light.intensity = float(source.intensity);
+    lighting.lights.push_back(light);
+  }
+  for (size_t c = 0; c < 3; ++c) lighting.ambient[c] = float(effects.ambient[c]);
+  return lighting;
 }
 
 void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings) {
@@ -628,6 +651,7 @@ void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings) {
   settings.depth = description.outputs.depth;
   settings.splat_count = description.outputs.splat_count;
   settings.antialiasing = description.effects.antialiasing;
+  settings.lighting = scene_lighting(description.effects);
   if (description.effects.sh_degree)
     settings.accuracy.sh_degree_cap = std::min(settings.accuracy.sh_degree_cap, *description.effects.sh_degree);
 }

@@ -139,6 +139,8 @@ struct CommonOptions {
   std::vector<std::string> sorts;  // validated against sort_strategies(); empty = the app's default
   // --mode: accuracy mode combinations (parse_accuracy_modes); empty = the reference alone.
   std::vector<AccuracyModes> modes;
+  // --antialiasing: the footprint filter the asset was trained with; unset = the scene file's, else classic.
+  std::optional<Antialiasing> antialiasing;
 };
 
 inline constexpr int kOrbitDefaultWidth = 1920;
@@ -150,7 +152,7 @@ enum class SceneChoice { kOne, kList };
 
 // Registers SCENE, --cameras, --view, --width, --height, the orbit flags, --strict, --device,
 // --list-devices, --validation, --sort (one name, or a comma list / "all" for kList) and --mode
-// (one accuracy mode combination, or a comma list of them for kList).
+// (one accuracy mode combination, or a comma list of them for kList), and --antialiasing.
 void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice,
                         SceneChoice scene_choice = SceneChoice::kOne);
 
@@ -199,12 +201,16 @@ struct SceneViews {
 SceneViews scene_views(const LoadedScene& loaded);
 
 // Throws std::runtime_error naming the scene file and the JSON path, e.g.
-// "scene.json: effects.lights: relighting is not implemented yet", for the first effect the
-// renderer cannot do yet: antialiasing other than classic, lights, tone_map, exposure.
+// "scene.json: effects.KEY: WHAT is not implemented yet", for the first effect the renderer cannot
+// do yet. There is none today: every effect of the format is implemented.
 void require_supported_effects(const SceneDescription& description);
 
-// What a scene file asks of every frame: its background, its outputs (depth, splat_count) and its
-// sh_degree effect (accuracy.sh_degree_cap: the smaller of it and the --mode's cap). A .ply
+// A scene file's lights and ambient as the renderer's Lighting (off when the file has no lights).
+Lighting scene_lighting(const SceneEffects& effects);
+
+// What a scene file asks of every frame: its background, its outputs (depth, splat_count), its
+// antialiasing, its lights (lighting) and its sh_degree effect (accuracy.sh_degree_cap: the smaller
+// of it and the --mode's cap). A .ply
 // leaves the settings as they are. Flags that override the scene file are applied after this.
 void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings);
 

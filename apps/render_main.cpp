@@ -1,6 +1,7 @@
 // tilesplat-render: renders one view of a scene to an EXR (and optionally a PNG preview).
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -25,11 +26,12 @@ struct RenderOptions {
   std::string output;
   std::string png;
   std::array<float, 3> background = {0, 0, 0};
-  double exposure = 1.0;
+  tilesplat::PreviewOptions preview;
   bool half = false;
   bool no_depth = false;
   bool no_count = false;
   bool reference = false;
+  int stochastic_frames = 0;  // --stochastic N: the sort-free compositor averaging N frames; 0 = sorted
   bool stats = false;
 };
 
@@ -72,12 +74,24 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                     "splats per pixel) unless turned off; for a scene file, the channels its \"outputs\" list",
                     &options.output, "-o");
   parser.add_string("--png", "FILE.png", "also write an 8-bit sRGB preview of the colours", &options.png);
-  parser.add_value("--exposure", "X", "multiply the colours of the --png preview (default 1)",
+  parser.add_value("--exposure", "STOPS",
+                   "brighten (or darken, if negative) the --png preview by 2^STOPS, -20 to 20 (default: the "
+                   "scene file's, else 0)",
                    [&options](const std::string& text) {
-                     const double exposure = cli::parse_double("--exposure", text);
-                     if (!(exposure > 0))
-                       throw cli::UsageError("--exposure must be positive, got " + single_quoted(text));
-                     options.exposure = exposure;
+                     const double stops = cli::parse_double("--exposure", text);
+                     if (!(std::abs(stops) <= 20))
+                       throw cli::UsageError("--exposure must be from -20 to 20 stops, got " + single_quoted(text));
+                     options.preview.exposure_stops = stops;
+                   });
+  parser.add_value("--tone-map", "CURVE",
+                   "the --png preview's tone curve: none (clip at 1), aces (filmic) or reinhard (x / (1 + x)) "
+                   "(default: the scene file's, else none)",
+                   [&options](const std::string& text) {
+                     if (text == "none") options.preview.tone_map = tilesplat::ToneMap::kNone;
+                     else if (text == "aces") options.preview.tone_map = tilesplat::ToneMap::kAces;
+                     else if (text == "reinhard") options.preview.tone_map = tilesplat::ToneMap::kReinhard;
+                     else
+                       throw cli::UsageError("--tone-map must be none, aces or reinhard, got " + single_quoted(text));
                    });
   parser.add_switch("--half", "store the EXR channels as 16-bit HALF instead of 32-bit FLOAT", &options.half);
   parser.add_switch("--no-depth", "do not compute or store the depth channel (Z)", &options.no_depth);
@@ -88,6 +102,10 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                    [&options](const std::string& text) {
                      options.background = cli::parse_rgb("--background", text);
                    });
+  parser.add_int("--stochastic", "N",
+                 "composite without a depth sort: each splat kept per pixel with probability alpha, nearest kept "
+                 "wins, the mean of N such frames (1 to 4096; converges to the sorted image as 1/sqrt(N))",
+                 &options.stochastic_frames, 1, 4096);
   parser.add_switch("--reference",
                     "render with the float64 CPU reference instead of the GPU (slow; for checking)",
                     &options.reference);
@@ -114,13 +132,16 @@ int run(int argc, char** argv) {
                           " (use --png for a PNG preview)");
   if (!options.png.empty() && !cli::has_extension(options.png, ".png"))
     throw cli::UsageError("--png expects a .png file, got " + single_quoted(options.png));
-  if (parser.seen("--exposure") && options.png.empty())
-    throw cli::UsageError("--exposure applies to the --png preview, and no --png was given");
+  for (const char* preview_flag : {"--exposure", "--tone-map"})
+    if (parser.seen(preview_flag) && options.png.empty())
+      throw cli::UsageError(std::string(preview_flag) + " applies to the --png preview, and no --png was given");
   cli::check_distinct_paths({{"SCENE", options.common.scene},
                              {"--cameras", options.common.cameras},
                              {"-o", options.output},
                              {"--png", options.png}});
   if (options.reference) {
+    if (parser.seen("--stochastic"))
+      throw cli::UsageError("--stochastic is a GPU compositor; the --reference renderer blends sorted lists");
     for (const char* gpu_flag : {"--device", "--validation", "--sort", "--mode"})
       if (parser.seen(gpu_flag))
         cli::print_warning(kProgram, std::string(gpu_flag) + " has no effect with --reference (CPU renderer)");
@@ -139,6 +160,18 @@ int run(int argc, char** argv) {
   if (parser.seen("--background") || !loaded.description) settings.background = options.background;
   if (options.no_depth) settings.depth = false;
   if (options.no_count) settings.splat_count = false;
+  if (options.common.antialiasing) settings.antialiasing = *options.common.antialiasing;
+  if (options.stochastic_frames > 0) {
+    settings.compositor = tilesplat::Compositor::kStochastic;
+    settings.stochastic.frames = static_cast<uint32_t>(options.stochastic_frames);
+  }
+  tilesplat::PreviewOptions preview;
+  if (loaded.description) {
+    preview.exposure_stops = loaded.description->effects.exposure_stops;
+    preview.tone_map = loaded.description->effects.tone_map;
+  }
+  if (parser.seen("--exposure")) preview.exposure_stops = options.preview.exposure_stops;
+  if (parser.seen("--tone-map")) preview.tone_map = options.preview.tone_map;
 
   tilesplat::RenderImage image;
   std::string timing;
@@ -183,7 +216,7 @@ int run(int argc, char** argv) {
   std::string written = options.output;
   if (!options.png.empty()) {
     try {
-      tilesplat::write_png_preview(options.png, image, static_cast<float>(options.exposure));
+      tilesplat::write_png_preview(options.png, image, preview);
     } catch (const std::exception& error) {
       throw std::runtime_error(write_failure(options.png, error));
     }

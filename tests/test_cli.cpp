@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -125,7 +126,8 @@ TEST(CliRender, HelpListsEveryFlag) {
   for (const char* flag :
        {"-o,", "--output", "--png", "--exposure", "--half", "--no-depth", "--no-count", "--background", "--reference",
         "--stats", "--cameras", "--view", "--width", "--height", "--azimuth", "--elevation", "--fov", "--distance",
-        "--strict", "--device", "--list-devices", "--sort", "--validation", "--help", "SCENE.ply"})
+        "--strict", "--device", "--list-devices", "--sort", "--validation", "--help", "SCENE.ply", "--tone-map",
+        "--antialiasing", "--stochastic"})
     EXPECT_TRUE(contains(result.out, flag)) << "--help does not mention " << flag << "\n" << result.out;
   EXPECT_TRUE(result.err.empty()) << result.err;
 }
@@ -137,7 +139,7 @@ TEST(CliBench, HelpListsEveryFlag) {
   for (const char* flag : {"--warmup", "--repeat", "--csv", "--json", "--plot", "--cameras", "--view", "--views",
                            "--orbit", "--resolutions", "--width", "--height", "--azimuth", "--elevation", "--fov",
                            "--distance", "--strict", "--device", "--list-devices", "--sort", "--validation", "--help",
-                           "SCENE.ply...", "--sort-bench", "--sort-sizes", "--key-bits"})
+                           "SCENE.ply...", "--sort-bench", "--sort-sizes", "--key-bits", "--effects", "--antialiasing"})
     EXPECT_TRUE(contains(result.out, flag)) << "--help does not mention " << flag << "\n" << result.out;
 }
 
@@ -365,6 +367,80 @@ TEST(CliRender, RendersExrAndPngPreview) {
   EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
 }
 
+TEST(CliBench, EffectsTableMeasuresEachEffectBesideItsNeverHadItRow) {
+  const auto out = fresh_output_dir();
+  const fs::path md = out / "effects.md";
+  const fs::path csv = out / "effects.csv";
+  const auto result =
+      run_exe(kBenchExe, {bundled_sh3().string(), "--effects", "--width", "64", "--height", "36", "--warmup", "1",
+                          "--repeat", "1", "--sort", "radix", "--markdown", md.string(), "--csv", csv.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  for (const char* row : {"base (all off, SH3)", "sh0 ", "sh1 ", "sh2 ", "sh0 [stored SH0]", "lights: 1 directional + 1 point",
+                          "lights off [no normals]", "antialiased", "mip", "+depth", "+splat count",
+                          "stochastic, 1 frame", "stochastic_composite", "tile_binning"})
+    EXPECT_TRUE(contains(result.out, row)) << row << "\n" << result.out;
+  // Every row is a whole frame: the projection and both sorts are measured, never skipped.
+  for (const char* pass : {"projection", "depth_sort", "tile_sort", "composite"})
+    EXPECT_TRUE(contains(result.out, pass)) << pass << "\n" << result.out;
+  const std::string markdown = read_file(md);
+  EXPECT_TRUE(contains(markdown, "| sh0 [stored SH0] |")) << markdown;
+  const std::string csv_text = read_file(csv);
+  EXPECT_TRUE(contains(csv_text, "mip,,projection,")) << csv_text;
+  EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+
+  const auto two = run_exe(kBenchExe, {bundled_sh3().string(), bundled_sh3().string(), "--effects"});
+  EXPECT_EQ(two.exit_code, 2) << two.err;
+  EXPECT_TRUE(contains(two.err, "--effects measures one SCENE")) << two.err;
+  const auto with_accuracy = run_exe(kBenchExe, {bundled_sh3().string(), "--effects", "--accuracy"});
+  EXPECT_EQ(with_accuracy.exit_code, 2) << with_accuracy.err;
+}
+
+TEST(CliRender, AntialiasingFlagSetsTheFootprintFilter) {
+  const auto out = fresh_output_dir();
+  auto render = [&](const std::string& mode, const std::string& name) {
+    std::vector<std::string> args = {bundled_sh3().string(), "--width", "64", "--height", "36", "-o",
+                                     (out / name).string()};
+    if (!mode.empty()) args.insert(args.end(), {"--antialiasing", mode});
+    return run_exe(kRenderExe, args);
+  };
+  ASSERT_EQ(render("", "default.exr").exit_code, 0);
+  ASSERT_EQ(render("classic", "classic.exr").exit_code, 0);
+  ASSERT_EQ(render("mip", "mip.exr").exit_code, 0);
+  EXPECT_EQ(tilesplat::read_exr(out / "default.exr").rgba, tilesplat::read_exr(out / "classic.exr").rgba);
+  EXPECT_NE(tilesplat::read_exr(out / "classic.exr").rgba, tilesplat::read_exr(out / "mip.exr").rgba);
+  const auto bad = render("gaussian", "bad.exr");
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_TRUE(contains(bad.err, "--antialiasing must be classic, antialiased or mip, got 'gaussian'")) << bad.err;
+  EXPECT_FALSE(fs::exists(out / "bad.exr"));
+}
+
+TEST(CliRender, StochasticFlagConvergesTowardTheSortedImage) {
+  const auto out = fresh_output_dir();
+  auto render = [&](std::vector<std::string> extra, const std::string& name) {
+    std::vector<std::string> args = {bundled_sh3().string(), "--width", "64", "--height", "36", "-o",
+                                     (out / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_exe(kRenderExe, args);
+  };
+  ASSERT_EQ(render({}, "sorted.exr").exit_code, 0);
+  const auto few = render({"--stochastic", "4"}, "few.exr");
+  ASSERT_EQ(few.exit_code, 0) << few.err;
+  ASSERT_EQ(render({"--stochastic", "256"}, "many.exr").exit_code, 0);
+  const auto sorted = tilesplat::read_exr(out / "sorted.exr");
+  const double few_db = tilesplat::compare_images(tilesplat::read_exr(out / "few.exr"), sorted).psnr_db;
+  const double many_db = tilesplat::compare_images(tilesplat::read_exr(out / "many.exr"), sorted).psnr_db;
+  std::printf("[ measure  ] stochastic vs sorted: 4 frames %.2f dB, 256 frames %.2f dB\n", few_db, many_db);
+  EXPECT_GT(many_db, few_db + 12);  // 64x the frames: 18 dB expected (error ~ 1/sqrt(N))
+  EXPECT_GT(many_db, 35);
+  const auto zero = render({"--stochastic", "0"}, "zero.exr");
+  EXPECT_EQ(zero.exit_code, 2) << zero.err;
+  EXPECT_TRUE(contains(zero.err, "--stochastic")) << zero.err;
+  const auto with_reference = render({"--stochastic", "4", "--reference"}, "ref.exr");
+  EXPECT_EQ(with_reference.exit_code, 2) << with_reference.err;
+  EXPECT_FALSE(fs::exists(out / "zero.exr"));
+  EXPECT_FALSE(fs::exists(out / "ref.exr"));
+}
+
 TEST(CliBench, PrintsTableAndWritesCsvAndJson) {
   const auto out = fresh_output_dir();
   const fs::path csv = out / "c.csv";
@@ -549,22 +625,41 @@ TEST(CliRender, RendersSceneFileToExr) {
   EXPECT_EQ(tilesplat::read_exr(side).rgba[2], 0.0f);
 }
 
-TEST(CliRender, SceneFileEffectNotImplementedYetFails) {
+TEST(CliRender, SceneFileLightsRelight) {
   const auto out = fresh_output_dir();
-  const fs::path scene_file =
-      write_scene_file(R"({"lights": [{"type": "directional", "direction": [0, 1, 0]}]})");
-  const auto result = run_exe(kRenderExe, {scene_file.string(), "-o", (out / "x.exr").string()});
-  EXPECT_EQ(result.exit_code, 1) << result.err;
-  EXPECT_TRUE(contains(result.err, "scene.json: effects.lights: relighting is not implemented yet")) << result.err;
-  expect_one_error_line(result, "tilesplat-render");
-  EXPECT_TRUE(entries(out).empty());
+  const fs::path scene_file = write_scene_file(
+      R"({"lights": [{"type": "directional", "direction": [0, 1, 0.5], "color": [1, 0.9, 0.8], "intensity": 2},
+                     {"type": "point", "position": [0.5, -1, 1.5], "intensity": 3}],
+          "ambient": [0.1, 0.1, 0.2]})");
+  const fs::path exr = out / "lit.exr";
+  const auto result = run_exe(kRenderExe, {scene_file.string(), "-o", exr.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
 
-  const fs::path tone_mapped = write_scene_file(R"({"tone_map": "aces"})");
-  const auto tone_map_result = run_exe(kRenderExe, {tone_mapped.string(), "-o", (out / "x.exr").string()});
-  EXPECT_EQ(tone_map_result.exit_code, 1) << tone_map_result.err;
-  EXPECT_TRUE(contains(tone_map_result.err, "scene.json: effects.tone_map: tone mapping is not implemented yet"))
-      << tone_map_result.err;
-  EXPECT_TRUE(entries(out).empty());
+  // The library with the file's lights, written out here as tilesplat::Lighting: the app must have
+  // mapped every field (directions normalised by the reader, which the renderer does too).
+  const tilesplat::SceneDescription description = tilesplat::load_scene_description(scene_file);
+  tilesplat::RenderSettings settings;
+  settings.background = {0, 0, 1};
+  settings.splat_count = false;
+  tilesplat::Light sun;
+  sun.direction = {0, float(1 / std::sqrt(1.25)), float(0.5 / std::sqrt(1.25))};
+  sun.color = {1, 0.9f, 0.8f};
+  sun.intensity = 2;
+  tilesplat::Light bulb;
+  bulb.type = tilesplat::Light::Type::kPoint;
+  bulb.position = {0.5f, -1, 1.5f};
+  bulb.intensity = 3;
+  settings.lighting.lights = {sun, bulb};
+  settings.lighting.ambient = {0.1f, 0.1f, 0.2f};
+  tilesplat::Renderer& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(tilesplat::load_described_scene(description));
+  const tilesplat::RenderImage expected = renderer.render(description.cameras[0].camera, settings);
+  EXPECT_LE(tilesplat::compare_images(tilesplat::read_exr(exr), expected).max_abs, 1e-6);
+  settings.lighting = {};
+  const tilesplat::RenderImage unlit = renderer.render(description.cameras[0].camera, settings);
+  EXPECT_GT(tilesplat::compare_images(unlit, expected).max_abs, 0.05);  // the lights changed the image
+  EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
 TEST(CliRender, SceneFileAntialiasingModeApplies) {
@@ -576,6 +671,43 @@ TEST(CliRender, SceneFileAntialiasingModeApplies) {
   ASSERT_EQ(mip_result.exit_code, 0) << mip_result.err;
   // Mip-Splatting's filter changes the image (dilation 0.1 and opacity compensation).
   EXPECT_NE(tilesplat::read_exr(out / "classic.exr").rgba, tilesplat::read_exr(out / "mip.exr").rgba);
+}
+
+TEST(CliRender, SceneFileExposureAndToneMapShapeThePngOnly) {
+  const auto out = fresh_output_dir();
+  const fs::path plain = write_scene_file();
+  ASSERT_EQ(run_exe(kRenderExe, {plain.string(), "-o", (out / "plain.exr").string(), "--png",
+                                 (out / "plain.png").string()})
+                .exit_code,
+            0);
+  const fs::path graded = write_scene_file(R"({"exposure": 2, "tone_map": "aces"})");
+  const auto graded_result = run_exe(
+      kRenderExe, {graded.string(), "-o", (out / "graded.exr").string(), "--png", (out / "graded.png").string()});
+  ASSERT_EQ(graded_result.exit_code, 0) << graded_result.err;
+  // The flags say the same as the scene file, so the preview is byte-identical.
+  const auto flags_result =
+      run_exe(kRenderExe, {plain.string(), "-o", (out / "flags.exr").string(), "--png", (out / "flags.png").string(),
+                           "--exposure", "2", "--tone-map", "aces"});
+  ASSERT_EQ(flags_result.exit_code, 0) << flags_result.err;
+  // The EXR stays linear; only the preview is graded.
+  EXPECT_EQ(tilesplat::read_exr(out / "plain.exr").rgba, tilesplat::read_exr(out / "graded.exr").rgba);
+  EXPECT_NE(read_file(out / "plain.png"), read_file(out / "graded.png"));
+  EXPECT_EQ(read_file(out / "graded.png"), read_file(out / "flags.png"));
+  // A flag overrides the scene file: back to no grading.
+  ASSERT_EQ(run_exe(kRenderExe, {graded.string(), "-o", (out / "undone.exr").string(), "--png",
+                                 (out / "undone.png").string(), "--exposure", "0", "--tone-map", "none"})
+                .exit_code,
+            0);
+  EXPECT_EQ(read_file(out / "plain.png"), read_file(out / "undone.png"));
+
+  const auto bad_curve = run_exe(kRenderExe, {plain.string(), "-o", (out / "x.exr").string(), "--png",
+                                              (out / "x.png").string(), "--tone-map", "filmic"});
+  EXPECT_EQ(bad_curve.exit_code, 2) << bad_curve.err;
+  EXPECT_TRUE(contains(bad_curve.err, "--tone-map must be none, aces or reinhard, got 'filmic'")) << bad_curve.err;
+  const auto no_png = run_exe(kRenderExe, {plain.string(), "-o", (out / "x.exr").string(), "--tone-map", "aces"});
+  EXPECT_EQ(no_png.exit_code, 2) << no_png.err;
+  EXPECT_TRUE(contains(no_png.err, "--tone-map applies to the --png preview")) << no_png.err;
+  EXPECT_FALSE(fs::exists(out / "x.exr"));
 }
 
 TEST(CliRender, SceneFileMistakesAndViews) {

@@ -468,7 +468,11 @@ TEST(AtomicWrite, InvalidImageLeavesNoFiles) {
     const std::string message = error_message_of([&] { write_png_preview(png, *image); });
     EXPECT_EQ(message.rfind("cannot write " + png.string() + ": ", 0), 0u) << message;
   }
-  EXPECT_THROW(write_png_preview(png, make_image(2, 2, false, false), std::nanf("")), std::runtime_error);
+  for (double stops : {double(std::nanf("")), 21.0, -1e300})
+    EXPECT_EQ(error_message_of([&] { write_png_preview(png, make_image(2, 2, false, false), {.exposure_stops = stops}); })
+                  .find("cannot write " + png.string() + ": exposure"),
+              0u)
+        << stops;
   EXPECT_TRUE(directory_entries(dir).empty());
 }
 
@@ -595,12 +599,69 @@ TEST(PngPreview, ExposureScalesLinearColour) {
   image.height = 1;
   image.rgba = {0.25f, 0.125f, 1.0f, 1.0f};
   const fs::path path = fresh_dir() / "exposed.png";
-  write_png_preview(path, image, 2.0f);
+  write_png_preview(path, image, {.exposure_stops = 1.0});  // times 2
   const DecodedPng decoded = read_png_rgb(path);
   ASSERT_EQ(decoded.rgb.size(), 3u);
   EXPECT_EQ(decoded.rgb[0], expected_srgb_byte(0.5));
   EXPECT_EQ(decoded.rgb[1], expected_srgb_byte(0.25));
   EXPECT_EQ(decoded.rgb[2], 255);
+
+  write_png_preview(path, image, {.exposure_stops = -2.0});  // times 1/4
+  const DecodedPng darker = read_png_rgb(path);
+  EXPECT_EQ(darker.rgb[0], expected_srgb_byte(0.0625));
+  EXPECT_EQ(darker.rgb[2], expected_srgb_byte(0.25));
+}
+
+TEST(ToneMap, CurvesFollowTheirFormulasAndStayInRange) {
+  // Reinhard: x / (1 + x). ACES (Narkowicz): x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), at most 1.
+  for (double x : {0.01, 0.18, 0.5, 1.0, 4.0, 100.0}) {
+    EXPECT_DOUBLE_EQ(apply_tone_map(ToneMap::kReinhard, x), x / (1 + x)) << x;
+    EXPECT_DOUBLE_EQ(apply_tone_map(ToneMap::kAces, x),
+                     std::min(1.0, x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)))
+        << x;
+    EXPECT_DOUBLE_EQ(apply_tone_map(ToneMap::kNone, x), x) << x;
+  }
+  // Monotonic, from 0 to at most 1; garbage in gives black or white, never NaN.
+  for (ToneMap curve : {ToneMap::kAces, ToneMap::kReinhard}) {
+    double previous = 0;
+    for (double x = 0; x < 50; x += 0.01) {
+      const double y = apply_tone_map(curve, x);
+      EXPECT_GE(y, previous) << to_string(curve) << " at " << x;
+      EXPECT_LE(y, 1.0) << to_string(curve) << " at " << x;
+      previous = y;
+    }
+    EXPECT_EQ(apply_tone_map(curve, std::nan("")), 0.0);
+    EXPECT_EQ(apply_tone_map(curve, -3.0), 0.0);
+    EXPECT_EQ(apply_tone_map(curve, std::numeric_limits<double>::infinity()), 1.0);
+  }
+  EXPECT_EQ(to_string(ToneMap::kAces), "aces");
+  EXPECT_EQ(to_string(ToneMap::kReinhard), "reinhard");
+  EXPECT_EQ(to_string(ToneMap::kNone), "none");
+}
+
+TEST(PngPreview, ToneMapCompressesHighlightsInsteadOfClipping) {
+  RenderImage image;
+  image.width = 3;
+  image.height = 1;
+  image.rgba = {0.18f, 0.18f, 0.18f, 1.0f, 2.0f, 2.0f, 2.0f, 1.0f, 8.0f, 8.0f, 8.0f, 1.0f};
+  const fs::path path = fresh_dir() / "tone.png";
+  write_png_preview(path, image);
+  const DecodedPng clipped = read_png_rgb(path);
+  EXPECT_EQ(clipped.rgb[3], 255);  // 2.0 and 8.0 both clip to white
+  EXPECT_EQ(clipped.rgb[6], 255);
+
+  write_png_preview(path, image, {.tone_map = ToneMap::kReinhard});
+  const DecodedPng reinhard = read_png_rgb(path);
+  EXPECT_EQ(reinhard.rgb[0], expected_srgb_byte(0.18 / 1.18));
+  EXPECT_EQ(reinhard.rgb[3], expected_srgb_byte(2.0 / 3.0));
+  EXPECT_EQ(reinhard.rgb[6], expected_srgb_byte(8.0 / 9.0));
+  EXPECT_LT(reinhard.rgb[3], reinhard.rgb[6]);  // highlights stay distinct
+
+  write_png_preview(path, image, {.exposure_stops = 1.0, .tone_map = ToneMap::kAces});
+  const DecodedPng aces = read_png_rgb(path);
+  EXPECT_EQ(aces.rgb[0], expected_srgb_byte(apply_tone_map(ToneMap::kAces, 0.36)));
+  EXPECT_EQ(aces.rgb[3], expected_srgb_byte(apply_tone_map(ToneMap::kAces, 4.0)));
+  EXPECT_LT(aces.rgb[3], 255);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,0 +1,252 @@
+#include "effects_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "cli.h"
+#include "tilesplat/scene_description.h"
+
+namespace tilesplat::effects {
+
+namespace {
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+std::string fixed(double value, int decimals) { return cli::format_fixed(value, decimals); }
+
+// Pass names in frame order, over all rows (a row may have passes the others lack).
+std::vector<std::string> pass_names(const std::vector<Row>& rows) {
+  std::vector<std::string> names;
+  for (const Row& row : rows)
+    for (const PassTiming& pass : row.passes)
+      if (std::find(names.begin(), names.end(), pass.name) == names.end()) names.push_back(pass.name);
+  return names;
+}
+
+double pass_ms(const Row& row, const std::string& name) {
+  for (const PassTiming& pass : row.passes)
+    if (pass.name == name) return pass.gpu_ms;
+  return 0;
+}
+
+std::string row_label(const Row& row) {
+  return row.scene_variant.empty() ? row.name : row.name + " [" + row.scene_variant + "]";
+}
+
+// Relative to the first row (the base), in percent.
+std::string versus_base(const std::vector<Row>& rows, const Row& row) {
+  const double base = rows.front().frame_ms;
+  if (&row == &rows.front() || !(base > 0)) return "";
+  const double percent = 100.0 * (row.frame_ms - base) / base;
+  std::string text = percent >= 0 ? "+" : "";
+  text += fixed(percent, 1);
+  return text + "%";
+}
+
+}  // namespace
+
+Lighting bench_lighting(const GaussianScene& scene) {
+  const Bounds bounds = compute_bounds(scene);
+  Lighting lighting;
+  lighting.ambient = {0.2f, 0.2f, 0.2f};
+  Light sun;  // travels down (+y is down in the trainer's convention) and away from the default orbit
+  sun.direction = {0.3f, 0.8f, 0.52f};
+  const float norm = std::sqrt(0.3f * 0.3f + 0.8f * 0.8f + 0.52f * 0.52f);
+  for (float& v : sun.direction) v /= norm;
+  sun.color = {1.0f, 0.95f, 0.9f};
+  Light lamp;
+  lamp.type = Light::Type::kPoint;
+  lamp.position = {float(bounds.center[0]), float(bounds.center[1] - bounds.radius), float(bounds.center[2])};
+  lamp.color = {0.6f, 0.7f, 1.0f};
+  lamp.intensity = float(bounds.radius * bounds.radius);  // about 1 at the scene's centre
+  lighting.lights = {sun, lamp};
+  return lighting;
+}
+
+std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& base_settings) {
+  RenderSettings base = base_settings;
+  base.accuracy.sh_degree_cap = 3;
+  base.antialiasing = Antialiasing::kClassic;
+  base.lighting = {};
+  base.depth = false;
+  base.splat_count = false;
+  base.compositor = Compositor::kSorted;
+
+  std::vector<Row> rows;
+  auto add = [&](const std::string& name, const std::string& variant, auto&& change) {
+    Row row;
+    row.name = name;
+    row.scene_variant = variant;
+    row.settings = base;
+    change(row.settings);
+    rows.push_back(std::move(row));
+  };
+  add("base (all off, SH" + std::to_string(scene.sh_degree) + ")", "", [](RenderSettings&) {});
+  for (int degree = 0; degree < scene.sh_degree; ++degree)
+    add("sh" + std::to_string(degree), "", [degree](RenderSettings& s) { s.accuracy.sh_degree_cap = degree; });
+  if (scene.sh_degree > 0) add("sh0", "stored SH0", [](RenderSettings&) {});
+  const Lighting lighting = bench_lighting(scene);
+  add("lights: 1 directional + 1 point", "", [&](RenderSettings& s) { s.lighting = lighting; });
+  if (scene.has_normals()) add("lights off", "no normals", [](RenderSettings&) {});
+  add("antialiased", "", [](RenderSettings& s) { s.antialiasing = Antialiasing::kAntialiased; });
+  add("mip", "", [](RenderSettings& s) { s.antialiasing = Antialiasing::kMip; });
+  add("+depth", "", [](RenderSettings& s) { s.depth = true; });
+  add("+splat count", "", [](RenderSettings& s) { s.splat_count = true; });
+  add("+depth +splat count", "", [](RenderSettings& s) { s.depth = s.splat_count = true; });
+  // Not an effect but the other side of the sort's cost: no depth sort, one hashed sample per pixel.
+  // (The modes that reorder by depth have no stochastic form.)
+  if (base.accuracy.depth_key_bits == 32 && base.accuracy.resort_window == 0)
+    add("stochastic, 1 frame", "", [](RenderSettings& s) {
+    s.compositor = Compositor::kStochastic;
+    s.stochastic.frames = 1;
+  });
+  return rows;
+}
+
+int work_units(const std::vector<Row>& rows, const Options& options) {
+  return int(rows.size() * options.views.size()) * (options.warmup + options.repeat);
+}
+
+Run measure(const RendererOptions& renderer_options, const GaussianScene& scene, std::vector<Row>& rows,
+            const Options& options, const std::function<void(int, int, const std::string&)>& progress) {
+  // One renderer per scene variant, each holding its scene, so that rows interleave without uploads.
+  std::map<std::string, std::unique_ptr<Renderer>> renderers;
+  for (const Row& row : rows) {
+    if (renderers.count(row.scene_variant)) continue;
+    GaussianScene variant;
+    if (row.scene_variant == "stored SH0") {
+      variant = with_sh_degree(scene, 0);
+    } else if (row.scene_variant == "no normals") {
+      variant = scene;
+      variant.normals.clear();
+    }
+    auto renderer = Renderer::create(renderer_options);
+    renderer->set_scene(row.scene_variant.empty() ? scene : variant);
+    renderers.emplace(row.scene_variant, std::move(renderer));
+  }
+
+  const int total = work_units(rows, options);
+  int done = 0;
+  // samples[row][view][pass name] and frame times, over the repeats.
+  std::vector<std::vector<std::map<std::string, std::vector<double>>>> pass_samples(
+      rows.size(), std::vector<std::map<std::string, std::vector<double>>>(options.views.size()));
+  std::vector<std::vector<std::vector<double>>> frame_samples(rows.size(),
+                                                              std::vector<std::vector<double>>(options.views.size()));
+  std::vector<std::vector<std::string>> pass_order(rows.size());  // as the renderer reports them
+  for (int frame = 0; frame < options.warmup + options.repeat; ++frame) {
+    for (size_t r = 0; r < rows.size(); ++r) {
+      Renderer& renderer = *renderers.at(rows[r].scene_variant);
+      RenderSettings settings = rows[r].settings;
+      settings.sort = options.sort;
+      settings.reuse_lists = false;  // whole frames: consecutive rows often share the camera and lists
+      for (size_t v = 0; v < options.views.size(); ++v) {
+        renderer.render(options.views[v], settings);
+        const FrameStats& stats = renderer.last_frame_stats();
+        if (frame == 0 && v == 0) rows[r].device_bytes = stats.device_bytes;
+        if (frame >= options.warmup) {
+          frame_samples[r][v].push_back(stats.gpu_ms);
+          for (const PassTiming& pass : stats.passes) {
+            pass_samples[r][v][pass.name].push_back(pass.gpu_ms);
+            auto& order = pass_order[r];
+            if (std::find(order.begin(), order.end(), pass.name) == order.end()) order.push_back(pass.name);
+          }
+        }
+        progress(++done, total, row_label(rows[r]));
+      }
+    }
+  }
+  for (size_t r = 0; r < rows.size(); ++r) {
+    std::vector<double> frame_medians;
+    std::map<std::string, std::vector<double>> pass_medians;
+    for (size_t v = 0; v < options.views.size(); ++v) {
+      frame_medians.push_back(median(frame_samples[r][v]));
+      for (const auto& [name, samples] : pass_samples[r][v]) pass_medians[name].push_back(median(samples));
+    }
+    rows[r].frame_ms = median(frame_medians);
+    rows[r].passes.clear();
+    for (const std::string& name : pass_order[r]) rows[r].passes.push_back({name, median(pass_medians[name])});
+  }
+  Run run;
+  run.device = renderers.begin()->second->device_info();
+  for (const auto& [variant, renderer] : renderers) run.validation_messages += renderer->validation_messages();
+  return run;
+}
+
+std::string text_table(const std::vector<Row>& rows) {
+  const std::vector<std::string> passes = pass_names(rows);
+  size_t label_width = 10;
+  for (const Row& row : rows) label_width = std::max(label_width, row_label(row).size());
+  std::string out;
+  auto cell = [](const std::string& text, size_t width) {
+    return std::string(width > text.size() ? width - text.size() : 0, ' ') + text;
+  };
+  std::string header = "effect" + std::string(label_width - 6, ' ');
+  for (const auto& name : passes) header += cell(name, std::max<size_t>(name.size(), 8) + 2);
+  header += cell("frame ms", 10) + cell("vs base", 9) + cell("MiB", 9);
+  out += header + "\n";
+  for (const Row& row : rows) {
+    const std::string label = row_label(row);
+    std::string line = label + std::string(label_width - label.size(), ' ');
+    for (const auto& name : passes) line += cell(fixed(pass_ms(row, name), 3), std::max<size_t>(name.size(), 8) + 2);
+    line += cell(fixed(row.frame_ms, 3), 10) + cell(versus_base(rows, row), 9) +
+            cell(fixed(double(row.device_bytes) / (1024.0 * 1024.0), 1), 9);
+    out += line + "\n";
+  }
+  return out;
+}
+
+std::string markdown(const std::vector<Row>& rows, const std::string& scene, const DeviceInfo& device,
+                     const std::string& command) {
+  const std::vector<std::string> passes = pass_names(rows);
+  std::string out = "# Effect costs: " + scene + "\n\n";
+  out += "Device: " + device.name + " (driver " + device.driver + "). Command: `" + command + "`.\n\n";
+  out += "GPU ms per pass (median over repeats, then views). `[stored SH0]` and `[no normals]` rows render a "
+         "scene that never had the effect, beside the row that turns it off.\n\n| effect |";
+  for (const auto& name : passes) out += " " + name + " |";
+  out += " frame ms | vs base | device MiB |\n|---|";
+  for (size_t i = 0; i < passes.size(); ++i) out += "---:|";
+  out += "---:|---:|---:|\n";
+  for (const Row& row : rows) {
+    // Appended piece by piece: GCC 12 warns (-Wrestrict, falsely) about "literal" + std::string.
+    std::vector<std::string> cells = {row_label(row)};
+    for (const auto& name : passes) cells.push_back(fixed(pass_ms(row, name), 3));
+    cells.push_back(fixed(row.frame_ms, 3));
+    cells.push_back(versus_base(rows, row));
+    cells.push_back(fixed(double(row.device_bytes) / (1024.0 * 1024.0), 1));
+    out += "|";
+    for (const std::string& text : cells) {
+      out += ' ';
+      out += text;
+      out += " |";
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+std::string csv(const std::vector<Row>& rows, const std::string& scene, const DeviceInfo& device) {
+  std::string out = "device,scene,effect,scene_variant,pass,gpu_ms\n";
+  auto quote = [](const std::string& text) {
+    if (text.find_first_of(",\"\n") == std::string::npos) return text;
+    std::string quoted = "\"";
+    for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return quoted + "\"";
+  };
+  for (const Row& row : rows) {
+    const std::string prefix =
+        quote(device.name) + "," + quote(scene) + "," + quote(row.name) + "," + quote(row.scene_variant) + ",";
+    for (const PassTiming& pass : row.passes) out += prefix + quote(pass.name) + "," + fixed(pass.gpu_ms, 4) + "\n";
+    out += prefix + "frame," + fixed(row.frame_ms, 4) + "\n";
+    out += prefix + "device_mib," + fixed(double(row.device_bytes) / (1024.0 * 1024.0), 3) + "\n";
+  }
+  return out;
+}
+
+}  // namespace tilesplat::effects

@@ -1,0 +1,63 @@
+// tilesplat-bench --effects: what each scene effect costs per pass, and that an effect turned off
+// costs what never having it costs.
+//
+// One scene, rendered at the chosen views with one effect changed at a time from a base that has
+// every effect off (the scene's SH degree, classic antialiasing, no lights, colour and alpha only):
+// SH degree 0..3, relighting, the antialiasing modes, the depth and splat-count outputs. Two rows
+// render a scene that never had the effect (its SH stored at degree 0; its normals removed) next to
+// the row that turns the effect off, so the table shows "off" and "never" side by side. The frames
+// of all rows are interleaved (row after row, repeat after repeat) so that a CPU driver's drifting
+// speed affects every row alike.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "tilesplat/camera.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat::effects {
+
+struct Row {
+  std::string name;  // "sh1", "lights 2", "mip", "+depth", ...
+  std::string scene_variant;  // "" (the scene), "stored SH0", "no normals": the "never had it" rows
+  RenderSettings settings;
+  // Measured: medians over the repeats, then over the views.
+  double frame_ms = 0;
+  std::vector<PassTiming> passes;
+  uint64_t device_bytes = 0;  // at the first view
+};
+
+struct Options {
+  std::vector<Camera> views;
+  int warmup = 1;
+  int repeat = 5;
+  std::string sort = "radix";
+};
+
+// The rows for a scene of this SH degree. `base` carries what the run shares (sort, accuracy,
+// background); every row starts from it with all effects off.
+std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& base);
+
+struct Run {
+  DeviceInfo device;
+  uint64_t validation_messages = 0;  // summed over the run's renderers
+};
+// Renders every row (interleaved) and fills in the measurements. progress(done, total) as it goes.
+Run measure(const RendererOptions& renderer_options, const GaussianScene& scene, std::vector<Row>& rows,
+            const Options& options, const std::function<void(int, int, const std::string&)>& progress);
+int work_units(const std::vector<Row>& rows, const Options& options);
+
+// Two lights that reach most of the scene: a directional light from above and the camera's side,
+// and a point light near the scene's centre, scaled to its extent.
+Lighting bench_lighting(const GaussianScene& scene);
+
+std::string text_table(const std::vector<Row>& rows);
+std::string markdown(const std::vector<Row>& rows, const std::string& scene, const DeviceInfo& device,
+                     const std::string& command);
+std::string csv(const std::vector<Row>& rows, const std::string& scene, const DeviceInfo& device);
+
+}  // namespace tilesplat::effects
