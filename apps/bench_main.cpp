@@ -1043,12 +1043,6 @@ fs::path scene_plot_path(const std::string& plot, const std::string& scene_file,
 // The report renders every mode against the reference itself, so a scene file's sh_degree effect is
 // applied to the scene (dropping the bands it excludes gives the same images as the cap) rather than
 // to the modes, whose SH cap is one of the things measured.
-void apply_scene_sh_degree(cli::LoadedScene& loaded) {
-  if (!loaded.description || !loaded.description->effects.sh_degree) return;
-  const int degree = std::min(loaded.scene.sh_degree, *loaded.description->effects.sh_degree);
-  loaded.scene = tilesplat::with_sh_degree(loaded.scene, degree);
-}
-
 int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& options, int argc, char** argv) {
   for (const char* flag : {"--resolutions", "--orbit", "--json"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");
@@ -1072,7 +1066,6 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
   for (size_t s = 0; s < options.common.scenes.size(); ++s) {
     Planned p;
     p.scene.loaded = cli::load_scene_file(options.common.scenes[s], options.common.strict, kProgram);
-    apply_scene_sh_degree(p.scene.loaded);
     p.scene.name = p.scene.loaded.path.filename().string();
     p.scene.description = cli::describe_scene(p.scene.loaded.scene);
     p.scene.sh_degree = p.scene.loaded.scene.sh_degree;
@@ -1143,7 +1136,6 @@ int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options
 
   BenchScene scene;
   scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
-  apply_scene_sh_degree(scene.loaded);
   scene.name = scene.loaded.path.filename().string();
   scene.description = cli::describe_scene(scene.loaded.scene);
   scene.sh_degree = scene.loaded.scene.sh_degree;

@@ -593,7 +593,6 @@ LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view 
   try {
     if (is_scene_description(loaded.path)) {
       loaded.description = load_scene_description(loaded.path);
-      require_supported_effects(*loaded.description);
       loaded.scene = load_described_scene(*loaded.description, load_options, &loaded.report);
     } else {
       loaded.scene = load_scene(loaded.path, load_options, &loaded.report);
@@ -619,12 +618,6 @@ SceneViews scene_views(const LoadedScene& loaded) {
   out.views = loaded.description->cameras;
   out.file = loaded.description->cameras_file.empty() ? loaded.path : loaded.description->cameras_file;
   return out;
-}
-
-void require_supported_effects(const SceneDescription&) {
-  // Every effect of the format is implemented (relighting was the last). An effect the format gains
-  // before the renderer does is refused here, as "FILE: effects.KEY: WHAT is not implemented yet",
-  // rather than ignored.
 }
 
 Lighting scene_lighting(const SceneEffects& effects) {

@@ -187,9 +187,7 @@ struct LoadedScene {
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program);
 
 // The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
-// load_scene_file fills path, scene, description, report and load_ms only. A scene file (.json)
-// asking for an effect the renderer does not implement yet fails before any splat file is read
-// (require_supported_effects).
+// load_scene_file fills path, scene, description, report and load_ms only.
 LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program);
 
 // The views a scene file brings ("cameras") and the file that names them (the cameras.json it
@@ -199,11 +197,6 @@ struct SceneViews {
   std::filesystem::path file;
 };
 SceneViews scene_views(const LoadedScene& loaded);
-
-// Throws std::runtime_error naming the scene file and the JSON path, e.g.
-// "scene.json: effects.KEY: WHAT is not implemented yet", for the first effect the renderer cannot
-// do yet. There is none today: every effect of the format is implemented.
-void require_supported_effects(const SceneDescription& description);
 
 // A scene file's lights and ambient as the renderer's Lighting (off when the file has no lights).
 Lighting scene_lighting(const SceneEffects& effects);

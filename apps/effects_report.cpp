@@ -30,10 +30,11 @@ std::vector<std::string> pass_names(const std::vector<Row>& rows) {
   return names;
 }
 
-double pass_ms(const Row& row, const std::string& name) {
+// "-" for a pass the row's frame does not run.
+std::string pass_ms(const Row& row, const std::string& name) {
   for (const PassTiming& pass : row.passes)
-    if (pass.name == name) return pass.gpu_ms;
-  return 0;
+    if (pass.name == name) return fixed(pass.gpu_ms, 3);
+  return "-";
 }
 
 std::string row_label(const Row& row) {
@@ -194,7 +195,7 @@ std::string text_table(const std::vector<Row>& rows) {
   for (const Row& row : rows) {
     const std::string label = row_label(row);
     std::string line = label + std::string(label_width - label.size(), ' ');
-    for (const auto& name : passes) line += cell(fixed(pass_ms(row, name), 3), std::max<size_t>(name.size(), 8) + 2);
+    for (const auto& name : passes) line += cell(pass_ms(row, name), std::max<size_t>(name.size(), 8) + 2);
     line += cell(fixed(row.frame_ms, 3), 10) + cell(versus_base(rows, row), 9) +
             cell(fixed(double(row.device_bytes) / (1024.0 * 1024.0), 1), 9);
     out += line + "\n";
@@ -216,7 +217,7 @@ std::string markdown(const std::vector<Row>& rows, const std::string& scene, con
   for (const Row& row : rows) {
     // Appended piece by piece: GCC 12 warns (-Wrestrict, falsely) about "literal" + std::string.
     std::vector<std::string> cells = {row_label(row)};
-    for (const auto& name : passes) cells.push_back(fixed(pass_ms(row, name), 3));
+    for (const auto& name : passes) cells.push_back(pass_ms(row, name));
     cells.push_back(fixed(row.frame_ms, 3));
     cells.push_back(versus_base(rows, row));
     cells.push_back(fixed(double(row.device_bytes) / (1024.0 * 1024.0), 1));

@@ -413,5 +413,30 @@ TEST(GpuRenderer, CompositeChunksFollowEachFrameAndReleaseTheirState) {
   EXPECT_EQ(renderer->validation_messages(), 0u);
 }
 
+// An output a frame does not ask for is neither computed (a specialization constant) nor held.
+TEST(GpuRenderer, OutputsNotAskedForHoldNoMemory) {
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(load_scene(testing::bundled_sh3()));
+  const Camera camera = look_at_camera({0, -0.5, 2.5}, {0, 0, 0}, {0, -1, 0}, 64, 36, 45);
+  RenderSettings all;
+  renderer.render(camera, all);  // drops what an earlier test's frames left (composite chunk state)
+  const RenderImage full = renderer.render(camera, all);
+  const uint64_t with_both = renderer.last_frame_stats().device_bytes;
+  RenderSettings colour_only;
+  colour_only.depth = colour_only.splat_count = false;
+  const RenderImage colour = renderer.render(camera, colour_only);
+  const uint64_t with_none = renderer.last_frame_stats().device_bytes;
+  EXPECT_EQ(with_both - with_none, 64u * 36u * 8u);  // a float depth and a uint count per pixel
+  EXPECT_TRUE(colour.depth.empty());
+  EXPECT_TRUE(colour.splat_count.empty());
+  EXPECT_EQ(colour.rgba, full.rgba);
+  RenderSettings depth_only = colour_only;
+  depth_only.depth = true;
+  const RenderImage depth = renderer.render(camera, depth_only);
+  EXPECT_EQ(renderer.last_frame_stats().device_bytes, with_none + 64u * 36u * 4u);
+  EXPECT_EQ(depth.depth, full.depth);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 }  // namespace
 }  // namespace tilesplat

@@ -470,6 +470,20 @@ TEST(SceneDescription, RelativePathsResolveAgainstTheSceneFile) {
   EXPECT_EQ(scene.size(), load_scene(bundled_sh3()).size());
 }
 
+TEST(SceneDescription, ShDegreeEffectDropsTheBandsItNeverEvaluates) {
+  const fs::path dir = temp_dir() / "sh_cap";
+  fs::create_directories(dir);
+  const std::string model = R"("models": [{"path": ")" + bundled_sh3().string() + R"("}])";
+  const GaussianScene full = load_described_scene(load_scene_description(write_text(dir / "full.json", "{" + model + "}")));
+  const GaussianScene capped = load_described_scene(
+      load_scene_description(write_text(dir / "capped.json", "{" + model + R"(, "effects": {"sh_degree": 1}})")));
+  ASSERT_EQ(full.sh_degree, 3);
+  EXPECT_EQ(capped.sh_degree, 1);
+  EXPECT_EQ(capped.sh.size(), full.size() * 4 * 3);  // 4 of 16 coefficients per splat held
+  EXPECT_EQ(capped.sh, with_sh_degree(full, 1).sh);
+  EXPECT_EQ(capped.positions, full.positions);
+}
+
 TEST(SceneDescription, LoadErrorsNameTheDescriptionAndTheModel) {
   const fs::path dir = temp_dir();
   std::string truncated;

@@ -128,16 +128,24 @@ struct Renderer::Impl {
     return *it->second;
   }
 
-  void ensure_outputs(uint32_t width, uint32_t height) {
-    if (outputs.width == width && outputs.height == height) return;
+  // The output images of this frame's size: colour always, depth and counts only while frames ask
+  // for them (an output not asked for holds no memory).
+  void ensure_outputs(uint32_t width, uint32_t height, bool depth, bool count) {
     const size_t pixels = size_t(width) * height;
-    outputs.rgba = vk::Buffer(ctx, pixels * 16, vk::MemoryUse::Device, "output rgba");
-    outputs.depth = vk::Buffer(ctx, pixels * 4, vk::MemoryUse::Device, "output depth");
-    outputs.count = vk::Buffer(ctx, pixels * 4, vk::MemoryUse::Device, "output splat count");
-    outputs.width = width;
-    outputs.height = height;
-    const uint32_t tiles = vk::div_ceil(width, kTileSize) * vk::div_ceil(height, kTileSize);
-    ranges = vk::Buffer(ctx, VkDeviceSize(tiles) * 8, vk::MemoryUse::Device, "tile ranges");
+    if (outputs.width != width || outputs.height != height) {
+      outputs.rgba = vk::Buffer(ctx, pixels * 16, vk::MemoryUse::Device, "output rgba");
+      outputs.depth.reset();
+      outputs.count.reset();
+      outputs.width = width;
+      outputs.height = height;
+      const uint32_t tiles = vk::div_ceil(width, kTileSize) * vk::div_ceil(height, kTileSize);
+      ranges = vk::Buffer(ctx, VkDeviceSize(tiles) * 8, vk::MemoryUse::Device, "tile ranges");
+    }
+    if (!depth) outputs.depth.reset();
+    else if (outputs.depth.size() == 0) outputs.depth = vk::Buffer(ctx, pixels * 4, vk::MemoryUse::Device, "output depth");
+    if (!count) outputs.count.reset();
+    else if (outputs.count.size() == 0)
+      outputs.count = vk::Buffer(ctx, pixels * 4, vk::MemoryUse::Device, "output splat count");
   }
 
   // The pair keys are 32-bit tile ids, or 64-bit (tile, depth) keys for a strategy that sorts
@@ -384,7 +392,7 @@ struct Renderer::Impl {
     validate(settings.accuracy);
     validate_compositor(settings);
     SortStrategy& sorter = sort(settings.sort);
-    ensure_outputs(uint32_t(camera.width), uint32_t(camera.height));
+    ensure_outputs(uint32_t(camera.width), uint32_t(camera.height), settings.depth, settings.splat_count);
 
     stats = {};
     const ListKey key{scene_generation, camera,   settings.sort,      settings.accuracy,

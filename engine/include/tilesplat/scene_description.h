@@ -135,7 +135,8 @@ SceneDescription load_scene_description(const std::filesystem::path& path);
 // The same on text already in memory; `file` names it in messages and anchors relative paths.
 SceneDescription parse_scene_description(std::string_view text, const std::filesystem::path& file);
 
-// Loads every model (load_scene), transforms and merges them. Throws SceneError naming the description,
+// Loads every model (load_scene), transforms and merges them, keeping only the SH bands the
+// description's sh_degree effect evaluates. Throws SceneError naming the description,
 // the model and the problem. The report sums the files' reports.
 GaussianScene load_described_scene(const SceneDescription& description, const LoadOptions& options = {},
                                    LoadReport* report = nullptr);

@@ -698,6 +698,9 @@ GaussianScene load_described_scene(const SceneDescription& description, const Lo
   }
   total.format += ")";
   GaussianScene merged = merge_scenes(scenes);
+  // Bands the sh_degree effect never evaluates are not kept (nor uploaded, nor allocated on a device).
+  if (description.effects.sh_degree && *description.effects.sh_degree < merged.sh_degree)
+    merged = with_sh_degree(merged, *description.effects.sh_degree);
   if (report) *report = std::move(total);
   return merged;
 }
