@@ -93,6 +93,8 @@ std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& bas
   for (int degree = 0; degree < scene.sh_degree; ++degree)
     add("sh" + std::to_string(degree), "", [degree](RenderSettings& s) { s.accuracy.sh_degree_cap = degree; });
   if (scene.sh_degree > 0) add("sh0", "stored SH0", [](RenderSettings&) {});
+  // A scene below SH3 is padded with zero bands to show what degree 3 would cost on this geometry.
+  if (scene.sh_degree < 3) add("sh3", "padded to SH3", [](RenderSettings&) {});
   const Lighting lighting = bench_lighting(scene);
   add("lights: 1 directional + 1 point", "", [&](RenderSettings& s) { s.lighting = lighting; });
   if (scene.has_normals()) add("lights off", "no normals", [](RenderSettings&) {});
@@ -124,6 +126,8 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
     GaussianScene variant;
     if (row.scene_variant == "stored SH0") {
       variant = with_sh_degree(scene, 0);
+    } else if (row.scene_variant == "padded to SH3") {
+      variant = with_sh_degree(scene, 3);
     } else if (row.scene_variant == "no normals") {
       variant = scene;
       variant.normals.clear();

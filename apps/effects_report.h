@@ -3,7 +3,8 @@
 //
 // One scene, rendered at the chosen views with one effect changed at a time from a base that has
 // every effect off (the scene's SH degree, classic antialiasing, no lights, colour and alpha only):
-// SH degree 0..3, relighting, the antialiasing modes, the depth and splat-count outputs. Two rows
+// SH degree 0..3 (a scene below SH3 padded with zero bands for the sh3 row), relighting, the
+// antialiasing modes, the depth and splat-count outputs, and the stochastic compositor. Two rows
 // render a scene that never had the effect (its SH stored at degree 0; its normals removed) next to
 // the row that turns the effect off, so the table shows "off" and "never" side by side. The frames
 // of all rows are interleaved (row after row, repeat after repeat) so that a CPU driver's drifting
@@ -23,7 +24,9 @@ namespace tilesplat::effects {
 
 struct Row {
   std::string name;  // "sh1", "lights 2", "mip", "+depth", ...
-  std::string scene_variant;  // "" (the scene), "stored SH0", "no normals": the "never had it" rows
+  // "" (the scene); "stored SH0", "no normals": the "never had it" rows; "padded to SH3": a scene
+  // below degree 3 given zero bands up to 3, to time degree 3 on its geometry.
+  std::string scene_variant;
   RenderSettings settings;
   // Measured: medians over the repeats, then over the views.
   double frame_ms = 0;
