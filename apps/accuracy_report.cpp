@@ -14,24 +14,10 @@ namespace tilesplat::accuracy {
 
 namespace {
 
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
 std::string fixed(double value, int decimals) {
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
   if (std::isnan(value)) return "nan";
   return cli::format_fixed(value, decimals);
-}
-
-std::string csv_quote(const std::string& text) {
-  if (text.find_first_of(",\"\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
 }
 
 AccuracyModes with(std::initializer_list<const char*> tokens) {
@@ -181,16 +167,16 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
         if (v == 0) result.intersections = stats.intersections;
         step(result.name + ", " + options.view_names[v]);
       }
-      frame_ms_per_view.push_back(median(frames));
-      for (const auto& [name, samples] : passes) pass_ms_per_view[name].push_back(median(samples));
+      frame_ms_per_view.push_back(cli::median(frames));
+      for (const auto& [name, samples] : passes) pass_ms_per_view[name].push_back(cli::median(samples));
       const ImageDifference difference = compare_images(image, references[v]);
       psnr_sum += difference.psnr_db;
       ssim_sum += ssim(image, references[v]);
       result.max_abs = std::max(result.max_abs, difference.max_abs);
       if (v == 0) first_view = std::move(image);
     }
-    result.frame_ms = median(frame_ms_per_view);
-    for (const auto& name : pass_order) result.passes.push_back({name, median(pass_ms_per_view[name])});
+    result.frame_ms = cli::median(frame_ms_per_view);
+    for (const auto& name : pass_order) result.passes.push_back({name, cli::median(pass_ms_per_view[name])});
     result.psnr_db = psnr_sum / double(options.views.size());
     result.ssim = ssim_sum / double(options.views.size());
 
@@ -283,10 +269,10 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
     for (const auto& m : report.modes) {
       std::string passes;
       for (const auto& p : m.passes) passes += (passes.empty() ? "" : ";") + p.name + "=" + fixed(p.ms, 4);
-      out += csv_quote(device.name) + "," + csv_quote(report.scene) + "," + csv_quote(m.name) + "," +
+      out += cli::csv_field(device.name) + "," + cli::csv_field(report.scene) + "," + cli::csv_field(m.name) + "," +
              fixed(m.frame_ms, 4) + "," + fixed(m.psnr_db, 4) + "," + fixed(m.ssim, 6) + "," + fixed(m.max_abs, 6) +
              "," + std::to_string(m.intersections) + "," + fixed(m.frame_change, 6) + "," + fixed(m.flicker, 6) +
-             "," + fixed(m.excess, 6) + "," + csv_quote(passes) + "\n";
+             "," + fixed(m.excess, 6) + "," + cli::csv_field(passes) + "\n";
     }
   return out;
 }

@@ -95,11 +95,9 @@ struct Summary {
 Summary summarize(std::vector<double> samples) {
   Summary summary;
   if (samples.empty()) return summary;
-  std::sort(samples.begin(), samples.end());
-  const size_t n = samples.size();
-  summary.median = n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
-  summary.min = samples.front();
-  summary.max = samples.back();
+  summary.min = *std::min_element(samples.begin(), samples.end());
+  summary.max = *std::max_element(samples.begin(), samples.end());
+  summary.median = cli::median(std::move(samples));
   return summary;
 }
 
@@ -441,16 +439,6 @@ void print_group(const Group& group, const BenchScene& scene, const BenchOptions
   print_comparison(group.over_views, "median over the views of the median gpu frame");
 }
 
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"') out += '"';
-    out += c;
-  }
-  return out + "\"";
-}
-
 // Exact for counts (integers up to 2^53), 9 significant digits otherwise; null when not finite.
 std::string json_number(double value) {
   if (!std::isfinite(value)) return "null";
@@ -508,8 +496,8 @@ std::string make_csv(const std::vector<Group>& groups, const std::vector<BenchSc
                  const char* over) {
     for_each_metric(result, [&](const Series& row) {
       const Summary summary = summarize(row.samples);
-      csv += csv_field(device.name) + "," + csv_field(scene) + "," + width + "," + height + "," + csv_field(view) +
-             "," + csv_field(camera) + "," + csv_field(result.sort) + "," + row.kind + "," + csv_field(row.name) +
+      csv += cli::csv_field(device.name) + "," + cli::csv_field(scene) + "," + width + "," + height + "," + cli::csv_field(view) +
+             "," + cli::csv_field(camera) + "," + cli::csv_field(result.sort) + "," + row.kind + "," + cli::csv_field(row.name) +
              "," + unit_name(row.unit) + "," + over + "," + json_number(summary.median) + "," +
              json_number(summary.min) + "," + json_number(summary.max) + "," + std::to_string(row.samples.size()) +
              "\n";
@@ -867,8 +855,8 @@ std::string make_sort_csv(const std::vector<SortRow>& rows, const tilesplat::Dev
       "device,key_bits,keys,sorter,where,median_ms,min_ms,max_ms,mkeys_per_s,vs_std_sort,misordered,fallbacks,samples\n";
   for (const auto& row : rows) {
     const Summary s = summarize(row.ms);
-    csv += csv_field(device.name) + "," + std::to_string(row.key_bits) + "," + std::to_string(row.keys) + "," +
-           csv_field(row.sorter) + "," + row.where + "," + json_number(s.median) + "," + json_number(s.min) + "," +
+    csv += cli::csv_field(device.name) + "," + std::to_string(row.key_bits) + "," + std::to_string(row.keys) + "," +
+           cli::csv_field(row.sorter) + "," + row.where + "," + json_number(s.median) + "," + json_number(s.min) + "," +
            json_number(s.max) + "," + json_number(mkeys_per_s(row)) + "," + json_number(vs_std_sort(rows, row)) +
            "," + json_number(row.misordered) + "," + std::to_string(row.fallbacks) + "," +
            std::to_string(row.ms.size()) + "\n";

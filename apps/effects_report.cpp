@@ -12,13 +12,6 @@ namespace tilesplat::effects {
 
 namespace {
 
-double median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  const size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
 std::string fixed(double value, int decimals) { return cli::format_fixed(value, decimals); }
 
 // Pass names in frame order, over all rows (a row may have passes the others lack).
@@ -171,12 +164,12 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
     std::vector<double> frame_medians;
     std::map<std::string, std::vector<double>> pass_medians;
     for (size_t v = 0; v < options.views.size(); ++v) {
-      frame_medians.push_back(median(frame_samples[r][v]));
-      for (const auto& [name, samples] : pass_samples[r][v]) pass_medians[name].push_back(median(samples));
+      frame_medians.push_back(cli::median(frame_samples[r][v]));
+      for (const auto& [name, samples] : pass_samples[r][v]) pass_medians[name].push_back(cli::median(samples));
     }
-    rows[r].frame_ms = median(frame_medians);
+    rows[r].frame_ms = cli::median(frame_medians);
     rows[r].passes.clear();
-    for (const std::string& name : pass_order[r]) rows[r].passes.push_back({name, median(pass_medians[name])});
+    for (const std::string& name : pass_order[r]) rows[r].passes.push_back({name, cli::median(pass_medians[name])});
   }
   Run run;
   run.device = renderers.begin()->second->device_info();
@@ -238,16 +231,11 @@ std::string markdown(const std::vector<Row>& rows, const std::string& scene, con
 
 std::string csv(const std::vector<Row>& rows, const std::string& scene, const DeviceInfo& device) {
   std::string out = "device,scene,effect,scene_variant,pass,gpu_ms\n";
-  auto quote = [](const std::string& text) {
-    if (text.find_first_of(",\"\n") == std::string::npos) return text;
-    std::string quoted = "\"";
-    for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return quoted + "\"";
-  };
   for (const Row& row : rows) {
     const std::string prefix =
-        quote(device.name) + "," + quote(scene) + "," + quote(row.name) + "," + quote(row.scene_variant) + ",";
-    for (const PassTiming& pass : row.passes) out += prefix + quote(pass.name) + "," + fixed(pass.gpu_ms, 4) + "\n";
+        cli::csv_field(device.name) + "," + cli::csv_field(scene) + "," + cli::csv_field(row.name) + "," +
+        cli::csv_field(row.scene_variant) + ",";
+    for (const PassTiming& pass : row.passes) out += prefix + cli::csv_field(pass.name) + "," + fixed(pass.gpu_ms, 4) + "\n";
     out += prefix + "frame," + fixed(row.frame_ms, 4) + "\n";
     out += prefix + "device_mib," + fixed(double(row.device_bytes) / (1024.0 * 1024.0), 3) + "\n";
   }
