@@ -127,6 +127,10 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     report.reference_change += frame_change(path_references[f - 1], path_references[f]) / pairs;
     report.reference_flicker += flicker_of(path_references[f - 1], path_references[f]) / pairs;
   }
+  for (size_t f = 2; f < path_references.size(); ++f)
+    report.reference_pops += popping(path_references[f - 2], path_references[f - 1], path_references[f],
+                                     kFlickerThreshold).flicker_fraction /
+                             double(path.size() - 2);
 
   renderer.set_scene(scene);
   for (const AccuracyModes& m : modes) {
@@ -196,6 +200,11 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
       result.excess +=
           temporal_excess(frames[f - 1], frames[f], path_references[f - 1], path_references[f]).mean_abs / pairs;
     }
+    for (size_t f = 2; f < frames.size(); ++f) {
+      const TemporalDifference pops = popping(frames[f - 2], frames[f - 1], frames[f], kFlickerThreshold);
+      result.pops += pops.flicker_fraction / double(frames.size() - 2);
+      result.pop_mean += pops.mean_abs / double(frames.size() - 2);
+    }
     report.modes.push_back(std::move(result));
   }
   return report;
@@ -204,18 +213,18 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
 std::string text_table(const SceneReport& report) {
   std::string text = "  " + report.scene + ", " + report.description + ", " + report.views +
                      "; float64 reference on the dolly: " + fixed(100.0 * report.reference_flicker, 3) +
-                     "% flicker\n";
+                     "% flicker, " + fixed(100.0 * report.reference_pops, 3) + "% pops\n";
   char line[512];
-  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s\n", "mode", "GPU ms", "vs ref",
-                "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess");
+  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s\n", "mode", "GPU ms", "vs ref",
+                "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess", "pops%");
   text += line;
   const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
   for (const auto& m : report.modes) {
-    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s\n", m.name.c_str(),
+    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s\n", m.name.c_str(),
                   fixed(m.frame_ms, 2).c_str(), fixed(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2).c_str(),
                   fixed(m.psnr_db, 2).c_str(), fixed(m.ssim, 5).c_str(), fixed(m.max_abs, 4).c_str(),
                   static_cast<unsigned long long>(m.intersections), fixed(100.0 * m.flicker, 3).c_str(),
-                  fixed(m.excess, 5).c_str());
+                  fixed(m.excess, 5).c_str(), fixed(100.0 * m.pops, 3).c_str());
     text += line;
   }
   return text;
@@ -228,15 +237,17 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
           std::to_string(report.path_frames) + "-frame dolly: the float64 reference itself changes " +
           fixed(report.reference_change, 5) + " per frame on average, with " +
           fixed(100.0 * report.reference_flicker, 3) + "% of pixels changing by more than " +
-          fixed(kFlickerThreshold, 2) + " (flicker).\n\n";
-    md += "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change |\n";
-    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+          fixed(kFlickerThreshold, 2) + " (flicker), and " + fixed(100.0 * report.reference_pops, 3) +
+          "% of pixels popping: their second difference over three frames exceeds that (`popping()`, which "
+          "smooth motion cancels).\n\n";
+    md += "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change | pops % |\n";
+    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
     for (const auto& m : report.modes)
       md += "| " + m.name + " | " + fixed(m.frame_ms, 2) + " | " +
             fixed(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2) + "x | " + fixed(m.psnr_db, 2) + " | " +
             fixed(m.ssim, 5) + " | " + fixed(m.max_abs, 4) + " | " + std::to_string(m.intersections) + " | " +
-            fixed(100.0 * m.flicker, 3) + " | " + fixed(m.excess, 5) + " |\n";
+            fixed(100.0 * m.flicker, 3) + " | " + fixed(m.excess, 5) + " | " + fixed(100.0 * m.pops, 3) + " |\n";
     // Per-pass times: a column per mode would not fit; the passes whose time a mode changes.
     md += "\nPer-pass median GPU ms:\n\n| mode |";
     std::vector<std::string> names;
@@ -264,7 +275,7 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
 std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& device) {
   std::string out =
       "device,scene,mode,gpu_frame_ms,psnr_db,ssim,max_abs,intersections,frame_change,flicker_fraction,"
-      "excess_change,passes\n";
+      "excess_change,pop_fraction,pop_mean,passes\n";
   for (const auto& report : reports)
     for (const auto& m : report.modes) {
       std::string passes;
@@ -272,7 +283,8 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
       out += cli::csv_field(device.name) + "," + cli::csv_field(report.scene) + "," + cli::csv_field(m.name) + "," +
              fixed(m.frame_ms, 4) + "," + fixed(m.psnr_db, 4) + "," + fixed(m.ssim, 6) + "," + fixed(m.max_abs, 6) +
              "," + std::to_string(m.intersections) + "," + fixed(m.frame_change, 6) + "," + fixed(m.flicker, 6) +
-             "," + fixed(m.excess, 6) + "," + cli::csv_field(passes) + "\n";
+             "," + fixed(m.excess, 6) + "," + fixed(m.pops, 6) + "," + fixed(m.pop_mean, 6) + "," +
+             cli::csv_field(passes) + "\n";
     }
   return out;
 }

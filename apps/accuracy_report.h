@@ -43,6 +43,10 @@ struct ModeResult {
   double frame_change = 0;     // mean |frame t+1 - frame t|
   double flicker = 0;          // fraction of pixels whose change exceeds kFlickerThreshold: pops
   double excess = 0;           // temporal_excess().mean_abs: change the float64 reference does not have
+  // Per consecutive triple of frames (means over the triples), popping(): the second difference,
+  // which smooth motion cancels and order flips do not.
+  double pops = 0;             // fraction of pixels whose second difference exceeds kFlickerThreshold
+  double pop_mean = 0;         // mean second difference over pixels and RGB
 };
 
 // A pixel "pops" between two frames of the slow dolly when a channel changes by more than this.
@@ -55,6 +59,7 @@ struct SceneReport {
   int path_frames = 0;
   double reference_change = 0;   // the float64 reference's own mean frame-to-frame change on the path
   double reference_flicker = 0;  // and its fraction of popping pixels
+  double reference_pops = 0;     // its popping() fraction (it blends in centre-depth order: it pops too)
   std::vector<ModeResult> modes;
 };
 

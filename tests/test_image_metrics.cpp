@@ -20,6 +20,7 @@ using tilesplat::compare_images;
 using tilesplat::frame_change;
 using tilesplat::RenderImage;
 using tilesplat::ssim;
+using tilesplat::popping;
 using tilesplat::temporal_excess;
 using tilesplat::TemporalDifference;
 
@@ -294,6 +295,23 @@ TEST(TemporalExcess, IsZeroWhenTheSequenceIsTheReference) {
     biased1.rgba[i] += 0.25f;
   }
   EXPECT_NEAR(temporal_excess(biased0, biased1, frame0, frame1).mean_abs, 0.0, 1e-7);
+}
+
+TEST(Popping, SmoothMotionCancelsAndAJumpDoesNot) {
+  // Pixel 0 brightens by 0.2 every frame (smooth: a sliding edge, changing shading); pixel 1 holds,
+  // then jumps by 0.5 in one step (an order flip).
+  const RenderImage f0 = tiny({0.1f, 0.1f, 0.1f, 0.2f, 0.2f, 0.2f});
+  const RenderImage f1 = tiny({0.3f, 0.3f, 0.3f, 0.2f, 0.2f, 0.2f});
+  const RenderImage f2 = tiny({0.5f, 0.5f, 0.5f, 0.7f, 0.7f, 0.7f});
+  const TemporalDifference pops = popping(f0, f1, f2, 0.05);
+  EXPECT_EQ(pops.flicker_fraction, 0.5);  // pixel 1 alone
+  EXPECT_NEAR(pops.mean_abs, 0.25, 1e-6);  // (0 * 3 + 0.5 * 3) / 6
+  // The plain frame change counts both pixels: it cannot tell motion from a pop.
+  EXPECT_EQ(temporal_excess(f1, f2, f1, f1, 0.05).flicker_fraction, 1.0);
+  const TemporalDifference steady = popping(f0, f1, tiny({0.5f, 0.5f, 0.5f, 0.2f, 0.2f, 0.2f}), 0.05);
+  EXPECT_NEAR(steady.mean_abs, 0.0, 1e-6);
+  EXPECT_EQ(steady.flicker_fraction, 0.0);
+  EXPECT_THROW(popping(f0, f1, random_image(3, 1, 5u)), std::invalid_argument);
 }
 
 TEST(TemporalExcess, MatchesHandComputedValues) {

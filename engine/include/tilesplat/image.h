@@ -103,4 +103,14 @@ TemporalDifference temporal_excess(const RenderImage& a0, const RenderImage& a1,
 // temporal_excess would report against a perfectly still reference. Errors as temporal_excess.
 double frame_change(const RenderImage& a0, const RenderImage& a1);
 
+// Popping along a path of equal steps, measured without any reference: the second difference
+// e = |(a2 - a1) - (a1 - a0)| of three consecutive frames. Smooth motion (an edge sliding, shading
+// changing with the view) changes the image by about the same amount each step and cancels; a
+// discontinuity (two splats swapping order, a splat culled) happens in one step and does not. This
+// is what a mode that removes popping must lower, even where the reference pops itself (the float64
+// reference blends in the same centre-depth order, so "change the reference does not have" cannot
+// credit a mode that pops less than the reference). It is temporal_excess(a1, a2, a0, a1, threshold).
+TemporalDifference popping(const RenderImage& a0, const RenderImage& a1, const RenderImage& a2,
+                           double threshold = 0.05);
+
 }  // namespace tilesplat

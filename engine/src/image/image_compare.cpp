@@ -266,6 +266,11 @@ TemporalDifference temporal_excess(const RenderImage& a0, const RenderImage& a1,
   return temporal_difference(a0, a1, &r0, &r1, threshold);
 }
 
+TemporalDifference popping(const RenderImage& a0, const RenderImage& a1, const RenderImage& a2, double threshold) {
+  check_same_size("popping", {&a0, &a1, &a2}, {"a0", "a1", "a2"});
+  return temporal_excess(a1, a2, a0, a1, threshold);
+}
+
 double frame_change(const RenderImage& a0, const RenderImage& a1) {
   check_same_size("frame_change", {&a0, &a1}, {"a0", "a1"});
   return temporal_difference(a0, a1, nullptr, nullptr, 0).mean_abs;
