@@ -752,18 +752,18 @@ void check_outputs(const BenchOptions& options, const std::vector<std::pair<std:
     if (!path.empty()) cli::check_output_path(path, flag);
 }
 
-// Writes the output files that were asked for (each atomically), warns about validation messages,
-// and returns " -> a.csv, b.json" for the closing line.
+// Writes the output files that were asked for (each atomically), warns about the run's validation
+// messages, and returns " -> a.csv, b.json" for the closing line.
 std::string write_outputs(const std::vector<std::pair<std::string, std::function<std::string()>>>& files,
-                          const tilesplat::Renderer& renderer) {
+                          uint64_t validation_messages) {
   std::string written;
   for (const auto& [path, make] : files) {
     if (path.empty()) continue;
     cli::write_file_atomic(path, make());
     written += (written.empty() ? " -> " : ", ") + path;
   }
-  if (const auto messages = renderer.validation_messages(); messages > 0)
-    cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
+  if (validation_messages > 0)
+    cli::print_warning(kProgram, std::to_string(validation_messages) + " Vulkan validation messages (see above)");
   return written;
 }
 
@@ -1012,7 +1012,7 @@ int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
       write_outputs({{options.csv, [&] { return make_sort_csv(rows, device); }},
                      {options.json, [&] { return make_sort_json(rows, device, options); }},
                      {options.plot, [&] { return make_sort_svg(rows, device, options); }}},
-                    *renderer);
+                    renderer->validation_messages());
   std::fprintf(stderr, "%s: sort micro-benchmark, %d sorts in %s s%s\n", kProgram, total,
                cli::format_fixed(seconds, 2).c_str(), written.c_str());
   return cli::kExitOk;
@@ -1106,7 +1106,7 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
       plot_paths.push_back(scene_plot_path(options.plot, report.scene, reports.size()).string());
       files.emplace_back(plot_paths.back(), [&report, &device] { return tilesplat::accuracy::pareto_svg(report, device); });
     }
-  const std::string written = write_outputs(files, *renderer);
+  const std::string written = write_outputs(files, renderer->validation_messages());
   std::fprintf(stderr, "%s: accuracy report, %d renders%s\n", kProgram, total, written.c_str());
   return cli::kExitOk;
 }
@@ -1151,16 +1151,10 @@ int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options
   std::printf("device  %s (driver %s)\n\n%s", run.device.name.c_str(), run.device.driver.c_str(),
               tilesplat::effects::text_table(rows).c_str());
   std::fflush(stdout);
-  std::string written;
-  for (const auto& [path, make] : std::vector<std::pair<std::string, std::function<std::string()>>>{
-           {options.markdown, [&] { return tilesplat::effects::markdown(rows, scene.name, run.device, command); }},
-           {options.csv, [&] { return tilesplat::effects::csv(rows, scene.name, run.device); }}}) {
-    if (path.empty()) continue;
-    cli::write_file_atomic(path, make());
-    written += (written.empty() ? " -> " : ", ") + path;
-  }
-  if (run.validation_messages > 0)
-    cli::print_warning(kProgram, std::to_string(run.validation_messages) + " Vulkan validation messages (see above)");
+  const std::string written = write_outputs(
+      {{options.markdown, [&] { return tilesplat::effects::markdown(rows, scene.name, run.device, command); }},
+       {options.csv, [&] { return tilesplat::effects::csv(rows, scene.name, run.device); }}},
+      run.validation_messages);
   std::fprintf(stderr, "%s: effect costs, %zu rows%s\n", kProgram, rows.size(), written.c_str());
   return cli::kExitOk;
 }
@@ -1303,7 +1297,7 @@ int run(int argc, char** argv) {
       write_outputs({{options.csv, [&] { return make_csv(groups, scenes, device); }},
                      {options.json, [&] { return make_json(groups, scenes, device, options); }},
                      {options.plot, [&] { return make_frame_svg(groups, scenes, device, options); }}},
-                    *renderer);
+                    renderer->validation_messages());
   std::string what = scenes.size() == 1 ? scenes.front().name + ", " + scenes.front().description
                                         : std::to_string(scenes.size()) + " scenes";
   what += cases.size() == 1 ? ", " + size_of(cases.front()) : ", " + std::to_string(cases.size()) + " cameras";

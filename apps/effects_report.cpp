@@ -31,7 +31,7 @@ std::string pass_ms(const Row& row, const std::string& name) {
 }
 
 std::string row_label(const Row& row) {
-  return row.scene_variant.empty() ? row.name : row.name + " [" + row.scene_variant + "]";
+  return row.scene_variant == SceneVariant::kScene ? row.name : row.name + " [" + to_string(row.scene_variant) + "]";
 }
 
 // Relative to the first row (the base), in percent.
@@ -45,6 +45,30 @@ std::string versus_base(const std::vector<Row>& rows, const Row& row) {
 }
 
 }  // namespace
+
+std::string to_string(SceneVariant variant) {
+  switch (variant) {
+    case SceneVariant::kScene: return "";
+    case SceneVariant::kStoredSh0: return "stored SH0";
+    case SceneVariant::kNoNormals: return "no normals";
+    case SceneVariant::kPaddedSh3: return "padded to SH3";
+  }
+  return "";
+}
+
+GaussianScene make_variant(const GaussianScene& scene, SceneVariant variant) {
+  switch (variant) {
+    case SceneVariant::kScene: return scene;
+    case SceneVariant::kStoredSh0: return with_sh_degree(scene, 0);
+    case SceneVariant::kPaddedSh3: return with_sh_degree(scene, 3);
+    case SceneVariant::kNoNormals: {
+      GaussianScene copy = scene;
+      copy.normals.clear();
+      return copy;
+    }
+  }
+  return scene;
+}
 
 Lighting bench_lighting(const GaussianScene& scene) {
   const Bounds bounds = compute_bounds(scene);
@@ -74,7 +98,7 @@ std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& bas
   base.compositor = Compositor::kSorted;
 
   std::vector<Row> rows;
-  auto add = [&](const std::string& name, const std::string& variant, auto&& change) {
+  auto add = [&](const std::string& name, SceneVariant variant, auto&& change) {
     Row row;
     row.name = name;
     row.scene_variant = variant;
@@ -82,27 +106,28 @@ std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& bas
     change(row.settings);
     rows.push_back(std::move(row));
   };
-  add("base (all off, SH" + std::to_string(scene.sh_degree) + ")", "", [](RenderSettings&) {});
+  add("base (all off, SH" + std::to_string(scene.sh_degree) + ")", SceneVariant::kScene, [](RenderSettings&) {});
   for (int degree = 0; degree < scene.sh_degree; ++degree)
-    add("sh" + std::to_string(degree), "", [degree](RenderSettings& s) { s.accuracy.sh_degree_cap = degree; });
-  if (scene.sh_degree > 0) add("sh0", "stored SH0", [](RenderSettings&) {});
+    add("sh" + std::to_string(degree), SceneVariant::kScene,
+        [degree](RenderSettings& s) { s.accuracy.sh_degree_cap = degree; });
+  if (scene.sh_degree > 0) add("sh0", SceneVariant::kStoredSh0, [](RenderSettings&) {});
   // A scene below SH3 is padded with zero bands to show what degree 3 would cost on this geometry.
-  if (scene.sh_degree < 3) add("sh3", "padded to SH3", [](RenderSettings&) {});
+  if (scene.sh_degree < 3) add("sh3", SceneVariant::kPaddedSh3, [](RenderSettings&) {});
   const Lighting lighting = bench_lighting(scene);
-  add("lights: 1 directional + 1 point", "", [&](RenderSettings& s) { s.lighting = lighting; });
-  if (scene.has_normals()) add("lights off", "no normals", [](RenderSettings&) {});
-  add("antialiased", "", [](RenderSettings& s) { s.antialiasing = Antialiasing::kAntialiased; });
-  add("mip", "", [](RenderSettings& s) { s.antialiasing = Antialiasing::kMip; });
-  add("+depth", "", [](RenderSettings& s) { s.depth = true; });
-  add("+splat count", "", [](RenderSettings& s) { s.splat_count = true; });
-  add("+depth +splat count", "", [](RenderSettings& s) { s.depth = s.splat_count = true; });
+  add("lights: 1 directional + 1 point", SceneVariant::kScene, [&](RenderSettings& s) { s.lighting = lighting; });
+  if (scene.has_normals()) add("lights off", SceneVariant::kNoNormals, [](RenderSettings&) {});
+  add("antialiased", SceneVariant::kScene, [](RenderSettings& s) { s.antialiasing = Antialiasing::kAntialiased; });
+  add("mip", SceneVariant::kScene, [](RenderSettings& s) { s.antialiasing = Antialiasing::kMip; });
+  add("+depth", SceneVariant::kScene, [](RenderSettings& s) { s.depth = true; });
+  add("+splat count", SceneVariant::kScene, [](RenderSettings& s) { s.splat_count = true; });
+  add("+depth +splat count", SceneVariant::kScene, [](RenderSettings& s) { s.depth = s.splat_count = true; });
   // Not an effect but the other side of the sort's cost: no depth sort, one hashed sample per pixel.
   // (The modes that reorder by depth have no stochastic form.)
   if (base.accuracy.depth_key_bits == 32 && base.accuracy.resort_window == 0)
-    add("stochastic, 1 frame", "", [](RenderSettings& s) {
-    s.compositor = Compositor::kStochastic;
-    s.stochastic.frames = 1;
-  });
+    add("stochastic, 1 frame", SceneVariant::kScene, [](RenderSettings& s) {
+      s.compositor = Compositor::kStochastic;
+      s.stochastic.frames = 1;
+    });
   return rows;
 }
 
@@ -113,20 +138,14 @@ int work_units(const std::vector<Row>& rows, const Options& options) {
 Run measure(const RendererOptions& renderer_options, const GaussianScene& scene, std::vector<Row>& rows,
             const Options& options, const std::function<void(int, int, const std::string&)>& progress) {
   // One renderer per scene variant, each holding its scene, so that rows interleave without uploads.
-  std::map<std::string, std::unique_ptr<Renderer>> renderers;
+  std::map<SceneVariant, std::unique_ptr<Renderer>> renderers;
   for (const Row& row : rows) {
     if (renderers.count(row.scene_variant)) continue;
-    GaussianScene variant;
-    if (row.scene_variant == "stored SH0") {
-      variant = with_sh_degree(scene, 0);
-    } else if (row.scene_variant == "padded to SH3") {
-      variant = with_sh_degree(scene, 3);
-    } else if (row.scene_variant == "no normals") {
-      variant = scene;
-      variant.normals.clear();
-    }
     auto renderer = Renderer::create(renderer_options);
-    renderer->set_scene(row.scene_variant.empty() ? scene : variant);
+    if (row.scene_variant == SceneVariant::kScene)
+      renderer->set_scene(scene);
+    else
+      renderer->set_scene(make_variant(scene, row.scene_variant));
     renderers.emplace(row.scene_variant, std::move(renderer));
   }
 
@@ -234,7 +253,7 @@ std::string csv(const std::vector<Row>& rows, const std::string& scene, const De
   for (const Row& row : rows) {
     const std::string prefix =
         cli::csv_field(device.name) + "," + cli::csv_field(scene) + "," + cli::csv_field(row.name) + "," +
-        cli::csv_field(row.scene_variant) + ",";
+        cli::csv_field(to_string(row.scene_variant)) + ",";
     for (const PassTiming& pass : row.passes) out += prefix + cli::csv_field(pass.name) + "," + fixed(pass.gpu_ms, 4) + "\n";
     out += prefix + "frame," + fixed(row.frame_ms, 4) + "\n";
     out += prefix + "device_mib," + fixed(double(row.device_bytes) / (1024.0 * 1024.0), 3) + "\n";

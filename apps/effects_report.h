@@ -22,11 +22,20 @@
 
 namespace tilesplat::effects {
 
+// The scene a row renders: the measured scene itself, or a copy of it.
+enum class SceneVariant {
+  kScene,
+  kStoredSh0,  // "never had it": the SH stored at degree 0
+  kNoNormals,  // "never had it": the normals removed
+  kPaddedSh3,  // a scene below degree 3 given zero bands up to 3, to time degree 3 on its geometry
+};
+std::string to_string(SceneVariant variant);  // "", "stored SH0", "no normals", "padded to SH3"
+// The copy of `scene` a variant renders.
+GaussianScene make_variant(const GaussianScene& scene, SceneVariant variant);
+
 struct Row {
   std::string name;  // "sh1", "lights 2", "mip", "+depth", ...
-  // "" (the scene); "stored SH0", "no normals": the "never had it" rows; "padded to SH3": a scene
-  // below degree 3 given zero bands up to 3, to time degree 3 on its geometry.
-  std::string scene_variant;
+  SceneVariant scene_variant = SceneVariant::kScene;
   RenderSettings settings;
   // Measured: medians over the repeats, then over the views.
   double frame_ms = 0;

@@ -230,22 +230,7 @@ namespace {
 TEST(GpuRenderer, CompositeLayoutsGiveIdenticalImages) {
   GaussianScene scene = load_scene(testing::bundled_playbot());
   Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(2).camera, 333, 187);
-  std::vector<RenderImage> images;
-  for (const char* pixels : {"1", "4", "16"}) {
-    ::setenv("TILESPLAT_COMPOSITE_PIXELS", pixels, 1);
-    RendererOptions options;
-    options.validation = true;
-    auto renderer = Renderer::create(options);
-    ::unsetenv("TILESPLAT_COMPOSITE_PIXELS");
-    renderer->set_scene(scene);
-    images.push_back(renderer->render(camera));
-    EXPECT_EQ(renderer->validation_messages(), 0u);
-  }
-  for (size_t k = 1; k < images.size(); ++k) {
-    EXPECT_EQ(images[k].rgba, images[0].rgba) << "layout " << k;
-    EXPECT_EQ(images[k].depth, images[0].depth) << "layout " << k;
-    EXPECT_EQ(images[k].splat_count, images[0].splat_count) << "layout " << k;
-  }
+  testing::expect_composite_layouts_identical(scene, camera);
 }
 
 }  // namespace

@@ -251,22 +251,7 @@ TEST(Stochastic, TileListsLongerThanTheCpuLoopLimitAreTestedWhole) {
 // one list each) run on lavapipe and give the CPU layout's image bit for bit.
 TEST(Stochastic, CompositeLayoutsGiveIdenticalImages) {
   const Case c = playbot_case();
-  std::vector<RenderImage> images;
-  for (const char* pixels : {"1", "4", "16"}) {
-    ::setenv("TILESPLAT_COMPOSITE_PIXELS", pixels, 1);
-    RendererOptions options;
-    options.validation = true;
-    auto renderer = Renderer::create(options);
-    ::unsetenv("TILESPLAT_COMPOSITE_PIXELS");
-    renderer->set_scene(c.scene);
-    images.push_back(renderer->render(c.camera, stochastic(3)));
-    EXPECT_EQ(renderer->validation_messages(), 0u);
-  }
-  for (size_t k = 1; k < images.size(); ++k) {
-    EXPECT_EQ(images[k].rgba, images[0].rgba) << "layout " << k;
-    EXPECT_EQ(images[k].depth, images[0].depth) << "layout " << k;
-    EXPECT_EQ(images[k].splat_count, images[0].splat_count) << "layout " << k;
-  }
+  testing::expect_composite_layouts_identical(c.scene, c.camera, stochastic(3));
 }
 
 TEST(Stochastic, RejectsSettingsItCannotHonour) {

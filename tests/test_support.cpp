@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <vector>
 
 namespace tilesplat::testing {
 
@@ -48,6 +49,26 @@ Renderer& validated_renderer() {
     return Renderer::create(options);
   }();
   return *renderer;
+}
+
+void expect_composite_layouts_identical(const GaussianScene& scene, const Camera& camera,
+                                        const RenderSettings& settings) {
+  std::vector<RenderImage> images;
+  for (const char* pixels : {"1", "4", "16"}) {
+    ::setenv("TILESPLAT_COMPOSITE_PIXELS", pixels, 1);
+    RendererOptions options;
+    options.validation = true;
+    auto renderer = Renderer::create(options);
+    ::unsetenv("TILESPLAT_COMPOSITE_PIXELS");
+    renderer->set_scene(scene);
+    images.push_back(renderer->render(camera, settings));
+    EXPECT_EQ(renderer->validation_messages(), 0u) << pixels << " pixels per invocation";
+  }
+  for (size_t k = 1; k < images.size(); ++k) {
+    EXPECT_EQ(images[k].rgba, images[0].rgba) << "layout " << k;
+    EXPECT_EQ(images[k].depth, images[0].depth) << "layout " << k;
+    EXPECT_EQ(images[k].splat_count, images[0].splat_count) << "layout " << k;
+  }
 }
 
 }  // namespace tilesplat::testing

@@ -5,7 +5,9 @@
 #include <memory>
 #include <string>
 
+#include "tilesplat/camera.h"
 #include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
 
 namespace tilesplat::testing {
 
@@ -25,6 +27,13 @@ std::filesystem::path temp_dir();
 // One renderer per test binary with the Khronos validation layer on (the layer being absent
 // is itself a failure). Tests assert validation_messages() == 0 after rendering.
 Renderer& validated_renderer();
+
+// The composite picks a 16-pixel column per invocation on CPU drivers and one pixel per invocation
+// on GPUs (TILESPLAT_COMPOSITE_PIXELS overrides it). Renders the scene once in each layout (16, 4
+// and 1 pixels per invocation), each with a fresh validated renderer, and expects them to agree bit
+// for bit (rgba, depth, splat counts) and the validation layer to stay silent.
+void expect_composite_layouts_identical(const GaussianScene& scene, const Camera& camera,
+                                        const RenderSettings& settings = {});
 
 }  // namespace tilesplat::testing
 

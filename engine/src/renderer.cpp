@@ -375,14 +375,7 @@ struct Renderer::Impl {
     Lighting lighting;
     Compositor compositor = Compositor::kSorted;  // sorted and binned-only lists differ
 
-    bool operator==(const ListKey& o) const {
-      const Camera& a = camera;
-      const Camera& b = o.camera;
-      return scene_generation == o.scene_generation && a.width == b.width && a.height == b.height && a.fx == b.fx &&
-             a.fy == b.fy && a.cx == b.cx && a.cy == b.cy && a.rotation == b.rotation && a.position == b.position &&
-             sort == o.sort && accuracy == o.accuracy && antialiasing == o.antialiasing && lighting == o.lighting &&
-             compositor == o.compositor;
-    }
+    bool operator==(const ListKey&) const = default;
   };
 
   // Renders into the output buffers, growing the key buffers and re-rendering on overflow, and

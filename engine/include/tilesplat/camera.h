@@ -23,6 +23,8 @@ struct Camera {
   // Horizontal and vertical tan(fov / 2).
   double tan_half_fov_x() const { return width / (2.0 * fx); }
   double tan_half_fov_y() const { return height / (2.0 * fy); }
+
+  bool operator==(const Camera&) const = default;
 };
 
 // Throws std::invalid_argument ("invalid camera: ...", saying what) for a camera no renderer can use:

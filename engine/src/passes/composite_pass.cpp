@@ -94,8 +94,12 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
   }
 }
 
+uint32_t composite_chunks_needed(uint64_t longest_tile_list, uint32_t chunk_splats) {
+  return uint32_t(std::max<uint64_t>(1, (longest_tile_list + chunk_splats - 1) / chunk_splats));
+}
+
 uint32_t CompositePass::chunks_for(uint64_t longest_tile_list) const {
-  return uint32_t(std::max<uint64_t>(1, (longest_tile_list + chunk_splats_ - 1) / chunk_splats_));
+  return composite_chunks_needed(longest_tile_list, chunk_splats_);
 }
 
 }  // namespace tilesplat

@@ -24,6 +24,8 @@ struct OutputBuffers {
 // loop limit; unlimited on GPUs).
 uint32_t composite_pixels_per_invocation(const vk::Context& ctx);
 uint32_t composite_chunk_splats(const vk::Context& ctx);
+// Dispatches of chunk_splats each that a tile list of this length needs (at least 1).
+uint32_t composite_chunks_needed(uint64_t longest_tile_list, uint32_t chunk_splats);
 
 class CompositePass {
  public:

@@ -1,6 +1,5 @@
 #include "passes/stochastic_composite_pass.h"
 
-#include <algorithm>
 #include <bit>
 #include <stdexcept>
 
@@ -79,7 +78,7 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer
 }
 
 uint32_t StochasticCompositePass::chunks_for(uint64_t longest_tile_list) const {
-  return uint32_t(std::max<uint64_t>(1, (longest_tile_list + chunk_splats_ - 1) / chunk_splats_));
+  return composite_chunks_needed(longest_tile_list, chunk_splats_);
 }
 
 }  // namespace tilesplat
