@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
 #include "bench_plot.h"
@@ -49,6 +50,7 @@ std::vector<AccuracyModes> default_modes() {
           with({"alpha-cutoff=1/64"}),
           with({"resort4"}),
           with({"resort8"}),
+          with({"resort16"}),
           // What a web viewer does: 16-bit depths, fp16 attributes, opacity-aware squares.
           with({"depth16", "opacity-extent", "fp16-sh", "fp16-cov"}),
           // ... and looser cut-offs on top.
@@ -59,16 +61,77 @@ bool applies_to(const AccuracyModes& modes, int scene_sh_degree) {
   return modes.sh_degree_cap >= 3 || modes.sh_degree_cap < scene_sh_degree;
 }
 
-std::vector<Camera> dolly_path(const Camera& start, const std::array<double, 3>& centre, int frames,
-                               double step_fraction) {
+namespace {
+
+// The rotation by `angle` radians about the unit `axis` (Rodrigues), row-major.
+std::array<double, 9> axis_rotation(const std::array<double, 3>& axis, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
+  const auto [x, y, z] = axis;
+  return {t * x * x + c,     t * x * y - s * z, t * x * z + s * y,
+          t * x * y + s * z, t * y * y + c,     t * y * z - s * x,
+          t * x * z - s * y, t * y * z + s * x, t * z * z + c};
+}
+
+std::array<double, 9> multiply(const std::array<double, 9>& a, const std::array<double, 9>& b) {
+  std::array<double, 9> product{};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) product[3 * r + c] += a[3 * r + k] * b[3 * k + c];
+  return product;
+}
+
+std::array<double, 9> transpose(const std::array<double, 9>& m) {
+  return {m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8]};
+}
+
+}  // namespace
+
+const char* to_string(CameraPath path) {
+  switch (path) {
+    case CameraPath::kDolly: return "dolly";
+    case CameraPath::kPan: return "pan";
+    case CameraPath::kOrbit: return "orbit";
+  }
+  return "?";
+}
+
+std::optional<CameraPath> parse_camera_path(const std::string& text) {
+  for (CameraPath path : {CameraPath::kDolly, CameraPath::kPan, CameraPath::kOrbit})
+    if (text == to_string(path)) return path;
+  return std::nullopt;
+}
+
+std::vector<Camera> camera_path(CameraPath kind, const Camera& start, const std::array<double, 3>& centre, int frames,
+                                double step_fraction) {
   double distance = 0;
   for (int k = 0; k < 3; ++k) distance += (centre[k] - start.position[k]) * (centre[k] - start.position[k]);
-  const double step = step_fraction * std::sqrt(distance);
+  distance = std::sqrt(distance);
+  // The rows of the world-to-camera rotation are the camera's axes in world space: row 0 is x, row 1 y.
+  const std::array<double, 3> camera_x = {start.rotation[0], start.rotation[1], start.rotation[2]};
+  const std::array<double, 3> camera_y = {start.rotation[3], start.rotation[4], start.rotation[5]};
   std::vector<Camera> path;
   for (int f = 0; f < frames; ++f) {
     Camera camera = start;
-    // The rows of the world-to-camera rotation are the camera's axes in world space; row 0 is x.
-    for (int k = 0; k < 3; ++k) camera.position[k] += f * step * start.rotation[k];
+    switch (kind) {
+      case CameraPath::kDolly:
+        for (int k = 0; k < 3; ++k) camera.position[k] += f * step_fraction * distance * camera_x[k];
+        break;
+      case CameraPath::kPan:
+        // Turning in place about the camera's own y axis: x_cam' = R_y * x_cam.
+        camera.rotation = multiply(axis_rotation({0, 1, 0}, f * step_fraction), start.rotation);
+        break;
+      case CameraPath::kOrbit: {
+        // The whole rig turns about the line through `centre` along the camera's y axis: the position
+        // moves by Q and the world-to-camera rotation becomes R * Q^T, so the scene turns under the camera.
+        const auto q = axis_rotation(camera_y, f * step_fraction);
+        for (int r = 0; r < 3; ++r) {
+          camera.position[r] = centre[r];
+          for (int k = 0; k < 3; ++k) camera.position[r] += q[3 * r + k] * (start.position[k] - centre[k]);
+        }
+        camera.rotation = multiply(start.rotation, transpose(q));
+        break;
+      }
+    }
     path.push_back(camera);
   }
   return path;
@@ -82,7 +145,9 @@ int work_units(const Options& options, int scene_sh_degree) {
   // The path starts at the first view, whose reference and render it reuses. References: each view and
   // each later path frame; renders: per mode, per view the timed frames, and the later path frames.
   const int later_path_frames = std::max(options.path_frames - 1, 0);
-  return views + later_path_frames + applicable * (views * (options.warmup + options.repeat) + later_path_frames);
+  const int consistency_pair = options.consistency_angle > 0 ? 2 : 0;
+  return views + later_path_frames + consistency_pair +
+         applicable * (views * (options.warmup + options.repeat) + later_path_frames + consistency_pair);
 }
 
 SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const Options& options,
@@ -94,7 +159,9 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
   auto step = [&](const std::string& what) { progress(++done, total, what); };
 
   SceneReport report;
+  report.path = options.path;
   report.path_frames = options.path_frames;
+  report.path_step = options.path_step;
   RenderSettings reference_settings;
   reference_settings.depth = false;
   reference_settings.splat_count = false;
@@ -106,8 +173,8 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
   }
   const Bounds bounds = compute_bounds(scene);
   const std::vector<Camera> path =
-      dolly_path(options.views.front(), {bounds.center[0], bounds.center[1], bounds.center[2]},
-                 options.path_frames, options.path_step);
+      camera_path(options.path, options.views.front(), {bounds.center[0], bounds.center[1], bounds.center[2]},
+                  options.path_frames, options.path_step);
   // path[0] is the first view: its reference is already made.
   std::vector<RenderImage> path_references;
   for (size_t f = 0; f < path.size(); ++f) {
@@ -131,6 +198,29 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     report.reference_pops += popping(path_references[f - 2], path_references[f - 1], path_references[f],
                                      kFlickerThreshold).flicker_fraction /
                              double(path.size() - 2);
+
+  // The view-consistency pair: the first view and the same camera turned in place, at a size where a
+  // block of pixels stands for one pixel of the view.
+  std::vector<Camera> turned;
+  if (options.consistency_angle > 0) {
+    const Camera& view = options.views.front();
+    const Camera large = resize_camera(view, kConsistencyScale * view.width, kConsistencyScale * view.height);
+    turned = camera_path(CameraPath::kPan, large, {}, 2, options.consistency_angle);
+  }
+  auto inconsistency_of = [&turned](const RenderImage& a, const RenderImage& b) {
+    return rotation_inconsistency(a, turned[0], b, turned[1], kConsistencyBlock, kConsistencyThreshold);
+  };
+  report.consistency_angle = turned.empty() ? 0 : options.consistency_angle;
+  if (!turned.empty()) {
+    std::vector<RenderImage> pair;
+    for (size_t f = 0; f < turned.size(); ++f) {
+      pair.push_back(render_reference(scene, turned[f], reference_settings));
+      step("float64 reference, turned view " + std::to_string(f));
+    }
+    const TemporalDifference inconsistency = inconsistency_of(pair[0], pair[1]);
+    report.reference_inconsistency = inconsistency.flicker_fraction;
+    report.reference_inconsistency_mean = inconsistency.mean_abs;
+  }
 
   renderer.set_scene(scene);
   for (const AccuracyModes& m : modes) {
@@ -205,6 +295,16 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
       result.pops += pops.flicker_fraction / double(frames.size() - 2);
       result.pop_mean += pops.mean_abs / double(frames.size() - 2);
     }
+    if (!turned.empty()) {
+      std::vector<RenderImage> pair;
+      for (size_t f = 0; f < turned.size(); ++f) {
+        pair.push_back(renderer.render(turned[f], settings));
+        step(result.name + ", turned view " + std::to_string(f));
+      }
+      const TemporalDifference inconsistency = inconsistency_of(pair[0], pair[1]);
+      result.inconsistency = inconsistency.flicker_fraction;
+      result.inconsistency_mean = inconsistency.mean_abs;
+    }
     report.modes.push_back(std::move(result));
   }
   return report;
@@ -212,19 +312,22 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
 
 std::string text_table(const SceneReport& report) {
   std::string text = "  " + report.scene + ", " + report.description + ", " + report.views +
-                     "; float64 reference on the dolly: " + fixed(100.0 * report.reference_flicker, 3) +
-                     "% flicker, " + fixed(100.0 * report.reference_pops, 3) + "% pops\n";
+                     "; float64 reference on the " + to_string(report.path) + ": " + fixed(100.0 * report.reference_flicker, 3) +
+                     "% flicker, " + fixed(100.0 * report.reference_pops, 3) + "% pops; turned " +
+                     fixed(report.consistency_angle, 3) + " rad: " + fixed(100.0 * report.reference_inconsistency, 3) +
+                     "% inconsistent\n";
   char line[512];
-  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s\n", "mode", "GPU ms", "vs ref",
-                "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess", "pops%");
+  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s %9s\n", "mode", "GPU ms", "vs ref",
+                "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess", "pops%", "incons%");
   text += line;
   const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
   for (const auto& m : report.modes) {
-    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s\n", m.name.c_str(),
+    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s %9s\n", m.name.c_str(),
                   fixed(m.frame_ms, 2).c_str(), fixed(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2).c_str(),
                   fixed(m.psnr_db, 2).c_str(), fixed(m.ssim, 5).c_str(), fixed(m.max_abs, 4).c_str(),
                   static_cast<unsigned long long>(m.intersections), fixed(100.0 * m.flicker, 3).c_str(),
-                  fixed(m.excess, 5).c_str(), fixed(100.0 * m.pops, 3).c_str());
+                  fixed(m.excess, 5).c_str(), fixed(100.0 * m.pops, 3).c_str(),
+                  fixed(100.0 * m.inconsistency, 3).c_str());
     text += line;
   }
   return text;
@@ -234,20 +337,33 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
   std::string md = "Device: " + device.name + " (" + device.driver + "). Command:\n\n```\n" + command + "\n```\n";
   for (const auto& report : reports) {
     md += "\n### " + report.scene + "\n\n" + report.description + "; " + report.views + ". Popping over a " +
-          std::to_string(report.path_frames) + "-frame dolly: the float64 reference itself changes " +
+          std::to_string(report.path_frames) + "-frame " + to_string(report.path) + " (step " +
+          cli::format_fixed(report.path_step, 4) + "): the float64 reference itself changes " +
           fixed(report.reference_change, 5) + " per frame on average, with " +
           fixed(100.0 * report.reference_flicker, 3) + "% of pixels changing by more than " +
           fixed(kFlickerThreshold, 2) + " (flicker), and " + fixed(100.0 * report.reference_pops, 3) +
           "% of pixels popping: their second difference over three frames exceeds that (`popping()`, which "
-          "smooth motion cancels).\n\n";
-    md += "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change | pops % |\n";
-    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+          "smooth motion cancels).";
+    if (report.consistency_angle > 0)
+      md += " View consistency: the first view and the same camera turned in place by " +
+            fixed(report.consistency_angle, 3) + " rad, rendered at " + std::to_string(kConsistencyScale) +
+            "x its size; the first resampled onto the second and compared over blocks of " +
+            std::to_string(kConsistencyBlock) + "x" + std::to_string(kConsistencyBlock) +
+            " pixels (`rotation_inconsistency()`): the float64 reference has " +
+            fixed(100.0 * report.reference_inconsistency, 3) + "% of blocks differing by more than " +
+            fixed(kConsistencyThreshold, 2) + " (inconsistent %), and a mean difference of " +
+            fixed(report.reference_inconsistency_mean, 6) + ".";
+    md += "\n\n";
+    md += "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change | pops % "
+          "| inconsistent % | inconsistency |\n";
+    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
     for (const auto& m : report.modes)
       md += "| " + m.name + " | " + fixed(m.frame_ms, 2) + " | " +
             fixed(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2) + "x | " + fixed(m.psnr_db, 2) + " | " +
             fixed(m.ssim, 5) + " | " + fixed(m.max_abs, 4) + " | " + std::to_string(m.intersections) + " | " +
-            fixed(100.0 * m.flicker, 3) + " | " + fixed(m.excess, 5) + " | " + fixed(100.0 * m.pops, 3) + " |\n";
+            fixed(100.0 * m.flicker, 3) + " | " + fixed(m.excess, 5) + " | " + fixed(100.0 * m.pops, 3) + " | " +
+            fixed(100.0 * m.inconsistency, 3) + " | " + fixed(m.inconsistency_mean, 6) + " |\n";
     // Per-pass times: a column per mode would not fit; the passes whose time a mode changes.
     md += "\nPer-pass median GPU ms:\n\n| mode |";
     std::vector<std::string> names;
@@ -275,7 +391,7 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
 std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& device) {
   std::string out =
       "device,scene,mode,gpu_frame_ms,psnr_db,ssim,max_abs,intersections,frame_change,flicker_fraction,"
-      "excess_change,pop_fraction,pop_mean,passes\n";
+      "excess_change,pop_fraction,pop_mean,inconsistent_fraction,inconsistency_mean,passes\n";
   for (const auto& report : reports)
     for (const auto& m : report.modes) {
       std::string passes;
@@ -284,6 +400,7 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
              fixed(m.frame_ms, 4) + "," + fixed(m.psnr_db, 4) + "," + fixed(m.ssim, 6) + "," + fixed(m.max_abs, 6) +
              "," + std::to_string(m.intersections) + "," + fixed(m.frame_change, 6) + "," + fixed(m.flicker, 6) +
              "," + fixed(m.excess, 6) + "," + fixed(m.pops, 6) + "," + fixed(m.pop_mean, 6) + "," +
+             fixed(m.inconsistency, 6) + "," + fixed(m.inconsistency_mean, 6) + "," +
              cli::csv_field(passes) + "\n";
     }
   return out;

@@ -2,7 +2,7 @@
 //
 // For each scene, each accuracy mode combination is rendered at the chosen views (timed over
 // repeats) and compared with the float64 CPU reference of the same view: PSNR, SSIM and max abs
-// error. Along a short camera path (a sideways dolly from the first view) the frame-to-frame change
+// error. Along a short camera path (an orbit, a pan or a sideways dolly from the first view) the frame-to-frame change
 // that the reference does not have is measured: popping. The results go to a table on stdout and,
 // as asked, Markdown, CSV and one Pareto plot (error against time) per scene.
 #pragma once
@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,21 @@ std::vector<AccuracyModes> default_modes();
 // Whether a mode combination changes anything for a scene of this SH degree (an SH cap at or above
 // the scene's degree does not; such rows are left out of a report rather than shown as free).
 bool applies_to(const AccuracyModes& modes, int scene_sh_degree);
+
+// The camera path the popping is measured on, each a small step per frame from the first view:
+enum class CameraPath {
+  kDolly,  // sideways along the camera's x axis: view-space depths only shift, so centre-depth order never flips
+  kPan,    // turning in place about the camera's y axis: depths along each ray stay, centre depths do not
+  kOrbit,  // around the scene centre about the camera's y axis: what a viewer's user does
+};
+const char* to_string(CameraPath path);
+std::optional<CameraPath> parse_camera_path(const std::string& text);  // "dolly", "pan", "orbit"
+
+// `frames` cameras from `start`. A step moves the dolly by step_fraction times the distance from the
+// camera to `centre`, and turns the pan and the orbit by step_fraction radians (so that the scene centre
+// moves across the view by about the same amount on each path).
+std::vector<Camera> camera_path(CameraPath kind, const Camera& start, const std::array<double, 3>& centre, int frames,
+                                double step_fraction);
 
 struct PassTime {
   std::string name;
@@ -47,19 +63,35 @@ struct ModeResult {
   // which smooth motion cancels and order flips do not.
   double pops = 0;             // fraction of pixels whose second difference exceeds kFlickerThreshold
   double pop_mean = 0;         // mean second difference over pixels and RGB
+  // Between the first view and the same camera turned by Options::consistency_angle, both rendered at
+  // kConsistencyScale times its size: rotation_inconsistency() over blocks of kConsistencyScale * 4
+  // pixels, what re-sorting along each pixel's ray is for.
+  double inconsistency = 0;       // fraction of blocks whose difference exceeds kConsistencyThreshold
+  double inconsistency_mean = 0;  // mean difference over the blocks and RGB
 };
 
-// A pixel "pops" between two frames of the slow dolly when a channel changes by more than this.
+// A pixel "pops" between two frames of the slow path when a channel changes by more than this.
 constexpr double kFlickerThreshold = 0.05;
+
+// The view-consistency pair is rendered at this many times the first view's size and compared over
+// blocks of kConsistencyBlock pixels: one block per 4x4 pixels of the view.
+constexpr int kConsistencyScale = 2;
+constexpr int kConsistencyBlock = 4 * kConsistencyScale;
+constexpr double kConsistencyThreshold = 0.01;
 
 struct SceneReport {
   std::string scene;  // file name
   std::string description;  // "31,000 Gaussians (SH2)"
   std::string views;        // "views 0, 3 of cameras.json at 480x270"
+  CameraPath path = CameraPath::kPan;
   int path_frames = 0;
+  double path_step = 0;
   double reference_change = 0;   // the float64 reference's own mean frame-to-frame change on the path
   double reference_flicker = 0;  // and its fraction of popping pixels
   double reference_pops = 0;     // its popping() fraction (it blends in centre-depth order: it pops too)
+  double consistency_angle = 0;  // radians; 0: not measured
+  double reference_inconsistency = 0;       // the float64 reference's (centre-depth order: not 0)
+  double reference_inconsistency_mean = 0;
   std::vector<ModeResult> modes;
 };
 
@@ -69,15 +101,12 @@ struct Options {
   std::vector<std::string> view_names;
   int warmup = 1;
   int repeat = 3;
-  int path_frames = 6;              // frames of the dolly path (0: no temporal measurement)
-  double path_step = 0.0005;        // dolly step, as a fraction of the camera's distance to the scene centre
+  CameraPath path = CameraPath::kPan;
+  int path_frames = 6;              // frames of the path (0: no temporal measurement)
+  double path_step = 0.0005;        // per frame (see camera_path())
+  double consistency_angle = 0.08;  // radians the camera turns in place for the view-consistency pair; 0: none
   std::string sort = "radix";
 };
-
-// The dolly path: `frames` cameras moving sideways (along the camera's x axis) from `start` in
-// steps of step_fraction times the distance from the camera to `centre`.
-std::vector<Camera> dolly_path(const Camera& start, const std::array<double, 3>& centre, int frames,
-                               double step_fraction);
 
 // Measures one scene. progress(done, total, what) is called as it goes.
 SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const Options& options,

@@ -48,7 +48,10 @@ struct BenchOptions {
   bool accuracy = false;  // --accuracy: the error/time report
   bool effects = false;   // --effects: the per-effect cost table
   std::string markdown;
+  tilesplat::accuracy::CameraPath path = tilesplat::accuracy::CameraPath::kPan;
   int path_frames = 6;
+  double path_step = 0.0005;
+  double consistency_angle = 0.08;
   std::vector<int> sort_sizes{10, 12, 14, 16, 18, 20, 22, 24};  // log2 of the key counts
   std::vector<int> key_bits{32, 64};
 };
@@ -706,13 +709,39 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     "measure what each accuracy mode costs: per --mode combination (default: each approximation "
                     "alone and the combinations that matter), the GPU time per pass and frame and the error "
                     "against the float64 CPU reference (PSNR, SSIM, max abs) at each view, and the popping "
-                    "along a short dolly from the first view; --plot draws one Pareto chart per scene",
+                    "along a short camera path from the first view (--path); --plot draws one Pareto chart per scene",
                     &options.accuracy);
   parser.add_string("--markdown", "FILE.md", "with --accuracy or --effects: also write the report as Markdown tables",
                     &options.markdown);
+  parser.add_value("--path", "dolly|pan|orbit",
+                   "with --accuracy: the camera path the popping is measured on, from the first view: 'pan' "
+                   "(turning in place, default), 'orbit' (around the scene centre) or 'dolly' (sideways; "
+                   "centre-depth order never changes on it, so the reference cannot pop there)",
+                   [&options](const std::string& text) {
+                     const auto path = tilesplat::accuracy::parse_camera_path(text);
+                     if (!path) throw cli::UsageError("--path: '" + text + "' is not dolly, pan or orbit");
+                     options.path = *path;
+                   });
   parser.add_int("--path-frames", "N",
-                 "with --accuracy: frames of the dolly path the popping is measured on (default 6; 0: none)",
+                 "with --accuracy: frames of the camera path the popping is measured on (default 6; 0: none)",
                  &options.path_frames, 0, 1000);
+  parser.add_value("--consistency-angle", "RAD",
+                   "with --accuracy: the view-consistency pair turns the first view in place by RAD radians "
+                   "(default 0.08; 0: no pair), rendered at twice its size, and measures what does not follow the "
+                   "rotation: the popping per-pixel re-sorting removes",
+                   [&options](const std::string& text) {
+                     options.consistency_angle = cli::parse_double("--consistency-angle", text);
+                     if (!(options.consistency_angle >= 0 && options.consistency_angle <= 0.5))
+                       throw cli::UsageError("--consistency-angle: " + text + " is not in [0, 0.5]");
+                   });
+  parser.add_value("--path-step", "F",
+                   "with --accuracy: the path's step per frame: radians for the orbit and the pan, a fraction of "
+                   "the distance to the scene centre for the dolly (default 0.0005), in (0, 0.1]",
+                   [&options](const std::string& text) {
+                     options.path_step = cli::parse_double("--path-step", text);
+                     if (!(options.path_step > 0 && options.path_step <= 0.1))
+                       throw cli::UsageError("--path-step: " + text + " is not in (0, 0.1]");
+                   });
 
   parser.section("effect costs");
   parser.add_switch("--effects",
@@ -1066,7 +1095,10 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
     p.options.modes = options.common.modes;
     p.options.warmup = options.warmup;
     p.options.repeat = options.repeat;
+    p.options.path = options.path;
     p.options.path_frames = options.path_frames;
+    p.options.path_step = options.path_step;
+    p.options.consistency_angle = options.consistency_angle;
     if (!options.common.sorts.empty()) p.options.sort = options.common.sorts.front();
     planned.push_back(std::move(p));
   }

@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <tuple>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -139,7 +140,8 @@ TEST(CliBench, HelpListsEveryFlag) {
   for (const char* flag : {"--warmup", "--repeat", "--csv", "--json", "--plot", "--cameras", "--view", "--views",
                            "--orbit", "--resolutions", "--width", "--height", "--azimuth", "--elevation", "--fov",
                            "--distance", "--strict", "--device", "--list-devices", "--sort", "--validation", "--help",
-                           "SCENE.ply...", "--sort-bench", "--sort-sizes", "--key-bits", "--effects", "--antialiasing"})
+                           "SCENE.ply...", "--sort-bench", "--sort-sizes", "--key-bits", "--effects", "--antialiasing",
+                           "--accuracy", "--path", "--path-frames", "--path-step", "--consistency-angle"})
     EXPECT_TRUE(contains(result.out, flag)) << "--help does not mention " << flag << "\n" << result.out;
 }
 
@@ -463,6 +465,40 @@ TEST(CliBench, PrintsTableAndWritesCsvAndJson) {
   EXPECT_TRUE(contains(json_text, "\"projection\"")) << json_text;
   EXPECT_EQ(entries(out), (std::vector<std::string>{"c.csv", "j.json"}));
   EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+}
+
+TEST(CliBench, AccuracyReportMeasuresPoppingAndViewConsistencyPerMode) {
+  const auto out = fresh_output_dir();
+  const fs::path csv = out / "a.csv";
+  const fs::path md = out / "a.md";
+  const auto result =
+      run_exe(kBenchExe, {bundled_sh3().string(), "--accuracy", "--mode", "reference,resort4", "--width", "64",
+                          "--height", "36", "--warmup", "0", "--repeat", "1", "--path", "orbit", "--path-frames", "3",
+                          "--path-step", "0.01", "--consistency-angle", "0.05", "--csv", csv.string(), "--markdown",
+                          md.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(contains(result.out, "float64 reference on the orbit")) << result.out;
+  EXPECT_TRUE(contains(result.out, "turned 0.050 rad")) << result.out;
+  EXPECT_TRUE(contains(result.out, "incons%")) << result.out;
+  const std::string csv_text = read_file(csv);
+  EXPECT_EQ(csv_text.rfind("device,scene,mode,", 0), 0u) << csv_text;
+  EXPECT_TRUE(contains(csv_text, ",pop_fraction,pop_mean,inconsistent_fraction,inconsistency_mean,")) << csv_text;
+  EXPECT_EQ(std::count(csv_text.begin(), csv_text.end(), '\n'), 3) << csv_text;  // header, two modes
+  const std::string md_text = read_file(md);
+  EXPECT_TRUE(contains(md_text, "3-frame orbit (step 0.0100)")) << md_text;
+  EXPECT_TRUE(contains(md_text, "turned in place by 0.050 rad")) << md_text;
+  EXPECT_TRUE(contains(md_text, "| inconsistent % | inconsistency |")) << md_text;
+  EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+
+  for (const auto& [flag, value, message] :
+       {std::tuple<const char*, const char*, const char*>{"--path", "spiral", "--path: 'spiral' is not dolly, pan or orbit"},
+        {"--path-step", "0", "--path-step: 0 is not in (0, 0.1]"},
+        {"--consistency-angle", "-0.1", "--consistency-angle: -0.1 is not in [0, 0.5]"}}) {
+    const auto bad = run_exe(kBenchExe, {bundled_sh3().string(), "--accuracy", flag, value});
+    EXPECT_EQ(bad.exit_code, 2) << flag << ": " << bad.err;
+    EXPECT_TRUE(contains(bad.err, message)) << bad.err;
+    expect_one_error_line(bad, "tilesplat-bench");
+  }
 }
 
 TEST(CliBench, OutputIntoMissingDirectoryFailsBeforeMeasuring) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -383,3 +384,140 @@ TEST(TemporalExcess, RejectsMismatchedImagesAndBadThresholdsAndPoisonsOnNonFinit
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// rotation_inconsistency: a renderer whose colour is a function of the world ray alone is consistent.
+
+namespace rotation {
+
+using tilesplat::Camera;
+using tilesplat::rotation_inconsistency;
+
+Camera camera(double yaw) {
+  Camera c;
+  c.width = 160;
+  c.height = 96;
+  c.fx = c.fy = 140;
+  c.cx = 80;
+  c.cy = 48;
+  c.position = {0.5, -0.25, 2};
+  // x_cam = R_y(yaw) x_world: turning in place about the camera's y axis.
+  c.rotation = {std::cos(yaw), 0, std::sin(yaw), 0, 1, 0, -std::sin(yaw), 0, std::cos(yaw)};
+  return c;
+}
+
+// Renders colour(world direction) at each pixel centre, as a view-consistent renderer would.
+template <typename Colour>
+RenderImage render_rays(const Camera& c, Colour colour) {
+  RenderImage image;
+  image.width = c.width;
+  image.height = c.height;
+  image.rgba.resize(4 * image.pixels());
+  for (int y = 0; y < c.height; ++y)
+    for (int x = 0; x < c.width; ++x) {
+      const double d[3] = {(x + 0.5 - c.cx) / c.fx, (y + 0.5 - c.cy) / c.fy, 1};
+      double w[3] = {0, 0, 0};
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) w[r] += c.rotation[3 * k + r] * d[k];
+      const double n = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+      const std::array<double, 3> rgb = colour(w[0] / n, w[1] / n, w[2] / n);
+      for (int ch = 0; ch < 3; ++ch) image.rgba[4 * (size_t(y) * c.width + x) + ch] = float(rgb[ch]);
+      image.rgba[4 * (size_t(y) * c.width + x) + 3] = 1.0f;
+    }
+  return image;
+}
+
+std::array<double, 3> smooth(double x, double y, double z) {
+  return {0.5 + 0.4 * std::sin(6 * x), 0.5 + 0.4 * std::cos(5 * y + z), 0.5 + 0.3 * std::sin(4 * x + 3 * y)};
+}
+
+// A hard edge fixed in the world: what per-pixel re-sorting draws where two splats' ray depths cross.
+std::array<double, 3> edge(double x, double y, double) {
+  const double v = x + 0.3 * y > 0.05 ? 0.8 : 0.2;
+  return {v, v, v};
+}
+
+// The blocks of b whose pixel centres all look along rays that a sees between its outer pixel centres.
+int blocks_inside(const Camera& a, const Camera& b, int block) {
+  int kept = 0;
+  for (int by = 0; by + block <= b.height; by += block)
+    for (int bx = 0; bx + block <= b.width; bx += block) {
+      bool inside = true;
+      for (int y = by; y < by + block; ++y)
+        for (int x = bx; x < bx + block; ++x) {
+          const double d[3] = {(x + 0.5 - b.cx) / b.fx, (y + 0.5 - b.cy) / b.fy, 1};
+          double w[3] = {0, 0, 0}, in_a[3] = {0, 0, 0};
+          for (int r = 0; r < 3; ++r)
+            for (int k = 0; k < 3; ++k) w[r] += b.rotation[3 * k + r] * d[k];
+          for (int r = 0; r < 3; ++r)
+            for (int k = 0; k < 3; ++k) in_a[r] += a.rotation[3 * r + k] * w[k];
+          const double u = a.fx * in_a[0] / in_a[2] + a.cx - 0.5, v = a.fy * in_a[1] / in_a[2] + a.cy - 0.5;
+          inside = inside && u >= 0 && v >= 0 && u <= a.width - 1 && v <= a.height - 1;
+        }
+      kept += inside ? 1 : 0;
+    }
+  return kept;
+}
+
+}  // namespace rotation
+
+TEST(RotationInconsistency, AConsistentRendererScoresZeroWhateverTheTurn) {
+  using namespace rotation;
+  const Camera a = camera(0), b = camera(0.08);
+  const RenderImage image_a = render_rays(a, smooth), image_b = render_rays(b, smooth);
+  // The turn moved the image by about 11 pixels: the plain difference is large.
+  EXPECT_GT(frame_change(image_a, image_b), 0.02);
+  const TemporalDifference consistent = rotation_inconsistency(image_a, a, image_b, b, 4);
+  EXPECT_EQ(consistent.flicker_fraction, 0.0);
+  EXPECT_LT(consistent.mean_abs, 2e-4);  // bilinear resampling of a smooth function
+  // The same camera twice: exactly nothing.
+  const TemporalDifference same = rotation_inconsistency(image_a, a, image_a, a, 1);
+  EXPECT_LT(same.mean_abs, 1e-12);  // the pixel's ray there and back, in doubles
+  EXPECT_EQ(same.flicker_fraction, 0.0);
+}
+
+TEST(RotationInconsistency, BlocksAverageAwayTheResamplingOfAHardEdgeButNotAChangedRegion) {
+  using namespace rotation;
+  const Camera a = camera(0), b = camera(0.05);
+  const RenderImage edge_a = render_rays(a, edge), edge_b = render_rays(b, edge);
+  // Per pixel, resampling the edge misses along it; over 8x8 blocks those misses average out.
+  EXPECT_GT(rotation_inconsistency(edge_a, a, edge_b, b, 1, 0.05).flicker_fraction, 0.003);
+  EXPECT_EQ(rotation_inconsistency(edge_a, a, edge_b, b, 8, 0.05).flicker_fraction, 0.0);
+
+  // A region of b that changed where nothing moved (an order flip in centre-depth blending): the
+  // blocks wholly inside it count, at full size.
+  RenderImage flipped = render_rays(b, smooth);
+  for (int y = 32; y < 64; ++y)
+    for (int x = 40; x < 88; ++x)
+      for (int c = 0; c < 3; ++c) flipped.rgba[4 * (size_t(y) * b.width + x) + c] += 0.1f;
+  const RenderImage smooth_a = render_rays(a, smooth);
+  const TemporalDifference popped = rotation_inconsistency(smooth_a, a, flipped, b, 8, 0.05);
+  // b's blocks whose samples all land inside a: the turned camera sees new columns at one side.
+  const int kept_blocks = blocks_inside(a, b, 8);
+  EXPECT_LT(kept_blocks, (b.width / 8) * (b.height / 8));
+  EXPECT_NEAR(popped.flicker_fraction, (4.0 * 6.0) / kept_blocks, 1e-12);
+  EXPECT_NEAR(popped.mean_abs, 0.1 * (4.0 * 6.0) / kept_blocks, 2e-4);
+}
+
+TEST(RotationInconsistency, RefusesCamerasThatDoNotDifferByARotationAndPropagatesNaN) {
+  using namespace rotation;
+  const Camera a = camera(0), b = camera(0.05);
+  const RenderImage image_a = render_rays(a, smooth), image_b = render_rays(b, smooth);
+  Camera moved = b;
+  moved.position[0] += 0.1;
+  EXPECT_THROW(rotation_inconsistency(image_a, a, image_b, moved, 4), std::invalid_argument);
+  Camera zoomed = b;
+  zoomed.fx *= 1.1;
+  EXPECT_THROW(rotation_inconsistency(image_a, a, image_b, zoomed, 4), std::invalid_argument);
+  EXPECT_THROW(rotation_inconsistency(image_a, a, image_b, b, 0), std::invalid_argument);
+  EXPECT_THROW(rotation_inconsistency(image_a, a, image_b, b, 4, -1), std::invalid_argument);
+  EXPECT_THROW(rotation_inconsistency(image_a, a, random_image(8, 8, 3u), b, 4), std::invalid_argument);
+  Camera small = b;
+  small.width = 80;
+  EXPECT_THROW(rotation_inconsistency(image_a, a, image_b, small, 4), std::invalid_argument);
+  RenderImage broken = image_b;
+  broken.rgba[4 * 500 + 1] = std::numeric_limits<float>::quiet_NaN();
+  const TemporalDifference nan = rotation_inconsistency(image_a, a, broken, b, 4);
+  EXPECT_TRUE(std::isnan(nan.mean_abs));
+  EXPECT_TRUE(std::isnan(nan.flicker_fraction));
+}

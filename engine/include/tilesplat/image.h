@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "tilesplat/camera.h"
+
 namespace tilesplat {
 
 // What a render produces, row-major with row 0 at the top.
@@ -112,5 +114,23 @@ double frame_change(const RenderImage& a0, const RenderImage& a1);
 // credit a mode that pops less than the reference). It is temporal_excess(a1, a2, a0, a1, threshold).
 TemporalDifference popping(const RenderImage& a0, const RenderImage& a1, const RenderImage& a2,
                            double threshold = 0.05);
+
+// View consistency under rotation, the popping that per-pixel re-sorting removes (StopThePop,
+// Radl et al. 2024). The scene gives every ray one colour; a renderer that blends in centre-depth
+// order does not: turning the camera in place changes the splats' view depths and so their order,
+// and a region of the image changes where nothing moved. Between two cameras that differ only by a
+// rotation about their common centre every pixel of b sees a ray that a saw as well, so a is
+// resampled (bilinearly) onto b's pixels and compared with b, per pixel and RGB channel: e = |b -
+// warp(a)|, averaged over blocks of block x block pixels before the threshold. The blocks are what
+// makes it fair to a renderer with hard edges: resampling an edge misses by up to a pixel, which a
+// block averages away, whereas a splat changing its colour over its whole footprint stays. Render
+// a and b at block times the resolution the result is meant for. Blocks with a sample outside a are
+// left out. The cameras must share size, intrinsics and position (std::invalid_argument otherwise,
+// also for a block below 1, a negative or non-finite threshold, or images not of the cameras' size);
+// mean_abs is over the blocks kept and RGB, flicker_fraction the fraction of them whose largest
+// channel exceeds the threshold. NaN or infinity in either image gives NaN, as in ssim; no block
+// kept gives {0, 0}.
+TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& camera_a, const RenderImage& b,
+                                          const Camera& camera_b, int block, double threshold = 0.01);
 
 }  // namespace tilesplat

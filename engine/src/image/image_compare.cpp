@@ -1,5 +1,6 @@
 // Differences between two RenderImages, as used by the tests and the reference comparisons.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <initializer_list>
 #include <limits>
@@ -274,6 +275,105 @@ TemporalDifference popping(const RenderImage& a0, const RenderImage& a1, const R
 double frame_change(const RenderImage& a0, const RenderImage& a1) {
   check_same_size("frame_change", {&a0, &a1}, {"a0", "a1"});
   return temporal_difference(a0, a1, nullptr, nullptr, 0).mean_abs;
+}
+
+namespace {
+
+// The camera-space direction of pixel (x, y)'s centre turned into world space: R^T K^-1 (x + 0.5, y + 0.5, 1).
+std::array<double, 3> pixel_ray(const Camera& camera, double x, double y) {
+  const double d[3] = {(x + 0.5 - camera.cx) / camera.fx, (y + 0.5 - camera.cy) / camera.fy, 1.0};
+  std::array<double, 3> world{};
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) world[r] += camera.rotation[3 * k + r] * d[k];
+  return world;
+}
+
+}  // namespace
+
+TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& camera_a, const RenderImage& b,
+                                          const Camera& camera_b, int block, double threshold) {
+  constexpr const char* kFunction = "rotation_inconsistency";
+  check_same_size(kFunction, {&a, &b}, {"a", "b"});
+  validate(camera_a);
+  validate(camera_b);
+  if (camera_a.width != a.width || camera_a.height != a.height || camera_b.width != a.width ||
+      camera_b.height != a.height)
+    throw std::invalid_argument(std::string(kFunction) + ": the images are " + size_text(a) + ", the cameras " +
+                                std::to_string(camera_a.width) + "x" + std::to_string(camera_a.height) + " and " +
+                                std::to_string(camera_b.width) + "x" + std::to_string(camera_b.height));
+  if (camera_a.fx != camera_b.fx || camera_a.fy != camera_b.fy || camera_a.cx != camera_b.cx ||
+      camera_a.cy != camera_b.cy || camera_a.position != camera_b.position)
+    throw std::invalid_argument(std::string(kFunction) +
+                                ": the cameras must differ by a rotation alone (same intrinsics and position)");
+  if (block < 1) throw std::invalid_argument(std::string(kFunction) + ": block must be >= 1, got " + std::to_string(block));
+  if (!std::isfinite(threshold) || threshold < 0)
+    throw std::invalid_argument(std::string(kFunction) + ": the threshold must be finite and >= 0, got " +
+                                std::to_string(threshold));
+  TemporalDifference result;
+  if (!all_finite(a) || !all_finite(b)) {
+    result.mean_abs = std::numeric_limits<double>::quiet_NaN();
+    result.flicker_fraction = std::numeric_limits<double>::quiet_NaN();
+    return result;
+  }
+  const int width = a.width, height = a.height;
+  // Per pixel of b: b - warp(a) over RGB, and whether the ray landed inside a (with its 2x2 neighbourhood).
+  std::vector<std::array<double, 3>> difference(b.pixels());
+  std::vector<char> inside(b.pixels(), 0);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::array<double, 3> world = pixel_ray(camera_b, x, y);
+      double in_a[3] = {0, 0, 0};
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) in_a[r] += camera_a.rotation[3 * r + k] * world[k];
+      if (!(in_a[2] > 0)) continue;
+      // Continuous coordinates with pixel centres on the integers.
+      const double u = camera_a.fx * in_a[0] / in_a[2] + camera_a.cx - 0.5;
+      const double v = camera_a.fy * in_a[1] / in_a[2] + camera_a.cy - 0.5;
+      if (!(u >= 0 && v >= 0 && u <= width - 1 && v <= height - 1)) continue;
+      const int x0 = std::min(int(u), width - 2 < 0 ? 0 : width - 2);
+      const int y0 = std::min(int(v), height - 2 < 0 ? 0 : height - 2);
+      const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
+      const double fx = u - x0, fy = v - y0;
+      const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+      auto at = [&](int px, int py, int c) { return double{a.rgba[4 * (size_t(py) * size_t(width) + size_t(px)) + c]}; };
+      for (int c = 0; c < 3; ++c) {
+        const double warped = (1 - fy) * ((1 - fx) * at(x0, y0, c) + fx * at(x1, y0, c)) +
+                              fy * ((1 - fx) * at(x0, y1, c) + fx * at(x1, y1, c));
+        difference[pixel][c] = double{b.rgba[4 * pixel + c]} - warped;
+      }
+      inside[pixel] = 1;
+    }
+  }
+  double sum = 0;
+  size_t kept = 0, over = 0;
+  for (int by = 0; by + block <= height; by += block) {
+    for (int bx = 0; bx + block <= width; bx += block) {
+      std::array<double, 3> mean{};
+      bool complete = true;
+      for (int y = by; y < by + block && complete; ++y)
+        for (int x = bx; x < bx + block; ++x) {
+          const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+          if (!inside[pixel]) {
+            complete = false;
+            break;
+          }
+          for (int c = 0; c < 3; ++c) mean[c] += difference[pixel][c];
+        }
+      if (!complete) continue;
+      double largest = 0;
+      for (double& channel : mean) {
+        channel = std::fabs(channel) / double(block * block);
+        sum += channel;
+        largest = std::max(largest, channel);
+      }
+      ++kept;
+      if (largest > threshold) ++over;
+    }
+  }
+  if (kept == 0) return result;
+  result.mean_abs = sum / (3.0 * double(kept));
+  result.flicker_fraction = double(over) / double(kept);
+  return result;
 }
 
 }  // namespace tilesplat

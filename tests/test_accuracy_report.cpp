@@ -1,0 +1,82 @@
+// The camera paths of tilesplat-bench --accuracy: what each moves and what it keeps.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+
+#include "accuracy_report.h"
+#include "tilesplat/camera.h"
+
+namespace {
+
+using tilesplat::Camera;
+using tilesplat::accuracy::camera_path;
+using tilesplat::accuracy::CameraPath;
+
+Camera start_camera() {
+  // Looking at the origin from (3, -1, -4), its up the world's -y (OpenCV axes).
+  return tilesplat::look_at_camera({3, -1, -4}, {0, 0, 0}, {0, -1, 0}, 320, 180, 50);
+}
+
+double distance(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+// The angle between the camera axes (rows) of two world-to-camera rotations about their common row `axis`.
+double turn_about(const Camera& a, const Camera& b, int row) {
+  const int other = row == 1 ? 2 : 1;
+  double cosine = 0;
+  for (int k = 0; k < 3; ++k) cosine += a.rotation[3 * other + k] * b.rotation[3 * other + k];
+  return std::acos(std::min(1.0, cosine));
+}
+
+TEST(CameraPath, NamesRoundTrip) {
+  for (CameraPath path : {CameraPath::kDolly, CameraPath::kPan, CameraPath::kOrbit})
+    EXPECT_EQ(tilesplat::accuracy::parse_camera_path(to_string(path)), path);
+  EXPECT_FALSE(tilesplat::accuracy::parse_camera_path("spiral").has_value());
+}
+
+TEST(CameraPath, EachPathMovesWhatItSaysAndKeepsTheRest) {
+  const Camera start = start_camera();
+  const std::array<double, 3> centre = {0, 0, 0};
+  const double step = 0.01;
+  for (CameraPath kind : {CameraPath::kDolly, CameraPath::kPan, CameraPath::kOrbit}) {
+    const auto path = camera_path(kind, start, centre, 4, step);
+    ASSERT_EQ(path.size(), 4u);
+    EXPECT_EQ(path[0], start) << to_string(kind);
+    for (int f = 1; f < 4; ++f) {
+      const Camera& c = path[size_t(f)];
+      EXPECT_EQ(c.width, start.width);
+      EXPECT_EQ(c.fx, start.fx);
+      EXPECT_EQ(c.cx, start.cx);
+      // The rotation stays a rotation.
+      for (int r = 0; r < 3; ++r) {
+        double norm = 0;
+        for (int k = 0; k < 3; ++k) norm += c.rotation[3 * r + k] * c.rotation[3 * r + k];
+        EXPECT_NEAR(norm, 1.0, 1e-12);
+      }
+      // The camera's y axis (row 1) is the axis every path keeps.
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(c.rotation[3 + k], start.rotation[3 + k], 1e-12) << to_string(kind);
+      switch (kind) {
+        case CameraPath::kDolly:
+          EXPECT_EQ(c.rotation, start.rotation);
+          EXPECT_NEAR(distance(c.position, start.position), f * step * distance(start.position, centre), 1e-12);
+          break;
+        case CameraPath::kPan:
+          EXPECT_EQ(c.position, start.position);
+          EXPECT_NEAR(turn_about(start, c, 1), f * step, 1e-9);
+          break;
+        case CameraPath::kOrbit: {
+          EXPECT_NEAR(distance(c.position, centre), distance(start.position, centre), 1e-12);
+          EXPECT_NEAR(turn_about(start, c, 1), f * step, 1e-9);
+          // The scene centre keeps its place in the view: the rig turns about it.
+          const auto seen = c.to_camera(centre), seen_from_start = start.to_camera(centre);
+          for (int k = 0; k < 3; ++k) EXPECT_NEAR(seen[k], seen_from_start[k], 1e-12);
+          break;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
