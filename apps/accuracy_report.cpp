@@ -406,6 +406,22 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
   return out;
 }
 
+std::string consistency_svg(const SceneReport& report, const DeviceInfo& device) {
+  plot::ScatterChart chart;
+  chart.title = "View consistency against time: " + report.scene;
+  chart.subtitle = report.description + ", turned in place by " + fixed(report.consistency_angle, 3) +
+                   " rad; float64 reference " + fixed(100.0 * report.reference_inconsistency, 3) + "%; " + device.name;
+  chart.x_label = "median GPU frame time (ms, log scale)";
+  chart.x_scale = plot::Scale::kLog10;
+  chart.y_label = "blocks inconsistent under the turn (%)";
+  chart.y_higher_is_better = false;
+  for (size_t i = 0; i < report.modes.size(); ++i) {
+    const auto& m = report.modes[i];
+    chart.points.push_back({m.name, m.frame_ms, 100.0 * m.inconsistency, i});
+  }
+  return plot::scatter_svg(chart);
+}
+
 std::string pareto_svg(const SceneReport& report, const DeviceInfo& device) {
   plot::ScatterChart chart;
   chart.title = "Accuracy against time: " + report.scene;

@@ -116,6 +116,8 @@ int work_units(const Options& options, int scene_sh_degree);  // progress() tota
 std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& device, const std::string& command);
 std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& device);
 std::string pareto_svg(const SceneReport& report, const DeviceInfo& device);
+// The same modes' rotation_inconsistency() fraction against time (lower is better), when measured.
+std::string consistency_svg(const SceneReport& report, const DeviceInfo& device);
 // The stdout table of one scene.
 std::string text_table(const SceneReport& report);
 

@@ -701,7 +701,9 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     &options.json);
   parser.add_string("--plot", "FILE.svg",
                     "also draw an SVG chart: the median GPU time of each pass as stacked bars, one per scene, "
-                    "size and sort; with --sort-bench, Mkeys/s against key count per sort and key width",
+                    "size and sort; with --sort-bench, Mkeys/s against key count per sort and key width; with "
+                    "--accuracy, per scene PSNR against time and, beside it (..._consistency.svg), the view "
+                    "inconsistency against time",
                     &options.plot);
 
   parser.section("accuracy report");
@@ -709,7 +711,8 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     "measure what each accuracy mode costs: per --mode combination (default: each approximation "
                     "alone and the combinations that matter), the GPU time per pass and frame and the error "
                     "against the float64 CPU reference (PSNR, SSIM, max abs) at each view, and the popping "
-                    "along a short camera path from the first view (--path); --plot draws one Pareto chart per scene",
+                    "along a short camera path from the first view (--path) and the view consistency under a turn "
+                    "(--consistency-angle); --plot draws the Pareto charts",
                     &options.accuracy);
   parser.add_string("--markdown", "FILE.md", "with --accuracy or --effects: also write the report as Markdown tables",
                     &options.markdown);
@@ -1137,6 +1140,13 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
     for (const auto& report : reports) {
       plot_paths.push_back(scene_plot_path(options.plot, report.scene, reports.size()).string());
       files.emplace_back(plot_paths.back(), [&report, &device] { return tilesplat::accuracy::pareto_svg(report, device); });
+      if (report.consistency_angle > 0) {
+        fs::path consistency = plot_paths.back();
+        consistency.replace_filename(consistency.stem().string() + "_consistency.svg");
+        plot_paths.push_back(consistency.string());
+        files.emplace_back(plot_paths.back(),
+                           [&report, &device] { return tilesplat::accuracy::consistency_svg(report, device); });
+      }
     }
   const std::string written = write_outputs(files, renderer->validation_messages());
   std::fprintf(stderr, "%s: accuracy report, %d renders%s\n", kProgram, total, written.c_str());

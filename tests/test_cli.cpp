@@ -471,11 +471,12 @@ TEST(CliBench, AccuracyReportMeasuresPoppingAndViewConsistencyPerMode) {
   const auto out = fresh_output_dir();
   const fs::path csv = out / "a.csv";
   const fs::path md = out / "a.md";
+  const fs::path plot = out / "p.svg";
   const auto result =
       run_exe(kBenchExe, {bundled_sh3().string(), "--accuracy", "--mode", "reference,resort4", "--width", "64",
                           "--height", "36", "--warmup", "0", "--repeat", "1", "--path", "orbit", "--path-frames", "3",
                           "--path-step", "0.01", "--consistency-angle", "0.05", "--csv", csv.string(), "--markdown",
-                          md.string()});
+                          md.string(), "--plot", plot.string()});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(contains(result.out, "float64 reference on the orbit")) << result.out;
   EXPECT_TRUE(contains(result.out, "turned 0.050 rad")) << result.out;
@@ -488,6 +489,9 @@ TEST(CliBench, AccuracyReportMeasuresPoppingAndViewConsistencyPerMode) {
   EXPECT_TRUE(contains(md_text, "3-frame orbit (step 0.0100)")) << md_text;
   EXPECT_TRUE(contains(md_text, "turned in place by 0.050 rad")) << md_text;
   EXPECT_TRUE(contains(md_text, "| inconsistent % | inconsistency |")) << md_text;
+  EXPECT_TRUE(contains(read_file(plot), "PSNR against the float64 reference"));
+  EXPECT_TRUE(contains(read_file(out / "p_consistency.svg"), "blocks inconsistent under the turn"));
+  EXPECT_EQ(entries(out), (std::vector<std::string>{"a.csv", "a.md", "p.svg", "p_consistency.svg"}));
   EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
 
   for (const auto& [flag, value, message] :
