@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages tilesplat builds and tests with, only when one is missing.
 # Safe to run repeatedly; needs root (or sudo) only when something must be installed.
+# xvfb and xauth give the viewer's tests a display (xvfb-run) on a machine without one.
 # --fuzz adds clang and its compiler-rt (libFuzzer) for tests/fuzz/run.sh; the normal build needs neither.
 set -euo pipefail
 pkgs=(
@@ -9,6 +10,7 @@ pkgs=(
   glslang-tools spirv-tools
   libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev
   libgtest-dev googletest
+  xvfb xauth
 )
 if [ "${1:-}" = "--fuzz" ]; then
   pkgs+=(clang libclang-rt-dev)

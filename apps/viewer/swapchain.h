@@ -1,0 +1,83 @@
+// What the viewer shows and how: the float image the renderer writes, and the window's swapchain,
+// into which each frame is blitted (float to 8-bit, the format conversion done by the blit).
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "tilesplat/vulkan_interop.h"
+#include "viewer/window_device.h"
+
+namespace tilesplat::viewer {
+
+// An R32G32B32A32_SFLOAT image the renderer writes with render_to_image (TRANSFER_DST) and the
+// swapchain blits from (TRANSFER_SRC), in device memory. It lives in TRANSFER_SRC_OPTIMAL, the
+// layout of the blit; render_to_image leaves it in the layout it found it in.
+class FloatImage {
+ public:
+  FloatImage(const WindowDevice& device, uint32_t width, uint32_t height);
+  ~FloatImage();
+  FloatImage(const FloatImage&) = delete;
+  FloatImage& operator=(const FloatImage&) = delete;
+
+  static constexpr VkImageLayout kLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+
+  ExternalImage target() const { return {image_, width_, height_, VK_FORMAT_R32G32B32A32_SFLOAT, kLayout}; }
+  VkImage image() const { return image_; }
+  uint32_t width() const { return width_; }
+  uint32_t height() const { return height_; }
+
+ private:
+  void enter_blit_layout(const WindowDevice& device);
+  void destroy();
+
+  VkDevice device_;
+  VkImage image_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  uint32_t width_, height_;
+};
+
+class Swapchain {
+ public:
+  explicit Swapchain(const WindowDevice& device);
+  ~Swapchain();
+  Swapchain(const Swapchain&) = delete;
+  Swapchain& operator=(const Swapchain&) = delete;
+
+  // (Re)creates the images to fit the surface; `width` x `height` (the framebuffer) is used where the
+  // surface leaves the size to the application. Waits for the device to be idle first. The extent
+  // may be 0x0 (a minimized window): then there are no images and nothing can be presented.
+  void recreate(uint32_t width, uint32_t height);
+  VkExtent2D extent() const { return extent_; }
+  VkFormat format() const { return format_; }
+
+  // Blits `source` (the swapchain's extent) into the next image and presents it, FIFO (vsync).
+  // Returns when the blit has read the source, so the caller may render into it again. Returns
+  // false when nothing was shown (VK_ERROR_OUT_OF_DATE_KHR, or no images): recreate, present again.
+  // Either way, stale() says whether the swapchain no longer fits the surface (also after
+  // VK_SUBOPTIMAL_KHR, when the frame was shown): recreate it before the next frame.
+  bool present(const FloatImage& source);
+  bool stale() const { return stale_; }
+
+ private:
+  void destroy_images();
+  void destroy();
+
+  const WindowDevice& device_;
+  VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
+  VkFormat format_ = VK_FORMAT_UNDEFINED;
+  VkExtent2D extent_{0, 0};
+  std::vector<VkImage> images_;
+  // Signalled by the blit's submission and waited on by the presentation of that image. One per
+  // image: the presentation engine may still hold an image's semaphore while another is acquired.
+  std::vector<VkSemaphore> blit_done_;
+  VkSemaphore image_acquired_ = VK_NULL_HANDLE;
+  VkFence blit_fence_ = VK_NULL_HANDLE;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  VkCommandBuffer commands_ = VK_NULL_HANDLE;
+  bool stale_ = true;  // no images yet
+};
+
+}  // namespace tilesplat::viewer

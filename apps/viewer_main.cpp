@@ -1,0 +1,368 @@
+// tilesplat-viewer: a window onto a scene. The engine renders into a float image this app owns
+// (tilesplat/vulkan_interop.h, on the window's own Vulkan device) and each frame is blitted to the
+// window's swapchain. Nothing is rendered while nothing changes: the loop then sleeps in
+// glfwWaitEvents, so an idle viewer costs nothing.
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cli.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/image.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+#include "tilesplat/vulkan_interop.h"
+#include "viewer/orbit_controller.h"
+#include "viewer/swapchain.h"
+#include "viewer/window_device.h"
+
+namespace {
+
+namespace cli = tilesplat::cli;
+namespace fs = std::filesystem;
+using tilesplat::viewer::FloatImage;
+using tilesplat::viewer::OrbitController;
+using tilesplat::viewer::Swapchain;
+using tilesplat::viewer::WindowDevice;
+
+constexpr const char* kProgram = "tilesplat-viewer";
+constexpr int kDefaultWindowWidth = 960;  // the height follows the view's aspect
+// What key M steps through: the reference; depth16, the web viewers' sort keys; resort8, per-pixel
+// re-sorting, more exact than the reference; and the web viewers' shortcuts all together.
+constexpr const char* kModeCycle[] = {"reference", "depth16", "resort8", "depth16+opacity-extent+fp16-sh+fp16-cov"};
+
+struct ViewerOptions {
+  cli::CommonOptions common;
+  int frames = 0;  // 0: until the window is closed
+  std::string screenshot;
+};
+
+bool validation_from_environment() {
+  const char* value = std::getenv("TILESPLAT_VALIDATION");
+  return value && *value && std::string_view(value) != "0";
+}
+
+// GLFW reports why a call failed through a callback; the last report goes into the error message.
+std::string last_glfw_error;
+void record_glfw_error(int, const char* description) { last_glfw_error = description; }
+
+// glfwInit to glfwTerminate.
+class GlfwSession {
+ public:
+  GlfwSession() {
+    glfwSetErrorCallback(record_glfw_error);
+    if (!glfwInit())
+      throw std::runtime_error("cannot open a window: " + last_glfw_error +
+                               " (no display? set DISPLAY, or run it under xvfb-run)");
+    if (!glfwVulkanSupported()) {
+      glfwTerminate();
+      throw std::runtime_error("cannot open a window: GLFW finds no Vulkan loader with surface support");
+    }
+  }
+  ~GlfwSession() { glfwTerminate(); }
+  GlfwSession(const GlfwSession&) = delete;
+  GlfwSession& operator=(const GlfwSession&) = delete;
+};
+
+using WindowHandle = std::unique_ptr<GLFWwindow, decltype(&glfwDestroyWindow)>;
+
+// The interactive state (camera, view, accuracy mode, sort) and the loop that redraws when it changes.
+class Viewer {
+ public:
+  Viewer(GLFWwindow* window, const WindowDevice& device, tilesplat::Renderer& renderer, const ViewerOptions& options,
+         const cli::LoadedScene& loaded, std::vector<tilesplat::CameraView> views)
+      : window_(window),
+        device_(device),
+        renderer_(renderer),
+        swapchain_(device),
+        controller_(loaded.camera, tilesplat::compute_bounds(loaded.scene)),
+        scene_name_(loaded.path.filename().string()),
+        views_(std::move(views)),
+        view_(options.common.view),
+        sorts_(tilesplat::sort_strategies()) {
+    cli::apply_scene_settings(loaded, base_settings_);
+    if (options.common.antialiasing) base_settings_.antialiasing = *options.common.antialiasing;
+    for (const char* mode : kModeCycle) modes_.push_back(tilesplat::parse_accuracy_modes(mode));
+    if (!options.common.modes.empty()) mode_ = find_or_append(modes_, options.common.modes.front());
+    if (!options.common.sorts.empty()) sort_ = find_or_append(sorts_, options.common.sorts.front());
+
+    glfwSetWindowUserPointer(window_, this);
+    glfwSetKeyCallback(window_, on_key);
+    glfwSetMouseButtonCallback(window_, on_mouse_button);
+    glfwSetCursorPosCallback(window_, on_cursor);
+    glfwSetScrollCallback(window_, on_scroll);
+    glfwSetFramebufferSizeCallback(window_, [](GLFWwindow* w, int, int) { self(w).resized_ = true; });
+    // The window was uncovered: show the last frame again, which needs no render.
+    glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) { self(w).needs_present_ = true; });
+  }
+
+  // Runs until the window closes (Esc, Q, the close button), or for `frame_limit` frames when it is
+  // positive, each of which is rendered even if nothing changed.
+  void run(int frame_limit) {
+    while (!glfwWindowShouldClose(window_)) {
+      if (frame_limit > 0) needs_render_ = true;
+      if ((needs_render_ || needs_present_ || swapchain_.stale()) && !minimized_)
+        glfwPollEvents();
+      else
+        glfwWaitEvents();
+      if (resized_ || swapchain_.stale()) fit_to_window();
+      if (minimized_) continue;
+      const auto start = std::chrono::steady_clock::now();
+      const bool rendering = needs_render_;
+      if (rendering) render();
+      if (needs_present_) needs_present_ = !swapchain_.present(*image_);
+      if (rendering) {
+        show_title(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        if (frame_limit > 0 && frames_ >= frame_limit) break;
+      }
+    }
+  }
+
+  // The camera and settings of the last frame, for a screenshot. The settings have the depth and
+  // count outputs the scene asks for, which the window's frames leave out.
+  const tilesplat::Camera& camera() const { return controller_.camera(); }
+  tilesplat::RenderSettings settings() const {
+    tilesplat::RenderSettings settings = base_settings_;
+    settings.sort = sorts_[sort_];
+    settings.accuracy = modes_[mode_];
+    // A scene file's sh_degree effect caps every mode, as in tilesplat-render.
+    settings.accuracy.sh_degree_cap =
+        std::min(settings.accuracy.sh_degree_cap, base_settings_.accuracy.sh_degree_cap);
+    return settings;
+  }
+  int frames() const { return frames_; }
+
+ private:
+  static Viewer& self(GLFWwindow* window) { return *static_cast<Viewer*>(glfwGetWindowUserPointer(window)); }
+
+  // The index of `value` in `list`, appended when it is not there (a --mode outside the cycle).
+  template <typename T>
+  static size_t find_or_append(std::vector<T>& list, const T& value) {
+    const auto found = std::find(list.begin(), list.end(), value);
+    if (found != list.end()) return size_t(found - list.begin());
+    list.push_back(value);
+    return list.size() - 1;
+  }
+
+  // The callbacks run inside glfwPollEvents/glfwWaitEvents (C code): they only change state, and
+  // the loop does the work that can throw.
+  static void on_key(GLFWwindow* window, int key, int, int action, int) {
+    if (action == GLFW_RELEASE) return;
+    Viewer& viewer = self(window);
+    switch (key) {
+      case GLFW_KEY_ESCAPE:
+      case GLFW_KEY_Q: glfwSetWindowShouldClose(window, GLFW_TRUE); return;
+      case GLFW_KEY_N:
+      case GLFW_KEY_RIGHT: viewer.step_view(1); return;
+      case GLFW_KEY_P:
+      case GLFW_KEY_LEFT: viewer.step_view(-1); return;
+      case GLFW_KEY_M: viewer.mode_ = (viewer.mode_ + 1) % viewer.modes_.size(); break;
+      case GLFW_KEY_S: viewer.sort_ = (viewer.sort_ + 1) % viewer.sorts_.size(); break;
+      default: return;
+    }
+    viewer.needs_render_ = true;
+  }
+
+  static void on_mouse_button(GLFWwindow* window, int button, int action, int) {
+    Viewer& viewer = self(window);
+    if (action == GLFW_PRESS) {
+      viewer.drag_button_ = button;
+      glfwGetCursorPos(window, &viewer.cursor_x_, &viewer.cursor_y_);
+    } else if (button == viewer.drag_button_) {
+      viewer.drag_button_ = -1;
+    }
+  }
+
+  static void on_cursor(GLFWwindow* window, double x, double y) {
+    Viewer& viewer = self(window);
+    if (viewer.drag_button_ < 0) return;
+    // Cursor positions are in window coordinates; the camera is in framebuffer pixels.
+    int window_width = 0, framebuffer_width = 0;
+    glfwGetWindowSize(window, &window_width, nullptr);
+    glfwGetFramebufferSize(window, &framebuffer_width, nullptr);
+    const double scale = window_width > 0 ? double(framebuffer_width) / window_width : 1.0;
+    const double dx = (x - viewer.cursor_x_) * scale, dy = (y - viewer.cursor_y_) * scale;
+    viewer.cursor_x_ = x;
+    viewer.cursor_y_ = y;
+    if (viewer.drag_button_ == GLFW_MOUSE_BUTTON_LEFT)
+      viewer.controller_.orbit(dx, dy);
+    else
+      viewer.controller_.pan(dx, dy);
+    viewer.needs_render_ = true;
+  }
+
+  static void on_scroll(GLFWwindow* window, double, double steps) {
+    self(window).controller_.zoom(steps);
+    self(window).needs_render_ = true;
+  }
+
+  void step_view(int step) {
+    if (views_.empty()) return;
+    const int count = int(views_.size());
+    view_ = ((view_ + step) % count + count) % count;
+    controller_.set_camera(views_[size_t(view_)].camera);
+    needs_render_ = true;
+  }
+
+  // The swapchain, the float image and the camera follow the framebuffer; a 0x0 one (minimized)
+  // has no swapchain images, and the loop sleeps until it grows again.
+  void fit_to_window() {
+    resized_ = false;
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(window_, &width, &height);
+    swapchain_.recreate(uint32_t(std::max(width, 0)), uint32_t(std::max(height, 0)));
+    const VkExtent2D extent = swapchain_.extent();
+    minimized_ = extent.width == 0 || extent.height == 0;
+    if (minimized_ || (image_ && image_->width() == extent.width && image_->height() == extent.height)) return;
+    image_.reset();
+    image_ = std::make_unique<FloatImage>(device_, extent.width, extent.height);
+    controller_.resize(int(extent.width), int(extent.height));
+    needs_render_ = true;
+  }
+
+  void render() {
+    tilesplat::RenderSettings frame = settings();
+    frame.depth = frame.splat_count = false;  // the window shows colour alone
+    tilesplat::render_to_image(renderer_, controller_.camera(), frame, image_->target());
+    needs_render_ = false;
+    needs_present_ = true;
+    ++frames_;
+  }
+
+  void show_title(double frame_ms) {
+    std::string title = scene_name_;
+    if (!views_.empty()) {
+      const tilesplat::CameraView& view = views_[size_t(view_)];
+      title += " | view " + std::to_string(view_) + (view.name.empty() ? "" : " (" + view.name + ")");
+    }
+    title += " | " + tilesplat::to_string(modes_[mode_]) + " | " + sorts_[sort_] + " | GPU " +
+             cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | " +
+             cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps";
+    glfwSetWindowTitle(window_, title.c_str());
+  }
+
+  GLFWwindow* window_;
+  const WindowDevice& device_;
+  tilesplat::Renderer& renderer_;
+  std::unique_ptr<FloatImage> image_;  // the swapchain's size
+  Swapchain swapchain_;                // destroyed first: it waits for the device to be idle
+  OrbitController controller_;
+  std::string scene_name_;
+  std::vector<tilesplat::CameraView> views_;  // of --cameras or the scene file; N and P step through them
+  int view_ = 0;
+  std::vector<tilesplat::AccuracyModes> modes_;
+  size_t mode_ = 0;
+  std::vector<std::string> sorts_;
+  size_t sort_ = 0;
+  tilesplat::RenderSettings base_settings_;  // the scene file's background, effects and outputs
+
+  int drag_button_ = -1;  // the mouse button held, or -1
+  double cursor_x_ = 0, cursor_y_ = 0;
+  bool needs_render_ = true;
+  bool needs_present_ = false;
+  bool resized_ = true;
+  bool minimized_ = false;
+  int frames_ = 0;
+};
+
+void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, const Viewer& viewer,
+                      const cli::LoadedScene& loaded) {
+  // The last frame is in the window's float image; rendering its camera and settings once more
+  // returns it as a RenderImage (only the composite runs: the lists are reused) with the outputs
+  // the EXR carries, exactly as tilesplat-render writes them.
+  const tilesplat::RenderImage image = renderer.render(viewer.camera(), viewer.settings());
+  if (cli::has_extension(path, ".png")) {
+    tilesplat::PreviewOptions preview;
+    if (loaded.description) {
+      preview.exposure_stops = loaded.description->effects.exposure_stops;
+      preview.tone_map = loaded.description->effects.tone_map;
+    }
+    tilesplat::write_png_preview(path, image, preview);
+  } else {
+    tilesplat::ExrWriteOptions exr;
+    exr.alpha = !loaded.description || loaded.description->outputs.alpha;
+    tilesplat::write_exr(path, image, exr);
+  }
+}
+
+int run(int argc, char** argv) {
+  ViewerOptions options;
+  cli::ArgParser parser(
+      kProgram, "tilesplat-viewer SCENE.ply|SCENE.json [options]",
+      "Shows a 3D Gaussian Splatting scene in a window. Left-drag orbits around the scene's centre, right- or "
+      "middle-drag pans, the wheel zooms; N and P (or the arrow keys) step through the views of --cameras or the "
+      "scene file, M cycles accuracy modes, S cycles sort strategies, Esc or Q quits. The window starts at "
+      "--width x --height (default 960 wide, the view's aspect) and the image follows its size.");
+  cli::add_common_options(parser, options.common, cli::SortChoice::kOne);
+  parser.section("scripting");
+  parser.add_int("--frames", "N", "render N frames, then exit (default: run until the window is closed)",
+                 &options.frames, 1, 1000000);
+  parser.add_string("--screenshot", "FILE",
+                    "on exit, write the last frame: an .exr as tilesplat-render writes it, or a .png preview",
+                    &options.screenshot);
+  if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
+  cli::check_common_options(parser, options.common);
+  if (!options.screenshot.empty()) {
+    if (!cli::has_extension(options.screenshot, ".exr") && !cli::has_extension(options.screenshot, ".png"))
+      throw cli::UsageError("--screenshot expects an .exr or .png file, got '" + options.screenshot + "'");
+    cli::check_distinct_paths(
+        {{"SCENE", options.common.scene}, {"--cameras", options.common.cameras}, {"--screenshot", options.screenshot}});
+    cli::check_output_path(options.screenshot, "--screenshot");
+  }
+  if (!parser.seen("--width") && !parser.seen("--height")) options.common.width = kDefaultWindowWidth;
+  options.common.validation = options.common.validation || validation_from_environment();
+
+  // The scene and cameras before the window: a bad file fails without one flashing up.
+  const cli::LoadedScene loaded = cli::load_scene_and_camera(options.common, kProgram);
+  std::vector<tilesplat::CameraView> views = options.common.cameras.empty()
+                                                 ? cli::scene_views(loaded).views
+                                                 : cli::load_camera_views(options.common.cameras);
+
+  GlfwSession glfw;
+  glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);  // Vulkan presents; no OpenGL context
+  const WindowHandle window(
+      glfwCreateWindow(loaded.camera.width, loaded.camera.height, kProgram, nullptr, nullptr), glfwDestroyWindow);
+  if (!window) throw std::runtime_error("cannot open a window: " + last_glfw_error);
+  const WindowDevice device(window.get(), options.common.validation, options.common.device);
+  const auto renderer = tilesplat::create_renderer(device.external());
+  renderer->set_scene(loaded.scene);
+
+  Viewer viewer(window.get(), device, *renderer, options, loaded, std::move(views));
+  viewer.run(options.frames);
+  const double last_gpu_ms = renderer->last_frame_stats().gpu_ms;  // before a screenshot renders again
+  if (!options.screenshot.empty()) {
+    if (viewer.frames() == 0)
+      throw std::runtime_error("the window closed before a frame was rendered; " + options.screenshot +
+                               " was not written");
+    write_screenshot(options.screenshot, *renderer, viewer, loaded);
+  }
+
+  const tilesplat::Camera& camera = viewer.camera();
+  std::string summary = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
+                        cli::describe_scene(loaded.scene) + ", " + std::to_string(viewer.frames()) +
+                        (viewer.frames() == 1 ? " frame on " : " frames on ") +
+                        device.name() + ", the last " + cli::format_size(camera.width, camera.height) + " in " +
+                        cli::format_fixed(last_gpu_ms, 2) + " GPU ms";
+  if (device.validation()) summary += ", validation: " + std::to_string(device.validation_messages()) + " messages";
+  if (!options.screenshot.empty()) summary += " -> " + options.screenshot;
+  std::fputs((summary + "\n").c_str(), stderr);
+  if (device.validation_messages() > 0)
+    cli::print_warning(kProgram, std::to_string(device.validation_messages()) +
+                                     " Vulkan validation messages (see above)");
+  return cli::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return cli::run_app(kProgram, [argc, argv] { return run(argc, argv); });
+}
