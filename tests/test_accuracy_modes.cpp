@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "accuracy_report.h"
 #include "test_support.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
@@ -245,6 +246,16 @@ TEST(AccuracyModes, ResortingOrdersEachPixelByRayDepth) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// rotation_inconsistency() over 8x8 blocks of the two frames the renderer draws from cameras that
+// differ by a turn, re-sorting each pixel's nearest `window` splats (0: centre-depth order alone).
+TemporalDifference turn_inconsistency(Renderer& renderer, RenderSettings settings, const Camera& before,
+                                      const Camera& after, int window, double threshold) {
+  settings.accuracy.resort_window = window;
+  const RenderImage a = renderer.render(before, settings);
+  const RenderImage b = renderer.render(after, settings);
+  return rotation_inconsistency(a, before, b, after, 8, threshold);
+}
+
 // Turning the camera in place changes the splats' view depths, so centre-depth blending may flip the
 // order of two splats and change their whole overlap, though no ray saw anything new: popping. Depth
 // along each pixel's ray does not change with a turn, so re-sorting by it keeps each ray's colour.
@@ -280,15 +291,8 @@ TEST(AccuracyModes, ResortingKeepsEachRaysColourWhenTheCameraTurns) {
   const Camera before = turned(0.0), after = turned(0.08);
   Renderer& renderer = testing::validated_renderer();
   renderer.set_scene(scene);
-  RenderSettings settings;
-  auto inconsistency = [&](int window) {
-    settings.accuracy.resort_window = window;
-    const RenderImage a = renderer.render(before, settings);
-    const RenderImage b = renderer.render(after, settings);
-    return rotation_inconsistency(a, before, b, after, 8, 0.05);
-  };
-  const TemporalDifference centre_order = inconsistency(0);
-  const TemporalDifference ray_order = inconsistency(4);
+  const TemporalDifference centre_order = turn_inconsistency(renderer, {}, before, after, 0, 0.05);
+  const TemporalDifference ray_order = turn_inconsistency(renderer, {}, before, after, 4, 0.05);
   std::printf("turned 0.08 rad: centre-depth order %.4f of blocks (mean %.5f), ray order %.4f (mean %.5f)\n",
               centre_order.flicker_fraction, centre_order.mean_abs, ray_order.flicker_fraction, ray_order.mean_abs);
   EXPECT_GT(centre_order.flicker_fraction, 0.3) << "the flip changes the overlap's colour";
@@ -306,26 +310,14 @@ TEST(AccuracyModes, ResortingCutsTheViewInconsistencyOfARealScene) {
   const GaussianScene scene = load_scene(testing::bundled_playbot());
   const auto views = load_cameras_json(testing::bundled_playbot_cameras());
   renderer.set_scene(scene);
-  Camera before = resize_camera(views.at(0).camera, 640, 360);
-  Camera after = before;
-  const double yaw = 0.08;
-  const std::array<double, 9> turn = {std::cos(yaw), 0, std::sin(yaw), 0, 1, 0, -std::sin(yaw), 0, std::cos(yaw)};
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) {
-      after.rotation[3 * r + c] = 0;
-      for (int k = 0; k < 3; ++k) after.rotation[3 * r + c] += turn[3 * r + k] * before.rotation[3 * k + c];
-    }
+  // The report's own pair: the view and the same camera turned in place.
+  const auto pair = accuracy::camera_path(accuracy::CameraPath::kPan, resize_camera(views.at(0).camera, 640, 360),
+                                          {}, 2, 0.08);
   RenderSettings settings;
   settings.depth = false;
   settings.splat_count = false;
-  auto inconsistency = [&](int window) {
-    settings.accuracy.resort_window = window;
-    const RenderImage a = renderer.render(before, settings);
-    const RenderImage b = renderer.render(after, settings);
-    return rotation_inconsistency(a, before, b, after, 8, 0.01);
-  };
-  const TemporalDifference centre_order = inconsistency(0);
-  const TemporalDifference ray_order = inconsistency(16);
+  const TemporalDifference centre_order = turn_inconsistency(renderer, settings, pair[0], pair[1], 0, 0.01);
+  const TemporalDifference ray_order = turn_inconsistency(renderer, settings, pair[0], pair[1], 16, 0.01);
   std::printf("playbot view 0 turned 0.08 rad: reference %.3f%% of blocks (mean %.6f), resort16 %.3f%% (mean %.6f)\n",
               100 * centre_order.flicker_fraction, centre_order.mean_abs, 100 * ray_order.flicker_fraction,
               ray_order.mean_abs);

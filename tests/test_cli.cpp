@@ -1,6 +1,5 @@
 // Runs tilesplat-render and tilesplat-bench as processes: exit codes, error messages, outputs.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <tuple>
@@ -8,10 +7,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
+#include "process_support.h"
 #include "test_support.h"
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
@@ -25,83 +24,20 @@ using tilesplat::testing::bundled_playbot_cameras;
 using tilesplat::testing::bundled_sh3;
 using tilesplat::testing::bundled_sh3_cameras;
 using tilesplat::testing::temp_dir;
+using tilesplat::testing::entries;
+using tilesplat::testing::expect_one_error_line;
+using tilesplat::testing::fresh_output_dir;
+using tilesplat::testing::line_count;
+using tilesplat::testing::ProcessResult;
+using tilesplat::testing::read_file;
+using tilesplat::testing::run_process;
 
 constexpr const char* kRenderExe = TILESPLAT_RENDER_EXE;
 constexpr const char* kBenchExe = TILESPLAT_BENCH_EXE;
 
-struct ProcessResult {
-  int exit_code = -1;  // -1 when the process did not exit normally (a signal, a crash)
-  std::string out;
-  std::string err;
-};
-
-std::string shell_quote(const std::string& text) {
-  std::string quoted = "'";
-  for (const char c : text) {
-    if (c == '\'')
-      quoted += "'\\''";
-    else
-      quoted += c;
-  }
-  return quoted + "'";
-}
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-// Runs `exe args...` through the shell with stdout captured and stderr in a file beside the
-// test's temporaries. VK_LOADER_DEBUG is emptied so that loader chatter cannot pollute stderr.
-ProcessResult run_exe(const char* exe, const std::vector<std::string>& args) {
-  static int invocation = 0;
-  std::string err_name = "stderr_";
-  err_name += std::to_string(invocation++);
-  err_name += ".txt";
-  const fs::path err_path = temp_dir() / err_name;
-  std::string command = "VK_LOADER_DEBUG= ";
-  command += shell_quote(exe);
-  for (const auto& arg : args) {
-    command += ' ';
-    command += shell_quote(arg);
-  }
-  command += " 2>";
-  command += shell_quote(err_path.string());
-  command += " </dev/null";
-
-  ProcessResult result;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) {
-    result.err = "popen failed for: " + command;
-    return result;
-  }
-  char buffer[4096];
-  size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) result.out.append(buffer, n);
-  const int status = ::pclose(pipe);
-  if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-  result.err = read_file(err_path);
-  return result;
-}
-
-// An empty directory for a test's outputs (temporaries persist between runs, so start clean).
-fs::path fresh_output_dir() {
-  const fs::path dir = temp_dir() / "out";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::vector<std::string> entries(const fs::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
+ProcessResult run_exe(const char* exe, const std::vector<std::string>& args) { return run_process("", exe, args); }
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
-
-size_t line_count(const std::string& text) { return static_cast<size_t>(std::count(text.begin(), text.end(), '\n')); }
 
 size_t views_in(const fs::path& cameras_json) {
   const std::string text = read_file(cameras_json);
@@ -109,12 +45,6 @@ size_t views_in(const fs::path& cameras_json) {
   for (size_t pos = text.find("\"img_name\""); pos != std::string::npos; pos = text.find("\"img_name\"", pos + 1))
     ++count;
   return count;
-}
-
-// Every failure is exactly one line: "PROGRAM: error: ...".
-void expect_one_error_line(const ProcessResult& result, const std::string& program) {
-  EXPECT_EQ(result.err.rfind(program + ": error: ", 0), 0u) << result.err;
-  EXPECT_EQ(line_count(result.err), 1u) << result.err;
 }
 
 // ---------------------------------------------------------------------------------------------

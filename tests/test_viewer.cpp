@@ -2,7 +2,6 @@
 // private Xvfb server (xvfb-run): its screenshot is tilesplat-render's image of the same view, the
 // validation layer stays silent, and bad input fails with one line and writes nothing.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,11 +9,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "process_support.h"
 #include "test_support.h"
 #include "tilesplat/image.h"
 
@@ -25,6 +24,10 @@ using tilesplat::testing::bundled_playbot;
 using tilesplat::testing::bundled_playbot_cameras;
 using tilesplat::testing::bundled_sh3;
 using tilesplat::testing::bundled_sh3_cameras;
+using tilesplat::testing::fresh_output_dir;
+using tilesplat::testing::line_count;
+using tilesplat::testing::ProcessResult;
+using tilesplat::testing::run_process;
 using tilesplat::testing::temp_dir;
 
 #ifdef TILESPLAT_VIEWER_EXE
@@ -35,38 +38,6 @@ constexpr const char* kViewerExe = "";
 #define REQUIRE_VIEWER() GTEST_SKIP() << "tilesplat-viewer is not built (configure with -DTILESPLAT_BUILD_VIEWER=ON)"
 #endif
 constexpr const char* kRenderExe = TILESPLAT_RENDER_EXE;
-
-struct ProcessResult {
-  int exit_code = -1;  // -1 when the process did not exit normally (a signal, a crash)
-  std::string err;
-};
-
-std::string shell_quote(const std::string& text) {
-  std::string quoted = "'";
-  for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
-// Runs `prefix exe args...` through the shell, stderr captured in a file beside the test's
-// temporaries (loader chatter kept out of it by emptying VK_LOADER_DEBUG).
-ProcessResult run(const std::string& prefix, const std::string& exe, const std::vector<std::string>& args) {
-  static int invocation = 0;
-  const fs::path err_path = temp_dir() / ("stderr_" + std::to_string(invocation++) + ".txt");
-  std::string command = "VK_LOADER_DEBUG= " + prefix + shell_quote(exe);
-  for (const auto& arg : args) {
-    command += ' ';
-    command += shell_quote(arg);
-  }
-  command += " >/dev/null 2>";
-  command += shell_quote(err_path.string());
-  command += " </dev/null";
-  ProcessResult result;
-  const int status = std::system(command.c_str());
-  if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-  std::ifstream err(err_path);
-  result.err.assign(std::istreambuf_iterator<char>(err), std::istreambuf_iterator<char>());
-  return result;
-}
 
 bool env_set(const char* name) {
   const char* value = std::getenv(name);
@@ -90,19 +61,8 @@ std::vector<std::string> view_args(const fs::path& scene, const fs::path& camera
           "--height", "180"};
 }
 
-size_t line_count(const std::string& text) { return size_t(std::count(text.begin(), text.end(), '\n')); }
-
 void expect_one_error_line(const ProcessResult& result) {
-  EXPECT_EQ(result.err.rfind("tilesplat-viewer: error: ", 0), 0u) << result.err;
-  EXPECT_EQ(line_count(result.err), 1u) << result.err;
-}
-
-// An empty directory for a test's outputs (temporaries persist between runs).
-fs::path fresh_output_dir() {
-  const fs::path dir = temp_dir() / "out";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  tilesplat::testing::expect_one_error_line(result, "tilesplat-viewer");
 }
 
 TEST(Viewer, ScreenshotIsTheRenderOfTheSameView) {
@@ -115,10 +75,10 @@ TEST(Viewer, ScreenshotIsTheRenderOfTheSameView) {
   viewer_args.insert(viewer_args.end(), {"--frames", "3", "--screenshot", (out / "viewer.exr").string()});
   render_args.insert(render_args.end(), {"-o", (out / "render.exr").string()});
 
-  const ProcessResult viewer = run(*prefix, kViewerExe, viewer_args);
+  const ProcessResult viewer = run_process(*prefix, kViewerExe, viewer_args);
   ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
   EXPECT_NE(viewer.err.find("3 frames"), std::string::npos) << viewer.err;
-  const ProcessResult render = run("", kRenderExe, render_args);
+  const ProcessResult render = run_process("", kRenderExe, render_args);
   ASSERT_EQ(render.exit_code, 0) << render.err;
 
   const tilesplat::RenderImage shown = tilesplat::read_exr(out / "viewer.exr");
@@ -142,7 +102,7 @@ TEST(Viewer, ValidationLayerStaysSilent) {
   std::vector<std::string> args = view_args(bundled_sh3(), bundled_sh3_cameras(), 1);
   args.insert(args.end(), {"--validation", "--mode", "depth16", "--sort", "onesweep", "--frames", "2", "--screenshot",
                            (out / "shot.png").string()});
-  const ProcessResult result = run(*prefix, kViewerExe, args);
+  const ProcessResult result = run_process(*prefix, kViewerExe, args);
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.err.find("validation: 0 messages"), std::string::npos) << result.err;
   EXPECT_EQ(result.err.find("vulkan validation"), std::string::npos) << result.err;
@@ -161,22 +121,22 @@ TEST(Viewer, BadInputFailsWithOneLineAndWritesNothing) {
   const fs::path missing = temp_dir() / "no_such_scene.ply";
   fs::remove(missing);
 
-  const ProcessResult no_scene = run("", kViewerExe, {missing.string(), "--frames", "1", "--screenshot", shot});
+  const ProcessResult no_scene = run_process("", kViewerExe, {missing.string(), "--frames", "1", "--screenshot", shot});
   EXPECT_EQ(no_scene.exit_code, 1) << no_scene.err;  // a runtime error, as tilesplat-render's
   EXPECT_NE(no_scene.err.find("no_such_scene.ply"), std::string::npos) << no_scene.err;
   expect_one_error_line(no_scene);
 
-  const ProcessResult bad_flag = run("", kViewerExe, {bundled_sh3().string(), "--frobnicate", "--screenshot", shot});
+  const ProcessResult bad_flag = run_process("", kViewerExe, {bundled_sh3().string(), "--frobnicate", "--screenshot", shot});
   EXPECT_EQ(bad_flag.exit_code, 2) << bad_flag.err;
   EXPECT_NE(bad_flag.err.find("--frobnicate"), std::string::npos) << bad_flag.err;
   expect_one_error_line(bad_flag);
 
-  const ProcessResult no_frames = run("", kViewerExe, {bundled_sh3().string(), "--frames", "0"});
+  const ProcessResult no_frames = run_process("", kViewerExe, {bundled_sh3().string(), "--frames", "0"});
   EXPECT_EQ(no_frames.exit_code, 2) << no_frames.err;
   expect_one_error_line(no_frames);
 
   const std::string jpg = (out / "x.jpg").string();
-  const ProcessResult bad_shot = run("", kViewerExe, {bundled_sh3().string(), "--screenshot", jpg});
+  const ProcessResult bad_shot = run_process("", kViewerExe, {bundled_sh3().string(), "--screenshot", jpg});
   EXPECT_EQ(bad_shot.exit_code, 2) << bad_shot.err;
   expect_one_error_line(bad_shot);
 
@@ -186,7 +146,7 @@ TEST(Viewer, BadInputFailsWithOneLineAndWritesNothing) {
 TEST(Viewer, NoDisplayFailsWithOneLine) {
   REQUIRE_VIEWER();
   const fs::path out = fresh_output_dir();
-  const ProcessResult result = run("env -u DISPLAY -u WAYLAND_DISPLAY ", kViewerExe,
+  const ProcessResult result = run_process("env -u DISPLAY -u WAYLAND_DISPLAY ", kViewerExe,
                                    {bundled_sh3().string(), "--frames", "1", "--screenshot",
                                     (out / "shot.exr").string()});
   EXPECT_EQ(result.exit_code, 1) << result.err;
