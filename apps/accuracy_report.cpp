@@ -61,31 +61,6 @@ bool applies_to(const AccuracyModes& modes, int scene_sh_degree) {
   return modes.sh_degree_cap >= 3 || modes.sh_degree_cap < scene_sh_degree;
 }
 
-namespace {
-
-// The rotation by `angle` radians about the unit `axis` (Rodrigues), row-major.
-std::array<double, 9> axis_rotation(const std::array<double, 3>& axis, double angle) {
-  const double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
-  const auto [x, y, z] = axis;
-  return {t * x * x + c,     t * x * y - s * z, t * x * z + s * y,
-          t * x * y + s * z, t * y * y + c,     t * y * z - s * x,
-          t * x * z - s * y, t * y * z + s * x, t * z * z + c};
-}
-
-std::array<double, 9> multiply(const std::array<double, 9>& a, const std::array<double, 9>& b) {
-  std::array<double, 9> product{};
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      for (int k = 0; k < 3; ++k) product[3 * r + c] += a[3 * r + k] * b[3 * k + c];
-  return product;
-}
-
-std::array<double, 9> transpose(const std::array<double, 9>& m) {
-  return {m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8]};
-}
-
-}  // namespace
-
 const char* to_string(CameraPath path) {
   switch (path) {
     case CameraPath::kDolly: return "dolly";
@@ -117,20 +92,13 @@ std::vector<Camera> camera_path(CameraPath kind, const Camera& start, const std:
         for (int k = 0; k < 3; ++k) camera.position[k] += f * step_fraction * distance * camera_x[k];
         break;
       case CameraPath::kPan:
-        // Turning in place about the camera's own y axis: x_cam' = R_y * x_cam.
-        camera.rotation = multiply(axis_rotation({0, 1, 0}, f * step_fraction), start.rotation);
+        // Turning in place about the camera's y axis. Turning the rig by -a is x_cam' = R_y(a) x_cam.
+        camera = turn_camera(start, start.position, camera_y, -f * step_fraction);
         break;
-      case CameraPath::kOrbit: {
-        // The whole rig turns about the line through `centre` along the camera's y axis: the position
-        // moves by Q and the world-to-camera rotation becomes R * Q^T, so the scene turns under the camera.
-        const auto q = axis_rotation(camera_y, f * step_fraction);
-        for (int r = 0; r < 3; ++r) {
-          camera.position[r] = centre[r];
-          for (int k = 0; k < 3; ++k) camera.position[r] += q[3 * r + k] * (start.position[k] - centre[k]);
-        }
-        camera.rotation = multiply(start.rotation, transpose(q));
+      case CameraPath::kOrbit:
+        // The whole rig turns about the line through `centre` along the camera's y axis.
+        camera = turn_camera(start, centre, camera_y, f * step_fraction);
         break;
-      }
     }
     path.push_back(camera);
   }

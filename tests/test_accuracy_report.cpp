@@ -79,4 +79,41 @@ TEST(CameraPath, EachPathMovesWhatItSaysAndKeepsTheRest) {
   }
 }
 
+// The pan turns the camera's coordinates by R_y: x_cam' = R_y(f step) x_cam, R_y = [[c 0 s] [0 1 0] [-s 0 c]].
+TEST(CameraPath, PanTurnsCameraCoordinatesAboutY) {
+  const Camera start = start_camera();
+  const auto path = camera_path(CameraPath::kPan, start, {0, 0, 0}, 3, 0.02);
+  for (int f = 1; f < 3; ++f) {
+    const double c = std::cos(f * 0.02), s = std::sin(f * 0.02);
+    const double turn[9] = {c, 0, s, 0, 1, 0, -s, 0, c};
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) {
+        double expected = 0;
+        for (int j = 0; j < 3; ++j) expected += turn[3 * r + j] * start.rotation[3 * j + k];
+        EXPECT_NEAR(path[size_t(f)].rotation[3 * r + k], expected, 1e-12) << "frame " << f;
+      }
+  }
+}
+
+TEST(TurnCamera, TurnsAboutTheLineAndBack) {
+  const Camera start = start_camera();
+  const std::array<double, 3> pivot = {0.5, -0.25, 1}, axis = {0, 0.6, 0.8};
+  const Camera turned = tilesplat::turn_camera(start, pivot, axis, 0.3);
+  // A point on the line keeps its place in the view; the camera keeps its distance to the line's points.
+  const std::array<double, 3> on_line = {pivot[0] + 2 * axis[0], pivot[1] + 2 * axis[1], pivot[2] + 2 * axis[2]};
+  for (const auto& point : {pivot, on_line}) {
+    const auto before = start.to_camera(point), after = turned.to_camera(point);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(after[k], before[k], 1e-12);
+  }
+  EXPECT_NEAR(distance(turned.position, pivot), distance(start.position, pivot), 1e-12);
+  const Camera back = tilesplat::turn_camera(turned, pivot, axis, -0.3);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(back.position[k], start.position[k], 1e-12);
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR(back.rotation[k], start.rotation[k], 1e-12);
+  // Turning in place about the view axis is a roll: the position stays, the view axis too.
+  const std::array<double, 3> forward = {start.rotation[6], start.rotation[7], start.rotation[8]};
+  const Camera rolled = tilesplat::turn_camera(start, start.position, forward, 0.5);
+  EXPECT_EQ(rolled.position, start.position);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(rolled.rotation[6 + k], forward[k], 1e-12);
+}
+
 }  // namespace

@@ -13,34 +13,11 @@ using Vec3 = std::array<double, 3>;
 constexpr Vec3 kWorldUp = {0, -1, 0};
 
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-
-// Rodrigues' rotation of v by `angle` radians about the unit `axis`.
-Vec3 rotated(const Vec3& v, const Vec3& axis, double angle) {
-  const double c = std::cos(angle), s = std::sin(angle);
-  const Vec3 across = cross(axis, v);
-  const double along = dot(axis, v) * (1 - c);
-  return {v[0] * c + across[0] * s + axis[0] * along, v[1] * c + across[1] * s + axis[1] * along,
-          v[2] * c + across[2] * s + axis[2] * along};
-}
 
 // Camera::rotation is world to camera, row-major: row k is the camera's axis k (x right, y down,
 // z forward) in world space.
 Vec3 axis(const Camera& camera, int k) {
   return {camera.rotation[3 * k], camera.rotation[3 * k + 1], camera.rotation[3 * k + 2]};
-}
-
-// Turns the camera (position and axes) by `angle` about the line through `pivot` along `direction`.
-void turn(Camera& camera, const Vec3& pivot, const Vec3& direction, double angle) {
-  Vec3 offset = {camera.position[0] - pivot[0], camera.position[1] - pivot[1], camera.position[2] - pivot[2]};
-  offset = rotated(offset, direction, angle);
-  for (int i = 0; i < 3; ++i) camera.position[i] = pivot[i] + offset[i];
-  for (int k = 0; k < 3; ++k) {
-    const Vec3 turned = rotated(axis(camera, k), direction, angle);
-    std::copy(turned.begin(), turned.end(), camera.rotation.begin() + 3 * k);
-  }
 }
 
 }  // namespace
@@ -69,11 +46,10 @@ void OrbitController::resize(int width, int height) {
 
 void OrbitController::orbit(double dx, double dy) {
   const double radians_per_pixel = std::numbers::pi / camera_.height;
-  turn(camera_, pivot_, kWorldUp, -dx * radians_per_pixel);
+  camera_ = turn_camera(camera_, pivot_, kWorldUp, -dx * radians_per_pixel);
   // Tilting past the pole would turn the image upside down and make the next horizontal drag
   // go the wrong way: such a step is not taken.
-  Camera tilted = camera_;
-  turn(tilted, pivot_, axis(camera_, 0), -dy * radians_per_pixel);
+  const Camera tilted = turn_camera(camera_, pivot_, axis(camera_, 0), -dy * radians_per_pixel);
   if (std::abs(dot(axis(tilted, 2), kWorldUp)) < 0.99) camera_ = tilted;
 }
 

@@ -56,6 +56,12 @@ struct OrbitParams {
 };
 Camera orbit_camera(const GaussianScene& scene, int width, int height, const OrbitParams& params = {});
 
+// The camera turned by `radians` (right-handed) about the line through `pivot` along the unit
+// `axis`: its position moves around the line and its axes turn with it, so the scene turns the
+// other way in its view. Orbiting is a pivot at the scene; pivot = camera.position turns it in place.
+Camera turn_camera(const Camera& camera, const std::array<double, 3>& pivot, const std::array<double, 3>& axis,
+                   double radians);
+
 // A camera at `eye` looking at `target`; `up` is the world up direction (the camera's -y).
 Camera look_at_camera(const std::array<double, 3>& eye, const std::array<double, 3>& target,
                       const std::array<double, 3>& up, int width, int height, double vertical_fov_deg);

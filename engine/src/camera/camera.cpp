@@ -27,6 +27,15 @@ double degrees_to_radians(double degrees) { return degrees * std::numbers::pi / 
 // Rounds a scaled image dimension, never below one pixel.
 int scaled_dimension(double value) { return std::max(1, static_cast<int>(std::lround(value))); }
 
+// Rodrigues' rotation of v by `angle` radians about the unit `axis`.
+Vec3 rotated(const Vec3& v, const Vec3& axis, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  const Vec3 across = cross(axis, v);
+  const double along = dot(axis, v) * (1 - c);
+  return {v[0] * c + across[0] * s + axis[0] * along, v[1] * c + across[1] * s + axis[1] * along,
+          v[2] * c + across[2] * s + axis[2] * along};
+}
+
 }  // namespace
 
 void validate(const Camera& camera) {
@@ -140,6 +149,20 @@ Camera orbit_camera(const GaussianScene& scene, int width, int height, const Orb
   const Vec3 eye = {center[0] + distance * offset[0], center[1] + distance * offset[1],
                     center[2] + distance * offset[2]};
   return look_at_camera(eye, center, world_up, width, height, params.vertical_fov_deg);
+}
+
+Camera turn_camera(const Camera& camera, const std::array<double, 3>& pivot, const std::array<double, 3>& axis,
+                   double radians) {
+  Camera turned = camera;
+  const Vec3 offset = rotated(subtract(camera.position, pivot), axis, radians);
+  for (int i = 0; i < 3; ++i) turned.position[i] = pivot[i] + offset[i];
+  // Row k of the world-to-camera rotation is the camera's axis k in world space: each turns alike.
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 row = rotated({camera.rotation[3 * k], camera.rotation[3 * k + 1], camera.rotation[3 * k + 2]}, axis,
+                             radians);
+    std::copy(row.begin(), row.end(), turned.rotation.begin() + 3 * k);
+  }
+  return turned;
 }
 
 }  // namespace tilesplat

@@ -330,8 +330,8 @@ TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& ca
       const double u = camera_a.fx * in_a[0] / in_a[2] + camera_a.cx - 0.5;
       const double v = camera_a.fy * in_a[1] / in_a[2] + camera_a.cy - 0.5;
       if (!(u >= 0 && v >= 0 && u <= width - 1 && v <= height - 1)) continue;
-      const int x0 = std::min(int(u), width - 2 < 0 ? 0 : width - 2);
-      const int y0 = std::min(int(v), height - 2 < 0 ? 0 : height - 2);
+      const int x0 = std::min(int(u), std::max(width - 2, 0));
+      const int y0 = std::min(int(v), std::max(height - 2, 0));
       const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
       const double fx = u - x0, fy = v - y0;
       const size_t pixel = size_t(y) * size_t(width) + size_t(x);
