@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages tilesplat builds and tests with, only when one is missing.
 # Safe to run repeatedly; needs root (or sudo) only when something must be installed.
+# zlib, zstd, libwebp and libzip are the containers of the compressed splat formats (.spz, .sog).
 # xvfb and xauth give the viewer's tests a display (xvfb-run) on a machine without one.
 # --fuzz adds clang and its compiler-rt (libFuzzer) for tests/fuzz/run.sh; the normal build needs neither.
 set -euo pipefail
@@ -9,6 +10,7 @@ pkgs=(
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
   glslang-tools spirv-tools
   libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev
+  zlib1g-dev libzstd-dev libwebp-dev libzip-dev
   libgtest-dev googletest
   xvfb xauth
 )

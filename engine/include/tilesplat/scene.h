@@ -52,7 +52,10 @@ struct DroppedProperty {
 };
 
 struct LoadReport {
-  std::string format;        // "ply binary_little_endian", "ply ascii", ...
+  // The format as the reader found it from the content: "ply binary_little_endian", "ply ascii",
+  // "compressed ply", "splat", "spz", "sog", "sog (unbundled)", "glb", "gltf".
+  std::string format;
+  std::string version;       // the format's version where it has one ("1.0", "3", "2", ...), else empty
   size_t gaussians_in_file = 0;
   size_t dropped = 0;        // Gaussians removed for non-finite values
   std::vector<DroppedProperty> dropped_by_property;
@@ -60,7 +63,8 @@ struct LoadReport {
   std::string summary() const;  // one human-readable line, empty when nothing was dropped
 };
 
-// Reads a 3DGS PLY (binary little/big endian or ASCII). Throws SceneError.
+// Reads a 3DGS PLY (binary little/big endian or ASCII), or a PlayCanvas compressed PLY (told apart
+// by its header's elements). Throws SceneError.
 GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& options = {},
                        LoadReport* report = nullptr);
 
@@ -68,9 +72,23 @@ GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& opt
 GaussianScene parse_ply(std::span<const std::byte> data, std::string_view name, const LoadOptions& options = {},
                         LoadReport* report = nullptr);
 
-// Picks the reader by extension (only .ply for now). Throws SceneError.
+// Reads a scene file of any supported format, chosen by its content (magic bytes, zip or JSON
+// structure), with the extension only deciding for .splat, the one format without a header:
+//   .ply (binary or ASCII), PlayCanvas compressed .ply, antimatter15 .splat, Niantic .spz
+//   (versions 2, 3 and 4), PlayCanvas SOG version 2 (and 1) as a .sog zip or an unbundled
+//   meta.json beside its WebP images, glTF 2.0 (.glb or .gltf) with KHR_gaussian_splatting.
+// Every reader yields the same GaussianScene (trainer's activations and axes; see docs/formats.md)
+// and shares one post-processing step: non-finite values dropped (or rejected, strict), quaternions
+// normalized, a quaternion of zero or denormal components the identity. Throws SceneError naming
+// the file and the problem.
 GaussianScene load_scene(const std::filesystem::path& path, const LoadOptions& options = {},
                          LoadReport* report = nullptr);
+
+// The same readers on a file already in memory; `name` stands for the file in error messages and
+// decides, by its extension, only whether headerless bytes are read as .splat. Formats that refer
+// to other files (an unbundled SOG meta.json, a .gltf with external buffers) need load_scene.
+GaussianScene parse_scene(std::span<const std::byte> data, std::string_view name, const LoadOptions& options = {},
+                          LoadReport* report = nullptr);
 
 struct Bounds {
   double min[3] = {0, 0, 0};

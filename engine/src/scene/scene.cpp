@@ -1,9 +1,14 @@
-// Scene-level entry points: format dispatch, load reports and robust scene bounds.
+// Scene-level entry points: the format chosen by content, load reports and robust scene bounds.
 #include "tilesplat/scene.h"
+
+#include "scene/scene_readers.h"
+#include "scene/scene_reading.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,20 +34,89 @@ double median(std::vector<double> values) {
 
 }  // namespace
 
-GaussianScene load_scene(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report) {
-  const std::string extension = lowercase(path.extension().string());
-  if (extension == ".ply") return load_ply(path, options, report);
-  std::string message = path.string();
-  message += ": unsupported scene format ";
-  if (extension.empty()) {
-    message += "(no extension)";
-  } else {
-    message += '\'';
-    message += path.extension().string();
-    message += '\'';
+namespace {
+
+enum class Container { kPly, kSpz, kZip, kGlb, kJson, kUnknown };
+
+Container container_of(std::span<const std::byte> data) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
+  const auto starts_with = [&](std::string_view magic) {
+    return data.size() >= magic.size() && std::memcmp(bytes, magic.data(), magic.size()) == 0;
+  };
+  if (starts_with("ply\n") || starts_with("ply\r\n")) return Container::kPly;
+  if (starts_with("PK\x03\x04")) return Container::kZip;
+  if (starts_with("glTF")) return Container::kGlb;
+  if (detail::is_spz(data)) return Container::kSpz;
+  for (size_t i = 0; i < data.size(); ++i) {
+    const char c = static_cast<char>(bytes[i]);
+    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') continue;
+    return c == '{' ? Container::kJson : Container::kUnknown;
   }
-  message += " (supported: .ply)";
-  throw SceneError(message);
+  return Container::kUnknown;
+}
+
+// Reads a file that `referrer` names, resolved beside it; only plain relative names are followed.
+detail::FileLoader sibling_loader(const std::filesystem::path& referrer) {
+  return [referrer](const std::string& name) {
+    const std::filesystem::path relative(name);
+    const bool escapes = relative.is_absolute() ||
+                         std::any_of(relative.begin(), relative.end(), [](const auto& part) { return part == ".."; });
+    if (name.empty() || escapes)
+      detail::fail(referrer.string(), "it names the file '" + name + "', which is not a path beside it");
+    const std::filesystem::path path = referrer.parent_path() / relative;
+    detail::FileContents contents;
+    try {
+      detail::open_scene_file(path, contents);
+    } catch (const SceneError& error) {
+      detail::fail(referrer.string(), "it names '" + name + "', which cannot be read (" + error.what() + ")");
+    }
+    return std::vector<unsigned char>(contents.data(), contents.data() + contents.size());
+  };
+}
+
+GaussianScene read_any(std::span<const std::byte> data, const std::string& name, const std::filesystem::path* path,
+                       const LoadOptions& options, LoadReport* report) {
+  const detail::FileLoader no_files;
+  const detail::FileLoader files = path ? sibling_loader(*path) : no_files;
+  switch (container_of(data)) {
+    case Container::kPly:
+      return parse_ply(data, name, options, report);
+    case Container::kSpz:
+      return detail::read_spz(data, name, options, report);
+    case Container::kZip:
+      return detail::read_sog_zip(data, name, options, report);
+    case Container::kGlb:
+      return detail::read_gltf(data, name, files, options, report);
+    case Container::kJson: {
+      const std::string_view text(reinterpret_cast<const char*>(data.data()), data.size());
+      if (detail::is_sog_meta(text)) {
+        if (!path) detail::fail(name, "an unbundled SOG meta.json: its images are files, read it with load_scene");
+        return detail::read_sog_meta(text, name, files, options, report);
+      }
+      return detail::read_gltf(data, name, files, options, report);
+    }
+    case Container::kUnknown:
+      break;
+  }
+  if (lowercase(std::filesystem::path(name).extension().string()) == ".splat")
+    return detail::read_splat(data, name, options, report);
+  if (data.empty()) detail::fail(name, "empty file, not a scene file");
+  detail::fail(name, "unrecognized scene format: not a PLY, compressed PLY, SPZ, SOG, glTF or GLB file by its "
+                     "content (supported: .ply, .compressed.ply, .splat, .spz, .sog, SOG meta.json, .glb, .gltf; "
+                     "a headerless .splat file needs the .splat extension)");
+}
+
+}  // namespace
+
+GaussianScene load_scene(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report) {
+  detail::FileContents contents;
+  detail::open_scene_file(path, contents);
+  return read_any(contents.bytes(), path.string(), &path, options, report);
+}
+
+GaussianScene parse_scene(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
+                          LoadReport* report) {
+  return read_any(data, std::string(name), nullptr, options, report);
 }
 
 std::string LoadReport::summary() const {

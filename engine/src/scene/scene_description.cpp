@@ -705,6 +705,14 @@ GaussianScene load_described_scene(const SceneDescription& description, const Lo
   return merged;
 }
 
-bool is_scene_description(const fs::path& path) { return lowercase(path.extension().string()) == ".json"; }
+bool is_scene_description(const fs::path& path) {
+  if (lowercase(path.extension().string()) != ".json") return false;
+  // A SOG's meta.json is a scene of its own (load_scene reads it), not a scene description.
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return true;  // load_scene_description reports why it cannot be read
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
+  return !(json.is_object() && json.contains("means") && json.contains("quats"));
+}
 
 }  // namespace tilesplat

@@ -1,0 +1,50 @@
+// The format readers behind load_scene() and parse_scene(), one source file each. Each decodes a
+// file already in memory into the engine's GaussianScene and ends with finish_scene(); each throws
+// SceneError naming the file (`name`) and the problem. Formats that refer to other files take a
+// FileLoader for them.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scene/ply_header.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat::detail {
+
+// Reads a file that another one names (an unbundled SOG's WebP image, a .gltf's buffer), by the
+// name as written there; throws SceneError when it cannot.
+using FileLoader = std::function<std::vector<unsigned char>(const std::string& name)>;
+
+// PlayCanvas compressed PLY: a 'chunk' element of per-256-splat bounds, a 'vertex' element of
+// packed_* uint32 fields and an optional 'sh' element of uint8 coefficients.
+bool is_compressed_ply(const PlyHeader& header);
+GaussianScene read_compressed_ply(const PlyBytes& ply, const PlyHeader& header, const LoadOptions& options,
+                                  LoadReport* report);
+
+// antimatter15 .splat: 32 bytes a Gaussian, no header.
+GaussianScene read_splat(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
+                         LoadReport* report);
+
+// Niantic .spz: versions 2 and 3 (gzip, or the same bytes uncompressed) and 4 (zstd streams).
+bool is_spz(std::span<const std::byte> data);  // the NGSP magic, or a gzip stream
+GaussianScene read_spz(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
+                       LoadReport* report);
+
+// PlayCanvas SOG: a zip of meta.json and WebP images, or meta.json with the images beside it.
+GaussianScene read_sog_zip(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
+                           LoadReport* report);
+bool is_sog_meta(std::string_view json_text);  // a JSON object with SOG's "means" and "quats"
+GaussianScene read_sog_meta(std::string_view meta_json, std::string_view name, const FileLoader& load_image,
+                            const LoadOptions& options, LoadReport* report);
+
+// glTF 2.0 with KHR_gaussian_splatting: binary .glb, or JSON .gltf whose buffers are data: URIs or
+// files that `load_buffer` reads (nullptr: external buffers are an error).
+GaussianScene read_gltf(std::span<const std::byte> data, std::string_view name, const FileLoader& load_buffer,
+                        const LoadOptions& options, LoadReport* report);
+
+}  // namespace tilesplat::detail
