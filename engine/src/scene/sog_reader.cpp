@@ -112,8 +112,12 @@ class SogDecoder {
     if (!(declared >= 0 && declared <= 4294967295.0) || declared != std::floor(declared))
       fail("meta.json: the count " + std::to_string(declared) + " is not a count of Gaussians");
     const size_t count = static_cast<size_t>(declared);
-    // Images are near-square, row-major: anything much larger than the count is not a SOG image.
-    const size_t max_texels = 2 * count + 4096 * 4;
+    // Texel i is Gaussian i, row-major, in rows of at most 16383 (WebP's limit), padded to whole
+    // rows (writers round them up to multiples of 4): a larger image is not this scene's.
+    constexpr size_t kMaxSide = 16383;
+    if (count > kMaxSide * kMaxSide)
+      fail("meta.json: " + std::to_string(count) + " Gaussians are more than a WebP image can hold");
+    const size_t max_texels = count + 4 * kMaxSide;
 
     int sh_degree = 0;
     const json* sh_n = meta.contains("shN") ? &meta["shN"] : nullptr;
@@ -144,9 +148,12 @@ class SogDecoder {
              std::to_string(sh_degree) + " SH bands (" + std::to_string(64 * rest) + ")");
     }
 
+    // The means first: their images prove the count before the scene is sized by it.
+    const Image low = image(file(means, 0, "means"), count, max_texels);
+    const Image high = image(file(means, 1, "means"), count, max_texels);
     GaussianScene scene;
     allocate_scene(scene, count, sh_degree);
-    decode_means(meta, means, count, max_texels, scene);
+    decode_means(means, low, high, count, scene);
     decode_quats(meta, count, max_texels, scene);
     decode_scales_and_colours(meta, v2, count, max_texels, scene);
     if (sh_n) decode_sh(*sh_n, v2, centroids, labels, palette, scene);
@@ -154,11 +161,9 @@ class SogDecoder {
   }
 
  private:
-  void decode_means(const json&, const json& means, size_t count, size_t max_texels, GaussianScene& scene) const {
+  void decode_means(const json& means, const Image& low, const Image& high, size_t count, GaussianScene& scene) const {
     const std::vector<double> mins = numbers(means, "mins", 3, "means");
     const std::vector<double> maxs = numbers(means, "maxs", 3, "means");
-    const Image low = image(file(means, 0, "means"), count, max_texels);
-    const Image high = image(file(means, 1, "means"), count, max_texels);
     for (size_t i = 0; i < count; ++i)
       for (size_t a = 0; a < 3; ++a) {
         const double range = maxs[a] - mins[a] != 0 ? maxs[a] - mins[a] : 1.0;
@@ -239,7 +244,7 @@ class SogDecoder {
     } else {
       const double low = number(sh_n, "mins", "shN");
       const double high = number(sh_n, "maxs", "shN");
-      for (size_t b = 0; b < 256; ++b) book[b] = to_float(low + (high - low) * (b / 255.0));
+      for (size_t b = 0; b < 256; ++b) book[b] = to_float(low + (high - low) * (static_cast<double>(b) / 255.0));
     }
     for (size_t i = 0; i < count; ++i) {
       const size_t label = labels.texel(i)[0] | (labels.texel(i)[1] << 8);

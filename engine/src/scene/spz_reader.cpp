@@ -87,8 +87,7 @@ void check_plausible(std::string_view name, const Layout& layout, size_t file_si
 }
 
 // Inflates the gzip stream into `out` until it holds `wanted` bytes; false if it ends before.
-bool inflate_prefix(std::span<const std::byte> data, std::vector<unsigned char>& out, size_t wanted,
-                    z_stream& stream) {
+bool inflate_prefix(std::vector<unsigned char>& out, size_t wanted, z_stream& stream) {
   const size_t start = out.size();
   out.resize(wanted);
   stream.next_out = out.data() + start;
@@ -99,7 +98,6 @@ bool inflate_prefix(std::span<const std::byte> data, std::vector<unsigned char>&
     if (result != Z_OK) return false;
     if (stream.avail_in == 0) return false;
   }
-  (void)data;
   return stream.avail_out == 0;
 }
 
@@ -123,13 +121,13 @@ std::vector<unsigned char> legacy_payload(std::span<const std::byte> data, std::
   stream.next_in = const_cast<Bytef*>(bytes);
   stream.avail_in = static_cast<uInt>(std::min<size_t>(data.size(), std::numeric_limits<uInt>::max()));
   std::vector<unsigned char> payload;
-  if (!inflate_prefix(data, payload, kLegacyHeaderSize, stream))
+  if (!inflate_prefix(payload, kLegacyHeaderSize, stream))
     fail(name, "truncated or corrupt gzip stream: it ends before the 16-byte SPZ header");
   *header = parse_header(name, payload.data());
   if (header->version == 4) fail(name, "an SPZ version 4 header inside gzip (version 4 files are not gzipped)");
   const Layout layout = layout_of(*header);
   check_plausible(name, layout, data.size());
-  if (!inflate_prefix(data, payload, kLegacyHeaderSize + layout.total(), stream))
+  if (!inflate_prefix(payload, kLegacyHeaderSize + layout.total(), stream))
     fail(name, "truncated or corrupt gzip stream: it ends before the " + std::to_string(header->count) +
                    " Gaussians the header declares (" + std::to_string(layout.total()) + " bytes)");
   payload.erase(payload.begin(), payload.begin() + kLegacyHeaderSize);
