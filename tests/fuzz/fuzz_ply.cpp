@@ -13,52 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_checks.h"
 #include "tilesplat/scene.h"
 
-namespace {
+using tilesplat::fuzz::check_scene;
 
-[[noreturn]] void invariant_failed(const char* what) {
-  std::fprintf(stderr, "fuzz_ply: invariant violated: %s\n", what);
-  std::abort();
-}
-
-#define FUZZ_CHECK(condition) \
-  do {                        \
-    if (!(condition)) invariant_failed(#condition); \
-  } while (0)
-
-bool all_finite(const std::vector<float>& values) {
-  for (const float value : values)
-    if (!std::isfinite(value)) return false;
-  return true;
-}
-
-void check_scene(const tilesplat::GaussianScene& scene, const tilesplat::LoadReport& report) {
-  const size_t n = scene.size();
-  FUZZ_CHECK(scene.sh_degree >= 0 && scene.sh_degree <= 3);
-  FUZZ_CHECK(scene.positions.size() == 3 * n);
-  FUZZ_CHECK(scene.log_scales.size() == 3 * n);
-  FUZZ_CHECK(scene.rotations.size() == 4 * n);
-  FUZZ_CHECK(scene.sh.size() == 3 * static_cast<size_t>(scene.sh_coefficients()) * n);
-  FUZZ_CHECK(scene.normals.empty() || scene.normals.size() == 3 * n);
-  FUZZ_CHECK(n + report.dropped == report.gaussians_in_file);
-  size_t dropped = 0;
-  for (const tilesplat::DroppedProperty& entry : report.dropped_by_property) dropped += entry.count;
-  FUZZ_CHECK(dropped == report.dropped);
-  FUZZ_CHECK(report.dropped == 0 || !report.summary().empty());
-  FUZZ_CHECK(all_finite(scene.positions) && all_finite(scene.log_scales) && all_finite(scene.rotations) &&
-             all_finite(scene.opacity_logits) && all_finite(scene.sh) && all_finite(scene.normals));
-  for (size_t i = 0; i < n; ++i) {
-    const float* q = scene.rotations.data() + 4 * i;
-    const double norm = std::sqrt(static_cast<double>(q[0]) * q[0] + static_cast<double>(q[1]) * q[1] +
-                                  static_cast<double>(q[2]) * q[2] + static_cast<double>(q[3]) * q[3]);
-    FUZZ_CHECK(std::fabs(norm - 1.0) < 1e-5);
-  }
-  const tilesplat::Bounds bounds = tilesplat::compute_bounds(scene);
-  FUZZ_CHECK(!(bounds.radius < 0));
-}
-
-}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const auto bytes = std::as_bytes(std::span(data, size));

@@ -14,8 +14,11 @@ cd "$(dirname "$0")/../.."
 seconds="${1:-60}"
 build="${FUZZ_BUILD_DIR:-build-fuzz}"
 scenes="${TILESPLAT_SHARED_SCENES:-$(cd .. && pwd)/shared/scenes}"
-readers=(ply)
-fuzz_flags=(-timeout=10 -rss_limit_mb=2048 -max_len=16384)
+readers=(ply splat spz sog compressed_ply gltf)
+fuzz_flags=(-timeout=10 -rss_limit_mb=2048)
+max_len() {  # a SOG zip or a GLB of 64 Gaussians with SH3 is about 20 kB; the rest fit in 16 kB
+  case "$1" in sog | gltf) echo 65536 ;; *) echo 16384 ;; esac
+}
 
 mkdir -p "$build"
 findings() {  # the end of a libFuzzer log without its progress lines
@@ -37,6 +40,19 @@ seed_dirs=(scenes)
 rm -rf "$build/seeds"
 quiet "$build/seeds.log" "$build/tests/fuzz/make_ply_seeds" "$build/seeds/ply" "${seed_dirs[@]}"
 echo "fuzz: $(tail -n 1 "$build/seeds.log")"
+# The other readers are seeded with the small real files of each format in the shared scenes.
+seed() {  # seed READER FILE...: copies the files that exist
+  mkdir -p "$build/seeds/$1"
+  local reader="$1"
+  shift
+  for file in "$@"; do [ -f "$file" ] && cp "$file" "$build/seeds/$reader/" || true; done
+}
+head -c 2048 "$scenes/plant_113648.splat" >"$build/seeds/plant_64.splat" 2>/dev/null || true
+seed splat "$scenes/train_3pts.splat" "$build/seeds/plant_64.splat"
+seed spz "$scenes/train_3pts.spz" "$scenes/formats/playcanvas_test_64_sh3.v3.spz" "$scenes/formats/playcanvas_test_64_sh3.v4.spz"
+seed sog "$scenes/formats/playcanvas_test_64_sh3.sog"
+seed compressed_ply "$scenes/playcanvas_test_64.compressed.ply" "$scenes/formats/playcanvas_test_64_sh3.compressed.ply"
+seed gltf "$scenes/formats/playcanvas_test_64_sh3.glb"
 
 # libFuzzer's timeout is wall-clock: a process the machine stops or starves for a while reports
 # one on whatever input it was running. Such a "timeout" that replays in time is not a finding.
@@ -53,7 +69,7 @@ for reader in "${readers[@]}"; do
   log="$build/fuzz_$reader.log"
   artifacts="$build/artifacts/$reader/"
   rm -rf "$artifacts"
-  mkdir -p "$regressions" "$build/corpus/$reader" "$artifacts"
+  mkdir -p "$regressions" "$build/corpus/$reader" "$build/seeds/$reader" "$artifacts"
   # Each regression input once, whole (no -max_len), no mutation.
   mapfile -t inputs < <(find "$regressions" -type f | sort)
   if [ ${#inputs[@]} -gt 0 ] &&
@@ -66,8 +82,10 @@ for reader in "${readers[@]}"; do
   echo "fuzz: $reader: ${#inputs[@]} regression inputs replay cleanly"
   # New inputs go to the first directory (BUILD/corpus, kept between local runs), never to the seeds
   # or the committed regressions.
-  if "$fuzzer" "${fuzz_flags[@]}" -max_total_time="$seconds" -print_final_stats=1 \
-       -dict="tests/fuzz/$reader.dict" -artifact_prefix="$artifacts" \
+  dict=()
+  [ -f "tests/fuzz/$reader.dict" ] && dict=(-dict="tests/fuzz/$reader.dict")
+  if "$fuzzer" "${fuzz_flags[@]}" -max_len="$(max_len "$reader")" -max_total_time="$seconds" -print_final_stats=1 \
+       "${dict[@]}" -artifact_prefix="$artifacts" \
        "$build/corpus/$reader" "$build/seeds/$reader" "$regressions" >"$log" 2>&1; then
     runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
     cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1)

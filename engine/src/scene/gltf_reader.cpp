@@ -282,8 +282,11 @@ class GltfReader {
     if (a.contains("sparse")) fail(where + " is sparse, which this reader does not support");
     const bool normalized = a.value("normalized", false);
     const size_t size = component_type == 5126 || component_type == 5125 ? 4 : component_type == 5122 || component_type == 5123 ? 2 : 1;
-    std::vector<double> values(count * components);
-    if (!a.contains("bufferView")) return values;  // all zeros, per the glTF spec
+    if (!a.contains("bufferView")) {
+      // All zeros, per the glTF spec; POSITION's count, proven by its own buffer, sizes it.
+      if (attribute == "POSITION") fail(where + " has no bufferView");
+      return std::vector<double>(count * components);
+    }
     const json& view = at(array_of(gltf_, "bufferViews", "glTF"), index(a["bufferView"], where + ".bufferView"), "bufferViews");
     const std::span<const unsigned char> data = buffer(index(at(view, "buffer", "bufferView"), "bufferView.buffer"));
     const size_t view_offset = view.contains("byteOffset") ? index(view["byteOffset"], "bufferView.byteOffset") : 0;
@@ -301,6 +304,7 @@ class GltfReader {
         fail(where + ": " + std::to_string(count) + " elements run past the end of its bufferView (" +
              std::to_string(view_length) + " bytes); the file is truncated or the count is wrong");
     }
+    std::vector<double> values(count * components);
     const unsigned char* base = data.data() + view_offset + offset;
     for (size_t e = 0; e < count; ++e)
       for (size_t c = 0; c < components; ++c) {
