@@ -11,7 +11,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <new>
 #include <system_error>
@@ -909,5 +911,22 @@ bool parse_and_handle_info_flags(ArgParser& parser, int argc, const char* const*
   }
   return false;
 }
+
+namespace {
+
+uint64_t proc_status_kib(const char* field) {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  const std::string prefix = std::string(field) + ":";
+  while (std::getline(status, line))
+    if (line.starts_with(prefix)) return std::strtoull(line.c_str() + prefix.size(), nullptr, 10);
+  return 0;
+}
+
+}  // namespace
+
+void reset_peak_memory() { std::ofstream("/proc/self/clear_refs") << "5"; }
+uint64_t peak_memory_bytes() { return proc_status_kib("VmHWM") * 1024; }
+uint64_t resident_memory_bytes() { return proc_status_kib("VmRSS") * 1024; }
 
 }  // namespace tilesplat::cli

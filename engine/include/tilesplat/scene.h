@@ -98,4 +98,14 @@ struct Bounds {
 };
 Bounds compute_bounds(const GaussianScene& scene);
 
+// What a file holds, at a glance (tilesplat-info prints it): the means' box and a robust box that
+// ignores floaters, and the activated opacity and scale ranges. All zero for an empty scene.
+struct SceneStatistics {
+  double min[3] = {0, 0, 0}, max[3] = {0, 0, 0};                // box of the means
+  double robust_min[3] = {0, 0, 0}, robust_max[3] = {0, 0, 0};  // 1st and 99th percentile per axis
+  double opacity_min = 0, opacity_max = 0;  // sigmoid(opacity logit)
+  double scale_min = 0, scale_max = 0;      // exp(log scale), over the three axes
+};
+SceneStatistics compute_statistics(const GaussianScene& scene);
+
 }  // namespace tilesplat

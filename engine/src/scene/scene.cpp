@@ -173,4 +173,33 @@ Bounds compute_bounds(const GaussianScene& scene) {
   return bounds;
 }
 
+SceneStatistics compute_statistics(const GaussianScene& scene) {
+  SceneStatistics stats;
+  const size_t count = scene.size();
+  if (count == 0) return stats;
+  std::vector<double> axis(count);
+  // Nearest-rank percentiles.
+  const auto rank = [count](double p) {
+    const size_t r = static_cast<size_t>(std::ceil(p * static_cast<double>(count)));
+    return std::min(count - 1, r > 0 ? r - 1 : 0);
+  };
+  for (size_t a = 0; a < 3; ++a) {
+    for (size_t i = 0; i < count; ++i) axis[i] = scene.positions[3 * i + a];
+    const auto [low, high] = std::minmax_element(axis.begin(), axis.end());
+    stats.min[a] = *low;
+    stats.max[a] = *high;
+    std::nth_element(axis.begin(), axis.begin() + static_cast<std::ptrdiff_t>(rank(0.01)), axis.end());
+    stats.robust_min[a] = axis[rank(0.01)];
+    std::nth_element(axis.begin(), axis.begin() + static_cast<std::ptrdiff_t>(rank(0.99)), axis.end());
+    stats.robust_max[a] = axis[rank(0.99)];
+  }
+  const auto [low_logit, high_logit] = std::minmax_element(scene.opacity_logits.begin(), scene.opacity_logits.end());
+  stats.opacity_min = 1.0 / (1.0 + std::exp(-static_cast<double>(*low_logit)));
+  stats.opacity_max = 1.0 / (1.0 + std::exp(-static_cast<double>(*high_logit)));
+  const auto [low_scale, high_scale] = std::minmax_element(scene.log_scales.begin(), scene.log_scales.end());
+  stats.scale_min = std::exp(static_cast<double>(*low_scale));
+  stats.scale_max = std::exp(static_cast<double>(*high_scale));
+  return stats;
+}
+
 }  // namespace tilesplat

@@ -1,0 +1,148 @@
+// tilesplat-info: what each scene file holds, in any format the engine reads: format and version,
+// Gaussians and SH degree, size and bytes per Gaussian, boxes, opacity and scale ranges, what was
+// dropped for non-finite values, and what loading it cost (time and peak memory).
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "tilesplat/scene.h"
+
+namespace {
+
+namespace cli = tilesplat::cli;
+namespace fs = std::filesystem;
+
+constexpr const char* kProgram = "tilesplat-info";
+
+struct FileInfo {
+  cli::LoadedScene loaded;
+  uint64_t file_bytes = 0;
+  uint64_t peak_bytes = 0;  // peak resident memory while loading, above what was resident before
+  tilesplat::SceneStatistics stats;
+};
+
+// A file's size; a folder's (an unbundled SOG's meta.json brings its images) counts them all.
+uint64_t file_bytes(const fs::path& path) {
+  std::error_code ec;
+  uint64_t bytes = fs::file_size(path, ec);
+  if (ec) return 0;
+  if (path.filename() == "meta.json")
+    for (const auto& entry : fs::directory_iterator(path.parent_path(), ec))
+      if (entry.is_regular_file() && entry.path().extension() == ".webp") bytes += entry.file_size();
+  return bytes;
+}
+
+FileInfo inspect(const std::string& file, bool strict) {
+  FileInfo info;
+  cli::reset_peak_memory();
+  const uint64_t before = cli::resident_memory_bytes();
+  info.loaded = cli::load_scene_file(file, strict, kProgram);
+  const uint64_t peak = cli::peak_memory_bytes();
+  info.peak_bytes = peak > before ? peak - before : 0;
+  info.file_bytes = file_bytes(file);
+  info.stats = tilesplat::compute_statistics(info.loaded.scene);
+  return info;
+}
+
+std::string box(const double* low, const double* high) {
+  char text[160];
+  std::snprintf(text, sizeof text, "x [%.4g, %.4g]  y [%.4g, %.4g]  z [%.4g, %.4g]", low[0], high[0], low[1], high[1],
+                low[2], high[2]);
+  return text;
+}
+
+double megabytes(uint64_t bytes) { return static_cast<double>(bytes) / 1e6; }
+
+void print_text(const FileInfo& info) {
+  const auto& loaded = info.loaded;
+  const size_t n = loaded.scene.size();
+  std::printf("%s\n", loaded.path.string().c_str());
+  std::string format = loaded.report.format;
+  if (!loaded.report.version.empty()) format += " version " + loaded.report.version;
+  std::printf("  format       %s\n", format.c_str());
+  std::printf("  gaussians    %s\n", cli::describe_scene(loaded.scene).c_str());
+  std::printf("  file         %.3f MB, %.2f bytes per Gaussian\n", megabytes(info.file_bytes),
+              n ? static_cast<double>(info.file_bytes) / static_cast<double>(n) : 0.0);
+  if (n > 0) {
+    std::printf("  box          %s\n", box(info.stats.min, info.stats.max).c_str());
+    std::printf("  1-99%% box    %s\n", box(info.stats.robust_min, info.stats.robust_max).c_str());
+    std::printf("  opacity      %.4g .. %.4g\n", info.stats.opacity_min, info.stats.opacity_max);
+    std::printf("  scale        %.4g .. %.4g\n", info.stats.scale_min, info.stats.scale_max);
+  }
+  std::printf("  non-finite   %zu of %zu Gaussians dropped%s%s\n", loaded.report.dropped,
+              loaded.report.gaussians_in_file, loaded.report.dropped ? ": " : "", loaded.report.summary().c_str());
+  std::printf("  load         %.1f ms, peak memory +%.1f MB\n", loaded.load_ms, megabytes(info.peak_bytes));
+}
+
+nlohmann::json to_json(const FileInfo& info) {
+  const auto& loaded = info.loaded;
+  const auto triple = [](const double* v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
+  nlohmann::json dropped = nlohmann::json::array();
+  for (const auto& entry : loaded.report.dropped_by_property)
+    dropped.push_back({{"property", entry.property}, {"count", entry.count}, {"first_index", entry.first_index}});
+  return {{"file", loaded.path.string()},
+          {"format", loaded.report.format},
+          {"version", loaded.report.version},
+          {"gaussians", loaded.scene.size()},
+          {"gaussians_in_file", loaded.report.gaussians_in_file},
+          {"sh_degree", loaded.scene.sh_degree},
+          {"file_bytes", info.file_bytes},
+          {"bytes_per_gaussian", loaded.scene.empty() ? 0.0 : static_cast<double>(info.file_bytes) / static_cast<double>(loaded.scene.size())},
+          {"box_min", triple(info.stats.min)},
+          {"box_max", triple(info.stats.max)},
+          {"robust_box_min", triple(info.stats.robust_min)},
+          {"robust_box_max", triple(info.stats.robust_max)},
+          {"opacity_range", {info.stats.opacity_min, info.stats.opacity_max}},
+          {"scale_range", {info.stats.scale_min, info.stats.scale_max}},
+          {"non_finite_dropped", loaded.report.dropped},
+          {"dropped_by_property", dropped},
+          {"load_ms", loaded.load_ms},
+          {"peak_memory_bytes", info.peak_bytes}};
+}
+
+int run(int argc, char** argv) {
+  std::vector<std::string> files;
+  bool json = false;
+  bool strict = false;
+  cli::ArgParser parser(kProgram, "tilesplat-info [options] FILE...",
+                        "Prints what each scene file holds: format and version, Gaussians, SH degree, size, boxes, "
+                        "opacity and scale ranges, non-finite values, and the time and memory loading it took. Reads "
+                        ".ply, compressed .ply, .splat, .spz, .sog, SOG meta.json, .glb and .gltf.");
+  parser.add_switch("--json", "one JSON array of objects on stdout, for scripts", &json);
+  parser.add_switch("--strict", "fail on a non-finite value instead of dropping the Gaussian", &strict);
+  parser.add_positional_list("FILE", "scene files", &files);
+  if (parser.parse(argc, argv) == cli::ArgParser::Outcome::kHelp) {
+    std::printf("%s", parser.help_text().c_str());
+    return cli::kExitOk;
+  }
+  if (files.empty()) throw cli::UsageError("missing the FILE argument (see --help)");
+  nlohmann::json all = nlohmann::json::array();
+  int status = cli::kExitOk;
+  for (size_t i = 0; i < files.size(); ++i) {
+    try {
+      const FileInfo info = inspect(files[i], strict);
+      if (json) {
+        all.push_back(to_json(info));
+      } else {
+        if (i > 0) std::printf("\n");
+        print_text(info);
+      }
+    } catch (const std::exception& error) {
+      // One bad file does not hide the others; the exit status says something failed.
+      cli::print_error(kProgram, cli::one_line(error.what()));
+      status = cli::kExitFailure;
+    }
+  }
+  if (json) std::printf("%s\n", all.dump(2).c_str());
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return cli::run_app(kProgram, [argc, argv] { return run(argc, argv); });
+}
