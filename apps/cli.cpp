@@ -411,7 +411,8 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
       "take the camera from the trainer's cameras.json (default: an orbit camera framing the scene, see --azimuth)";
   if (scene_choice == SceneChoice::kOne) {
     parser.add_positional("SCENE.ply",
-                          "the scene: a 3D Gaussian Splatting .ply as the trainer writes it, or a scene file "
+                          "the scene: a 3D Gaussian Splatting file (.ply, .compressed.ply, .splat, .spz, .sog, SOG meta.json, "
+                          ".glb, .gltf; docs/formats.md), or a scene file "
                           "(.json, docs/scene-format.md) that places several of them and brings cameras, "
                           "background and outputs",
                           &options.scene);
