@@ -3,10 +3,9 @@
 // dropped for non-finite values, and what loading it cost (time and peak memory).
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "cli.h"
 #include "tilesplat/scene.h"
@@ -50,12 +49,14 @@ FileInfo inspect(const std::string& file, bool strict) {
 
 std::string box(const double* low, const double* high) {
   char text[160];
-  std::snprintf(text, sizeof text, "x [%.4g, %.4g]  y [%.4g, %.4g]  z [%.4g, %.4g]", low[0], high[0], low[1], high[1],
-                low[2], high[2]);
+  std::snprintf(text, sizeof text, "x [%.4g, %.4g]  y [%.4g, %.4g]  z [%.4g, %.4g]", low[0], high[0], low[1],
+                high[1], low[2], high[2]);
   return text;
 }
 
-double megabytes(uint64_t bytes) { return static_cast<double>(bytes) / 1e6; }
+double megabytes(uint64_t bytes) {
+  return static_cast<double>(bytes) / 1e6;
+}
 
 void print_text(const FileInfo& info) {
   const auto& loaded = info.loaded;
@@ -74,7 +75,8 @@ void print_text(const FileInfo& info) {
     std::printf("  scale        %.4g .. %.4g\n", info.stats.scale_min, info.stats.scale_max);
   }
   std::printf("  non-finite   %zu of %zu Gaussians dropped%s%s\n", loaded.report.dropped,
-              loaded.report.gaussians_in_file, loaded.report.dropped ? ": " : "", loaded.report.summary().c_str());
+              loaded.report.gaussians_in_file, loaded.report.dropped ? ": " : "",
+              loaded.report.summary().c_str());
   std::printf("  load         %.1f ms, peak memory +%.1f MB\n", loaded.load_ms, megabytes(info.peak_bytes));
 }
 
@@ -83,7 +85,8 @@ nlohmann::json to_json(const FileInfo& info) {
   const auto triple = [](const double* v) { return nlohmann::json::array({v[0], v[1], v[2]}); };
   nlohmann::json dropped = nlohmann::json::array();
   for (const auto& entry : loaded.report.dropped_by_property)
-    dropped.push_back({{"property", entry.property}, {"count", entry.count}, {"first_index", entry.first_index}});
+    dropped.push_back(
+        {{"property", entry.property}, {"count", entry.count}, {"first_index", entry.first_index}});
   return {{"file", loaded.path.string()},
           {"format", loaded.report.format},
           {"version", loaded.report.version},
@@ -91,7 +94,9 @@ nlohmann::json to_json(const FileInfo& info) {
           {"gaussians_in_file", loaded.report.gaussians_in_file},
           {"sh_degree", loaded.scene.sh_degree},
           {"file_bytes", info.file_bytes},
-          {"bytes_per_gaussian", loaded.scene.empty() ? 0.0 : static_cast<double>(info.file_bytes) / static_cast<double>(loaded.scene.size())},
+          {"bytes_per_gaussian", loaded.scene.empty() ? 0.0
+                                                      : static_cast<double>(info.file_bytes) /
+                                                            static_cast<double>(loaded.scene.size())},
           {"box_min", triple(info.stats.min)},
           {"box_max", triple(info.stats.max)},
           {"robust_box_min", triple(info.stats.robust_min)},
@@ -108,10 +113,11 @@ int run(int argc, char** argv) {
   std::vector<std::string> files;
   bool json = false;
   bool strict = false;
-  cli::ArgParser parser(kProgram, "tilesplat-info [options] FILE...",
-                        "Prints what each scene file holds: format and version, Gaussians, SH degree, size, boxes, "
-                        "opacity and scale ranges, non-finite values, and the time and memory loading it took. Reads "
-                        ".ply, compressed .ply, .splat, .spz, .sog, SOG meta.json, .glb and .gltf.");
+  cli::ArgParser parser(
+      kProgram, "tilesplat-info [options] FILE...",
+      "Prints what each scene file holds: format and version, Gaussians, SH degree, size, boxes, "
+      "opacity and scale ranges, non-finite values, and the time and memory loading it took. Reads "
+      ".ply, compressed .ply, .splat, .spz, .sog, SOG meta.json, .glb and .gltf.");
   parser.add_switch("--json", "one JSON array of objects on stdout, for scripts", &json);
   parser.add_switch("--strict", "fail on a non-finite value instead of dropping the Gaussian", &strict);
   parser.add_positional_list("FILE", "scene files", &files);

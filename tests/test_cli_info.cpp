@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
-
 #include <string>
 
 #include "process_support.h"
@@ -45,8 +44,8 @@ TEST(CliInfo, SummarizesFilesOfEveryFormat) {
 
   const auto text = run_process("", TILESPLAT_INFO_EXE, {files[0]});
   ASSERT_EQ(text.exit_code, 0) << text.err;
-  for (const char* field : {"format       spz version 4", "64 Gaussians (SH3)", "bytes per Gaussian", "1-99% box",
-                            "opacity", "scale", "non-finite   0 of 64", "peak memory"})
+  for (const char* field : {"format       spz version 4", "64 Gaussians (SH3)", "bytes per Gaussian",
+                            "1-99% box", "opacity", "scale", "non-finite   0 of 64", "peak memory"})
     EXPECT_NE(text.out.find(field), std::string::npos) << field << " in\n" << text.out;
 }
 

@@ -2,7 +2,6 @@
 // beside them in ../shared/scenes: the same Gaussians, the same images; and every malformed file
 // refused with one clear error that names it.
 #include <gtest/gtest.h>
-
 #include <zip.h>
 #include <zlib.h>
 
@@ -39,23 +38,24 @@ struct Tolerance {
 
 // train_3pts.splat/.spz sit beside the raw trainer output they were written from, not a decoding:
 // the bound is the formats' quantization step. 12 fractional bits of position (half a step 1.2e-4),
-// log scales in 1/16 (half 0.031), 8-bit opacity (a full step 3.9e-3: writers truncate or round), 8-bit colours over SPZ's 0.15
-// colour scale (1/255/0.15/2 = 0.013), SH in buckets of 1/8 for degree 1 and 2+ in SPZ v3 (0.0625)
-// plus float noise.
+// log scales in 1/16 (half 0.031), 8-bit opacity (a full step 3.9e-3: writers truncate or round), 8-bit
+// colours over SPZ's 0.15 colour scale (1/255/0.15/2 = 0.013), SH in buckets of 1/8 for degree 1 and 2+ in
+// SPZ v3 (0.0625) plus float noise.
 constexpr Tolerance kQuantized{2e-4, 0.035, 0.01, 4e-3, 0.014, 0.07};
 
 struct FormatCase {
-  std::string native;   // relative to the shared scenes
-  std::string decoded;  // the PLY it is checked against
-  std::string cameras;  // cameras/NAME.json
-  bool decoding = true; // false: `decoded` is the quantized file's source, not its decoding
+  std::string native;    // relative to the shared scenes
+  std::string decoded;   // the PLY it is checked against
+  std::string cameras;   // cameras/NAME.json
+  bool decoding = true;  // false: `decoded` is the quantized file's source, not its decoding
 };
 
 std::vector<FormatCase> format_cases() {
   std::vector<FormatCase> cases;
   for (const std::string name : {"playbot_lod6_1873_sh2", "playcanvas_test_64_sh3"}) {
     for (const std::string extension : {"v4.spz", "v3.spz", "compressed.ply", "sog"})
-      cases.push_back({"formats/" + name + "." + extension, "formats/decoded/" + name + "." + extension + ".ply", name});
+      cases.push_back(
+          {"formats/" + name + "." + extension, "formats/decoded/" + name + "." + extension + ".ply", name});
     // splat-transform does not read glTF: its source PLY is the reference (its values are float32 copies).
     cases.push_back({"formats/" + name + ".glb", name + ".ply", name});
   }
@@ -66,19 +66,25 @@ std::vector<FormatCase> format_cases() {
   cases.push_back({"plant_113648.splat", "plant_113648_sh0.ply", "plant_113648_sh0"});
   cases.push_back({"playbot_lod6_1873.sog", "playbot_lod6_1873_sh2.ply", "playbot_lod6_1873_sh2"});
   cases.push_back({"playbot_lod0_500000.sog", "playbot_lod0_500000_sh2.ply", "playbot_lod0_500000_sh2"});
-  cases.push_back({"playcanvas_test_64.compressed.ply", "playcanvas_test_64_sh3.ply", "playcanvas_test_64_sh3"});
+  cases.push_back(
+      {"playcanvas_test_64.compressed.ply", "playcanvas_test_64_sh3.ply", "playcanvas_test_64_sh3"});
   cases.push_back({"train_3pts.splat", "train_3pts_sh3.ply", "train_3pts_sh3", false});
   cases.push_back({"train_3pts.spz", "train_3pts_sh3.ply", "train_3pts_sh3", false});
   return cases;
 }
 
-double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
+double sigmoid(double x) {
+  return 1.0 / (1.0 + std::exp(-x));
+}
 
 // The largest violation of `tolerance`, as a fraction of it (<= 1 passes), per attribute.
-void expect_same_gaussians(const GaussianScene& native, const GaussianScene& decoded, const Tolerance& tolerance) {
+void expect_same_gaussians(const GaussianScene& native, const GaussianScene& decoded,
+                           const Tolerance& tolerance) {
   ASSERT_EQ(native.size(), decoded.size());
   const size_t n = native.size();
-  const auto close = [](double a, double b, double bound) { return std::fabs(a - b) <= bound * std::max(1.0, std::fabs(b)); };
+  const auto close = [](double a, double b, double bound) {
+    return std::fabs(a - b) <= bound * std::max(1.0, std::fabs(b));
+  };
   size_t bad_position = 0, bad_scale = 0, bad_rotation = 0, bad_opacity = 0, bad_dc = 0, bad_rest = 0;
   const size_t k_native = static_cast<size_t>(native.sh_coefficients());
   const size_t k_decoded = static_cast<size_t>(decoded.sh_coefficients());
@@ -91,8 +97,10 @@ void expect_same_gaussians(const GaussianScene& native, const GaussianScene& dec
     for (size_t j = 0; j < 4; ++j) dot += double(native.rotations[4 * i + j]) * decoded.rotations[4 * i + j];
     const double sign = dot < 0 ? -1 : 1;
     for (size_t j = 0; j < 4; ++j)
-      bad_rotation += std::fabs(native.rotations[4 * i + j] - sign * decoded.rotations[4 * i + j]) > tolerance.rotation;
-    bad_opacity += std::fabs(sigmoid(native.opacity_logits[i]) - sigmoid(decoded.opacity_logits[i])) > tolerance.opacity;
+      bad_rotation +=
+          std::fabs(native.rotations[4 * i + j] - sign * decoded.rotations[4 * i + j]) > tolerance.rotation;
+    bad_opacity +=
+        std::fabs(sigmoid(native.opacity_logits[i]) - sigmoid(decoded.opacity_logits[i])) > tolerance.opacity;
     // Coefficients both have; those only one side has must be zero on it (a file without SH bands
     // beside a source with them is compared on the DC term alone).
     for (size_t k = 0; k < std::min(k_native, k_decoded); ++k)
@@ -229,7 +237,9 @@ std::string gunzip(const std::string& data) {
   return out;
 }
 
-void put_u32(std::string& bytes, size_t offset, uint32_t value) { std::memcpy(bytes.data() + offset, &value, 4); }
+void put_u32(std::string& bytes, size_t offset, uint32_t value) {
+  std::memcpy(bytes.data() + offset, &value, 4);
+}
 
 // The entries of a zip (name, bytes), written with libzip.
 using ZipEntries = std::vector<std::pair<std::string, std::string>>;
@@ -288,7 +298,8 @@ TEST_F(FormatErrors, TruncatedFiles) {
   const std::string v3 = original("playcanvas_test_64_sh3.v3.spz");
   expect_error(write_file("cut.v3.spz", v3.substr(0, v3.size() / 2)), {"gzip stream", "64 Gaussians"});
   const std::string compressed = original("playcanvas_test_64_sh3.compressed.ply");
-  expect_error(write_file("cut.compressed.ply", compressed.substr(0, compressed.size() - 100)), {"truncated"});
+  expect_error(write_file("cut.compressed.ply", compressed.substr(0, compressed.size() - 100)),
+               {"truncated"});
   const std::string glb = original("playcanvas_test_64_sh3.glb");
   expect_error(write_file("cut.glb", glb.substr(0, glb.size() - 64)), {"truncated GLB"});
   const std::string sog = original("playcanvas_test_64_sh3.sog");
@@ -393,7 +404,8 @@ TEST(SceneFormatsMemory, ParseSceneReadsTheSameBytesAsLoadScene) {
     const fs::path path = testing::shared_scenes() / file;
     const std::string bytes = read_file(path);
     const GaussianScene from_file = load_scene(path);
-    const GaussianScene from_memory = parse_scene(std::as_bytes(std::span(bytes.data(), bytes.size())), path.string());
+    const GaussianScene from_memory =
+        parse_scene(std::as_bytes(std::span(bytes.data(), bytes.size())), path.string());
     EXPECT_EQ(from_file.positions, from_memory.positions) << file;
     EXPECT_EQ(from_file.sh, from_memory.sh) << file;
     EXPECT_EQ(from_file.rotations, from_memory.rotations) << file;
@@ -412,7 +424,8 @@ TEST(SceneFormatsPostProcessing, DenormalQuaternionsBecomeTheIdentity) {
       "0 0 0 0 0 0 1 0 0 0 1e-40 1 0 0\n";
   const GaussianScene scene = load_scene(write_file("denormal.ply", ply));
   ASSERT_EQ(scene.size(), 2u);
-  EXPECT_EQ(std::vector<float>(scene.rotations.begin(), scene.rotations.begin() + 4), (std::vector<float>{1, 0, 0, 0}));
+  EXPECT_EQ(std::vector<float>(scene.rotations.begin(), scene.rotations.begin() + 4),
+            (std::vector<float>{1, 0, 0, 0}));
   // One normal component among denormals is an ordinary direction.
   EXPECT_FLOAT_EQ(scene.rotations[5], 1.0f);
 }

@@ -16,8 +16,8 @@ namespace tilesplat::fuzz {
   std::abort();
 }
 
-#define FUZZ_CHECK(condition) \
-  do {                        \
+#define FUZZ_CHECK(condition)                                          \
+  do {                                                                 \
     if (!(condition)) ::tilesplat::fuzz::invariant_failed(#condition); \
   } while (0)
 

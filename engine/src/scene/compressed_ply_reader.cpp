@@ -38,9 +38,10 @@ const PlyProperty* find_property(const PlyElement& element, std::string_view nam
 }
 
 constexpr std::array<std::string_view, 12> kChunkBounds = {
-    "min_x", "min_y", "min_z", "max_x", "max_y", "max_z",
+    "min_x",       "min_y",       "min_z",       "max_x",       "max_y",       "max_z",
     "min_scale_x", "min_scale_y", "min_scale_z", "max_scale_x", "max_scale_y", "max_scale_z"};
-constexpr std::array<std::string_view, 6> kChunkColours = {"min_r", "min_g", "min_b", "max_r", "max_g", "max_b"};
+constexpr std::array<std::string_view, 6> kChunkColours = {"min_r", "min_g", "min_b",
+                                                           "max_r", "max_g", "max_b"};
 constexpr std::array<std::string_view, 4> kPacked = {"packed_position", "packed_rotation", "packed_scale",
                                                      "packed_color"};
 
@@ -49,7 +50,9 @@ double unorm(uint32_t value, int bits) {
   return static_cast<double>(value & mask) / static_cast<double>(mask);
 }
 
-double lerp(float a, float b, double t) { return static_cast<double>(a) * (1.0 - t) + static_cast<double>(b) * t; }
+double lerp(float a, float b, double t) {
+  return static_cast<double>(a) * (1.0 - t) + static_cast<double>(b) * t;
+}
 
 // A property's value in row `row` of an element of fixed-size rows starting at `base`.
 template <typename T>
@@ -79,8 +82,8 @@ GaussianScene read_compressed_ply(const PlyBytes& ply, const PlyHeader& header, 
     if (!property)
       ply.fail("compressed PLY: element '" + element.name + "' lacks property '" + std::string(name) + "'");
     if (property->is_list || property->type != type)
-      ply.fail("compressed PLY: property '" + std::string(name) + "' of element '" + element.name + "' must be " +
-               type_name);
+      ply.fail("compressed PLY: property '" + std::string(name) + "' of element '" + element.name +
+               "' must be " + type_name);
     return *property;
   };
   for (const PlyElement& element : header.elements) {
@@ -89,14 +92,16 @@ GaussianScene read_compressed_ply(const PlyBytes& ply, const PlyHeader& header, 
     if (element.has_list) ply.fail("compressed PLY: element '" + element.name + "' has a list property");
   }
   std::array<const PlyProperty*, 12> bounds{};
-  for (size_t i = 0; i < kChunkBounds.size(); ++i) bounds[i] = &require(chunk, kChunkBounds[i], ScalarType::kFloat32, "float");
+  for (size_t i = 0; i < kChunkBounds.size(); ++i)
+    bounds[i] = &require(chunk, kChunkBounds[i], ScalarType::kFloat32, "float");
   const bool chunk_colours = find_property(chunk, "min_r") != nullptr;
   std::array<const PlyProperty*, 6> colours{};
   if (chunk_colours)
     for (size_t i = 0; i < kChunkColours.size(); ++i)
       colours[i] = &require(chunk, kChunkColours[i], ScalarType::kFloat32, "float");
   std::array<const PlyProperty*, 4> packed{};
-  for (size_t i = 0; i < kPacked.size(); ++i) packed[i] = &require(vertex, kPacked[i], ScalarType::kUint32, "uint");
+  for (size_t i = 0; i < kPacked.size(); ++i)
+    packed[i] = &require(vertex, kPacked[i], ScalarType::kUint32, "uint");
 
   const uint64_t count = vertex.count;
   if (chunk.count != (count + kChunkSize - 1) / kChunkSize)
@@ -113,7 +118,8 @@ GaussianScene read_compressed_ply(const PlyBytes& ply, const PlyHeader& header, 
     if (sh->count != count)
       ply.fail("compressed PLY: element 'sh' has " + std::to_string(sh->count) + " rows for " +
                std::to_string(count) + " Gaussians");
-    for (size_t k = 0; k < n; ++k) rest.push_back(&require(*sh, "f_rest_" + std::to_string(k), ScalarType::kUint8, "uchar"));
+    for (size_t k = 0; k < n; ++k)
+      rest.push_back(&require(*sh, "f_rest_" + std::to_string(k), ScalarType::kUint8, "uchar"));
   }
 
   // Where each element's rows start; every size is checked against the file before allocating.
@@ -151,8 +157,8 @@ GaussianScene read_compressed_ply(const PlyBytes& ply, const PlyHeader& header, 
 
     // Smallest three: the stored components in w x y z order without the largest one.
     const double norm = 1.0 / (std::sqrt(2.0) * 0.5);
-    const double small[3] = {(unorm(rotation >> 20, 10) - 0.5) * norm, (unorm(rotation >> 10, 10) - 0.5) * norm,
-                             (unorm(rotation, 10) - 0.5) * norm};
+    const double small[3] = {(unorm(rotation >> 20, 10) - 0.5) * norm,
+                             (unorm(rotation >> 10, 10) - 0.5) * norm, (unorm(rotation, 10) - 0.5) * norm};
     const double largest =
         std::sqrt(std::max(0.0, 1.0 - (small[0] * small[0] + small[1] * small[1] + small[2] * small[2])));
     const size_t which = rotation >> 30;

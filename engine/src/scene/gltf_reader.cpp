@@ -15,11 +15,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "scene/scene_readers.h"
 #include "scene/scene_reading.h"
@@ -66,13 +65,16 @@ class GltfReader {
       json_text = std::string_view(reinterpret_cast<const char*>(bytes), data.size());
     }
     gltf_ = json::parse(json_text.begin(), json_text.end(), nullptr, false);
-    if (gltf_.is_discarded() || !gltf_.is_object()) fail("not a glTF file (its JSON does not parse to an object)");
+    if (gltf_.is_discarded() || !gltf_.is_object())
+      fail("not a glTF file (its JSON does not parse to an object)");
     check_asset_and_extensions();
 
     std::vector<GaussianScene> parts;
     for (const auto& [mesh, world] : mesh_instances())
-      for (const json& primitive : array_of(at(at(gltf_, "meshes", "glTF"), mesh, "meshes"), "primitives", "mesh")) {
-        if (!primitive.contains("extensions") || !primitive["extensions"].contains("KHR_gaussian_splatting")) continue;
+      for (const json& primitive :
+           array_of(at(at(gltf_, "meshes", "glTF"), mesh, "meshes"), "primitives", "mesh")) {
+        if (!primitive.contains("extensions") || !primitive["extensions"].contains("KHR_gaussian_splatting"))
+          continue;
         parts.push_back(place(read_primitive(primitive), world));
       }
     if (parts.empty()) fail("no mesh primitive with the KHR_gaussian_splatting extension");
@@ -85,18 +87,22 @@ class GltfReader {
     const uint32_t version = load_le<uint32_t>(bytes + 4);
     if (version != 2) fail("unsupported GLB version " + std::to_string(version) + " (supported: 2)");
     const uint32_t length = load_le<uint32_t>(bytes + 8);
-    if (length > size) fail("truncated GLB: the header declares " + std::to_string(length) + " bytes, the file has " + std::to_string(size));
+    if (length > size)
+      fail("truncated GLB: the header declares " + std::to_string(length) + " bytes, the file has " +
+           std::to_string(size));
     size_t offset = 12;
     std::string_view json_text;
     bool first = true;
     while (offset + 8 <= length) {
       const uint32_t chunk_length = load_le<uint32_t>(bytes + offset);
       const uint32_t chunk_type = load_le<uint32_t>(bytes + offset + 4);
-      if (chunk_length > length - offset - 8) fail("GLB chunk at byte " + std::to_string(offset) + " runs past the end of the file");
+      if (chunk_length > length - offset - 8)
+        fail("GLB chunk at byte " + std::to_string(offset) + " runs past the end of the file");
       const unsigned char* chunk = bytes + offset + 8;
       if (first && chunk_type != kJsonChunk) fail("the first GLB chunk is not JSON");
       if (first) json_text = std::string_view(reinterpret_cast<const char*>(chunk), chunk_length);
-      if (!first && chunk_type == kBinChunk && !bin_) bin_ = std::span<const unsigned char>(chunk, chunk_length);
+      if (!first && chunk_type == kBinChunk && !bin_)
+        bin_ = std::span<const unsigned char>(chunk, chunk_length);
       first = false;
       offset += 8 + chunk_length;
     }
@@ -171,7 +177,8 @@ class GltfReader {
       const Matrix4 world = multiply(visit.parent, local_matrix(node));
       if (node.contains("mesh")) instances.push_back({index(node["mesh"], "node.mesh"), world});
       if (node.contains("children"))
-        for (const json& child : node["children"]) stack.push_back({index(child, "node child"), world, visit.depth + 1});
+        for (const json& child : node["children"])
+          stack.push_back({index(child, "node child"), world, visit.depth + 1});
     }
     return instances;
   }
@@ -224,7 +231,8 @@ class GltfReader {
         fail("buffer " + std::to_string(i) + ": only base64 data: URIs are supported");
       loaded_[i] = decode_base64(std::string_view(uri).substr(comma + 1));
     } else {
-      if (!load_buffer_) fail("buffer " + std::to_string(i) + " is the external file '" + uri + "': read the .gltf from disk");
+      if (!load_buffer_)
+        fail("buffer " + std::to_string(i) + " is the external file '" + uri + "': read the .gltf from disk");
       loaded_[i] = load_buffer_(uri);
     }
     return *loaded_[i];
@@ -237,13 +245,20 @@ class GltfReader {
     int count = 0;
     for (char c : text) {
       int value;
-      if (c >= 'A' && c <= 'Z') value = c - 'A';
-      else if (c >= 'a' && c <= 'z') value = c - 'a' + 26;
-      else if (c >= '0' && c <= '9') value = c - '0' + 52;
-      else if (c == '+') value = 62;
-      else if (c == '/') value = 63;
-      else if (c == '=') break;
-      else fail("a data: URI holds a character that is not base64");
+      if (c >= 'A' && c <= 'Z')
+        value = c - 'A';
+      else if (c >= 'a' && c <= 'z')
+        value = c - 'a' + 26;
+      else if (c >= '0' && c <= '9')
+        value = c - '0' + 52;
+      else if (c == '+')
+        value = 62;
+      else if (c == '/')
+        value = 63;
+      else if (c == '=')
+        break;
+      else
+        fail("a data: URI holds a character that is not base64");
       bits = (bits << 6) | static_cast<uint32_t>(value);
       if (++count == 4) {
         out.push_back(static_cast<unsigned char>(bits >> 16));
@@ -267,40 +282,51 @@ class GltfReader {
                                std::initializer_list<int> allowed) {
     const std::string where = "accessor " + std::to_string(i) + " (" + attribute + ")";
     const json& a = at(array_of(gltf_, "accessors", "glTF"), i, "accessors");
-    static const std::pair<const char*, size_t> kTypes[] = {{"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4}};
+    static const std::pair<const char*, size_t> kTypes[] = {
+        {"SCALAR", 1}, {"VEC2", 2}, {"VEC3", 3}, {"VEC4", 4}};
     const json& type = at(a, "type", where);
     size_t type_components = 0;
     for (const auto& [type_name, n] : kTypes)
       if (type == type_name) type_components = n;
-    if (type_components != components) fail(where + " has type " + type.dump() + "; expected " + std::to_string(components) + " components");
-    const int component_type = static_cast<int>(number(at(a, "componentType", where), where + ".componentType"));
+    if (type_components != components)
+      fail(where + " has type " + type.dump() + "; expected " + std::to_string(components) + " components");
+    const int component_type =
+        static_cast<int>(number(at(a, "componentType", where), where + ".componentType"));
     if (std::find(allowed.begin(), allowed.end(), component_type) == allowed.end())
-      fail(where + " has component type " + std::to_string(component_type) + ", which the extension does not allow for it");
+      fail(where + " has component type " + std::to_string(component_type) +
+           ", which the extension does not allow for it");
     const size_t elements = index(at(a, "count", where), where + ".count");
     if (elements != count)
       fail(where + " has " + std::to_string(elements) + " elements; POSITION has " + std::to_string(count));
     if (a.contains("sparse")) fail(where + " is sparse, which this reader does not support");
     const bool normalized = a.value("normalized", false);
-    const size_t size = component_type == 5126 || component_type == 5125 ? 4 : component_type == 5122 || component_type == 5123 ? 2 : 1;
+    const size_t size = component_type == 5126 || component_type == 5125   ? 4
+                        : component_type == 5122 || component_type == 5123 ? 2
+                                                                           : 1;
     if (!a.contains("bufferView")) {
       // All zeros, per the glTF spec; POSITION's count, proven by its own buffer, sizes it.
       if (attribute == "POSITION") fail(where + " has no bufferView");
       return std::vector<double>(count * components);
     }
-    const json& view = at(array_of(gltf_, "bufferViews", "glTF"), index(a["bufferView"], where + ".bufferView"), "bufferViews");
-    const std::span<const unsigned char> data = buffer(index(at(view, "buffer", "bufferView"), "bufferView.buffer"));
-    const size_t view_offset = view.contains("byteOffset") ? index(view["byteOffset"], "bufferView.byteOffset") : 0;
+    const json& view = at(array_of(gltf_, "bufferViews", "glTF"),
+                          index(a["bufferView"], where + ".bufferView"), "bufferViews");
+    const std::span<const unsigned char> data =
+        buffer(index(at(view, "buffer", "bufferView"), "bufferView.buffer"));
+    const size_t view_offset =
+        view.contains("byteOffset") ? index(view["byteOffset"], "bufferView.byteOffset") : 0;
     const size_t view_length = index(at(view, "byteLength", "bufferView"), "bufferView.byteLength");
     const size_t element_size = size * components;
-    const size_t stride = view.contains("byteStride") ? index(view["byteStride"], "bufferView.byteStride") : element_size;
+    const size_t stride =
+        view.contains("byteStride") ? index(view["byteStride"], "bufferView.byteStride") : element_size;
     const size_t offset = a.contains("byteOffset") ? index(a["byteOffset"], where + ".byteOffset") : 0;
     if (view_offset > data.size() || view_length > data.size() - view_offset)
       fail("bufferView of " + where + " lies outside its buffer (" + std::to_string(data.size()) + " bytes)");
-    if (stride < element_size) fail(where + ": byteStride " + std::to_string(stride) + " is smaller than an element");
+    if (stride < element_size)
+      fail(where + ": byteStride " + std::to_string(stride) + " is smaller than an element");
     if (count > 0) {
       uint64_t span = 0;
-      if (!checked_multiply(count - 1, stride, &span) || offset > view_length || span > view_length - offset ||
-          element_size > view_length - offset - span)
+      if (!checked_multiply(count - 1, stride, &span) || offset > view_length ||
+          span > view_length - offset || element_size > view_length - offset - span)
         fail(where + ": " + std::to_string(count) + " elements run past the end of its bufferView (" +
              std::to_string(view_length) + " bytes); the file is truncated or the count is wrong");
     }
@@ -311,12 +337,23 @@ class GltfReader {
         const unsigned char* p = base + e * stride + c * size;
         double v = 0;
         switch (component_type) {
-          case 5126: v = load_le<float>(p); break;
-          case 5120: v = normalized ? std::max(static_cast<int8_t>(*p) / 127.0, -1.0) : static_cast<int8_t>(*p); break;
-          case 5121: v = normalized ? *p / 255.0 : *p; break;
-          case 5122: v = normalized ? std::max(load_le<int16_t>(p) / 32767.0, -1.0) : load_le<int16_t>(p); break;
-          case 5123: v = normalized ? load_le<uint16_t>(p) / 65535.0 : load_le<uint16_t>(p); break;
-          default: fail(where + ": unsupported component type " + std::to_string(component_type));
+          case 5126:
+            v = load_le<float>(p);
+            break;
+          case 5120:
+            v = normalized ? std::max(static_cast<int8_t>(*p) / 127.0, -1.0) : static_cast<int8_t>(*p);
+            break;
+          case 5121:
+            v = normalized ? *p / 255.0 : *p;
+            break;
+          case 5122:
+            v = normalized ? std::max(load_le<int16_t>(p) / 32767.0, -1.0) : load_le<int16_t>(p);
+            break;
+          case 5123:
+            v = normalized ? load_le<uint16_t>(p) / 65535.0 : load_le<uint16_t>(p);
+            break;
+          default:
+            fail(where + ": unsupported component type " + std::to_string(component_type));
         }
         values[e * components + c] = v;
       }
@@ -325,7 +362,8 @@ class GltfReader {
 
   GaussianScene read_primitive(const json& primitive) {
     const json& attributes = at(primitive, "attributes", "the primitive");
-    if (primitive.contains("mode") && primitive["mode"] != 0) fail("a KHR_gaussian_splatting primitive must have mode POINTS (0)");
+    if (primitive.contains("mode") && primitive["mode"] != 0)
+      fail("a KHR_gaussian_splatting primitive must have mode POINTS (0)");
     const auto attribute = [&](const std::string& semantic) -> std::optional<size_t> {
       if (!attributes.contains(semantic)) return std::nullopt;
       return index(attributes[semantic], "attribute " + semantic);
@@ -341,19 +379,25 @@ class GltfReader {
     // Every accessor of `count` elements must fit its buffer: a count is checked there before the
     // scene's arrays are sized by it.
     const std::vector<double> positions = accessor(position_index, "POSITION", 3, count, {5126});
-    const std::vector<double> rotations = accessor(required(std::string(kPrefix) + "ROTATION"), "ROTATION", 4, count, {5126, 5120, 5122});
-    const std::vector<double> scales = accessor(required(std::string(kPrefix) + "SCALE"), "SCALE", 3, count, {5126, 5120, 5122});
-    const std::vector<double> opacities = accessor(required(std::string(kPrefix) + "OPACITY"), "OPACITY", 1, count, {5126, 5121, 5123});
+    const std::vector<double> rotations =
+        accessor(required(std::string(kPrefix) + "ROTATION"), "ROTATION", 4, count, {5126, 5120, 5122});
+    const std::vector<double> scales =
+        accessor(required(std::string(kPrefix) + "SCALE"), "SCALE", 3, count, {5126, 5120, 5122});
+    const std::vector<double> opacities =
+        accessor(required(std::string(kPrefix) + "OPACITY"), "OPACITY", 1, count, {5126, 5121, 5123});
 
     int degree = 0;
-    while (degree < 3 && attribute(std::string(kPrefix) + "SH_DEGREE_" + std::to_string(degree + 1) + "_COEF_0")) ++degree;
+    while (degree < 3 &&
+           attribute(std::string(kPrefix) + "SH_DEGREE_" + std::to_string(degree + 1) + "_COEF_0"))
+      ++degree;
     GaussianScene scene;
     allocate_scene(scene, count, degree);
     const size_t coefficients = static_cast<size_t>(scene.sh_coefficients());
     size_t k = 0;
     for (int l = 0; l <= degree; ++l)
       for (int n = 0; n < 2 * l + 1; ++n, ++k) {
-        const std::string semantic = std::string(kPrefix) + "SH_DEGREE_" + std::to_string(l) + "_COEF_" + std::to_string(n);
+        const std::string semantic =
+            std::string(kPrefix) + "SH_DEGREE_" + std::to_string(l) + "_COEF_" + std::to_string(n);
         std::vector<double> values;
         if (const auto i = attribute(semantic)) {
           values = accessor(*i, semantic, 3, count, {5126});
@@ -364,10 +408,12 @@ class GltfReader {
             for (size_t c = 0; c < 3; ++c) rgb.push_back((values[4 * e + c] - 0.5) / kShC0);
           values = std::move(rgb);
         } else {
-          fail("the KHR_gaussian_splatting primitive lacks " + semantic + (l == 0 ? "" : " (SH degrees must be complete)"));
+          fail("the KHR_gaussian_splatting primitive lacks " + semantic +
+               (l == 0 ? "" : " (SH degrees must be complete)"));
         }
         for (size_t e = 0; e < count; ++e)
-          for (size_t c = 0; c < 3; ++c) scene.sh[(e * coefficients + k) * 3 + c] = to_float(values[3 * e + c]);
+          for (size_t c = 0; c < 3; ++c)
+            scene.sh[(e * coefficients + k) * 3 + c] = to_float(values[3 * e + c]);
       }
     for (size_t e = 0; e < count; ++e) {
       for (size_t a = 0; a < 3; ++a) {
@@ -390,13 +436,16 @@ class GltfReader {
       ModelTransform transform;
       std::array<double, 3> column_norm{};
       for (int col = 0; col < 3; ++col)
-        column_norm[col] = std::sqrt(world[col * 4] * world[col * 4] + world[col * 4 + 1] * world[col * 4 + 1] +
-                                     world[col * 4 + 2] * world[col * 4 + 2]);
+        column_norm[col] =
+            std::sqrt(world[col * 4] * world[col * 4] + world[col * 4 + 1] * world[col * 4 + 1] +
+                      world[col * 4 + 2] * world[col * 4 + 2]);
       const double s = column_norm[0];
       if (!(s > 0) || std::fabs(column_norm[1] - s) > 1e-6 * s || std::fabs(column_norm[2] - s) > 1e-6 * s ||
           world[3] != 0 || world[7] != 0 || world[11] != 0 || world[15] != 1)
-        fail("a node transform with a non-uniform scale, a shear or a projection: Gaussians can only be moved, "
-             "rotated and scaled uniformly");
+        fail(
+            "a node transform with a non-uniform scale, a shear or a projection: Gaussians can only be "
+            "moved, "
+            "rotated and scaled uniformly");
       std::array<double, 9> r{};  // row-major rotation
       for (int col = 0; col < 3; ++col)
         for (int row = 0; row < 3; ++row) r[row * 3 + col] = world[col * 4 + row] / s;
@@ -450,7 +499,9 @@ class GltfReader {
     merged.sh_degree = degree;
     for (GaussianScene& part : parts) {
       const GaussianScene padded = with_sh_degree(part, degree);
-      const auto append = [](std::vector<float>& out, const std::vector<float>& in) { out.insert(out.end(), in.begin(), in.end()); };
+      const auto append = [](std::vector<float>& out, const std::vector<float>& in) {
+        out.insert(out.end(), in.begin(), in.end());
+      };
       append(merged.positions, padded.positions);
       append(merged.log_scales, padded.log_scales);
       append(merged.rotations, padded.rotations);

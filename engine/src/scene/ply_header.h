@@ -164,7 +164,8 @@ inline bool is_blank(char c) {
 // A PLY file's bytes and name, for parsing its header and walking its elements.
 class PlyBytes {
  public:
-  PlyBytes(std::string_view name, const unsigned char* bytes, size_t size) : name_(name), bytes_(bytes), size_(size) {}
+  PlyBytes(std::string_view name, const unsigned char* bytes, size_t size)
+      : name_(name), bytes_(bytes), size_(size) {}
 
   // Parses and validates the header: magic, format, elements and properties, an 'element vertex'.
   PlyHeader parse_header() const;

@@ -29,7 +29,7 @@ std::string FileContents::open(const std::filesystem::path& path) {
 #if TILESPLAT_HAS_MMAP
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return std::string("cannot open: ") + std::strerror(errno);
-  struct stat info{};
+  struct stat info {};
   if (fstat(fd, &info) != 0) {
     const std::string error = std::string("cannot open: ") + std::strerror(errno);
     ::close(fd);
@@ -46,7 +46,7 @@ std::string FileContents::open(const std::filesystem::path& path) {
   }
   ::close(fd);
   if (data_ || size_ == 0) return {};
-  // Mapping can fail on some file systems: fall back to reading.
+    // Mapping can fail on some file systems: fall back to reading.
 #endif
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (!file) return std::string("cannot open: ") + std::strerror(errno);
@@ -75,7 +75,8 @@ void open_scene_file(const std::filesystem::path& path, FileContents& contents) 
   const std::string name = path.string();
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
-  if (ec && status.type() != std::filesystem::file_type::not_found) fail(name, "cannot open: " + ec.message());
+  if (ec && status.type() != std::filesystem::file_type::not_found)
+    fail(name, "cannot open: " + ec.message());
   if (!std::filesystem::exists(status)) fail(name, "cannot open: no such file");
   if (std::filesystem::is_directory(status)) fail(name, "cannot open: is a directory, not a file");
   if (!std::filesystem::is_regular_file(status)) fail(name, "cannot open: not a regular file");
@@ -107,8 +108,8 @@ void allocate_scene(GaussianScene& scene, size_t count, int sh_degree) {
 void require_bytes(std::string_view name, std::string_view what, uint64_t count, uint64_t bytes_each,
                    uint64_t available) {
   if (bytes_each != 0 && count > available / bytes_each)
-    fail(name, std::string(what) + ": " + std::to_string(count) + " Gaussians of " + std::to_string(bytes_each) +
-                   " bytes need more than the " + std::to_string(available) +
+    fail(name, std::string(what) + ": " + std::to_string(count) + " Gaussians of " +
+                   std::to_string(bytes_each) + " bytes need more than the " + std::to_string(available) +
                    " bytes there are; the file is truncated or its count is wrong");
 }
 
@@ -201,10 +202,10 @@ void finish_scene(GaussianScene& scene, std::string_view name, const LoadOptions
   NonFiniteTally tally(name, options);
   size_t kept = 0;
   for (size_t i = 0; i < count; ++i) {
-    const bool finite = all_finite(scene.positions.data() + 3 * i, 3) &&
-                        all_finite(scene.log_scales.data() + 3 * i, 3) &&
-                        all_finite(scene.rotations.data() + 4 * i, 4) && std::isfinite(scene.opacity_logits[i]) &&
-                        all_finite(scene.sh.data() + sh_stride * i, sh_stride);
+    const bool finite =
+        all_finite(scene.positions.data() + 3 * i, 3) && all_finite(scene.log_scales.data() + 3 * i, 3) &&
+        all_finite(scene.rotations.data() + 4 * i, 4) && std::isfinite(scene.opacity_logits[i]) &&
+        all_finite(scene.sh.data() + sh_stride * i, sh_stride);
     if (!finite) {
       float value = 0;
       const std::string property = first_non_finite(scene, i, &value);

@@ -14,14 +14,14 @@
 //           coefficients j, whose RGB index the codebook
 // Version 1 (no "version"; means.shape [count, 3]) has per-channel mins/maxs in place of codebooks.
 // SOG stores the trainer's axes: no conversion.
-#include <algorithm>
-#include <cmath>
-#include <string>
-#include <vector>
-
-#include <nlohmann/json.hpp>
 #include <webp/decode.h>
 #include <zip.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "scene/scene_readers.h"
 #include "scene/scene_reading.h"
@@ -60,7 +60,8 @@ class SogDecoder {
     result.width = features.width;
     result.height = features.height;
     result.rgba.resize(4 * texels);
-    if (!WebPDecodeRGBAInto(bytes.data(), bytes.size(), result.rgba.data(), result.rgba.size(), 4 * features.width))
+    if (!WebPDecodeRGBAInto(bytes.data(), bytes.size(), result.rgba.data(), result.rgba.size(),
+                            4 * features.width))
       fail(file + ": the WebP image does not decode");
     return result;
   }
@@ -69,7 +70,8 @@ class SogDecoder {
     if (!object.is_object() || !object.contains(key)) fail("meta.json: " + where + " has no '" + key + "'");
     return object.at(key);
   }
-  std::vector<double> numbers(const json& object, const char* key, size_t size, const std::string& where) const {
+  std::vector<double> numbers(const json& object, const char* key, size_t size,
+                              const std::string& where) const {
     const json& value = member(object, key, where);
     if (!value.is_array() || value.size() != size)
       fail("meta.json: " + where + "." + key + " must be an array of " + std::to_string(size) + " numbers");
@@ -140,7 +142,8 @@ class SogDecoder {
         if (sh_degree == 0)
           fail(file(*sh_n, 0, "shN") + ": width " + std::to_string(centroids.width) +
                " is not a palette of 1, 2 or 3 SH bands (192, 512 or 960)");
-        palette = static_cast<size_t>(centroids.width / ((sh_degree + 1) * (sh_degree + 1) - 1)) * centroids.height;
+        palette =
+            static_cast<size_t>(centroids.width / ((sh_degree + 1) * (sh_degree + 1) - 1)) * centroids.height;
       }
       const int rest = (sh_degree + 1) * (sh_degree + 1) - 1;
       if (centroids.width != 64 * rest)
@@ -161,7 +164,8 @@ class SogDecoder {
   }
 
  private:
-  void decode_means(const json& means, const Image& low, const Image& high, size_t count, GaussianScene& scene) const {
+  void decode_means(const json& means, const Image& low, const Image& high, size_t count,
+                    GaussianScene& scene) const {
     const std::vector<double> mins = numbers(means, "mins", 3, "means");
     const std::vector<double> maxs = numbers(means, "maxs", 3, "means");
     for (size_t i = 0; i < count; ++i)
@@ -244,7 +248,8 @@ class SogDecoder {
     } else {
       const double low = number(sh_n, "mins", "shN");
       const double high = number(sh_n, "maxs", "shN");
-      for (size_t b = 0; b < 256; ++b) book[b] = to_float(low + (high - low) * (static_cast<double>(b) / 255.0));
+      for (size_t b = 0; b < 256; ++b)
+        book[b] = to_float(low + (high - low) * (static_cast<double>(b) / 255.0));
     }
     for (size_t i = 0; i < count; ++i) {
       const size_t label = labels.texel(i)[0] | (labels.texel(i)[1] << 8);
@@ -300,13 +305,15 @@ class ZipArchive {
     if (index < 0) detail::fail(name_, "the SOG archive has no '" + entry + "'");
     zip_stat_t stat;
     zip_stat_init(&stat);
-    if (zip_stat_index(archive_, static_cast<zip_uint64_t>(index), 0, &stat) != 0 || !(stat.valid & ZIP_STAT_SIZE))
+    if (zip_stat_index(archive_, static_cast<zip_uint64_t>(index), 0, &stat) != 0 ||
+        !(stat.valid & ZIP_STAT_SIZE))
       detail::fail(name_, entry + ": cannot read its size in the zip");
     // Deflate expands at most about 1032 times: a bigger declared size is a bomb or a lie.
     const bool compressed_known = (stat.valid & ZIP_STAT_COMP_SIZE) != 0;
     if (stat.size > max_size || (compressed_known && stat.size > 1032 * stat.comp_size + 1024))
-      detail::fail(name_, entry + ": declares " + std::to_string(stat.size) +
-                              " bytes uncompressed, more than such an entry can be; refusing to decompress it");
+      detail::fail(name_,
+                   entry + ": declares " + std::to_string(stat.size) +
+                       " bytes uncompressed, more than such an entry can be; refusing to decompress it");
     zip_file_t* file = zip_fopen_index(archive_, static_cast<zip_uint64_t>(index), 0);
     if (!file) detail::fail(name_, entry + ": cannot open it in the zip (" + zip_strerror(archive_) + ")");
     std::vector<unsigned char> bytes(stat.size);
@@ -315,8 +322,8 @@ class ZipArchive {
     const zip_int64_t more = zip_fread(file, &extra, 1);
     zip_fclose(file);
     if (got != static_cast<zip_int64_t>(bytes.size()) || more != 0)
-      detail::fail(name_, entry + ": corrupt or truncated in the zip (" + std::to_string(got < 0 ? 0 : got) + " of " +
-                              std::to_string(stat.size) + " bytes)");
+      detail::fail(name_, entry + ": corrupt or truncated in the zip (" + std::to_string(got < 0 ? 0 : got) +
+                              " of " + std::to_string(stat.size) + " bytes)");
     return bytes;
   }
 
@@ -348,7 +355,8 @@ GaussianScene read_sog_zip(std::span<const std::byte> data, std::string_view nam
   const ZipArchive archive(data, name);
   if (!archive.contains("meta.json")) fail(name, "a zip without meta.json, not a SOG archive");
   const std::vector<unsigned char> text = archive.read("meta.json", 64u << 20);
-  const json meta = parse_meta(std::string_view(reinterpret_cast<const char*>(text.data()), text.size()), name);
+  const json meta =
+      parse_meta(std::string_view(reinterpret_cast<const char*>(text.data()), text.size()), name);
   const FileLoader load = [&](const std::string& entry) { return archive.read(entry, kMaxEntry); };
   GaussianScene scene = SogDecoder(name, load).decode(meta);
   finish_scene(scene, name, options, "sog", meta.contains("version") ? "2" : "1", report);

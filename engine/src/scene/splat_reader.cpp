@@ -21,8 +21,9 @@ GaussianScene read_splat(std::span<const std::byte> data, std::string_view name,
                          LoadReport* report) {
   if (data.empty()) fail(name, "empty file, not a .splat file");
   if (data.size() % kBytesPerGaussian != 0)
-    fail(name, "not a .splat file: its size (" + std::to_string(data.size()) +
-                   " bytes) is not a multiple of 32 bytes a Gaussian; the file is truncated or of another format");
+    fail(name,
+         "not a .splat file: its size (" + std::to_string(data.size()) +
+             " bytes) is not a multiple of 32 bytes a Gaussian; the file is truncated or of another format");
   const size_t count = data.size() / kBytesPerGaussian;
   const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
 
@@ -33,11 +34,13 @@ GaussianScene read_splat(std::span<const std::byte> data, std::string_view name,
     for (size_t a = 0; a < 3; ++a) {
       scene.positions[3 * i + a] = load_le<float>(record + 4 * a);
       // log(0) is -inf and a negative scale NaN: finish_scene drops such Gaussians.
-      scene.log_scales[3 * i + a] = to_float(std::log(static_cast<double>(load_le<float>(record + 12 + 4 * a))));
+      scene.log_scales[3 * i + a] =
+          to_float(std::log(static_cast<double>(load_le<float>(record + 12 + 4 * a))));
       scene.sh[3 * i + a] = static_cast<float>((record[24 + a] / 255.0 - 0.5) / kShC0);
     }
     scene.opacity_logits[i] = static_cast<float>(clamped_logit(record[27] / 255.0));
-    for (size_t j = 0; j < 4; ++j) scene.rotations[4 * i + j] = static_cast<float>(record[28 + j] / 255.0 * 2.0 - 1.0);
+    for (size_t j = 0; j < 4; ++j)
+      scene.rotations[4 * i + j] = static_cast<float>(record[28 + j] / 255.0 * 2.0 - 1.0);
   }
   finish_scene(scene, name, options, "splat", "", report);
   return scene;

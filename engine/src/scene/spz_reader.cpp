@@ -16,14 +16,14 @@
 // SPZ stores RUB axes (x right, y up, z back) unless an extension says otherwise; the engine's are
 // the trainer's RDF, so y and z flip: positions, quaternions (w x -y -z) and the SH bands (each
 // basis function's parity in y and z).
+#include <zlib.h>
+#include <zstd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
-
-#include <zlib.h>
-#include <zstd.h>
 
 #include "scene/scene_readers.h"
 #include "scene/scene_reading.h"
@@ -102,7 +102,8 @@ bool inflate_prefix(std::vector<unsigned char>& out, size_t wanted, z_stream& st
 }
 
 // Versions 2 and 3: the header and arrays, inflated (or, uncompressed, as they are).
-std::vector<unsigned char> legacy_payload(std::span<const std::byte> data, std::string_view name, SpzHeader* header) {
+std::vector<unsigned char> legacy_payload(std::span<const std::byte> data, std::string_view name,
+                                          SpzHeader* header) {
   const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
   const bool gzip = data.size() >= 2 && bytes[0] == 0x1f && bytes[1] == 0x8b;
   if (!gzip) {
@@ -124,7 +125,8 @@ std::vector<unsigned char> legacy_payload(std::span<const std::byte> data, std::
   if (!inflate_prefix(payload, kLegacyHeaderSize, stream))
     fail(name, "truncated or corrupt gzip stream: it ends before the 16-byte SPZ header");
   *header = parse_header(name, payload.data());
-  if (header->version == 4) fail(name, "an SPZ version 4 header inside gzip (version 4 files are not gzipped)");
+  if (header->version == 4)
+    fail(name, "an SPZ version 4 header inside gzip (version 4 files are not gzipped)");
   const Layout layout = layout_of(*header);
   check_plausible(name, layout, data.size());
   if (!inflate_prefix(payload, kLegacyHeaderSize + layout.total(), stream))
@@ -135,17 +137,20 @@ std::vector<unsigned char> legacy_payload(std::span<const std::byte> data, std::
 }
 
 // Version 4: the TOC's streams, each zstd-decompressed to the size the count implies.
-std::vector<unsigned char> zstd_payload(std::span<const std::byte> data, std::string_view name, SpzHeader* header) {
+std::vector<unsigned char> zstd_payload(std::span<const std::byte> data, std::string_view name,
+                                        SpzHeader* header) {
   const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
-  if (data.size() < kHeaderSize) fail(name, "truncated SPZ version 4 header (" + std::to_string(data.size()) + " bytes)");
+  if (data.size() < kHeaderSize)
+    fail(name, "truncated SPZ version 4 header (" + std::to_string(data.size()) + " bytes)");
   *header = parse_header(name, bytes);
   if (header->version != 4)
-    fail(name, "SPZ version " + std::to_string(header->version) + " without gzip (only version 4 is uncompressed)");
+    fail(name,
+         "SPZ version " + std::to_string(header->version) + " without gzip (only version 4 is uncompressed)");
   const size_t streams = bytes[15];
   const uint32_t toc = load_le<uint32_t>(bytes + 16);
   const Layout layout = layout_of(*header);
-  const uint64_t expected[6] = {layout.positions, layout.alphas, layout.colours, layout.scales, layout.rotations,
-                                layout.sh};
+  const uint64_t expected[6] = {layout.positions, layout.alphas,    layout.colours,
+                                layout.scales,    layout.rotations, layout.sh};
   const size_t expected_streams = header->sh_degree > 0 ? 6 : 5;
   if (streams != expected_streams)
     fail(name, "SPZ version 4 with " + std::to_string(streams) + " streams; expected " +
@@ -162,7 +167,8 @@ std::vector<unsigned char> zstd_payload(std::span<const std::byte> data, std::st
     ZSTD_DCtx* c;
     ~Free() { ZSTD_freeDCtx(c); }
   } free_context{context};
-  static constexpr const char* kStreamNames[6] = {"positions", "alphas", "colours", "scales", "rotations", "SH"};
+  static constexpr const char* kStreamNames[6] = {"positions", "alphas",    "colours",
+                                                  "scales",    "rotations", "SH"};
   for (size_t s = 0; s < streams; ++s) {
     const uint64_t compressed = load_le<uint64_t>(bytes + toc + 16 * s);
     const uint64_t uncompressed = load_le<uint64_t>(bytes + toc + 16 * s + 8);
@@ -172,9 +178,9 @@ std::vector<unsigned char> zstd_payload(std::span<const std::byte> data, std::st
                      std::to_string(header->count) + " Gaussians need " + std::to_string(expected[s]));
     if (compressed > data.size() - in)
       fail(name, stream_name + " (" + std::to_string(compressed) + " bytes) runs past the end of the file");
-    const size_t produced = ZSTD_decompressDCtx(context, payload.data() + out, uncompressed, bytes + in, compressed);
-    if (ZSTD_isError(produced))
-      fail(name, stream_name + " is corrupt: " + ZSTD_getErrorName(produced));
+    const size_t produced =
+        ZSTD_decompressDCtx(context, payload.data() + out, uncompressed, bytes + in, compressed);
+    if (ZSTD_isError(produced)) fail(name, stream_name + " is corrupt: " + ZSTD_getErrorName(produced));
     if (produced != uncompressed)
       fail(name, stream_name + " decompresses to " + std::to_string(produced) + " bytes, not the " +
                      std::to_string(uncompressed) + " declared");
@@ -196,7 +202,8 @@ GaussianScene read_spz(std::span<const std::byte> data, std::string_view name, c
                        LoadReport* report) {
   if (data.empty()) fail(name, "empty file, not an SPZ file");
   const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
-  const bool plain_v4 = data.size() >= 8 && load_le<uint32_t>(bytes) == kMagic && load_le<uint32_t>(bytes + 4) == 4;
+  const bool plain_v4 =
+      data.size() >= 8 && load_le<uint32_t>(bytes) == kMagic && load_le<uint32_t>(bytes + 4) == 4;
   SpzHeader header;
   const std::vector<unsigned char> payload =
       plain_v4 ? zstd_payload(data, name, &header) : legacy_payload(data, name, &header);
@@ -221,7 +228,8 @@ GaussianScene read_spz(std::span<const std::byte> data, std::string_view name, c
       if (fixed & 0x800000) fixed -= 1 << 24;
       scene.positions[3 * i + a] = kFlip[a] * static_cast<float>(std::ldexp(fixed, -header.fractional_bits));
       scene.log_scales[3 * i + a] = static_cast<float>(scales[3 * i + a] / 16.0 - 10.0);
-      scene.sh[3 * coefficients * i + a] = static_cast<float>((colours[3 * i + a] / 255.0 - 0.5) / kColourScale);
+      scene.sh[3 * coefficients * i + a] =
+          static_cast<float>((colours[3 * i + a] / 255.0 - 0.5) / kColourScale);
     }
     scene.opacity_logits[i] = static_cast<float>(clamped_logit(alphas[i] / 255.0));
 
@@ -251,7 +259,8 @@ GaussianScene read_spz(std::span<const std::byte> data, std::string_view name, c
     float* coefficients_out = scene.sh.data() + 3 * coefficients * i + 3;
     for (size_t k = 0; k + 1 < coefficients; ++k)
       for (size_t c = 0; c < 3; ++c)
-        coefficients_out[3 * k + c] = kRubToRdfSh[k] * static_cast<float>((coefficients_in[3 * k + c] - 128) / 128.0);
+        coefficients_out[3 * k + c] =
+            kRubToRdfSh[k] * static_cast<float>((coefficients_in[3 * k + c] - 128) / 128.0);
   }
   const bool extensions = (header.flags & kFlagHasExtensions) != 0;
   std::string version = std::to_string(header.version);
