@@ -52,10 +52,11 @@ TEST(CliInfo, SummarizesFilesOfEveryFormat) {
 TEST(CliInfo, BadFilesAndFlags) {
   TILESPLAT_REQUIRE_SHARED_SCENES();
   const std::string good = (testing::shared_scenes() / "train_3pts.spz").string();
-  const auto missing = run_process("", TILESPLAT_INFO_EXE, {"/no/such/file.spz", good});
+  const std::string absent = (testing::temp_dir() / "no_such_file.spz").string();
+  const auto missing = run_process("", TILESPLAT_INFO_EXE, {absent, good});
   EXPECT_EQ(missing.exit_code, 1);
   testing::expect_one_error_line(missing, "tilesplat-info");
-  EXPECT_NE(missing.err.find("/no/such/file.spz"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find(absent), std::string::npos) << missing.err;
   EXPECT_NE(missing.out.find("train_3pts.spz"), std::string::npos) << "the good file is still shown";
   const auto none = run_process("", TILESPLAT_INFO_EXE, {});
   EXPECT_EQ(none.exit_code, 2);

@@ -10,10 +10,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
+#include "process_support.h"
 #include "test_support.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
@@ -184,10 +184,7 @@ TEST(SceneFormats, FormatAndVersionAreReported) {
 
 // ---- malformed files ----
 
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using testing::read_file;
 
 fs::path write_file(const std::string& name, const std::string& bytes) {
   const fs::path path = testing::temp_dir() / name;

@@ -2,8 +2,10 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -51,6 +53,37 @@ inline void check_scene(const tilesplat::GaussianScene& scene, const tilesplat::
   }
   const tilesplat::Bounds bounds = tilesplat::compute_bounds(scene);
   FUZZ_CHECK(!(bounds.radius < 0));
+}
+
+// The whole check of one fuzz input through a reader, `read(bytes, name, options, report)`: it must
+// load a well-formed scene or throw a SceneError that names the file, and strict mode must fail
+// exactly when the default mode drops a Gaussian, and otherwise load the same.
+template <typename Read>
+int check_reader(const uint8_t* data, size_t size, const char* name, Read read) {
+  const auto bytes = std::as_bytes(std::span(data, size));
+  bool loaded = false;
+  tilesplat::GaussianScene scene;
+  tilesplat::LoadReport report;
+  try {
+    scene = read(bytes, name, tilesplat::LoadOptions{}, &report);
+    loaded = true;
+  } catch (const tilesplat::SceneError& error) {
+    FUZZ_CHECK(std::string(error.what()).starts_with(std::string(name) + ": "));
+  }
+  if (loaded) check_scene(scene, report);
+
+  tilesplat::LoadOptions strict;
+  strict.strict = true;
+  try {
+    const tilesplat::GaussianScene strict_scene =
+        read(bytes, name, strict, static_cast<tilesplat::LoadReport*>(nullptr));
+    FUZZ_CHECK(loaded && report.dropped == 0);
+    FUZZ_CHECK(strict_scene.size() == scene.size() && strict_scene.positions == scene.positions &&
+               strict_scene.sh == scene.sh && strict_scene.rotations == scene.rotations);
+  } catch (const tilesplat::SceneError&) {
+    FUZZ_CHECK(!loaded || report.dropped > 0);
+  }
+  return 0;
 }
 
 }  // namespace tilesplat::fuzz

@@ -78,7 +78,8 @@ class GltfReader {
         parts.push_back(place(read_primitive(primitive), world));
       }
     if (parts.empty()) fail("no mesh primitive with the KHR_gaussian_splatting extension");
-    return merge(std::move(parts));
+    if (parts.size() == 1) return std::move(parts.front());
+    return merge_scenes(parts);
   }
 
  private:
@@ -489,26 +490,6 @@ class GltfReader {
         for (size_t c = 0; c < 3; ++c) sh[3 * k + c] *= kFlipSh[k - 1];
     }
     return scene;
-  }
-
-  static GaussianScene merge(std::vector<GaussianScene> parts) {
-    if (parts.size() == 1) return std::move(parts.front());
-    int degree = 0;
-    for (const GaussianScene& part : parts) degree = std::max(degree, part.sh_degree);
-    GaussianScene merged;
-    merged.sh_degree = degree;
-    for (GaussianScene& part : parts) {
-      const GaussianScene padded = with_sh_degree(part, degree);
-      const auto append = [](std::vector<float>& out, const std::vector<float>& in) {
-        out.insert(out.end(), in.begin(), in.end());
-      };
-      append(merged.positions, padded.positions);
-      append(merged.log_scales, padded.log_scales);
-      append(merged.rotations, padded.rotations);
-      append(merged.opacity_logits, padded.opacity_logits);
-      append(merged.sh, padded.sh);
-    }
-    return merged;
   }
 
   std::string_view name_;

@@ -49,7 +49,11 @@ struct ColumnTarget {
 class PlyReader {
  public:
   PlyReader(std::string_view name, const unsigned char* bytes, size_t size, const LoadOptions& options)
-      : name_(name), options_(options), ply_(name, bytes, size), bytes_(bytes), size_(size),
+      : name_(name),
+        options_(options),
+        ply_(name, bytes, size),
+        bytes_(bytes),
+        size_(size),
         non_finite_(name, options) {}
 
   GaussianScene read(LoadReport* report) {
@@ -198,12 +202,7 @@ class PlyReader {
   }
 
   void allocate(GaussianScene& scene, size_t count) const {
-    const size_t coefficients = static_cast<size_t>(scene.sh_coefficients());
-    scene.positions.resize(3 * count);
-    scene.log_scales.resize(3 * count);
-    scene.rotations.resize(4 * count);
-    scene.opacity_logits.resize(count);
-    scene.sh.resize(3 * coefficients * count);
+    allocate_scene(scene, count, sh_degree_);
     if (has_normals_) scene.normals.resize(3 * count);
   }
 
@@ -521,7 +520,7 @@ GaussianScene parse_ply(std::span<const std::byte> data, std::string_view name, 
 GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report) {
   detail::FileContents contents;
   detail::open_scene_file(path, contents);
-  return parse_ply(std::as_bytes(std::span(contents.data(), contents.size())), path.string(), options, report);
+  return parse_ply(contents.bytes(), path.string(), options, report);
 }
 
 }  // namespace tilesplat

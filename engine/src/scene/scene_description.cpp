@@ -18,6 +18,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scene/scene_readers.h"
+
 namespace tilesplat {
 namespace {
 
@@ -711,8 +713,7 @@ bool is_scene_description(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return true;  // load_scene_description reports why it cannot be read
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
-  return !(json.is_object() && json.contains("means") && json.contains("quats"));
+  return !detail::is_sog_meta(text);
 }
 
 }  // namespace tilesplat
