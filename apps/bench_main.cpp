@@ -15,8 +15,9 @@
 #include <vector>
 
 #include "accuracy_report.h"
-#include "effects_report.h"
 #include "bench_plot.h"
+#include "effects_report.h"
+#include "formats_report.h"
 #include "cli.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
@@ -47,6 +48,7 @@ struct BenchOptions {
   bool sort_bench = false;
   bool accuracy = false;  // --accuracy: the error/time report
   bool effects = false;   // --effects: the per-effect cost table
+  bool formats = false;   // --formats: what each file of a scene costs against its lossless PLY
   std::string markdown;
   tilesplat::accuracy::CameraPath path = tilesplat::accuracy::CameraPath::kPan;
   int path_frames = 6;
@@ -714,7 +716,8 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     "along a short camera path from the first view (--path) and the view consistency under a turn "
                     "(--consistency-angle); --plot draws the Pareto charts",
                     &options.accuracy);
-  parser.add_string("--markdown", "FILE.md", "with --accuracy or --effects: also write the report as Markdown tables",
+  parser.add_string("--markdown", "FILE.md",
+                    "with --accuracy, --effects or --formats: also write the report as Markdown tables",
                     &options.markdown);
   parser.add_value("--path", "dolly|pan|orbit",
                    "with --accuracy: the camera path the popping is measured on, from the first view: 'pan' "
@@ -753,6 +756,16 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     "and beside the 'off' rows a scene that never had the effect (SH stored at degree 0, no "
                     "normals); one SCENE, --views or --orbit cameras; --markdown and --csv write the table",
                     &options.effects);
+
+  parser.section("format costs");
+  parser.add_switch("--formats",
+                    "measure what each file format costs: the first SCENE is the lossless reference (a PLY), the "
+                    "others the same scene in other formats; per file its size and bytes per Gaussian, load time "
+                    "(median of --repeat loads after --warmup) and peak memory, the largest error of every decoded "
+                    "attribute, and the image PSNR and max abs error against the reference's at each view (default: "
+                    "the first and the middle view of --cameras, else two orbit views); --markdown, --csv and --plot "
+                    "(bytes per Gaussian against PSNR) write the report",
+                    &options.formats);
 
   parser.section("sort micro-benchmark");
   parser.add_switch("--sort-bench",
@@ -1201,6 +1214,81 @@ int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options
   return cli::kExitOk;
 }
 
+// The views the format report compares images at: those asked for, else two that see the scene
+// from different sides (the first and the middle view of its cameras, or two opposite orbit views).
+std::vector<Case> plan_format_views(const cli::ArgParser& parser, BenchOptions options, const BenchScene& reference) {
+  const bool chosen = parser.seen("--view") || parser.seen("--views") || parser.seen("--orbit");
+  if (!chosen) {
+    const cli::SceneViews own = cli::scene_views(reference.loaded);
+    const size_t count = !reference.cameras.empty() ? cli::load_camera_views(reference.cameras).size() : own.views.size();
+    if (count > 0) {
+      options.views = {0};
+      if (count > 1) options.views.push_back(int(count / 2));
+    } else {
+      options.orbit = 2;
+    }
+  }
+  return plan_cases(options, reference, 0, {{options.common.width, options.common.height}});
+}
+
+int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options, int argc, char** argv) {
+  for (const char* flag : {"--resolutions", "--json"})
+    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --formats");
+  if (options.common.scenes.size() < 2)
+    throw cli::UsageError("--formats compares files with a reference: give the lossless PLY first, then one or more "
+                          "files of the same scene");
+  if (options.common.sorts.size() > 1) throw cli::UsageError("--formats renders with one --sort strategy");
+  if (options.common.cameras_files.size() > 1) throw cli::UsageError("--formats takes one --cameras for all its files");
+  if (!options.plot.empty() && !cli::has_extension(options.plot, ".svg"))
+    throw cli::UsageError("--plot writes SVG: its file name must end in .svg, got '" + options.plot + "'");
+  std::vector<std::pair<std::string, fs::path>> inputs;
+  for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
+  for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
+  check_outputs(options, inputs);
+  std::string command = "tilesplat-bench";
+  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+
+  BenchScene reference;
+  reference.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
+  if (!options.common.cameras_files.empty()) reference.cameras = options.common.cameras_files.front();
+  tilesplat::formats::Options format_options;
+  std::string view_names;
+  for (const Case& c : plan_format_views(parser, options, reference)) {
+    format_options.views.push_back(c.camera.camera);
+    format_options.view_names.push_back(c.view_label);
+    view_names += (view_names.empty() ? "" : ", ") + c.view_label;
+  }
+  reference.loaded.scene = {};  // measure() loads every file itself, the reference included
+  format_options.warmup = options.warmup;
+  format_options.repeat = options.repeat;
+  if (!options.common.sorts.empty()) format_options.settings.sort = options.common.sorts.front();
+  if (!options.common.modes.empty()) format_options.settings.accuracy = options.common.modes.front();
+  if (options.common.antialiasing) format_options.settings.antialiasing = *options.common.antialiasing;
+
+  const std::vector<fs::path> files(options.common.scenes.begin() + 1, options.common.scenes.end());
+  const auto renderer = tilesplat::Renderer::create(cli::renderer_options(options.common));
+  tilesplat::formats::Report report;
+  {
+    const int total = tilesplat::formats::work_units(files.size(), format_options);
+    Progress progress(total, cli::stderr_is_terminal(), "steps");
+    report = tilesplat::formats::measure(*renderer, options.common.scenes.front(), files, format_options,
+                                         [&](int done, int, const std::string& what) { progress.update(done, what); });
+  }
+  report.views_label = view_names + " at " + cli::format_size(format_options.views.front().width,
+                                                              format_options.views.front().height);
+  std::printf("device  %s (driver %s)\n\n%s", report.device.name.c_str(), report.device.driver.c_str(),
+              tilesplat::formats::text_table(report).c_str());
+  std::fflush(stdout);
+  const std::string written =
+      write_outputs({{options.markdown, [&] { return tilesplat::formats::markdown(report, command); }},
+                     {options.csv, [&] { return tilesplat::formats::csv(report); }},
+                     {options.plot, [&] { return tilesplat::formats::size_psnr_svg(report); }}},
+                    report.validation_messages);
+  std::fprintf(stderr, "%s: format costs, %zu files against %s%s\n", kProgram, files.size(),
+               report.reference_name.c_str(), written.c_str());
+  return cli::kExitOk;
+}
+
 // ---------------------------------------------------------------------------------------------
 // The frame benchmark
 
@@ -1208,11 +1296,12 @@ int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options
 void check_frame_options(const cli::ArgParser& parser, const BenchOptions& options) {
   for (const char* flag : {"--sort-sizes", "--key-bits"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --sort-bench");
-  if (options.accuracy && options.effects) throw cli::UsageError("--accuracy and --effects are separate runs");
+  if (int(options.accuracy) + int(options.effects) + int(options.formats) > 1)
+    throw cli::UsageError("--accuracy, --effects and --formats are separate runs");
   if (!options.accuracy) {
     if (parser.seen("--path-frames")) throw cli::UsageError("--path-frames applies only with --accuracy");
-    if (parser.seen("--markdown") && !options.effects)
-      throw cli::UsageError("--markdown applies only with --accuracy or --effects");
+    if (parser.seen("--markdown") && !options.effects && !options.formats)
+      throw cli::UsageError("--markdown applies only with --accuracy, --effects or --formats");
     if (options.common.modes.size() > 1)
       throw cli::UsageError("several --mode combinations are compared by --accuracy; the frame benchmark takes one");
   }
@@ -1251,6 +1340,7 @@ int run(int argc, char** argv) {
   check_frame_options(parser, options);
   if (options.accuracy) return run_accuracy_report(parser, options, argc, argv);
   if (options.effects) return run_effects_report(parser, options, argc, argv);
+  if (options.formats) return run_formats_report(parser, options, argc, argv);
   std::vector<std::pair<std::string, fs::path>> inputs;
   for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
   for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);

@@ -260,7 +260,8 @@ std::string csv_field(const std::string& text);
 bool stderr_is_terminal();
 
 // The process's peak resident memory since the last reset_peak_memory(), in bytes (Linux: VmHWM,
-// reset through /proc/self/clear_refs; 0 where that cannot be read).
+// reset through /proc/self/clear_refs after returning freed heap memory to the system; 0 where that
+// cannot be read).
 void reset_peak_memory();
 uint64_t peak_memory_bytes();
 uint64_t resident_memory_bytes();
