@@ -130,6 +130,10 @@ class GltfReader {
     if (!value.is_number_unsigned()) fail(what + " is not an index");
     return value.get<size_t>();
   }
+  bool boolean(const json& value, const std::string& what) const {
+    if (!value.is_boolean()) fail(what + " is not true or false");
+    return value.get<bool>();
+  }
   double number(const json& value, const std::string& what) const {
     if (!value.is_number()) fail(what + " is not a number");
     return value.get<double>();
@@ -300,7 +304,7 @@ class GltfReader {
     if (elements != count)
       fail(where + " has " + std::to_string(elements) + " elements; POSITION has " + std::to_string(count));
     if (a.contains("sparse")) fail(where + " is sparse, which this reader does not support");
-    const bool normalized = a.value("normalized", false);
+    const bool normalized = a.contains("normalized") && boolean(a["normalized"], where + ".normalized");
     const size_t size = component_type == 5126 || component_type == 5125   ? 4
                         : component_type == 5122 || component_type == 5123 ? 2
                                                                            : 1;
