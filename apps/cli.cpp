@@ -1,5 +1,7 @@
 #include "cli.h"
 
+#include "tilesplat/version.h"
+
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -214,6 +216,11 @@ ArgParser::Outcome ArgParser::parse(int argc, const char* const* argv) {
     if (arg == "--") break;
     if (arg == "-h" || arg == "--help") return Outcome::kHelp;
   }
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (arg == "--") break;
+    if (arg == "--version") return Outcome::kVersion;
+  }
 
   size_t next_positional = 0;
   bool flags_ended = false;
@@ -290,7 +297,11 @@ std::string ArgParser::help_text() const {
                                          [section](const Option& option) { return option.section == section; });
     if (!has_entries && section != 0) continue;
     out += "\n" + sections_[section] + ":\n";
-    if (section == 0) append_entry("  -h, --help", "print this help and exit");
+    if (section == 0) {
+      append_entry("  -h, --help", "print this help and exit");
+      append_entry("      --version",
+                   "print the version of tilesplat (with its commit and build type) and exit");
+    }
     for (const auto& option : options_) {
       if (option.section != section) continue;
       std::string left = "  ";
@@ -904,12 +915,32 @@ std::string csv_field(const std::string& text) {
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) != 0; }
 
+std::string version_text(std::string_view program) {
+  const BuildInfo build = build_info();
+  std::string text = std::string(program) + " " + build.version;
+  std::string details;
+  if (*build.git_commit) details = std::string("commit ") + build.git_commit;
+  if (*build.build_type) details += (details.empty() ? "" : ", ") + std::string(build.build_type);
+  return details.empty() ? text : text + " (" + details + ")";
+}
+
+bool parse_and_handle_help(ArgParser& parser, int argc, const char* const* argv) {
+  switch (parser.parse(argc, argv)) {
+    case ArgParser::Outcome::kHelp:
+      std::fputs(parser.help_text().c_str(), stdout);
+      return true;
+    case ArgParser::Outcome::kVersion:
+      std::puts(version_text(parser.program()).c_str());
+      return true;
+    case ArgParser::Outcome::kRun:
+      break;
+  }
+  return false;
+}
+
 bool parse_and_handle_info_flags(ArgParser& parser, int argc, const char* const* argv,
                                  const CommonOptions& common) {
-  if (parser.parse(argc, argv) == ArgParser::Outcome::kHelp) {
-    std::fputs(parser.help_text().c_str(), stdout);
-    return true;
-  }
+  if (parse_and_handle_help(parser, argc, argv)) return true;
   if (common.list_devices) {
     print_devices();
     return true;

@@ -38,7 +38,7 @@ inline constexpr int kMaxImageSide = 65536;
 // the parser accepts. Value flags take "--flag value" or "--flag=value"; "--" ends the flags.
 class ArgParser {
  public:
-  enum class Outcome { kRun, kHelp };
+  enum class Outcome { kRun, kHelp, kVersion };
 
   ArgParser(std::string program, std::string usage, std::string description);
 
@@ -62,7 +62,8 @@ class ArgParser {
   // Takes every positional argument left over (register it last); shown as "VALUE_NAME..." in --help.
   void add_positional_list(std::string value_name, std::string help, std::vector<std::string>* target);
 
-  // Throws UsageError. Returns kHelp (without parsing anything else) when -h/--help is given.
+  // Throws UsageError. Returns kHelp (without parsing anything else) when -h/--help is given, else
+  // kVersion when --version is.
   Outcome parse(int argc, const char* const* argv);
 
   // Whether the flag (its long name) appeared on the command line.
@@ -163,8 +164,14 @@ void check_common_options(const ArgParser& parser, const CommonOptions& options)
 // Prints list_devices() with the indices --device accepts.
 void print_devices();
 
-// Parses the command line and handles the flags that end the program before it does any work
-// (--help, --list-devices). Returns true when the program should exit with kExitOk.
+// "tilesplat-render 0.3.0 (commit 1a2b3c..., Release)": the library's version and build.
+std::string version_text(std::string_view program);
+
+// Parses the command line and handles --help and --version, which end the program before it does
+// any work. Returns true when the program should exit with kExitOk.
+bool parse_and_handle_help(ArgParser& parser, int argc, const char* const* argv);
+
+// The same, and --list-devices.
 bool parse_and_handle_info_flags(ArgParser& parser, int argc, const char* const* argv,
                                  const CommonOptions& common);
 

@@ -121,10 +121,7 @@ int run(int argc, char** argv) {
   parser.add_switch("--json", "one JSON array of objects on stdout, for scripts", &json);
   parser.add_switch("--strict", "fail on a non-finite value instead of dropping the Gaussian", &strict);
   parser.add_positional_list("FILE", "scene files", &files);
-  if (parser.parse(argc, argv) == cli::ArgParser::Outcome::kHelp) {
-    std::printf("%s", parser.help_text().c_str());
-    return cli::kExitOk;
-  }
+  if (cli::parse_and_handle_help(parser, argc, argv)) return cli::kExitOk;
   if (files.empty()) throw cli::UsageError("missing the FILE argument (see --help)");
   nlohmann::json all = nlohmann::json::array();
   int status = cli::kExitOk;

@@ -1,4 +1,5 @@
-# Compiles GLSL compute shaders to SPIR-V at build time and embeds them in a static library.
+# Compiles GLSL compute shaders to SPIR-V at build time and embeds them in an object library that
+# the engine links in (an installed library needs no shader files).
 # Each shader NAME.comp becomes a uint32_t array; a generated registry maps "NAME" to its words.
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 
@@ -74,7 +75,8 @@ std::span<const uint32_t> find(std::string_view name) {
 }
 }  // namespace tilesplat::shaders
 " @ONLY)
-  add_library(${target} STATIC ${registry} ${headers})
+  add_library(${target} OBJECT ${registry} ${headers})
   target_include_directories(${target} PRIVATE ${gen_dir})
-  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  # Linked into libtilesplat, whose only exports are its public API.
+  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON CXX_VISIBILITY_PRESET hidden)
 endfunction()

@@ -6,11 +6,12 @@
 #include <string>
 #include <vector>
 
+#include "tilesplat/export.h"
 #include "tilesplat/scene.h"
 
 namespace tilesplat {
 
-struct Camera {
+struct TILESPLAT_API Camera {
   int width = 0;
   int height = 0;
   double fx = 0, fy = 0;  // focal lengths in pixels
@@ -30,7 +31,7 @@ struct Camera {
 // Throws std::invalid_argument ("invalid camera: ...", saying what) for a camera no renderer can use:
 // a size that is not positive, focal lengths that are not positive and finite, or a non-finite
 // principal point, rotation or position. Both renderers call it; device limits are checked on top.
-void validate(const Camera& camera);
+TILESPLAT_API void validate(const Camera& camera);
 
 // One entry of the trainer's cameras.json.
 struct CameraView {
@@ -40,11 +41,11 @@ struct CameraView {
 };
 
 // Reads cameras.json. Throws SceneError naming the file and the bad entry.
-std::vector<CameraView> load_cameras_json(const std::filesystem::path& path);
+TILESPLAT_API std::vector<CameraView> load_cameras_json(const std::filesystem::path& path);
 
 // The same view at another resolution: intrinsics scale with the image size.
 // width or height <= 0 keeps the aspect ratio from the other; both <= 0 keeps the original size.
-Camera resize_camera(const Camera& camera, int width, int height);
+TILESPLAT_API Camera resize_camera(const Camera& camera, int width, int height);
 
 // A look-at camera on an orbit around the scene that frames its bounds.
 // azimuth and elevation in degrees; vertical_fov in degrees.
@@ -54,16 +55,18 @@ struct OrbitParams {
   double vertical_fov_deg = 50;
   double distance_scale = 1.0;  // multiply the framing distance
 };
-Camera orbit_camera(const GaussianScene& scene, int width, int height, const OrbitParams& params = {});
+TILESPLAT_API Camera orbit_camera(const GaussianScene& scene, int width, int height,
+                                  const OrbitParams& params = {});
 
 // The camera turned by `radians` (right-handed) about the line through `pivot` along the unit
 // `axis`: its position moves around the line and its axes turn with it, so the scene turns the
 // other way in its view. Orbiting is a pivot at the scene; pivot = camera.position turns it in place.
-Camera turn_camera(const Camera& camera, const std::array<double, 3>& pivot, const std::array<double, 3>& axis,
-                   double radians);
+TILESPLAT_API Camera turn_camera(const Camera& camera, const std::array<double, 3>& pivot,
+                                 const std::array<double, 3>& axis, double radians);
 
 // A camera at `eye` looking at `target`; `up` is the world up direction (the camera's -y).
-Camera look_at_camera(const std::array<double, 3>& eye, const std::array<double, 3>& target,
-                      const std::array<double, 3>& up, int width, int height, double vertical_fov_deg);
+TILESPLAT_API Camera look_at_camera(const std::array<double, 3>& eye, const std::array<double, 3>& target,
+                                    const std::array<double, 3>& up, int width, int height,
+                                    double vertical_fov_deg);
 
 }  // namespace tilesplat

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tilesplat/camera.h"
+#include "tilesplat/export.h"
 
 namespace tilesplat {
 
@@ -31,11 +32,12 @@ struct ExrWriteOptions {
 // when counts are present.
 // Atomic: the image goes to a temporary file beside `path` that is renamed over it only once
 // complete, so a failure never leaves a partial file. Throws std::runtime_error naming the file.
-void write_exr(const std::filesystem::path& path, const RenderImage& image, const ExrWriteOptions& options = {});
+TILESPLAT_API void write_exr(const std::filesystem::path& path, const RenderImage& image,
+                             const ExrWriteOptions& options = {});
 
 // Reads an EXR's R G B A (A = 1 when absent), Z and "splats" (each when present), any pixel type
 // converted, any data window origin. Throws std::runtime_error naming the file.
-RenderImage read_exr(const std::filesystem::path& path);
+TILESPLAT_API RenderImage read_exr(const std::filesystem::path& path);
 
 // How a PNG preview maps linear radiance to display values: colour times 2^exposure_stops, then the
 // tone curve per channel, then a clamp to [0, 1] and the sRGB encoding. The EXR keeps the linear
@@ -45,9 +47,9 @@ enum class ToneMap {
   kAces,      // Narkowicz's fit of the ACES filmic curve: x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)
   kReinhard,  // x / (1 + x): never clips, compresses highlights
 };
-std::string to_string(ToneMap tone_map);  // "none", "aces", "reinhard"
+TILESPLAT_API std::string to_string(ToneMap tone_map);  // "none", "aces", "reinhard"
 // The tone curve of one linear channel value (exposure already applied); NaN and negatives map to 0.
-double apply_tone_map(ToneMap tone_map, double linear);
+TILESPLAT_API double apply_tone_map(ToneMap tone_map, double linear);
 
 struct PreviewOptions {
   double exposure_stops = 0;  // -20 to 20
@@ -56,8 +58,8 @@ struct PreviewOptions {
 
 // An 8-bit sRGB PNG preview of the colour channels (alpha dropped). Atomic like write_exr. Throws
 // std::runtime_error naming the file for an empty image or an exposure out of range.
-void write_png_preview(const std::filesystem::path& path, const RenderImage& image,
-                       const PreviewOptions& options = {});
+TILESPLAT_API void write_png_preview(const std::filesystem::path& path, const RenderImage& image,
+                                     const PreviewOptions& options = {});
 
 struct ImageDifference {
   double psnr_db = 0;       // over RGB, peak 1.0; +inf when identical
@@ -67,7 +69,7 @@ struct ImageDifference {
   int worst_x = 0, worst_y = 0, worst_channel = 0;
 };
 // Compares the RGB(A) of two images of the same size. Throws std::invalid_argument otherwise.
-ImageDifference compare_images(const RenderImage& a, const RenderImage& b);
+TILESPLAT_API ImageDifference compare_images(const RenderImage& a, const RenderImage& b);
 
 // Structural similarity (Wang, Bovik, Sheikh and Simoncelli 2004) of the RGB channels, in the
 // convention of scikit-image (gaussian_weights=True, use_sample_covariance=False, data_range=1) and
@@ -81,7 +83,7 @@ ImageDifference compare_images(const RenderImage& a, const RenderImage& b);
 // The same sizes and layout as compare_images are required (std::invalid_argument otherwise); a NaN
 // or an infinity in any channel of either image, alpha included, makes the result NaN: it means the
 // renderer is broken, and NaN cannot pass for a score in any comparison.
-double ssim(const RenderImage& a, const RenderImage& b);
+TILESPLAT_API double ssim(const RenderImage& a, const RenderImage& b);
 
 // Temporal stability along a camera path. An image metric of each frame alone misses "popping": a
 // splat that appears, vanishes or jumps between two nearby views (a sort order flip, a culling or
@@ -97,13 +99,14 @@ struct TemporalDifference {
 // All four images must have one size and the layout of compare_images (std::invalid_argument
 // otherwise, and for a threshold that is negative or not finite). A NaN or an infinity in any channel
 // of any of them makes both fields NaN, as in ssim. Empty images give {0, 0}.
-TemporalDifference temporal_excess(const RenderImage& a0, const RenderImage& a1, const RenderImage& r0,
-                                   const RenderImage& r1, double threshold = 0.05);
+TILESPLAT_API TemporalDifference temporal_excess(const RenderImage& a0, const RenderImage& a1,
+                                                 const RenderImage& r0, const RenderImage& r1,
+                                                 double threshold = 0.05);
 
 // The raw frame-to-frame change of one sequence: the mean over pixels and RGB channels of
 // |a1 - a0|. The scale for temporal_excess (how much of the change is excess), and what
 // temporal_excess would report against a perfectly still reference. Errors as temporal_excess.
-double frame_change(const RenderImage& a0, const RenderImage& a1);
+TILESPLAT_API double frame_change(const RenderImage& a0, const RenderImage& a1);
 
 // Popping along a path of equal steps, measured without any reference: the second difference
 // e = |(a2 - a1) - (a1 - a0)| of three consecutive frames. Smooth motion (an edge sliding, shading
@@ -112,8 +115,8 @@ double frame_change(const RenderImage& a0, const RenderImage& a1);
 // is what a mode that removes popping must lower, even where the reference pops itself (the float64
 // reference blends in the same centre-depth order, so "change the reference does not have" cannot
 // credit a mode that pops less than the reference). It is temporal_excess(a1, a2, a0, a1, threshold).
-TemporalDifference popping(const RenderImage& a0, const RenderImage& a1, const RenderImage& a2,
-                           double threshold = 0.05);
+TILESPLAT_API TemporalDifference popping(const RenderImage& a0, const RenderImage& a1, const RenderImage& a2,
+                                         double threshold = 0.05);
 
 // View consistency under rotation, the popping that per-pixel re-sorting removes (StopThePop,
 // Radl et al. 2024). The scene gives every ray one colour; a renderer that blends in centre-depth
@@ -130,7 +133,8 @@ TemporalDifference popping(const RenderImage& a0, const RenderImage& a1, const R
 // mean_abs is over the blocks kept and RGB, flicker_fraction the fraction of them whose largest
 // channel exceeds the threshold. NaN or infinity in either image gives NaN, as in ssim; no block
 // kept gives {0, 0}.
-TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& camera_a, const RenderImage& b,
-                                          const Camera& camera_b, int block, double threshold = 0.01);
+TILESPLAT_API TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& camera_a,
+                                                        const RenderImage& b, const Camera& camera_b,
+                                                        int block, double threshold = 0.01);
 
 }  // namespace tilesplat

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "tilesplat/camera.h"
+#include "tilesplat/export.h"
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
@@ -30,20 +31,21 @@ constexpr int kTileSize = 16;
 
 // Projects Gaussian i of the scene with the reference math, lit when `lighting` has lights.
 // Throws std::invalid_argument for invalid lights (validate).
-ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
-                                   Antialiasing antialiasing = Antialiasing::kClassic,
-                                   const Lighting& lighting = {});
+TILESPLAT_API ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
+                                                 Antialiasing antialiasing = Antialiasing::kClassic,
+                                                 const Lighting& lighting = {});
 
 // Evaluates real spherical harmonics up to `degree` for the (normalized) direction dir.
 // coeffs: K * 3 values, coefficient-major RGB innermost. Returns the raw sum (no +0.5, no clamp).
-std::array<double, 3> eval_sh(int degree, const float* coeffs, const std::array<double, 3>& dir);
+TILESPLAT_API std::array<double, 3> eval_sh(int degree, const float* coeffs,
+                                            const std::array<double, 3>& dir);
 
 // 3D covariance R S S^T R^T (row-major 3x3) from log scales and a w x y z quaternion.
-std::array<double, 9> covariance3d(const float log_scale[3], const float quat_wxyz[4]);
+TILESPLAT_API std::array<double, 9> covariance3d(const float log_scale[3], const float quat_wxyz[4]);
 
 // Renders the whole image in float64: projection, per-tile lists ordered by (depth, index),
 // front-to-back blending with the reference cut-offs. Uses all CPU cores.
-RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
-                             const RenderSettings& settings = {});
+TILESPLAT_API RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
+                                           const RenderSettings& settings = {});
 
 }  // namespace tilesplat

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tilesplat/camera.h"
+#include "tilesplat/export.h"
 #include "tilesplat/image.h"
 #include "tilesplat/scene.h"
 
@@ -60,13 +61,13 @@ struct AccuracyModes {
 };
 
 // "reference", or the modes that differ from it joined by '+', e.g. "depth16+sh1+t-cutoff=0.001".
-std::string to_string(const AccuracyModes& modes);
+TILESPLAT_API std::string to_string(const AccuracyModes& modes);
 // The inverse of to_string. Tokens: reference, depth24, depth16, opacity-extent, square-tiles,
 // sh0..sh3, fp16-sh, fp16-cov, t-cutoff=X, alpha-cutoff=X (X a number or a fraction like 1/64),
 // resortN or resort=N. Throws std::invalid_argument naming the bad token.
-AccuracyModes parse_accuracy_modes(const std::string& text);
+TILESPLAT_API AccuracyModes parse_accuracy_modes(const std::string& text);
 // Throws std::invalid_argument when a value is out of range (naming it).
-void validate(const AccuracyModes& modes);
+TILESPLAT_API void validate(const AccuracyModes& modes);
 
 // How a splat's 2D footprint is filtered (DESIGN-NOTES section 1). An asset is trained for one mode
 // and renders correctly only in that mode.
@@ -75,7 +76,7 @@ enum class Antialiasing {
   kAntialiased,  // gsplat's "antialiased": the same dilation, opacity * sqrt(det before / det after)
   kMip,          // Mip-Splatting's 2D filter: 0.1 px^2 and the same opacity compensation
 };
-std::string to_string(Antialiasing mode);  // "classic", "antialiased", "mip"
+TILESPLAT_API std::string to_string(Antialiasing mode);  // "classic", "antialiased", "mip"
 
 // Relighting (a scene effect): splats lit by lights through per-splat normals. Off when `lights`
 // is empty: the projection then never reads a normal and no normal buffer exists.
@@ -109,14 +110,14 @@ struct Lighting {
 // Throws std::invalid_argument naming the light and field ("lighting.lights[1].intensity: ...") for
 // a non-finite value, a negative colour, intensity or ambient, or a zero direction. The renderer and
 // the reference call it on every frame with lights.
-void validate(const Lighting& lighting);
+TILESPLAT_API void validate(const Lighting& lighting);
 
 // How the sorted splats become pixels.
 enum class Compositor {
   kSorted,      // front-to-back blending of each tile's depth-sorted list (the reference)
   kStochastic,  // sort-free: each splat kept per pixel with probability alpha, nearest kept wins; averaged
 };
-std::string to_string(Compositor compositor);  // "sorted", "stochastic"
+TILESPLAT_API std::string to_string(Compositor compositor);  // "sorted", "stochastic"
 // The stochastic compositor draws, per pixel and frame, each splat of its tile with probability
 // alpha (the sorted composite's alpha and cut-off) from a hash of (pixel, splat index, frame, seed)
 // and shows the nearest drawn splat (by view depth, then index), or the background. Its expectation
@@ -195,16 +196,16 @@ struct ExternalVulkanDevice;  // tilesplat/vulkan_interop.h
 struct ExternalImage;
 
 // Names of the available sort strategies, default first.
-std::vector<std::string> sort_strategies();
+TILESPLAT_API std::vector<std::string> sort_strategies();
 // Whether a strategy gives the exact order that all exact strategies share (and so bit-identical
 // images); false for one that sorts by approximated keys (cpu-radix16: 16-bit quantized depths).
 // Throws std::invalid_argument for an unknown name.
-bool sort_strategy_is_exact(const std::string& name);
+TILESPLAT_API bool sort_strategy_is_exact(const std::string& name);
 
 // Lists the Vulkan devices this machine has, in the order RendererOptions::device indexes them.
-std::vector<std::string> list_devices();
+TILESPLAT_API std::vector<std::string> list_devices();
 
-class Renderer {
+class TILESPLAT_API Renderer {
  public:
   // Creates its own headless VkInstance and VkDevice. Throws std::runtime_error when no usable
   // device exists (the message says why).

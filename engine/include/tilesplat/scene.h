@@ -10,10 +10,12 @@
 #include <string_view>
 #include <vector>
 
+#include "tilesplat/export.h"
+
 namespace tilesplat {
 
 // Thrown for any file that cannot be read as a scene. what() names the file and the problem.
-class SceneError : public std::runtime_error {
+class TILESPLAT_API SceneError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
@@ -51,7 +53,7 @@ struct DroppedProperty {
   size_t first_index = 0;
 };
 
-struct LoadReport {
+struct TILESPLAT_API LoadReport {
   // The format as the reader found it from the content: "ply binary_little_endian", "ply ascii",
   // "compressed ply", "splat", "spz", "sog", "sog (unbundled)", "glb", "gltf".
   std::string format;
@@ -65,12 +67,12 @@ struct LoadReport {
 
 // Reads a 3DGS PLY (binary little/big endian or ASCII), or a PlayCanvas compressed PLY (told apart
 // by its header's elements). Throws SceneError.
-GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& options = {},
-                       LoadReport* report = nullptr);
+TILESPLAT_API GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& options = {},
+                                     LoadReport* report = nullptr);
 
 // The same reader on a PLY already in memory; `name` stands for the file in error messages.
-GaussianScene parse_ply(std::span<const std::byte> data, std::string_view name, const LoadOptions& options = {},
-                        LoadReport* report = nullptr);
+TILESPLAT_API GaussianScene parse_ply(std::span<const std::byte> data, std::string_view name,
+                                      const LoadOptions& options = {}, LoadReport* report = nullptr);
 
 // Reads a scene file of any supported format, chosen by its content (magic bytes, zip or JSON
 // structure), with the extension only deciding for .splat, the one format without a header:
@@ -81,14 +83,14 @@ GaussianScene parse_ply(std::span<const std::byte> data, std::string_view name, 
 // and shares one post-processing step: non-finite values dropped (or rejected, strict), quaternions
 // normalized, a quaternion of zero or denormal components the identity. Throws SceneError naming
 // the file and the problem.
-GaussianScene load_scene(const std::filesystem::path& path, const LoadOptions& options = {},
-                         LoadReport* report = nullptr);
+TILESPLAT_API GaussianScene load_scene(const std::filesystem::path& path, const LoadOptions& options = {},
+                                       LoadReport* report = nullptr);
 
 // The same readers on a file already in memory; `name` stands for the file in error messages and
 // decides, by its extension, only whether headerless bytes are read as .splat. Formats that refer
 // to other files (an unbundled SOG meta.json, a .gltf with external buffers) need load_scene.
-GaussianScene parse_scene(std::span<const std::byte> data, std::string_view name, const LoadOptions& options = {},
-                          LoadReport* report = nullptr);
+TILESPLAT_API GaussianScene parse_scene(std::span<const std::byte> data, std::string_view name,
+                                        const LoadOptions& options = {}, LoadReport* report = nullptr);
 
 struct Bounds {
   double min[3] = {0, 0, 0};
@@ -96,7 +98,7 @@ struct Bounds {
   double center[3] = {0, 0, 0};
   double radius = 0;  // robust radius around center (covers most Gaussians, ignores outliers)
 };
-Bounds compute_bounds(const GaussianScene& scene);
+TILESPLAT_API Bounds compute_bounds(const GaussianScene& scene);
 
 // What a file holds, at a glance (tilesplat-info prints it): the means' box and a robust box that
 // ignores floaters, and the activated opacity and scale ranges. All zero for an empty scene.
@@ -106,6 +108,6 @@ struct SceneStatistics {
   double opacity_min = 0, opacity_max = 0;  // sigmoid(opacity logit)
   double scale_min = 0, scale_max = 0;      // exp(log scale), over the three axes
 };
-SceneStatistics compute_statistics(const GaussianScene& scene);
+TILESPLAT_API SceneStatistics compute_statistics(const GaussianScene& scene);
 
 }  // namespace tilesplat

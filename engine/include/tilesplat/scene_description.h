@@ -11,13 +11,14 @@
 #include <vector>
 
 #include "tilesplat/camera.h"
+#include "tilesplat/export.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 
 namespace tilesplat {
 
 // Places one splat file in the scene: p' = s R p + t, applied after the optional z_up conversion.
-struct ModelTransform {
+struct TILESPLAT_API ModelTransform {
   std::array<double, 3> translation = {0, 0, 0};
   // Unit quaternion w x y z. In JSON, "quaternion": [w, x, y, z] or "rotation_deg": [rx, ry, rz].
   std::array<double, 4> rotation = {1, 0, 0, 0};
@@ -33,25 +34,25 @@ struct ModelTransform {
 };
 
 // The rotation z_up applies: +90 degrees about +X, as a w x y z quaternion.
-std::array<double, 4> z_up_rotation();
+TILESPLAT_API std::array<double, 4> z_up_rotation();
 
 // Euler angles in degrees, extrinsic X then Y then Z (about the world axes): R = Rz Ry Rx.
-std::array<double, 4> quaternion_from_euler_xyz_deg(const std::array<double, 3>& degrees);
+TILESPLAT_API std::array<double, 4> quaternion_from_euler_xyz_deg(const std::array<double, 3>& degrees);
 
 // Row-major 3x3 matrix of a unit quaternion w x y z (the convention of the scene's rotations).
-std::array<double, 9> rotation_matrix(const std::array<double, 4>& quaternion);
+TILESPLAT_API std::array<double, 9> rotation_matrix(const std::array<double, 4>& quaternion);
 
 // Everything the transform rotates by, z_up included: rotation * z_up_rotation() when z_up.
-std::array<double, 4> total_rotation(const ModelTransform& transform);
+TILESPLAT_API std::array<double, 4> total_rotation(const ModelTransform& transform);
 
 // Throws std::invalid_argument when the transform cannot be applied exactly: a non-finite value, a
 // quaternion whose norm is not 1 (within 1e-3), a scale that is not positive, or a non-uniform scale.
-void validate(const ModelTransform& transform);
+TILESPLAT_API void validate(const ModelTransform& transform);
 
 // Exact rotation of real spherical harmonics, in the basis and signs of eval_sh (tilesplat/reference.h):
 // coefficients c' with eval_sh(c', R d) == eval_sh(c, d) for every direction d. Band l's (2l+1)x(2l+1)
 // matrix is fitted once per rotation from eval_sh itself, so it cannot drift from the renderers' basis.
-class ShRotation {
+class TILESPLAT_API ShRotation {
  public:
   explicit ShRotation(const std::array<double, 9>& rotation);  // row-major, a proper rotation
   // One Gaussian's coefficients: (degree + 1)^2 * 3 floats, coefficient-major, RGB innermost.
@@ -68,20 +69,20 @@ class ShRotation {
 // without rotation leaves rotations, SH and normals bit-identical; the identity leaves everything so.
 // Throws std::invalid_argument for an invalid transform (validate), above all a non-uniform scale,
 // or when a transformed value overflows float.
-GaussianScene transform_scene(const GaussianScene& scene, const ModelTransform& transform);
+TILESPLAT_API GaussianScene transform_scene(const GaussianScene& scene, const ModelTransform& transform);
 
 // The camera that sees transform_scene(scene, transform) as `camera` sees `scene`: centre moved by
 // the transform, axes rotated with it. The images agree (depths scale by s). Throws
 // std::invalid_argument for an invalid transform (validate).
-Camera transform_camera(const Camera& camera, const ModelTransform& transform);
+TILESPLAT_API Camera transform_camera(const Camera& camera, const ModelTransform& transform);
 
 // The same Gaussians with `degree` (0..3) SH bands: higher bands dropped, missing ones zero.
-GaussianScene with_sh_degree(const GaussianScene& scene, int degree);
+TILESPLAT_API GaussianScene with_sh_degree(const GaussianScene& scene, int degree);
 
 // All Gaussians of all scenes, in order. The result's SH degree is the largest; scenes of lower
 // degree get zero coefficients (the same colours). Normals are kept when any scene has them (zero
 // for those without). Throws std::invalid_argument for a scene whose arrays disagree in size.
-GaussianScene merge_scenes(std::span<const GaussianScene> scenes);
+TILESPLAT_API GaussianScene merge_scenes(std::span<const GaussianScene> scenes);
 
 struct SceneModel {
   std::filesystem::path path;  // resolved: relative paths in the file are relative to its directory
@@ -130,18 +131,20 @@ struct SceneDescription {
 // Reads a scene description. Throws SceneError for every mistake, as
 // "FILE: JSON.PATH: what is wrong, what is allowed" (e.g. "scene.json: effects.lights[1].type: ..."),
 // or "FILE: line L, column C: malformed JSON: ..." for a syntax error. Referenced files must exist.
-SceneDescription load_scene_description(const std::filesystem::path& path);
+TILESPLAT_API SceneDescription load_scene_description(const std::filesystem::path& path);
 
 // The same on text already in memory; `file` names it in messages and anchors relative paths.
-SceneDescription parse_scene_description(std::string_view text, const std::filesystem::path& file);
+TILESPLAT_API SceneDescription parse_scene_description(std::string_view text,
+                                                       const std::filesystem::path& file);
 
 // Loads every model (load_scene), transforms and merges them, keeping only the SH bands the
 // description's sh_degree effect evaluates. Throws SceneError naming the description,
 // the model and the problem. The report sums the files' reports.
-GaussianScene load_described_scene(const SceneDescription& description, const LoadOptions& options = {},
-                                   LoadReport* report = nullptr);
+TILESPLAT_API GaussianScene load_described_scene(const SceneDescription& description,
+                                                 const LoadOptions& options = {},
+                                                 LoadReport* report = nullptr);
 
 // Whether the path names a scene description (a .json file) rather than a splat file.
-bool is_scene_description(const std::filesystem::path& path);
+TILESPLAT_API bool is_scene_description(const std::filesystem::path& path);
 
 }  // namespace tilesplat

@@ -6,6 +6,7 @@
 
 #include <memory>
 
+#include "tilesplat/export.h"
 #include "tilesplat/renderer.h"
 
 namespace tilesplat {
@@ -27,7 +28,8 @@ struct ExternalVulkanDevice {
 
 // A renderer on the host's device. RendererOptions::device and ::validation do not apply (the
 // host chose the device and its instance's layers). Throws std::invalid_argument for bad handles.
-std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device, const RendererOptions& options = {});
+TILESPLAT_API std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device,
+                                                        const RendererOptions& options = {});
 
 // An image the caller owns, created on the same device as the renderer.
 struct ExternalImage {
@@ -42,7 +44,7 @@ struct ExternalImage {
 // Renders a frame and writes premultiplied RGBA (colour over the background, A = 1 - T) into the
 // image. The work has completed on the GPU when the call returns. Throws std::invalid_argument
 // when the image does not match the camera or has an unsupported format.
-void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
-                     const ExternalImage& target);
+TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                                   const ExternalImage& target);
 
 }  // namespace tilesplat

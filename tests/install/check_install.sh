@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# What CI checks of tilesplat as a library others install and link:
+#   - `cmake --install` of a static and of a shared build into prefixes that are then moved (the
+#     install is relocatable), each used by both examples through find_package(tilesplat 0.3);
+#   - one example built through pkg-config (static);
+#   - the shared library exporting only the tilesplat:: API (nm -D), with its SONAME;
+#   - a consumer using add_subdirectory, with no C++ standard of its own, building no tilesplat tests;
+#   - every example's image equal, to the bit, to tilesplat-render's of the same view.
+# usage: tests/install/check_install.sh BUILD_DIR   (a built static build with tests, as .ci/run makes)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+build=$(cd "${1:?usage: check_install.sh BUILD_DIR}" && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+jobs=${TILESPLAT_JOBS:-2}
+
+scene=$root/scenes/playbot_lod3/playbot_lod3_31000_sh2.ply
+cameras=$root/scenes/playbot_lod3/playbot_lod3_31000_sh2.json
+compare=$build/tests/tilesplat_compare_exr
+"$build/apps/tilesplat-render" "$scene" --cameras "$cameras" --view 1 --width 320 --height 180 \
+  -o "$work/expected.exr" >/dev/null 2>&1
+
+configure() { cmake -G Ninja -DCMAKE_BUILD_TYPE=Release "$@" >"$work/configure.log" 2>&1 || { cat "$work/configure.log"; return 1; }; }
+
+# Builds and runs both examples against the package in $1, and compares their images.
+check_examples() {
+  local prefix=$1 label=$2
+  for example in render_exr vulkan_host; do
+    configure -S "$root/examples/$example" -B "$work/$label-$example" -DCMAKE_PREFIX_PATH="$prefix"
+    cmake --build "$work/$label-$example" -j"$jobs" >/dev/null
+    "$work/$label-$example/$example" "$scene" "$cameras" 1 320 180 "$work/$label-$example.exr"
+    "$compare" "$work/expected.exr" "$work/$label-$example.exr"
+  done
+}
+
+echo "== static library: install, move, find_package =="
+cmake --install "$build" --prefix "$work/installed-static" >/dev/null
+mv "$work/installed-static" "$work/static"
+check_examples "$work/static" static
+
+echo "== static library through pkg-config =="
+flags=$(PKG_CONFIG_PATH="$work/static/lib/pkgconfig" pkg-config --cflags --libs --static tilesplat)
+echo "pkg-config --cflags --libs --static tilesplat: $flags"
+# shellcheck disable=SC2086  # the flags are words
+c++ -std=c++20 -O2 "$root/examples/render_exr/main.cpp" -o "$work/pkg-config-render_exr" $flags
+"$work/pkg-config-render_exr" "$scene" "$cameras" 1 320 180 "$work/pkg-config.exr"
+"$compare" "$work/expected.exr" "$work/pkg-config.exr"
+
+echo "== shared library: build, install, move, find_package =="
+configure -S "$root" -B "$work/build-shared" -DBUILD_SHARED_LIBS=ON -DTILESPLAT_BUILD_TESTS=OFF \
+  -DTILESPLAT_BUILD_VIEWER=OFF
+cmake --build "$work/build-shared" -j"$jobs" >/dev/null
+cmake --install "$work/build-shared" --prefix "$work/installed-shared" >/dev/null
+mv "$work/installed-shared" "$work/shared"
+check_examples "$work/shared" shared
+library=$(ls "$work"/shared/lib/libtilesplat.so.*.*.*)
+soname=$(objdump -p "$library" | awk '/SONAME/ { print $2 }')
+exported=$(nm -D --defined-only -C "$library" | cut -d' ' -f3-)
+foreign=$(grep -v -E '^(tilesplat::|typeinfo for tilesplat::|typeinfo name for tilesplat::|vtable for tilesplat::)' \
+  <<<"$exported" || true)
+echo "$(basename "$library"): SONAME $soname, $(wc -l <<<"$exported") exported symbols"
+[[ $soname == libtilesplat.so.$(cut -d. -f3 <<<"$(basename "$library")") ]] || { echo "bad SONAME"; exit 1; }
+if [[ -n $foreign ]]; then
+  echo "exported outside the tilesplat:: API:"
+  echo "$foreign"
+  exit 1
+fi
+"$work/shared/bin/tilesplat-render" --version
+
+echo "== public headers include no OpenEXR, glm or JSON, and Vulkan only in vulkan_interop.h =="
+if grep -n -E '#include <(Imf|Iex|OpenEXR|glm|nlohmann|vulkan)' "$work"/shared/include/tilesplat/*.h |
+  grep -v 'vulkan_interop.h:.*<vulkan/vulkan.h>'; then
+  echo "a public header includes a dependency's header"
+  exit 1
+fi
+
+echo "== add_subdirectory consumer, no C++ standard of its own =="
+configure -S "$root/tests/install/subproject" -B "$work/subproject" -DTILESPLAT_SOURCE_DIR="$root"
+cmake --build "$work/subproject" -j"$jobs" >/dev/null
+"$work/subproject/render_exr" "$scene" "$cameras" 1 320 180 "$work/subproject.exr"
+"$compare" "$work/expected.exr" "$work/subproject.exr"
+echo "install check passed"
