@@ -15,12 +15,6 @@ namespace tilesplat::accuracy {
 
 namespace {
 
-std::string fixed(double value, int decimals) {
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  if (std::isnan(value)) return "nan";
-  return cli::format_fixed(value, decimals);
-}
-
 AccuracyModes with(std::initializer_list<const char*> tokens) {
   std::string text;
   for (const char* token : tokens) {
@@ -279,23 +273,26 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
 }
 
 std::string text_table(const SceneReport& report) {
-  std::string text = "  " + report.scene + ", " + report.description + ", " + report.views +
-                     "; float64 reference on the " + to_string(report.path) + ": " + fixed(100.0 * report.reference_flicker, 3) +
-                     "% flicker, " + fixed(100.0 * report.reference_pops, 3) + "% pops; turned " +
-                     fixed(report.consistency_angle, 3) + " rad: " + fixed(100.0 * report.reference_inconsistency, 3) +
-                     "% inconsistent\n";
+  std::string text =
+      "  " + report.scene + ", " + report.description + ", " + report.views + "; float64 reference on the " +
+      to_string(report.path) + ": " + cli::format_number(100.0 * report.reference_flicker, 3) +
+      "% flicker, " + cli::format_number(100.0 * report.reference_pops, 3) + "% pops; turned " +
+      cli::format_number(report.consistency_angle, 3) +
+      " rad: " + cli::format_number(100.0 * report.reference_inconsistency, 3) + "% inconsistent\n";
   char line[512];
   std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s %9s\n", "mode", "GPU ms", "vs ref",
                 "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess", "pops%", "incons%");
   text += line;
   const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
   for (const auto& m : report.modes) {
-    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s %9s\n", m.name.c_str(),
-                  fixed(m.frame_ms, 2).c_str(), fixed(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2).c_str(),
-                  fixed(m.psnr_db, 2).c_str(), fixed(m.ssim, 5).c_str(), fixed(m.max_abs, 4).c_str(),
-                  static_cast<unsigned long long>(m.intersections), fixed(100.0 * m.flicker, 3).c_str(),
-                  fixed(m.excess, 5).c_str(), fixed(100.0 * m.pops, 3).c_str(),
-                  fixed(100.0 * m.inconsistency, 3).c_str());
+    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s %9s\n",
+                  m.name.c_str(), cli::format_number(m.frame_ms, 2).c_str(),
+                  cli::format_number(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2).c_str(),
+                  cli::format_number(m.psnr_db, 2).c_str(), cli::format_number(m.ssim, 5).c_str(),
+                  cli::format_number(m.max_abs, 4).c_str(), static_cast<unsigned long long>(m.intersections),
+                  cli::format_number(100.0 * m.flicker, 3).c_str(), cli::format_number(m.excess, 5).c_str(),
+                  cli::format_number(100.0 * m.pops, 3).c_str(),
+                  cli::format_number(100.0 * m.inconsistency, 3).c_str());
     text += line;
   }
   return text;
@@ -307,31 +304,36 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
     md += "\n### " + report.scene + "\n\n" + report.description + "; " + report.views + ". Popping over a " +
           std::to_string(report.path_frames) + "-frame " + to_string(report.path) + " (step " +
           cli::format_fixed(report.path_step, 4) + "): the float64 reference itself changes " +
-          fixed(report.reference_change, 5) + " per frame on average, with " +
-          fixed(100.0 * report.reference_flicker, 3) + "% of pixels changing by more than " +
-          fixed(kFlickerThreshold, 2) + " (flicker), and " + fixed(100.0 * report.reference_pops, 3) +
+          cli::format_number(report.reference_change, 5) + " per frame on average, with " +
+          cli::format_number(100.0 * report.reference_flicker, 3) + "% of pixels changing by more than " +
+          cli::format_number(kFlickerThreshold, 2) + " (flicker), and " +
+          cli::format_number(100.0 * report.reference_pops, 3) +
           "% of pixels popping: their second difference over three frames exceeds that (`popping()`, which "
           "smooth motion cancels).";
     if (report.consistency_angle > 0)
       md += " View consistency: the first view and the same camera turned in place by " +
-            fixed(report.consistency_angle, 3) + " rad, rendered at " + std::to_string(kConsistencyScale) +
+            cli::format_number(report.consistency_angle, 3) + " rad, rendered at " +
+            std::to_string(kConsistencyScale) +
             "x its size; the first resampled onto the second and compared over blocks of " +
             std::to_string(kConsistencyBlock) + "x" + std::to_string(kConsistencyBlock) +
             " pixels (`rotation_inconsistency()`): the float64 reference has " +
-            fixed(100.0 * report.reference_inconsistency, 3) + "% of blocks differing by more than " +
-            fixed(kConsistencyThreshold, 2) + " (inconsistent %), and a mean difference of " +
-            fixed(report.reference_inconsistency_mean, 6) + ".";
+            cli::format_number(100.0 * report.reference_inconsistency, 3) +
+            "% of blocks differing by more than " + cli::format_number(kConsistencyThreshold, 2) +
+            " (inconsistent %), and a mean difference of " +
+            cli::format_number(report.reference_inconsistency_mean, 6) + ".";
     md += "\n\n";
     md += "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change | pops % "
           "| inconsistent % | inconsistency |\n";
     md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
     for (const auto& m : report.modes)
-      md += "| " + m.name + " | " + fixed(m.frame_ms, 2) + " | " +
-            fixed(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2) + "x | " + fixed(m.psnr_db, 2) + " | " +
-            fixed(m.ssim, 5) + " | " + fixed(m.max_abs, 4) + " | " + std::to_string(m.intersections) + " | " +
-            fixed(100.0 * m.flicker, 3) + " | " + fixed(m.excess, 5) + " | " + fixed(100.0 * m.pops, 3) + " | " +
-            fixed(100.0 * m.inconsistency, 3) + " | " + fixed(m.inconsistency_mean, 6) + " |\n";
+      md += "| " + m.name + " | " + cli::format_number(m.frame_ms, 2) + " | " +
+            cli::format_number(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2) + "x | " +
+            cli::format_number(m.psnr_db, 2) + " | " + cli::format_number(m.ssim, 5) + " | " +
+            cli::format_number(m.max_abs, 4) + " | " + std::to_string(m.intersections) + " | " +
+            cli::format_number(100.0 * m.flicker, 3) + " | " + cli::format_number(m.excess, 5) + " | " +
+            cli::format_number(100.0 * m.pops, 3) + " | " + cli::format_number(100.0 * m.inconsistency, 3) +
+            " | " + cli::format_number(m.inconsistency_mean, 6) + " |\n";
     // Per-pass times: a column per mode would not fit; the passes whose time a mode changes.
     md += "\nPer-pass median GPU ms:\n\n| mode |";
     std::vector<std::string> names;
@@ -347,7 +349,7 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
       for (const auto& name : names) {
         auto it = std::find_if(m.passes.begin(), m.passes.end(), [&](const PassTime& p) { return p.name == name; });
         md += ' ';
-        md += it == m.passes.end() ? std::string("-") : fixed(it->ms, 2);
+        md += it == m.passes.end() ? std::string("-") : cli::format_number(it->ms, 2);
         md += " |";
       }
       md += "\n";
@@ -363,13 +365,16 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
   for (const auto& report : reports)
     for (const auto& m : report.modes) {
       std::string passes;
-      for (const auto& p : m.passes) passes += (passes.empty() ? "" : ";") + p.name + "=" + fixed(p.ms, 4);
-      out += cli::csv_field(device.name) + "," + cli::csv_field(report.scene) + "," + cli::csv_field(m.name) + "," +
-             fixed(m.frame_ms, 4) + "," + fixed(m.psnr_db, 4) + "," + fixed(m.ssim, 6) + "," + fixed(m.max_abs, 6) +
-             "," + std::to_string(m.intersections) + "," + fixed(m.frame_change, 6) + "," + fixed(m.flicker, 6) +
-             "," + fixed(m.excess, 6) + "," + fixed(m.pops, 6) + "," + fixed(m.pop_mean, 6) + "," +
-             fixed(m.inconsistency, 6) + "," + fixed(m.inconsistency_mean, 6) + "," +
-             cli::csv_field(passes) + "\n";
+      for (const auto& p : m.passes)
+        passes += (passes.empty() ? "" : ";") + p.name + "=" + cli::format_number(p.ms, 4);
+      out += cli::csv_field(device.name) + "," + cli::csv_field(report.scene) + "," + cli::csv_field(m.name) +
+             "," + cli::format_number(m.frame_ms, 4) + "," + cli::format_number(m.psnr_db, 4) + "," +
+             cli::format_number(m.ssim, 6) + "," + cli::format_number(m.max_abs, 6) + "," +
+             std::to_string(m.intersections) + "," + cli::format_number(m.frame_change, 6) + "," +
+             cli::format_number(m.flicker, 6) + "," + cli::format_number(m.excess, 6) + "," +
+             cli::format_number(m.pops, 6) + "," + cli::format_number(m.pop_mean, 6) + "," +
+             cli::format_number(m.inconsistency, 6) + "," + cli::format_number(m.inconsistency_mean, 6) +
+             "," + cli::csv_field(passes) + "\n";
     }
   return out;
 }
@@ -377,8 +382,9 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
 std::string consistency_svg(const SceneReport& report, const DeviceInfo& device) {
   plot::ScatterChart chart;
   chart.title = "View consistency against time: " + report.scene;
-  chart.subtitle = report.description + ", turned in place by " + fixed(report.consistency_angle, 3) +
-                   " rad; float64 reference " + fixed(100.0 * report.reference_inconsistency, 3) + "%; " + device.name;
+  chart.subtitle = report.description + ", turned in place by " +
+                   cli::format_number(report.consistency_angle, 3) + " rad; float64 reference " +
+                   cli::format_number(100.0 * report.reference_inconsistency, 3) + "%; " + device.name;
   chart.x_label = "median GPU frame time (ms, log scale)";
   chart.x_scale = plot::Scale::kLog10;
   chart.y_label = "blocks inconsistent under the turn (%)";

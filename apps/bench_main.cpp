@@ -797,6 +797,21 @@ void check_outputs(const BenchOptions& options, const std::vector<std::pair<std:
     if (!path.empty()) cli::check_output_path(path, flag);
 }
 
+// Every SCENE and --cameras file, which no output may overwrite.
+std::vector<std::pair<std::string, fs::path>> scene_and_camera_inputs(const BenchOptions& options) {
+  std::vector<std::pair<std::string, fs::path>> inputs;
+  for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
+  for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
+  return inputs;
+}
+
+// The command as typed, for the reports that record how they were made.
+std::string command_line(int argc, char** argv) {
+  std::string command = "tilesplat-bench";
+  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+  return command;
+}
+
 // Writes the output files that were asked for (each atomically), warns about the run's validation
 // messages, and returns " -> a.csv, b.json" for the closing line.
 std::string write_outputs(const std::vector<std::pair<std::string, std::function<std::string()>>>& files,
@@ -1081,13 +1096,9 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");
   if (options.common.sorts.size() > 1)
     throw cli::UsageError("--accuracy measures with one --sort strategy (the modes do not depend on it)");
-  std::vector<std::pair<std::string, fs::path>> inputs;
-  for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
-  for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
-  check_outputs(options, inputs);
+  check_outputs(options, scene_and_camera_inputs(options));
 
-  std::string command = "tilesplat-bench";
-  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+  const std::string command = command_line(argc, argv);
 
   // Every scene and camera first: a bad file or view fails now, not after an hour of measuring.
   struct Planned {
@@ -1174,8 +1185,7 @@ int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options
   if (parser.seen("--antialiasing"))
     throw cli::UsageError("--antialiasing does not apply to --effects (it measures every mode)");
   check_outputs(options, {{"SCENE", options.common.scenes.front()}});
-  std::string command = "tilesplat-bench";
-  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+  const std::string command = command_line(argc, argv);
 
   BenchScene scene;
   scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
@@ -1239,14 +1249,8 @@ int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options
                           "files of the same scene");
   if (options.common.sorts.size() > 1) throw cli::UsageError("--formats renders with one --sort strategy");
   if (options.common.cameras_files.size() > 1) throw cli::UsageError("--formats takes one --cameras for all its files");
-  if (!options.plot.empty() && !cli::has_extension(options.plot, ".svg"))
-    throw cli::UsageError("--plot writes SVG: its file name must end in .svg, got '" + options.plot + "'");
-  std::vector<std::pair<std::string, fs::path>> inputs;
-  for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
-  for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
-  check_outputs(options, inputs);
-  std::string command = "tilesplat-bench";
-  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+  check_outputs(options, scene_and_camera_inputs(options));
+  const std::string command = command_line(argc, argv);
 
   BenchScene reference;
   reference.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
@@ -1341,10 +1345,7 @@ int run(int argc, char** argv) {
   if (options.accuracy) return run_accuracy_report(parser, options, argc, argv);
   if (options.effects) return run_effects_report(parser, options, argc, argv);
   if (options.formats) return run_formats_report(parser, options, argc, argv);
-  std::vector<std::pair<std::string, fs::path>> inputs;
-  for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
-  for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
-  check_outputs(options, inputs);
+  check_outputs(options, scene_and_camera_inputs(options));
 
   std::vector<std::string> sorts = options.common.sorts;
   if (sorts.empty()) sorts = tilesplat::sort_strategies();

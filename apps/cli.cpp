@@ -210,17 +210,15 @@ const ArgParser::Option* ArgParser::find(std::string_view name) const {
 }
 
 ArgParser::Outcome ArgParser::parse(int argc, const char* const* argv) {
-  // --help wins over any other mistake on the line: whoever asks for help gets it.
+  // --help wins over any other mistake on the line (whoever asks for help gets it), then --version.
+  bool version = false;
   for (int i = 1; i < argc; ++i) {
     const std::string_view arg = argv[i];
     if (arg == "--") break;
     if (arg == "-h" || arg == "--help") return Outcome::kHelp;
+    version = version || arg == "--version";
   }
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view arg = argv[i];
-    if (arg == "--") break;
-    if (arg == "--version") return Outcome::kVersion;
-  }
+  if (version) return Outcome::kVersion;
 
   size_t next_positional = 0;
   bool flags_ended = false;
@@ -894,6 +892,12 @@ std::string format_fixed(double value, int decimals) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
   return buffer;
+}
+
+std::string format_number(double value, int decimals) {
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  if (std::isnan(value)) return "nan";
+  return format_fixed(value, decimals);
 }
 
 double median(std::vector<double> values) {

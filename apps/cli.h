@@ -260,6 +260,8 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view conte
 std::string one_line(std::string_view message);
 // Fixed-point number with `decimals` digits.
 std::string format_fixed(double value, int decimals);
+// The same, with "inf", "-inf" and "nan" for the values that have no digits (a PSNR of identical images).
+std::string format_number(double value, int decimals);
 // The median of the values (the mean of the middle two for an even count); 0 for none.
 double median(std::vector<double> values);
 // A CSV field: quoted (quotes doubled) when it holds a comma, quote or line break.

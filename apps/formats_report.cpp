@@ -17,12 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string fixed(double value, int decimals) {
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  if (std::isnan(value)) return "nan";
-  return cli::format_fixed(value, decimals);
-}
-
 // An error of any magnitude in three significant digits: 0, 0.00244, 1.2e-07.
 std::string error_text(double value) {
   if (value == 0) return "0";
@@ -50,6 +44,15 @@ uint64_t file_bytes(const fs::path& path) {
   for (const auto& entry : fs::directory_iterator(directory, error))
     if (entry.path().extension() == ".webp" && entry.is_regular_file(error)) total += entry.file_size(error);
   return total;
+}
+
+double distance(const float* a, const float* b) {
+  double sum = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double d = double(a[axis]) - double(b[axis]);
+    sum += d * d;
+  }
+  return std::sqrt(sum);
 }
 
 // Nearest-mean lookup over the reference's positions: a uniform grid of about two Gaussians per cell,
@@ -110,7 +113,7 @@ class NearestMean {
             const size_t cell = cell_index(c);
             for (uint32_t k = start_[cell]; k < start_[cell + 1]; ++k) {
               const uint32_t i = members_[k];
-              const double d = std::sqrt(squared_distance(p, &positions_[3 * size_t(i)]));
+              const double d = distance(p, &positions_[3 * size_t(i)]);
               best = std::min(best, d);
               found.emplace_back(d, i);
             }
@@ -126,14 +129,6 @@ class NearestMean {
   }
 
  private:
-  static double squared_distance(const float* a, const float* b) {
-    double sum = 0;
-    for (int axis = 0; axis < 3; ++axis) {
-      const double d = double(a[axis]) - double(b[axis]);
-      sum += d * d;
-    }
-    return sum;
-  }
   std::array<int, 3> cell_coordinates(const float* p) const {
     std::array<int, 3> c{};
     for (int axis = 0; axis < 3; ++axis) {
@@ -156,39 +151,24 @@ class NearestMean {
   std::vector<uint32_t> members_;  // Gaussian indices, grouped by cell
 };
 
-double position_distance(const GaussianScene& a, size_t i, const GaussianScene& b, size_t j) {
-  double sum = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    const double d = double(a.positions[3 * i + axis]) - double(b.positions[3 * j + axis]);
-    sum += d * d;
-  }
-  return std::sqrt(sum);
-}
-
-double median_of(std::vector<double> values) {
-  return cli::median(std::move(values));
+// SH coefficient k (0: DC) of colour channel c of Gaussian i, 0 beyond the scene's degree.
+double sh_value(const GaussianScene& scene, size_t i, int k, int c) {
+  if (k >= scene.sh_coefficients()) return 0;
+  return scene.sh[(i * size_t(scene.sh_coefficients()) + size_t(k)) * 3 + size_t(c)];
 }
 
 // How different two Gaussians look apart from their means: activated opacity, log scales, rotation
 // (sign-free) and base colour, each in its own units, summed. Used only to choose among near means.
 double appearance_distance(const GaussianScene& a, size_t i, const GaussianScene& b, size_t j) {
-  double sum = std::abs(1 / (1 + std::exp(-double(a.opacity_logits[i]))) -
-                        1 / (1 + std::exp(-double(b.opacity_logits[j]))));
+  double sum = std::abs(sigmoid(a.opacity_logits[i]) - sigmoid(b.opacity_logits[j]));
   double dot = 0;
   for (int k = 0; k < 4; ++k) dot += double(a.rotations[4 * i + k]) * double(b.rotations[4 * j + k]);
   sum += 1 - std::min(1.0, std::abs(dot));
   for (int k = 0; k < 3; ++k) {
     sum += std::abs(double(a.log_scales[3 * i + k]) - double(b.log_scales[3 * j + k]));
-    sum += std::abs(double(a.sh[i * size_t(a.sh_coefficients()) * 3 + size_t(k)]) -
-                    double(b.sh[j * size_t(b.sh_coefficients()) * 3 + size_t(k)]));
+    sum += std::abs(sh_value(a, i, 0, k) - sh_value(b, j, 0, k));
   }
   return sum;
-}
-
-// SH coefficient k (0: DC) of colour channel c of Gaussian i, 0 beyond the scene's degree.
-double sh_value(const GaussianScene& scene, size_t i, int k, int c) {
-  if (k >= scene.sh_coefficients()) return 0;
-  return scene.sh[(i * size_t(scene.sh_coefficients()) + size_t(k)) * 3 + size_t(c)];
 }
 
 void accumulate_errors(const GaussianScene& reference, size_t r, const GaussianScene& file, size_t f,
@@ -227,15 +207,18 @@ AttributeComparison compare_attributes(const GaussianScene& reference, const Gau
   std::vector<size_t> nearest(count);
   std::vector<double> by_nearest(count), by_index(count);
   for (size_t i = 0; i < count; ++i) {
-    const std::vector<uint32_t> candidates = lookup.nearest(&file.positions[3 * i]);
-    nearest[i] = candidates.front();
-    for (const uint32_t r : candidates)
-      if (appearance_distance(reference, r, file, i) < appearance_distance(reference, nearest[i], file, i))
+    double best = std::numeric_limits<double>::infinity();
+    for (const uint32_t r : lookup.nearest(&file.positions[3 * i])) {
+      const double looks = appearance_distance(reference, r, file, i);
+      if (looks < best) {
+        best = looks;
         nearest[i] = r;
-    by_nearest[i] = position_distance(reference, nearest[i], file, i);
-    by_index[i] = position_distance(reference, i, file, i);
+      }
+    }
+    by_nearest[i] = distance(&reference.positions[3 * nearest[i]], &file.positions[3 * i]);
+    by_index[i] = distance(&reference.positions[3 * i], &file.positions[3 * i]);
   }
-  result.reordered = median_of(by_index) > 2.0 * median_of(by_nearest);
+  result.reordered = cli::median(by_index) > 2.0 * cli::median(by_nearest);
 
   std::vector<bool> reached(count, false);
   for (size_t i = 0; i < count; ++i) {
@@ -292,12 +275,13 @@ Report measure(Renderer& renderer, const fs::path& reference, const std::vector<
     row.file_bytes = file_bytes(row.path);
     const std::string name = display_name(row.path);
     GaussianScene scene;
+    LoadReport load_report;
     for (int load = 0; load < options.warmup + options.repeat; ++load) {
       const bool measured = load >= options.warmup;
       scene = {};  // each load starts from nothing, as a first load would
       if (measured && row.load_ms.empty()) cli::reset_peak_memory();
       const uint64_t resident = cli::resident_memory_bytes();
-      LoadReport load_report;
+      load_report = {};
       const auto start = std::chrono::steady_clock::now();
       scene = load_scene(row.path, {}, &load_report);
       const auto stop = std::chrono::steady_clock::now();
@@ -308,15 +292,16 @@ Report measure(Renderer& renderer, const fs::path& reference, const std::vector<
         }
         row.load_ms.push_back(std::chrono::duration<double, std::milli>(stop - start).count());
       }
-      row.format = load_report.format + (load_report.version.empty() ? "" : " " + load_report.version);
       progress(++done, total, name + ": load");
     }
+    row.format = load_report.format + (load_report.version.empty() ? "" : " " + load_report.version);
     row.gaussians = scene.size();
     row.sh_degree = scene.sh_degree;
-    if (p == 0) reference_scene = scene;
-    row.attributes = compare_attributes(reference_scene, scene);
+    if (p == 0) reference_scene = std::move(scene);
+    const GaussianScene& measured = p == 0 ? reference_scene : scene;
+    row.attributes = compare_attributes(reference_scene, measured);
 
-    renderer.set_scene(scene);
+    renderer.set_scene(measured);
     for (size_t v = 0; v < options.views.size(); ++v) {
       RenderImage image = renderer.render(options.views[v], options.settings);
       if (p == 0) {
@@ -357,10 +342,12 @@ Columns size_columns(const Report& report) {
   const double reference_ms = report.rows.front().median_load_ms();
   for (const FileRow& row : report.rows) {
     const double ms = row.median_load_ms();
-    table.rows.push_back(
-        {display_name(row.path), row.format, std::to_string(row.gaussians), std::to_string(row.sh_degree),
-         fixed(mebibytes(row.file_bytes), 2), fixed(row.bytes_per_gaussian(), 1), fixed(ms, ms < 10 ? 2 : 1),
-         reference_ms > 0 ? fixed(ms / reference_ms, 2) : "-", fixed(mebibytes(row.load_peak_bytes), 1)});
+    table.rows.push_back({display_name(row.path), row.format, std::to_string(row.gaussians),
+                          std::to_string(row.sh_degree), cli::format_number(mebibytes(row.file_bytes), 2),
+                          cli::format_number(row.bytes_per_gaussian(), 1),
+                          cli::format_number(ms, ms < 10 ? 2 : 1),
+                          reference_ms > 0 ? cli::format_number(ms / reference_ms, 2) : "-",
+                          cli::format_number(mebibytes(row.load_peak_bytes), 1)});
   }
   return table;
 }
@@ -379,7 +366,7 @@ Columns fidelity_columns(const Report& report) {
                          a.max_abs.sh_dc, a.max_abs.sh_rest})
       cells.push_back(a.comparable ? error_text(value) : "-");
     for (const ImageDifference& view : row.views) {
-      cells.push_back(fixed(view.psnr_db, 2));
+      cells.push_back(cli::format_number(view.psnr_db, 2));
       cells.push_back(error_text(view.max_abs));
     }
     table.rows.push_back(std::move(cells));
@@ -462,20 +449,21 @@ std::string csv(const Report& report) {
       "abs\n";
   for (const FileRow& row : report.rows) {
     const AttributeComparison& a = row.attributes;
-    std::string prefix = cli::csv_field(report.device.name) + "," + cli::csv_field(report.reference_name) +
-                         "," + cli::csv_field(display_name(row.path)) + "," + cli::csv_field(row.format) +
-                         "," + std::to_string(row.gaussians) + "," + std::to_string(row.sh_degree) + "," +
-                         std::to_string(row.file_bytes) + "," + fixed(row.bytes_per_gaussian(), 3) + "," +
-                         fixed(row.median_load_ms(), 3) + "," + std::to_string(row.load_peak_bytes) + "," +
-                         cli::csv_field(order_text(a, row.gaussians));
+    std::string prefix =
+        cli::csv_field(report.device.name) + "," + cli::csv_field(report.reference_name) + "," +
+        cli::csv_field(display_name(row.path)) + "," + cli::csv_field(row.format) + "," +
+        std::to_string(row.gaussians) + "," + std::to_string(row.sh_degree) + "," +
+        std::to_string(row.file_bytes) + "," + cli::format_number(row.bytes_per_gaussian(), 3) + "," +
+        cli::format_number(row.median_load_ms(), 3) + "," + std::to_string(row.load_peak_bytes) + "," +
+        cli::csv_field(order_text(a, row.gaussians));
     for (double value : {a.max_abs.position, a.max_abs.log_scale, a.max_abs.rotation, a.max_abs.opacity,
                          a.max_abs.sh_dc, a.max_abs.sh_rest}) {
       prefix += ',';
       if (a.comparable) prefix += error_text(value);
     }
     for (size_t v = 0; v < row.views.size(); ++v)
-      out += prefix + "," + cli::csv_field(report.view_names[v]) + "," + fixed(row.views[v].psnr_db, 4) +
-             "," + error_text(row.views[v].max_abs) + "\n";
+      out += prefix + "," + cli::csv_field(report.view_names[v]) + "," +
+             cli::format_number(row.views[v].psnr_db, 4) + "," + error_text(row.views[v].max_abs) + "\n";
   }
   return out;
 }
