@@ -1,4 +1,4 @@
-// The stability suite: generated hard cases (DESIGN-NOTES section 4) that each have one defined
+// The stability suite: generated hard cases (docs/rendering-math.md, section 5) that each have one defined
 // outcome. Every case is a scene built in memory from raw parameters, a camera and an expectation:
 //  - render: every sort strategy renders without an exception or a validation message, every output
 //    value is finite, the image is within the case's bound of the float64 reference, the exact

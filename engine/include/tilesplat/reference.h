@@ -1,4 +1,4 @@
-// The float64 CPU reference renderer: the math of DESIGN-NOTES section 1, tiles and all.
+// The float64 CPU reference renderer: the math of docs/rendering-math.md, tiles and all.
 // It is the ground truth the GPU pipeline and every approximation are measured against.
 #pragma once
 

@@ -27,7 +27,7 @@ struct RendererOptions {
 };
 
 // The approximations of the reference a frame may make, each a named mode. The defaults are the
-// reference behaviour (DESIGN-NOTES section 1). `tilesplat-bench --accuracy` measures what each mode
+// reference behaviour (docs/rendering-math.md). `tilesplat-bench --accuracy` measures what each mode
 // costs in error against the float64 reference and what it saves in time (docs/accuracy.md).
 struct AccuracyModes {
   // Bits of the per-Gaussian depth key the depth sort orders by: 32 = the float bits of the view
@@ -69,8 +69,8 @@ TILESPLAT_API AccuracyModes parse_accuracy_modes(const std::string& text);
 // Throws std::invalid_argument when a value is out of range (naming it).
 TILESPLAT_API void validate(const AccuracyModes& modes);
 
-// How a splat's 2D footprint is filtered (DESIGN-NOTES section 1). An asset is trained for one mode
-// and renders correctly only in that mode.
+// How a splat's 2D footprint is filtered (docs/rendering-math.md, section 2). An asset is trained for one
+// mode and renders correctly only in that mode.
 enum class Antialiasing {
   kClassic,      // the original 3DGS: 0.3 px^2 added to the 2D covariance
   kAntialiased,  // gsplat's "antialiased": the same dilation, opacity * sqrt(det before / det after)

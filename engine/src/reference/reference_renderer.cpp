@@ -1,4 +1,4 @@
-// The float64 CPU reference renderer: DESIGN-NOTES section 1, step by step, tiles and all.
+// The float64 CPU reference renderer: docs/rendering-math.md, step by step, tiles and all.
 // Everything is computed in double from the scene's float inputs; only the per-tile sort key is
 // rounded to float32, because the GPU sorts by float_bits(depth) and the reference must order
 // splats exactly as it does.
