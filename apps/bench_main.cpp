@@ -16,15 +16,16 @@
 
 #include "accuracy_report.h"
 #include "bench_plot.h"
+#include "cli.h"
 #include "effects_report.h"
 #include "formats_report.h"
-#include "cli.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
 #include "tilesplat/sort.h"
+#include "tilesplat/version.h"
 
 namespace {
 
@@ -56,6 +57,7 @@ struct BenchOptions {
   double consistency_angle = 0.08;
   std::vector<int> sort_sizes{10, 12, 14, 16, 18, 20, 22, 24};  // log2 of the key counts
   std::vector<int> key_bits{32, 64};
+  std::string command;  // the command as typed, recorded in every output
 };
 
 enum class Unit { kMilliseconds, kCount, kMebibytes, kDecibels, kColour };  // kColour: a difference, 1 = white
@@ -478,6 +480,15 @@ std::string json_string(const std::string& text) {
   return out + "\"";
 }
 
+// The "tilesplat" build and "command" members that every JSON output starts with.
+std::string json_provenance(const std::string& command) {
+  const tilesplat::BuildInfo build = tilesplat::build_info();
+  return "  \"tilesplat\": {\"version\": " + json_string(build.version) +
+         ", \"commit\": " + json_string(build.git_commit) +
+         ", \"build_type\": " + json_string(build.build_type) + "},\n" +
+         "  \"command\": " + json_string(command) + ",\n";
+}
+
 std::string json_device(const tilesplat::DeviceInfo& device) {
   return "{\"name\": " + json_string(device.name) + ", \"driver\": " + json_string(device.driver) +
          ", \"subgroup_size\": " + std::to_string(device.subgroup_size) +
@@ -550,7 +561,7 @@ std::string json_metrics(const StrategyResult& result, bool with_samples) {
 // of each view's median.
 std::string make_json(const std::vector<Group>& groups, const std::vector<BenchScene>& scenes,
                       const tilesplat::DeviceInfo& device, const BenchOptions& options) {
-  std::string json = "{\n  \"tool\": \"tilesplat-bench\",\n";
+  std::string json = "{\n  \"tool\": \"tilesplat-bench\",\n" + json_provenance(options.command);
   json += "  \"device\": " + json_device(device) + ",\n";
   json += "  \"warmup\": " + std::to_string(options.warmup) + ",\n";
   json += "  \"repeat\": " + std::to_string(options.repeat) + ",\n";
@@ -805,13 +816,6 @@ std::vector<std::pair<std::string, fs::path>> scene_and_camera_inputs(const Benc
   return inputs;
 }
 
-// The command as typed, for the reports that record how they were made.
-std::string command_line(int argc, char** argv) {
-  std::string command = "tilesplat-bench";
-  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
-  return command;
-}
-
 // Writes the output files that were asked for (each atomically), warns about the run's validation
 // messages, and returns " -> a.csv, b.json" for the closing line.
 std::string write_outputs(const std::vector<std::pair<std::string, std::function<std::string()>>>& files,
@@ -926,7 +930,7 @@ std::string make_sort_csv(const std::vector<SortRow>& rows, const tilesplat::Dev
 
 std::string make_sort_json(const std::vector<SortRow>& rows, const tilesplat::DeviceInfo& device,
                            const BenchOptions& options) {
-  std::string json = "{\n  \"tool\": \"tilesplat-bench --sort-bench\",\n";
+  std::string json = "{\n  \"tool\": \"tilesplat-bench --sort-bench\",\n" + json_provenance(options.command);
   json += "  \"device\": {\"name\": " + json_string(device.name) + ", \"driver\": " + json_string(device.driver) +
           ", \"subgroup_size\": " + std::to_string(device.subgroup_size) + "},\n";
   json += "  \"warmup\": " + std::to_string(options.warmup) + ",\n  \"repeat\": " + std::to_string(options.repeat) +
@@ -1068,11 +1072,12 @@ int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
                 cli::format_fixed(100.0 * row.misordered, 2).c_str(), static_cast<unsigned long long>(row.fallbacks));
   std::fflush(stdout);
 
-  const std::string written =
-      write_outputs({{options.csv, [&] { return make_sort_csv(rows, device); }},
-                     {options.json, [&] { return make_sort_json(rows, device, options); }},
-                     {options.plot, [&] { return make_sort_svg(rows, device, options); }}},
-                    renderer->validation_messages());
+  const std::string written = write_outputs(
+      {{options.csv,
+        [&] { return cli::with_provenance_columns(make_sort_csv(rows, device), options.command); }},
+       {options.json, [&] { return make_sort_json(rows, device, options); }},
+       {options.plot, [&] { return make_sort_svg(rows, device, options); }}},
+      renderer->validation_messages());
   std::fprintf(stderr, "%s: sort micro-benchmark, %d sorts in %s s%s\n", kProgram, total,
                cli::format_fixed(seconds, 2).c_str(), written.c_str());
   return cli::kExitOk;
@@ -1091,14 +1096,14 @@ fs::path scene_plot_path(const std::string& plot, const std::string& scene_file,
 // The report renders every mode against the reference itself, so a scene file's sh_degree effect is
 // applied to the scene (dropping the bands it excludes gives the same images as the cap) rather than
 // to the modes, whose SH cap is one of the things measured.
-int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& options, int argc, char** argv) {
+int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& options) {
   for (const char* flag : {"--resolutions", "--orbit", "--json"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");
   if (options.common.sorts.size() > 1)
     throw cli::UsageError("--accuracy measures with one --sort strategy (the modes do not depend on it)");
   check_outputs(options, scene_and_camera_inputs(options));
 
-  const std::string command = command_line(argc, argv);
+  const std::string& command = options.command;
 
   // Every scene and camera first: a bad file or view fails now, not after an hour of measuring.
   struct Planned {
@@ -1158,7 +1163,8 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
 
   std::vector<std::pair<std::string, std::function<std::string()>>> files = {
       {options.markdown, [&] { return tilesplat::accuracy::markdown(reports, device, command); }},
-      {options.csv, [&] { return tilesplat::accuracy::csv(reports, device); }}};
+      {options.csv,
+       [&] { return cli::with_provenance_columns(tilesplat::accuracy::csv(reports, device), command); }}};
   std::vector<std::string> plot_paths;
   if (!options.plot.empty())
     for (const auto& report : reports) {
@@ -1177,7 +1183,7 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
   return cli::kExitOk;
 }
 
-int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options, int argc, char** argv) {
+int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options) {
   for (const char* flag : {"--resolutions", "--json", "--plot"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --effects");
   if (options.common.scenes.size() != 1) throw cli::UsageError("--effects measures one SCENE");
@@ -1185,7 +1191,7 @@ int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options
   if (parser.seen("--antialiasing"))
     throw cli::UsageError("--antialiasing does not apply to --effects (it measures every mode)");
   check_outputs(options, {{"SCENE", options.common.scenes.front()}});
-  const std::string command = command_line(argc, argv);
+  const std::string& command = options.command;
 
   BenchScene scene;
   scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
@@ -1217,8 +1223,12 @@ int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options
               tilesplat::effects::text_table(rows).c_str());
   std::fflush(stdout);
   const std::string written = write_outputs(
-      {{options.markdown, [&] { return tilesplat::effects::markdown(rows, scene.name, run.device, command); }},
-       {options.csv, [&] { return tilesplat::effects::csv(rows, scene.name, run.device); }}},
+      {{options.markdown,
+        [&] { return tilesplat::effects::markdown(rows, scene.name, run.device, command); }},
+       {options.csv,
+        [&] {
+          return cli::with_provenance_columns(tilesplat::effects::csv(rows, scene.name, run.device), command);
+        }}},
       run.validation_messages);
   std::fprintf(stderr, "%s: effect costs, %zu rows%s\n", kProgram, rows.size(), written.c_str());
   return cli::kExitOk;
@@ -1241,7 +1251,7 @@ std::vector<Case> plan_format_views(const cli::ArgParser& parser, BenchOptions o
   return plan_cases(options, reference, 0, {{options.common.width, options.common.height}});
 }
 
-int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options, int argc, char** argv) {
+int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options) {
   for (const char* flag : {"--resolutions", "--json"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --formats");
   if (options.common.scenes.size() < 2)
@@ -1250,7 +1260,7 @@ int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options
   if (options.common.sorts.size() > 1) throw cli::UsageError("--formats renders with one --sort strategy");
   if (options.common.cameras_files.size() > 1) throw cli::UsageError("--formats takes one --cameras for all its files");
   check_outputs(options, scene_and_camera_inputs(options));
-  const std::string command = command_line(argc, argv);
+  const std::string& command = options.command;
 
   BenchScene reference;
   reference.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
@@ -1283,11 +1293,11 @@ int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options
   std::printf("device  %s (driver %s)\n\n%s", report.device.name.c_str(), report.device.driver.c_str(),
               tilesplat::formats::text_table(report).c_str());
   std::fflush(stdout);
-  const std::string written =
-      write_outputs({{options.markdown, [&] { return tilesplat::formats::markdown(report, command); }},
-                     {options.csv, [&] { return tilesplat::formats::csv(report); }},
-                     {options.plot, [&] { return tilesplat::formats::size_psnr_svg(report); }}},
-                    report.validation_messages);
+  const std::string written = write_outputs(
+      {{options.markdown, [&] { return tilesplat::formats::markdown(report, command); }},
+       {options.csv, [&] { return cli::with_provenance_columns(tilesplat::formats::csv(report), command); }},
+       {options.plot, [&] { return tilesplat::formats::size_psnr_svg(report); }}},
+      report.validation_messages);
   std::fprintf(stderr, "%s: format costs, %zu files against %s%s\n", kProgram, files.size(),
                report.reference_name.c_str(), written.c_str());
   return cli::kExitOk;
@@ -1340,11 +1350,12 @@ int run(int argc, char** argv) {
                         "--orbit); a progress bar on stderr counts the frames of the whole run.");
   add_bench_options(parser, options);
   if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
+  options.command = cli::command_line(kProgram, argc, argv);
   if (options.sort_bench) return run_sort_bench(parser, options);
   check_frame_options(parser, options);
-  if (options.accuracy) return run_accuracy_report(parser, options, argc, argv);
-  if (options.effects) return run_effects_report(parser, options, argc, argv);
-  if (options.formats) return run_formats_report(parser, options, argc, argv);
+  if (options.accuracy) return run_accuracy_report(parser, options);
+  if (options.effects) return run_effects_report(parser, options);
+  if (options.formats) return run_formats_report(parser, options);
   check_outputs(options, scene_and_camera_inputs(options));
 
   std::vector<std::string> sorts = options.common.sorts;
@@ -1426,11 +1437,12 @@ int run(int argc, char** argv) {
   for (const auto& group : groups) print_group(group, scenes[group.cases.front()->scene], options);
   std::fflush(stdout);
 
-  const std::string written =
-      write_outputs({{options.csv, [&] { return make_csv(groups, scenes, device); }},
-                     {options.json, [&] { return make_json(groups, scenes, device, options); }},
-                     {options.plot, [&] { return make_frame_svg(groups, scenes, device, options); }}},
-                    renderer->validation_messages());
+  const std::string written = write_outputs(
+      {{options.csv,
+        [&] { return cli::with_provenance_columns(make_csv(groups, scenes, device), options.command); }},
+       {options.json, [&] { return make_json(groups, scenes, device, options); }},
+       {options.plot, [&] { return make_frame_svg(groups, scenes, device, options); }}},
+      renderer->validation_messages());
   std::string what = scenes.size() == 1 ? scenes.front().name + ", " + scenes.front().description
                                         : std::to_string(scenes.size()) + " scenes";
   what += cases.size() == 1 ? ", " + size_of(cases.front()) : ", " + std::to_string(cases.size()) + " cameras";

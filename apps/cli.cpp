@@ -928,6 +928,52 @@ std::string version_text(std::string_view program) {
   return details.empty() ? text : text + " (" + details + ")";
 }
 
+std::string command_line(std::string_view program, int argc, const char* const* argv) {
+  std::string command(program);
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view argument = argv[i];
+    command += ' ';
+    if (!argument.empty() && argument.find_first_of(" \t\n'\"\\$`;&|<>()*?") == std::string_view::npos) {
+      command += argument;
+      continue;
+    }
+    command += '\'';
+    for (const char c : argument) {
+      if (c == '\'')
+        command += "'\\''";
+      else
+        command += c;
+    }
+    command += '\'';
+  }
+  return command;
+}
+
+std::string with_provenance_columns(const std::string& csv, const std::string& command) {
+  const BuildInfo build = build_info();
+  const std::string header = ",tilesplat_version,tilesplat_commit,build_type,command";
+  const std::string values = "," + csv_field(build.version) + "," + csv_field(build.git_commit) + "," +
+                             csv_field(build.build_type) + "," + csv_field(command);
+  std::string out;
+  out.reserve(csv.size() + 64 * size_t(std::count(csv.begin(), csv.end(), '\n')));
+  bool quoted = false, first_record = true;
+  for (size_t i = 0; i < csv.size(); ++i) {
+    const char c = csv[i];
+    if (c == '"') quoted = !quoted;  // a doubled quote inside a field toggles twice
+    if (c == '\n' && !quoted) {
+      const bool crlf = !out.empty() && out.back() == '\r';
+      if (crlf) out.pop_back();
+      out += first_record ? header : values;
+      if (crlf) out += '\r';
+      first_record = false;
+    }
+    out += c;
+  }
+  if (!csv.empty() && csv.back() != '\n')
+    out += first_record ? header : values;  // a last record without '\n'
+  return out;
+}
+
 bool parse_and_handle_help(ArgParser& parser, int argc, const char* const* argv) {
   switch (parser.parse(argc, argv)) {
     case ArgParser::Outcome::kHelp:

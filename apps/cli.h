@@ -167,6 +167,15 @@ void print_devices();
 // "tilesplat-render 0.3.0 (commit 1a2b3c..., Release)": the library's version and build.
 std::string version_text(std::string_view program);
 
+// The command as typed ("tilesplat-bench a.ply --csv c.csv"), for the outputs that record how they
+// were made. Arguments with spaces or quotes are single-quoted so that a shell runs it again.
+std::string command_line(std::string_view program, int argc, const char* const* argv);
+
+// A CSV table with four provenance columns appended to every record: tilesplat_version,
+// tilesplat_commit, build_type (build_info()) and command. Every row carries them, so the rows of
+// runs concatenated into one table still say which build and command produced each.
+std::string with_provenance_columns(const std::string& csv, const std::string& command);
+
 // Parses the command line and handles --help and --version, which end the program before it does
 // any work. Returns true when the program should exit with kExitOk.
 bool parse_and_handle_help(ArgParser& parser, int argc, const char* const* argv);

@@ -208,6 +208,7 @@ int run(int argc, char** argv) {
   tilesplat::ExrWriteOptions exr_options;
   exr_options.half = options.half;
   exr_options.alpha = !loaded.description || loaded.description->outputs.alpha;
+  exr_options.attributes["commandLine"] = cli::command_line(kProgram, argc, argv);
   try {
     tilesplat::write_exr(options.output, image, exr_options);
   } catch (const std::exception& error) {

@@ -2,23 +2,26 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <tuple>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "cli.h"
 #include "process_support.h"
 #include "test_support.h"
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene_description.h"
+#include "tilesplat/version.h"
 
 namespace {
 
 namespace fs = std::filesystem;
+namespace cli = tilesplat::cli;
 using tilesplat::testing::bundled_playbot;
 using tilesplat::testing::bundled_playbot_cameras;
 using tilesplat::testing::bundled_sh3;
@@ -395,6 +398,84 @@ TEST(CliBench, PrintsTableAndWritesCsvAndJson) {
   EXPECT_TRUE(contains(json_text, "\"projection\"")) << json_text;
   EXPECT_EQ(entries(out), (std::vector<std::string>{"c.csv", "j.json"}));
   EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+}
+
+// Every output says which build and command made it: the CSV in four columns of every record, the
+// JSON in "tilesplat" and "command" members, an EXR in string attributes.
+TEST(CliBench, CsvAndJsonRecordTheBuildAndTheCommand) {
+  const auto out = fresh_output_dir();
+  const fs::path csv = out / "c.csv";
+  const fs::path json = out / "j.json";
+  const std::vector<std::string> arguments = {bundled_sh3().string(),
+                                              "--width",
+                                              "32",
+                                              "--height",
+                                              "18",
+                                              "--sort",
+                                              "radix",
+                                              "--warmup",
+                                              "0",
+                                              "--repeat",
+                                              "1",
+                                              "--csv",
+                                              csv.string(),
+                                              "--json",
+                                              json.string()};
+  const auto result = run_exe(kBenchExe, arguments);
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  std::string command = "tilesplat-bench";
+  for (const auto& argument : arguments) command += " " + argument;
+  const tilesplat::BuildInfo build = tilesplat::build_info();
+  const std::string provenance = std::string(",") + build.version + "," + build.git_commit + "," +
+                                 build.build_type + "," + cli::csv_field(command);
+
+  std::ifstream lines(csv);
+  std::string line;
+  ASSERT_TRUE(std::getline(lines, line));
+  EXPECT_TRUE(line.ends_with(",samples,tilesplat_version,tilesplat_commit,build_type,command")) << line;
+  int records = 0;
+  while (std::getline(lines, line)) {
+    EXPECT_TRUE(line.ends_with(provenance)) << line << "\nexpected to end with " << provenance;
+    ++records;
+  }
+  EXPECT_GT(records, 3);
+
+  const std::string json_text = read_file(json);
+  EXPECT_TRUE(contains(json_text, std::string("\"tilesplat\": {\"version\": \"") + build.version +
+                                      "\", \"commit\": \"" + build.git_commit + "\", \"build_type\": \"" +
+                                      build.build_type + "\"}"))
+      << json_text;
+  EXPECT_TRUE(contains(json_text, "\"command\": \"" + command + "\"")) << json_text;
+}
+
+TEST(CliRender, ExrRecordsTheBuildAndTheCommand) {
+  const auto out = fresh_output_dir();
+  const fs::path exr = out / "with space.exr";
+  const auto result =
+      run_exe(kRenderExe, {bundled_sh3().string(), "--width", "32", "--height", "18", "-o", exr.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto attributes = tilesplat::read_exr_string_attributes(exr);
+  EXPECT_EQ(attributes.at("tilesplatVersion"), tilesplat::version());
+  // The argument with a space is quoted, so that a shell can run the command again.
+  EXPECT_EQ(attributes.at("commandLine"), "tilesplat-render " + bundled_sh3().string() +
+                                              " --width 32 --height 18 -o '" + exr.string() + "'");
+}
+
+TEST(CliProvenance, ColumnsFollowRecordsNotLinesInsideQuotedFields) {
+  const tilesplat::BuildInfo build = tilesplat::build_info();
+  const std::string values = std::string(",") + build.version + "," + build.git_commit + "," +
+                             build.build_type + ",\"run \"\"x\"\", y\"";
+  const std::string csv = "a,b\r\n\"two\nlines\",\"q\"\"\"\n1,2";
+  EXPECT_EQ(cli::with_provenance_columns(csv, "run \"x\", y"),
+            "a,b,tilesplat_version,tilesplat_commit,build_type,command\r\n\"two\nlines\",\"q\"\"\"" + values +
+                "\n1,2" + values);
+  EXPECT_EQ(cli::with_provenance_columns("", "c"), "");
+}
+
+TEST(CliProvenance, CommandLineQuotesWhatAShellWouldSplit) {
+  const char* argv[] = {"./build/apps/tilesplat-bench", "a.ply", "my file.csv", "it's", "", "--x=$HOME"};
+  EXPECT_EQ(cli::command_line("tilesplat-bench", 6, argv),
+            "tilesplat-bench a.ply 'my file.csv' 'it'\\''s' '' '--x=$HOME'");
 }
 
 TEST(CliBench, AccuracyReportMeasuresPoppingAndViewConsistencyPerMode) {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -19,6 +20,7 @@
 #include "image/atomic_file.h"
 #include "test_support.h"
 #include "tilesplat/image.h"
+#include "tilesplat/version.h"
 
 // The EXR channel checks read the header with the spec-level parser below, and additionally with
 // OpenEXR itself when the test target has OpenEXR's include directories.
@@ -26,6 +28,7 @@
 #include <ImfChannelList.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfStringAttribute.h>
 #define TILESPLAT_TEST_HAS_OPENEXR 1
 #else
 #define TILESPLAT_TEST_HAS_OPENEXR 0
@@ -381,6 +384,63 @@ TEST(ExrIo, MissingFileGivesClearError) {
   const std::string message = error_message_of([&] { read_exr(path); });
   EXPECT_EQ(message, "cannot read " + path.string() + ": the file does not exist");
   EXPECT_THROW(read_exr(path), std::runtime_error);
+}
+
+TEST(ExrIo, RecordsProvenanceAndTheCallersAttributes) {
+  const fs::path path = fresh_dir() / "provenance.exr";
+  ExrWriteOptions options;
+  options.attributes = {{"commandLine", "tilesplat-render scene.ply -o provenance.exr"},
+                        {"owner", "a, b \"c\""}};
+  write_exr(path, make_image(4, 3, true, false), options);
+
+  const std::map<std::string, std::string> attributes = read_exr_string_attributes(path);
+  const tilesplat::BuildInfo build = tilesplat::build_info();
+  EXPECT_EQ(attributes.at("tilesplatVersion"), build.version);
+  EXPECT_EQ(attributes.at("tilesplatVersion"), TILESPLAT_VERSION_STRING);
+  if (*build.git_commit) {
+    EXPECT_EQ(attributes.at("tilesplatCommit"), build.git_commit);
+  } else {
+    EXPECT_EQ(attributes.count("tilesplatCommit"), 0u);
+  }
+  if (*build.build_type) {
+    EXPECT_EQ(attributes.at("tilesplatBuildType"), build.build_type);
+  }
+  EXPECT_EQ(attributes.at("commandLine"), options.attributes.at("commandLine"));
+  EXPECT_EQ(attributes.at("owner"), "a, b \"c\"");
+  // Only string attributes are returned: the writer's own (channels, compression, ...) are not strings.
+  EXPECT_EQ(attributes.count("compression"), 0u);
+  EXPECT_EQ(read_exr(path).width, 4);  // and the file is an ordinary image
+#if TILESPLAT_TEST_HAS_OPENEXR
+  const Imf::InputFile file(path.c_str());
+  EXPECT_NE(file.header().findTypedAttribute<Imf::StringAttribute>("tilesplatVersion"), nullptr);
+#endif
+}
+
+TEST(ExrIo, AttributesTheWriterOwnsAreRejectedAndNothingIsWritten) {
+  const fs::path dir = fresh_dir();
+  for (const std::string name :
+       {"", "channels", "dataWindow", "compression", "tilesplatVersion", "tilesplatAnything"}) {
+    const fs::path path = dir / "rejected.exr";
+    ExrWriteOptions options;
+    options.attributes[name] = "x";
+    const std::string message =
+        error_message_of([&] { write_exr(path, make_image(2, 2, false, false), options); });
+    EXPECT_EQ(message.rfind("cannot write " + path.string() + ": ", 0), 0u) << message;
+    EXPECT_NE(message.find(name.empty() ? "empty name" : "'" + name + "'"), std::string::npos) << message;
+    EXPECT_FALSE(fs::exists(path)) << name;
+  }
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(ExrIo, StringAttributesOfMissingOrForeignFileGiveClearErrors) {
+  const fs::path dir = fresh_dir();
+  const fs::path missing = dir / "missing.exr";
+  EXPECT_EQ(error_message_of([&] { read_exr_string_attributes(missing); }),
+            "cannot read " + missing.string() + ": the file does not exist");
+  const fs::path text = dir / "text.exr";
+  write_bytes(text, {'n', 'o', 't', ' ', 'e', 'x', 'r'});
+  EXPECT_EQ(error_message_of([&] { read_exr_string_attributes(text); }),
+            "cannot read " + text.string() + ": not an OpenEXR file");
 }
 
 TEST(ExrIo, TruncatedOrForeignFileGivesClearError) {

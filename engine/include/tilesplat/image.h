@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -26,10 +27,16 @@ struct RenderImage {
 struct ExrWriteOptions {
   bool half = false;   // store HALF instead of FLOAT channels
   bool alpha = true;   // write the A channel (false: R G B only, which readers take as opaque)
+  // Extra string attributes for the header, name -> value (e.g. "commandLine"). A name may not be
+  // empty, one of the attributes the writer sets itself (the required EXR attributes, "compression",
+  // "channels", ...) or start with "tilesplat", which is reserved for the provenance below.
+  std::map<std::string, std::string> attributes;
 };
 
 // Writes channels R G B A (A unless options.alpha is false), Z when depth is present, and "splats"
-// when counts are present.
+// when counts are present. Every file records which engine wrote it, as string attributes:
+// "tilesplatVersion" (build_info().version), "tilesplatCommit" (when built from a checkout) and
+// "tilesplatBuildType" (when set); then options.attributes.
 // Atomic: the image goes to a temporary file beside `path` that is renamed over it only once
 // complete, so a failure never leaves a partial file. Throws std::runtime_error naming the file.
 TILESPLAT_API void write_exr(const std::filesystem::path& path, const RenderImage& image,
@@ -38,6 +45,11 @@ TILESPLAT_API void write_exr(const std::filesystem::path& path, const RenderImag
 // Reads an EXR's R G B A (A = 1 when absent), Z and "splats" (each when present), any pixel type
 // converted, any data window origin. Throws std::runtime_error naming the file.
 TILESPLAT_API RenderImage read_exr(const std::filesystem::path& path);
+
+// Every string attribute of an EXR's header, name -> value: the provenance write_exr records and
+// whatever else the file carries. Throws std::runtime_error naming the file.
+TILESPLAT_API std::map<std::string, std::string> read_exr_string_attributes(
+    const std::filesystem::path& path);
 
 // How a PNG preview maps linear radiance to display values: colour times 2^exposure_stops, then the
 // tone curve per channel, then a clamp to [0, 1] and the sRGB encoding. The EXR keeps the linear

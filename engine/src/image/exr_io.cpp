@@ -7,6 +7,7 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfPixelType.h>
+#include <ImfStringAttribute.h>
 #include <ImfTestFile.h>
 #include <half.h>
 
@@ -21,6 +22,7 @@
 
 #include "image/atomic_file.h"
 #include "tilesplat/image.h"
+#include "tilesplat/version.h"
 
 namespace tilesplat {
 namespace {
@@ -47,6 +49,38 @@ void check_writable_image(const std::filesystem::path& path, const RenderImage& 
     throw std::runtime_error(prefix + "splat_count holds " + std::to_string(image.splat_count.size()) +
                              " values, a " + size_text + " image needs " + std::to_string(pixels) +
                              " (or none)");
+}
+
+// The attributes write_exr sets itself, which options.attributes may not replace: OpenEXR would
+// overwrite them with strings and write a file no reader opens.
+bool is_written_by_the_writer(const std::string& name) {
+  static const std::array<const char*, 11> kOwn = {
+      "channels",         "compression",        "dataWindow",        "displayWindow", "lineOrder",
+      "pixelAspectRatio", "screenWindowCenter", "screenWindowWidth", "tiles",         "type",
+      "version"};
+  for (const char* own : kOwn)
+    if (name == own) return true;
+  return name.rfind("tilesplat", 0) == 0;
+}
+
+void check_attributes(const std::filesystem::path& path, const ExrWriteOptions& options) {
+  for (const auto& [name, value] : options.attributes) {
+    if (name.empty())
+      throw std::runtime_error("cannot write " + path.string() + ": an attribute has an empty name");
+    if (is_written_by_the_writer(name))
+      throw std::runtime_error(
+          "cannot write " + path.string() + ": attribute '" + name +
+          "' is set by the writer itself (names starting with 'tilesplat' are reserved)");
+  }
+}
+
+// The provenance every file carries, then the caller's attributes.
+void add_string_attributes(Imf::Header& header, const ExrWriteOptions& options) {
+  const BuildInfo build = build_info();
+  header.insert("tilesplatVersion", Imf::StringAttribute(build.version));
+  if (*build.git_commit) header.insert("tilesplatCommit", Imf::StringAttribute(build.git_commit));
+  if (*build.build_type) header.insert("tilesplatBuildType", Imf::StringAttribute(build.build_type));
+  for (const auto& [name, value] : options.attributes) header.insert(name, Imf::StringAttribute(value));
 }
 
 std::string channel_names(const Imf::ChannelList& channels) {
@@ -120,10 +154,27 @@ RenderImage read_exr_file(const std::filesystem::path& path) {
   return image;
 }
 
+// Runs read(), a reader of `path`, with the file named in every error: OpenEXR's messages
+// (Iex::BaseExc derives from std::exception) rarely name it.
+template <typename Read>
+auto with_file_named_in_errors(const std::filesystem::path& path, const Read& read) {
+  const std::string prefix = "cannot read " + path.string() + ": ";
+  std::error_code status_error;
+  const auto status = std::filesystem::status(path, status_error);
+  if (!std::filesystem::exists(status)) throw std::runtime_error(prefix + "the file does not exist");
+  if (std::filesystem::is_directory(status)) throw std::runtime_error(prefix + "it is a directory");
+  try {
+    return read();
+  } catch (const std::exception& error) {
+    std::throw_with_nested(std::runtime_error(prefix + error.what()));
+  }
+}
+
 }  // namespace
 
 void write_exr(const std::filesystem::path& path, const RenderImage& image, const ExrWriteOptions& options) {
   check_writable_image(path, image);
+  check_attributes(path, options);
 
   const Imf::PixelType colour_type = options.half ? Imf::HALF : Imf::FLOAT;
   std::vector<Imath::half> rgba_half;
@@ -139,6 +190,7 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
   detail::write_file_atomically(path, [&](const std::filesystem::path& temp) {
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
+    add_string_attributes(header, options);
     const Imath::Box2i data_window = header.dataWindow();
 
     Imf::FrameBuffer frame;
@@ -169,17 +221,19 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
 }
 
 RenderImage read_exr(const std::filesystem::path& path) {
-  const std::string prefix = "cannot read " + path.string() + ": ";
-  std::error_code status_error;
-  const auto status = std::filesystem::status(path, status_error);
-  if (!std::filesystem::exists(status)) throw std::runtime_error(prefix + "the file does not exist");
-  if (std::filesystem::is_directory(status)) throw std::runtime_error(prefix + "it is a directory");
-  try {
-    return read_exr_file(path);
-  } catch (const std::exception& error) {
-    // OpenEXR's messages (Iex::BaseExc derives from std::exception) rarely name the file.
-    std::throw_with_nested(std::runtime_error(prefix + error.what()));
-  }
+  return with_file_named_in_errors(path, [&] { return read_exr_file(path); });
+}
+
+std::map<std::string, std::string> read_exr_string_attributes(const std::filesystem::path& path) {
+  return with_file_named_in_errors(path, [&] {
+    if (!Imf::isOpenExrFile(path.c_str())) throw std::runtime_error("not an OpenEXR file");
+    const Imf::InputFile file(path.c_str());
+    std::map<std::string, std::string> attributes;
+    for (auto attribute = file.header().begin(); attribute != file.header().end(); ++attribute)
+      if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&attribute.attribute()))
+        attributes.emplace(attribute.name(), text->value());
+    return attributes;
+  });
 }
 
 }  // namespace tilesplat
