@@ -1341,6 +1341,7 @@ void check_frame_options(const cli::ArgParser& parser, const BenchOptions& optio
 }
 
 int run(int argc, char** argv) {
+  cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
   BenchOptions options;
   cli::ArgParser parser(kProgram, "tilesplat-bench SCENE.ply|SCENE.json [SCENE...] [options]",
                         "Renders 3D Gaussian Splatting scenes repeatedly and prints the GPU time of every pass "

@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include "tilesplat/sort_strategy.h"
 #include "tilesplat/version.h"
 
 #if defined(__GLIBC__)
@@ -417,6 +418,20 @@ std::vector<std::string> split(std::string_view text, char separator) {
 // ---------------------------------------------------------------------------------------------
 // Common options
 
+void load_sort_plugins(int argc, const char* const* argv) {
+  constexpr std::string_view kFlag = "--sort-plugin";
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view argument = argv[i];
+    if (argument == "--") break;
+    if (argument == kFlag && i + 1 < argc) {
+      tilesplat::load_sort_plugin(argv[++i]);
+    } else if (argument.size() > kFlag.size() + 1 && argument.starts_with(kFlag) &&
+               argument[kFlag.size()] == '=') {
+      tilesplat::load_sort_plugin(std::string(argument.substr(kFlag.size() + 1)));
+    }
+  }
+}
+
 void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice,
                         SceneChoice scene_choice) {
   const OrbitParams orbit_defaults;
@@ -509,6 +524,10 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                     "enable the Khronos validation layer and report its messages (also TILESPLAT_VALIDATION=1)",
                     &options.validation);
 
+  parser.add_value("--sort-plugin", "FILE.so",
+                   "load the sort strategies of a plugin (tilesplat/sort_strategy.h) before --sort is read; "
+                   "repeatable",
+                   [](const std::string&) {});  // loaded by load_sort_plugins before parsing
   const auto available = available_sorts();
   const std::string default_sort = available.empty() ? "radix" : available.front();
   if (sort_choice == SortChoice::kOne) {

@@ -157,6 +157,11 @@ enum class SceneChoice { kOne, kList };
 void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice,
                         SceneChoice scene_choice = SceneChoice::kOne);
 
+// Loads the sort plugins that --sort-plugin FILE names (tilesplat::load_sort_plugin), before the
+// parser is built: their strategies must be known when --sort is checked and --help lists the
+// names. add_common_options registers the flag itself for --help. Throws what loading throws.
+void load_sort_plugins(int argc, const char* const* argv);
+
 // Checks what the parser cannot check flag by flag (a SCENE was given, orbit flags are not
 // mixed with --cameras, --view has cameras to pick from, ...). Throws UsageError.
 void check_common_options(const ArgParser& parser, const CommonOptions& options);

@@ -116,6 +116,7 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
 }
 
 int run(int argc, char** argv) {
+  cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
   RenderOptions options;
   cli::ArgParser parser(kProgram, "tilesplat-render SCENE.ply|SCENE.json -o OUT.exr [options]",
                         "Renders one view of a 3D Gaussian Splatting scene with the Vulkan compute renderer "

@@ -295,6 +295,7 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, const
 }
 
 int run(int argc, char** argv) {
+  cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
   ViewerOptions options;
   cli::ArgParser parser(
       kProgram, "tilesplat-viewer SCENE.ply|SCENE.json [options]",

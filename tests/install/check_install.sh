@@ -5,7 +5,9 @@
 #   - one example built through pkg-config (static);
 #   - the shared library exporting only the tilesplat:: API (nm -D), with its SONAME;
 #   - a consumer using add_subdirectory, with no C++ standard of its own, building no tilesplat tests;
-#   - every example's image equal, to the bit, to tilesplat-render's of the same view.
+#   - every example's image equal, to the bit, to tilesplat-render's of the same view;
+#   - the example sort strategy (examples/custom_sort) built against each install, as a program that
+#     checks itself against the built-in radix sort and as a plugin of the installed tilesplat-bench.
 # usage: tests/install/check_install.sh BUILD_DIR   (a built static build with tests, as .ci/run makes)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -33,10 +35,26 @@ check_examples() {
   done
 }
 
+# Builds examples/custom_sort against the package in $1, runs its self-check and runs it as a plugin
+# of the package's tilesplat-bench (frame benchmark: identical images; sort benchmark: same order).
+check_custom_sort() {
+  local prefix=$1 label=$2
+  configure -S "$root/examples/custom_sort" -B "$work/$label-custom_sort" -DCMAKE_PREFIX_PATH="$prefix"
+  cmake --build "$work/$label-custom_sort" -j"$jobs" >/dev/null
+  "$work/$label-custom_sort/custom_sort" "$scene" 320 180
+  "$prefix/bin/tilesplat-bench" "$scene" --sort-plugin "$work/$label-custom_sort/libserial_radix_sort.so" \
+    --sort radix,serial-radix --width 320 --height 180 --warmup 0 --repeat 1 >"$work/plugin-bench.txt" 2>&1
+  if grep -q "different images" "$work/plugin-bench.txt"; then cat "$work/plugin-bench.txt"; exit 1; fi
+  "$prefix/bin/tilesplat-bench" --sort-bench --sort-plugin "$work/$label-custom_sort/libserial_radix_sort.so" \
+    --sort serial-radix --sort-sizes 16 --key-bits 32,64 --warmup 0 --repeat 1 >/dev/null
+  echo "serial-radix plugin in $label tilesplat-bench: identical images, exact order"
+}
+
 echo "== static library: install, move, find_package =="
 cmake --install "$build" --prefix "$work/installed-static" >/dev/null
 mv "$work/installed-static" "$work/static"
 check_examples "$work/static" static
+check_custom_sort "$work/static" static
 
 echo "== static library through pkg-config =="
 flags=$(PKG_CONFIG_PATH="$work/static/lib/pkgconfig" pkg-config --cflags --libs --static tilesplat)
@@ -53,6 +71,7 @@ cmake --build "$work/build-shared" -j"$jobs" >/dev/null
 cmake --install "$work/build-shared" --prefix "$work/installed-shared" >/dev/null
 mv "$work/installed-shared" "$work/shared"
 check_examples "$work/shared" shared
+check_custom_sort "$work/shared" shared
 library=$(ls "$work"/shared/lib/libtilesplat.so.*.*.*)
 soname=$(objdump -p "$library" | awk '/SONAME/ { print $2 }')
 exported=$(nm -D --defined-only -C "$library" | cut -d' ' -f3-)
@@ -68,6 +87,7 @@ fi
 "$work/shared/bin/tilesplat-render" --version
 
 echo "== public headers include no OpenEXR, glm or JSON, and Vulkan only in vulkan_interop.h =="
+# (sort_strategy.h, the extension point for GPU sorts, reaches Vulkan through vulkan_interop.h.)
 if grep -n -E '#include <(Imf|Iex|OpenEXR|glm|nlohmann|vulkan)' "$work"/shared/include/tilesplat/*.h |
   grep -v 'vulkan_interop.h:.*<vulkan/vulkan.h>'; then
   echo "a public header includes a dependency's header"

@@ -1,6 +1,7 @@
 #include "sort/sort_strategy.h"
 
 #include <functional>
+#include <mutex>
 #include <stdexcept>
 
 #include "sort/bitonic_sort.h"
@@ -14,14 +15,18 @@ namespace tilesplat {
 namespace {
 
 struct Registration {
-  const char* name;
+  std::string name;
   bool exact;  // SortStrategy::exact(), known without a device (tests check that the two agree)
-  std::function<std::unique_ptr<SortStrategy>(vk::Context&)> make;
+  SortStrategyMaker make;
 };
 
-// The default first, then the other GPU sorts, then the host ones.
-const std::vector<Registration>& registry() {
-  static const std::vector<Registration> strategies = {
+// Guards registry(): strategies registered by a program or a plugin join the built-in ones while
+// renderers on other threads may be looking names up.
+std::mutex registry_mutex;
+
+// The default first, then the other GPU sorts, then the host ones, then those registered at run time.
+std::vector<Registration>& registry() {
+  static std::vector<Registration> strategies = {
       {"radix", true, [](vk::Context& ctx) { return std::make_unique<RadixSort>(ctx); }},
       {"onesweep", true, [](vk::Context& ctx) { return std::make_unique<OnesweepSort>(ctx); }},
       {"bitonic", true, [](vk::Context& ctx) { return std::make_unique<BitonicSort>(ctx); }},
@@ -29,25 +34,44 @@ const std::vector<Registration>& registry() {
       {"cpu-radix", true,
        [](vk::Context& ctx) { return std::make_unique<CpuRadixSort>(ctx, CpuRadixSort::Keys::kExact); }},
       {"cpu-radix16", false,
-       [](vk::Context& ctx) { return std::make_unique<CpuRadixSort>(ctx, CpuRadixSort::Keys::kQuantized16); }},
+       [](vk::Context& ctx) {
+         return std::make_unique<CpuRadixSort>(ctx, CpuRadixSort::Keys::kQuantized16);
+       }},
   };
   return strategies;
 }
 
-const Registration& find(const std::string& name) {
+// A copy: the registry may grow (and move its entries) once the lock is released.
+Registration find(const std::string& name) {
+  const std::lock_guard lock(registry_mutex);
   for (const auto& r : registry())
     if (name == r.name) return r;
   std::string valid;
-  for (const auto& r : registry()) valid += (valid.empty() ? "" : ", ") + std::string(r.name);
+  for (const auto& r : registry()) valid += (valid.empty() ? "" : ", ") + r.name;
   throw std::invalid_argument("unknown sort strategy '" + name + "' (available: " + valid + ")");
 }
 
 }  // namespace
 
 std::vector<std::string> available_sort_strategies() {
+  const std::lock_guard lock(registry_mutex);
   std::vector<std::string> names;
-  for (const auto& r : registry()) names.emplace_back(r.name);
+  for (const auto& r : registry()) names.push_back(r.name);
   return names;
+}
+
+void add_sort_strategy(const std::string& name, bool exact, SortStrategyMaker make) {
+  if (name.empty()) throw std::invalid_argument("a sort strategy needs a name");
+  for (const char c : name)
+    if (c == ',' || c == ' ' || c == '\t' || c == '\n' || c == '\r')
+      throw std::invalid_argument("sort strategy name '" + name +
+                                  "' contains a comma or whitespace (names are listed comma-separated)");
+  if (!make) throw std::invalid_argument("sort strategy '" + name + "' has no factory");
+  const std::lock_guard lock(registry_mutex);
+  for (const auto& r : registry())
+    if (r.name == name)
+      throw std::invalid_argument("a sort strategy named '" + name + "' is already registered");
+  registry().push_back({name, exact, std::move(make)});
 }
 
 std::unique_ptr<SortStrategy> make_sort_strategy(const std::string& name, vk::Context& ctx) {

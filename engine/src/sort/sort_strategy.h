@@ -5,6 +5,7 @@
 // exact(): cpu-radix16 orders by 16-bit quantized depths, stably.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,7 +57,12 @@ class SortStrategy {
   virtual uint64_t stall_fallbacks() const { return 0; }
 };
 
+// Every strategy by name: the built-in ones, then those added at run time. Thread-safe.
 std::vector<std::string> available_sort_strategies();
+using SortStrategyMaker = std::function<std::unique_ptr<SortStrategy>(vk::Context&)>;
+// Adds a strategy after the built-in ones (tilesplat::register_sort_strategy). Thread-safe. Throws
+// std::invalid_argument for an empty name, one with a comma or whitespace, or one already taken.
+void add_sort_strategy(const std::string& name, bool exact, SortStrategyMaker make);
 // Throws std::invalid_argument naming the strategy and the valid names.
 std::unique_ptr<SortStrategy> make_sort_strategy(const std::string& name, vk::Context& ctx);
 // SortStrategy::exact() of a strategy, without a device to make it on. Throws like make_sort_strategy.
