@@ -1,4 +1,5 @@
-// Rendered images, their files (EXR, PNG preview) and comparisons between them.
+/// @file
+/// Rendered images, their files (EXR, PNG preview) and comparisons between them.
 #pragma once
 
 #include <cstdint>
@@ -12,139 +13,145 @@
 
 namespace tilesplat {
 
-// What a render produces, row-major with row 0 at the top.
+/// What a render produces, row-major with row 0 at the top.
 struct RenderImage {
-  int width = 0;
-  int height = 0;
-  std::vector<float> rgba;  // 4 per pixel: premultiplied colour over the background, A = 1 - T
-  std::vector<float> depth; // 1 per pixel: expected view depth of the blended splats
-                            // (sum w z / sum w), 0 where nothing was blended; may be empty
-  std::vector<uint32_t> splat_count;  // 1 per pixel: splats blended; may be empty
+  int width = 0;                      ///< pixels per row
+  int height = 0;                     ///< rows
+  std::vector<float> rgba;            ///< 4 per pixel: premultiplied colour over the background, A = 1 - T
+  std::vector<float> depth;           ///< 1 per pixel: expected view depth of the blended splats
+                                      ///< (sum w z / sum w), 0 where nothing was blended; may be empty
+  std::vector<uint32_t> splat_count;  ///< 1 per pixel: splats blended; may be empty
 
+  /// width * height.
   size_t pixels() const { return size_t(width) * size_t(height); }
 };
 
+/// How write_exr() stores an image.
 struct ExrWriteOptions {
-  bool half = false;   // store HALF instead of FLOAT channels
-  bool alpha = true;   // write the A channel (false: R G B only, which readers take as opaque)
-  // Extra string attributes for the header, name -> value (e.g. "commandLine"). A name may not be
-  // empty, one of the attributes the writer sets itself (the required EXR attributes, "compression",
-  // "channels", ...) or start with "tilesplat", which is reserved for the provenance below.
+  bool half = false;  ///< store HALF instead of FLOAT channels
+  bool alpha = true;  ///< write the A channel (false: R G B only, which readers take as opaque)
+  /// Extra string attributes for the header, name -> value (e.g. "commandLine"). A name may not be
+  /// empty, one of the attributes the writer sets itself (the required EXR attributes, "compression",
+  /// "channels", ...) or start with "tilesplat", which is reserved for the provenance below.
   std::map<std::string, std::string> attributes;
 };
 
-// Writes channels R G B A (A unless options.alpha is false), Z when depth is present, and "splats"
-// when counts are present. Every file records which engine wrote it, as string attributes:
-// "tilesplatVersion" (build_info().version), "tilesplatCommit" (when built from a checkout) and
-// "tilesplatBuildType" (when set); then options.attributes.
-// Atomic: the image goes to a temporary file beside `path` that is renamed over it only once
-// complete, so a failure never leaves a partial file. Throws std::runtime_error naming the file.
+/// Writes channels R G B A (A unless options.alpha is false), Z when depth is present, and "splats"
+/// when counts are present. Every file records which engine wrote it, as string attributes:
+/// "tilesplatVersion" (build_info().version), "tilesplatCommit" (when built from a checkout) and
+/// "tilesplatBuildType" (when set); then options.attributes.
+/// Atomic: the image goes to a temporary file beside `path` that is renamed over it only once
+/// complete, so a failure never leaves a partial file. Throws std::runtime_error naming the file.
 TILESPLAT_API void write_exr(const std::filesystem::path& path, const RenderImage& image,
                              const ExrWriteOptions& options = {});
 
-// Reads an EXR's R G B A (A = 1 when absent), Z and "splats" (each when present), any pixel type
-// converted, any data window origin. Throws std::runtime_error naming the file.
+/// Reads an EXR's R G B A (A = 1 when absent), Z and "splats" (each when present), any pixel type
+/// converted, any data window origin. Throws std::runtime_error naming the file.
 TILESPLAT_API RenderImage read_exr(const std::filesystem::path& path);
 
-// Every string attribute of an EXR's header, name -> value: the provenance write_exr records and
-// whatever else the file carries. Throws std::runtime_error naming the file.
+/// Every string attribute of an EXR's header, name -> value: the provenance write_exr records and
+/// whatever else the file carries. Throws std::runtime_error naming the file.
 TILESPLAT_API std::map<std::string, std::string> read_exr_string_attributes(
     const std::filesystem::path& path);
 
-// How a PNG preview maps linear radiance to display values: colour times 2^exposure_stops, then the
-// tone curve per channel, then a clamp to [0, 1] and the sRGB encoding. The EXR keeps the linear
-// values; only previews are tone mapped.
+/// How a PNG preview maps linear radiance to display values: colour times 2^exposure_stops, then the
+/// tone curve per channel, then a clamp to [0, 1] and the sRGB encoding. The EXR keeps the linear
+/// values; only previews are tone mapped.
 enum class ToneMap {
-  kNone,      // clamp: values above 1 clip
-  kAces,      // Narkowicz's fit of the ACES filmic curve: x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)
-  kReinhard,  // x / (1 + x): never clips, compresses highlights
+  kNone,      ///< clamp: values above 1 clip
+  kAces,      ///< Narkowicz's fit of the ACES filmic curve: x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)
+  kReinhard,  ///< x / (1 + x): never clips, compresses highlights
 };
-TILESPLAT_API std::string to_string(ToneMap tone_map);  // "none", "aces", "reinhard"
-// The tone curve of one linear channel value (exposure already applied); NaN and negatives map to 0.
+TILESPLAT_API std::string to_string(ToneMap tone_map);  ///< "none", "aces", "reinhard"
+/// The tone curve of one linear channel value (exposure already applied); NaN and negatives map to 0.
 TILESPLAT_API double apply_tone_map(ToneMap tone_map, double linear);
 
+/// How write_png_preview() maps linear colour to the 8-bit preview (see ToneMap).
 struct PreviewOptions {
-  double exposure_stops = 0;  // -20 to 20
-  ToneMap tone_map = ToneMap::kNone;
+  double exposure_stops = 0;          ///< colour times 2^exposure_stops before the curve; -20 to 20
+  ToneMap tone_map = ToneMap::kNone;  ///< the tone curve
 };
 
-// An 8-bit sRGB PNG preview of the colour channels (alpha dropped). Atomic like write_exr. Throws
-// std::runtime_error naming the file for an empty image or an exposure out of range.
+/// An 8-bit sRGB PNG preview of the colour channels (alpha dropped). Atomic like write_exr. Throws
+/// std::runtime_error naming the file for an empty image or an exposure out of range.
 TILESPLAT_API void write_png_preview(const std::filesystem::path& path, const RenderImage& image,
                                      const PreviewOptions& options = {});
 
+/// How two images differ (compare_images()).
 struct ImageDifference {
-  double psnr_db = 0;       // over RGB, peak 1.0; +inf when identical
-  double max_abs = 0;       // largest |a - b| over RGB
-  double max_abs_alpha = 0; // largest |a - b| over A
-  double rmse = 0;
-  int worst_x = 0, worst_y = 0, worst_channel = 0;
+  double psnr_db = 0;        ///< over RGB, peak 1.0; +inf when identical
+  double max_abs = 0;        ///< largest |a - b| over RGB
+  double max_abs_alpha = 0;  ///< largest |a - b| over A
+  double rmse = 0;           ///< root mean square of a - b over RGB
+  int worst_x = 0;           ///< column of the largest RGB difference
+  int worst_y = 0;           ///< row of the largest RGB difference
+  int worst_channel = 0;     ///< its channel: 0 R, 1 G, 2 B
 };
-// Compares the RGB(A) of two images of the same size. Throws std::invalid_argument otherwise.
+/// Compares the RGB(A) of two images of the same size. Throws std::invalid_argument otherwise.
 TILESPLAT_API ImageDifference compare_images(const RenderImage& a, const RenderImage& b);
 
-// Structural similarity (Wang, Bovik, Sheikh and Simoncelli 2004) of the RGB channels, in the
-// convention of scikit-image (gaussian_weights=True, use_sample_covariance=False, data_range=1) and
-// pytorch-msssim: an 11x11 Gaussian window of sigma 1.5 (weights normalised to sum 1), K1 = 0.01,
-// K2 = 0.03, dynamic range L = 1, population (not sample) variances, the SSIM map computed only where
-// the whole window fits inside the image ("valid"), and the result the mean of that map over its
-// pixels and the three channels. 1 for identical images (exactly), and symmetric in a and b.
-// An image narrower or lower than 11 pixels gets, in that dimension, the window clipped to the image:
-// as many taps as the image has pixels, placed around the image's centre with the same sigma and
-// renormalised, so that the map has one column (or row) there; two empty images score 1.
-// The same sizes and layout as compare_images are required (std::invalid_argument otherwise); a NaN
-// or an infinity in any channel of either image, alpha included, makes the result NaN: it means the
-// renderer is broken, and NaN cannot pass for a score in any comparison.
+/// Structural similarity (Wang, Bovik, Sheikh and Simoncelli 2004) of the RGB channels, in the
+/// convention of scikit-image (gaussian_weights=True, use_sample_covariance=False, data_range=1) and
+/// pytorch-msssim: an 11x11 Gaussian window of sigma 1.5 (weights normalised to sum 1), K1 = 0.01,
+/// K2 = 0.03, dynamic range L = 1, population (not sample) variances, the SSIM map computed only where
+/// the whole window fits inside the image ("valid"), and the result the mean of that map over its
+/// pixels and the three channels. 1 for identical images (exactly), and symmetric in a and b.
+/// An image narrower or lower than 11 pixels gets, in that dimension, the window clipped to the image:
+/// as many taps as the image has pixels, placed around the image's centre with the same sigma and
+/// renormalised, so that the map has one column (or row) there; two empty images score 1.
+/// The same sizes and layout as compare_images are required (std::invalid_argument otherwise); a NaN
+/// or an infinity in any channel of either image, alpha included, makes the result NaN: it means the
+/// renderer is broken, and NaN cannot pass for a score in any comparison.
 TILESPLAT_API double ssim(const RenderImage& a, const RenderImage& b);
 
-// Temporal stability along a camera path. An image metric of each frame alone misses "popping": a
-// splat that appears, vanishes or jumps between two nearby views (a sort order flip, a culling or
-// tile-rect decision) can cost little error in either frame but is what the eye notices in motion.
-// Camera motion itself changes the image too, so the change of the tested sequence (a0 -> a1) is
-// measured against the change the reference has between the same two views (r0 -> r1): per pixel
-// and RGB channel e = |(a1 - a0) - (r1 - r0)|. Popping is change that the reference does not have;
-// change that the reference has too cancels out, whatever its size.
+/// Temporal stability along a camera path. An image metric of each frame alone misses "popping": a
+/// splat that appears, vanishes or jumps between two nearby views (a sort order flip, a culling or
+/// tile-rect decision) can cost little error in either frame but is what the eye notices in motion.
+/// Camera motion itself changes the image too, so the change of the tested sequence (a0 -> a1) is
+/// measured against the change the reference has between the same two views (r0 -> r1): per pixel
+/// and RGB channel e = |(a1 - a0) - (r1 - r0)|. Popping is change that the reference does not have;
+/// change that the reference has too cancels out, whatever its size.
 struct TemporalDifference {
-  double mean_abs = 0;          // mean of e over pixels and RGB channels
-  double flicker_fraction = 0;  // fraction of pixels whose largest e over RGB exceeds the threshold
+  double mean_abs = 0;          ///< mean of e over pixels and RGB channels
+  double flicker_fraction = 0;  ///< fraction of pixels whose largest e over RGB exceeds the threshold
 };
-// All four images must have one size and the layout of compare_images (std::invalid_argument
-// otherwise, and for a threshold that is negative or not finite). A NaN or an infinity in any channel
-// of any of them makes both fields NaN, as in ssim. Empty images give {0, 0}.
+/// All four images must have one size and the layout of compare_images (std::invalid_argument
+/// otherwise, and for a threshold that is negative or not finite). A NaN or an infinity in any channel
+/// of any of them makes both fields NaN, as in ssim. Empty images give {0, 0}.
 TILESPLAT_API TemporalDifference temporal_excess(const RenderImage& a0, const RenderImage& a1,
                                                  const RenderImage& r0, const RenderImage& r1,
                                                  double threshold = 0.05);
 
-// The raw frame-to-frame change of one sequence: the mean over pixels and RGB channels of
-// |a1 - a0|. The scale for temporal_excess (how much of the change is excess), and what
-// temporal_excess would report against a perfectly still reference. Errors as temporal_excess.
+/// The raw frame-to-frame change of one sequence: the mean over pixels and RGB channels of
+/// |a1 - a0|. The scale for temporal_excess (how much of the change is excess), and what
+/// temporal_excess would report against a perfectly still reference. Errors as temporal_excess.
 TILESPLAT_API double frame_change(const RenderImage& a0, const RenderImage& a1);
 
-// Popping along a path of equal steps, measured without any reference: the second difference
-// e = |(a2 - a1) - (a1 - a0)| of three consecutive frames. Smooth motion (an edge sliding, shading
-// changing with the view) changes the image by about the same amount each step and cancels; a
-// discontinuity (two splats swapping order, a splat culled) happens in one step and does not. This
-// is what a mode that removes popping must lower, even where the reference pops itself (the float64
-// reference blends in the same centre-depth order, so "change the reference does not have" cannot
-// credit a mode that pops less than the reference). It is temporal_excess(a1, a2, a0, a1, threshold).
+/// Popping along a path of equal steps, measured without any reference: the second difference
+/// e = |(a2 - a1) - (a1 - a0)| of three consecutive frames. Smooth motion (an edge sliding, shading
+/// changing with the view) changes the image by about the same amount each step and cancels; a
+/// discontinuity (two splats swapping order, a splat culled) happens in one step and does not. This
+/// is what a mode that removes popping must lower, even where the reference pops itself (the float64
+/// reference blends in the same centre-depth order, so "change the reference does not have" cannot
+/// credit a mode that pops less than the reference). It is temporal_excess(a1, a2, a0, a1, threshold).
 TILESPLAT_API TemporalDifference popping(const RenderImage& a0, const RenderImage& a1, const RenderImage& a2,
                                          double threshold = 0.05);
 
-// View consistency under rotation, the popping that per-pixel re-sorting removes (StopThePop,
-// Radl et al. 2024). The scene gives every ray one colour; a renderer that blends in centre-depth
-// order does not: turning the camera in place changes the splats' view depths and so their order,
-// and a region of the image changes where nothing moved. Between two cameras that differ only by a
-// rotation about their common centre every pixel of b sees a ray that a saw as well, so a is
-// resampled (bilinearly) onto b's pixels and compared with b, per pixel and RGB channel: e = |b -
-// warp(a)|, averaged over blocks of block x block pixels before the threshold. The blocks are what
-// makes it fair to a renderer with hard edges: resampling an edge misses by up to a pixel, which a
-// block averages away, whereas a splat changing its colour over its whole footprint stays. Render
-// a and b at block times the resolution the result is meant for. Blocks with a sample outside a are
-// left out. The cameras must share size, intrinsics and position (std::invalid_argument otherwise,
-// also for a block below 1, a negative or non-finite threshold, or images not of the cameras' size);
-// mean_abs is over the blocks kept and RGB, flicker_fraction the fraction of them whose largest
-// channel exceeds the threshold. NaN or infinity in either image gives NaN, as in ssim; no block
-// kept gives {0, 0}.
+/// View consistency under rotation, the popping that per-pixel re-sorting removes (StopThePop,
+/// Radl et al. 2024). The scene gives every ray one colour; a renderer that blends in centre-depth
+/// order does not: turning the camera in place changes the splats' view depths and so their order,
+/// and a region of the image changes where nothing moved. Between two cameras that differ only by a
+/// rotation about their common centre every pixel of b sees a ray that a saw as well, so a is
+/// resampled (bilinearly) onto b's pixels and compared with b, per pixel and RGB channel: e = |b -
+/// warp(a)|, averaged over blocks of block x block pixels before the threshold. The blocks are what
+/// makes it fair to a renderer with hard edges: resampling an edge misses by up to a pixel, which a
+/// block averages away, whereas a splat changing its colour over its whole footprint stays. Render
+/// a and b at block times the resolution the result is meant for. Blocks with a sample outside a are
+/// left out. The cameras must share size, intrinsics and position (std::invalid_argument otherwise,
+/// also for a block below 1, a negative or non-finite threshold, or images not of the cameras' size);
+/// mean_abs is over the blocks kept and RGB, flicker_fraction the fraction of them whose largest
+/// channel exceeds the threshold. NaN or infinity in either image gives NaN, as in ssim; no block
+/// kept gives {0, 0}.
 TILESPLAT_API TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& camera_a,
                                                         const RenderImage& b, const Camera& camera_b,
                                                         int block, double threshold = 0.01);

@@ -1,5 +1,6 @@
-// The float64 CPU reference renderer: the math of docs/rendering-math.md, tiles and all.
-// It is the ground truth the GPU pipeline and every approximation are measured against.
+/// @file
+/// The float64 CPU reference renderer: the math of docs/rendering-math.md, tiles and all.
+/// It is the ground truth the GPU pipeline and every approximation are measured against.
 #pragma once
 
 #include <array>
@@ -13,38 +14,39 @@
 
 namespace tilesplat {
 
-// Per-Gaussian screen-space result of the projection step, in float64.
+/// Per-Gaussian screen-space result of the projection step, in float64.
 struct ProjectedGaussian {
-  bool visible = false;   // passed every cull and touches at least one tile
-  double depth = 0;       // view-space z
-  double mean[2] = {0, 0};
-  double cov2d[3] = {0, 0, 0};  // a b c of the dilated 2D covariance [[a b] [b c]]
-  double conic[3] = {0, 0, 0};  // inverse of cov2d: A B C
-  double opacity = 0;           // sigmoid(logit)
-  double color[3] = {0, 0, 0};  // max(SH + 0.5, 0), times the light factor when lit (tilesplat::Lighting)
-  int radius = 0;               // pixels
-  int tile_min[2] = {0, 0};     // tile rect, max exclusive
-  int tile_max[2] = {0, 0};
+  bool visible = false;         ///< passed every cull and touches at least one tile
+  double depth = 0;             ///< view-space z
+  double mean[2] = {0, 0};      ///< projected mean in pixels (x, y)
+  double cov2d[3] = {0, 0, 0};  ///< a b c of the dilated 2D covariance [[a b] [b c]]
+  double conic[3] = {0, 0, 0};  ///< inverse of cov2d: A B C
+  double opacity = 0;           ///< sigmoid(logit)
+  double color[3] = {0, 0, 0};  ///< max(SH + 0.5, 0), times the light factor when lit (tilesplat::Lighting)
+  int radius = 0;               ///< pixels
+  int tile_min[2] = {0, 0};     ///< first tile (x, y) of the tile rectangle
+  int tile_max[2] = {0, 0};     ///< one past the last tile (x, y): the maximum is exclusive
 };
 
+/// Width and height of a screen tile in pixels: the unit of binning and sorting.
 constexpr int kTileSize = 16;
 
-// Projects Gaussian i of the scene with the reference math, lit when `lighting` has lights.
-// Throws std::invalid_argument for invalid lights (validate).
+/// Projects Gaussian i of the scene with the reference math, lit when `lighting` has lights.
+/// Throws std::invalid_argument for invalid lights (validate).
 TILESPLAT_API ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
                                                  Antialiasing antialiasing = Antialiasing::kClassic,
                                                  const Lighting& lighting = {});
 
-// Evaluates real spherical harmonics up to `degree` for the (normalized) direction dir.
-// coeffs: K * 3 values, coefficient-major RGB innermost. Returns the raw sum (no +0.5, no clamp).
+/// Evaluates real spherical harmonics up to `degree` for the (normalized) direction dir.
+/// coeffs: K * 3 values, coefficient-major RGB innermost. Returns the raw sum (no +0.5, no clamp).
 TILESPLAT_API std::array<double, 3> eval_sh(int degree, const float* coeffs,
                                             const std::array<double, 3>& dir);
 
-// 3D covariance R S S^T R^T (row-major 3x3) from log scales and a w x y z quaternion.
+/// 3D covariance R S S^T R^T (row-major 3x3) from log scales and a w x y z quaternion.
 TILESPLAT_API std::array<double, 9> covariance3d(const float log_scale[3], const float quat_wxyz[4]);
 
-// Renders the whole image in float64: projection, per-tile lists ordered by (depth, index),
-// front-to-back blending with the reference cut-offs. Uses all CPU cores.
+/// Renders the whole image in float64: projection, per-tile lists ordered by (depth, index),
+/// front-to-back blending with the reference cut-offs. Uses all CPU cores.
 TILESPLAT_API RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
                                            const RenderSettings& settings = {});
 

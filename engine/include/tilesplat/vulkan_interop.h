@@ -1,5 +1,6 @@
-// Running the renderer inside a host application's Vulkan: on its device, into its images.
-// The only public header with Vulkan types; the rest of the API stays Vulkan-free.
+/// @file
+/// Running the renderer inside a host application's Vulkan: on its device, into its images.
+/// The only public header with Vulkan types; the rest of the API stays Vulkan-free.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -11,39 +12,41 @@
 
 namespace tilesplat {
 
-// A device the host application created. The renderer borrows these handles: it never destroys
-// them, and they must outlive the renderer. The device must have been created with Vulkan 1.2,
-// VkPhysicalDeviceVulkan12Features::bufferDeviceAddress and VkPhysicalDeviceFeatures::shaderInt64
-// (and preferably shaderFloat64, which makes the projection's geometry exact; say so below).
-// The renderer submits to `queue` and waits for its own fence; do not use the queue from another
-// thread while a render call runs.
+/// A device the host application created. The renderer borrows these handles: it never destroys
+/// them, and they must outlive the renderer. The device must have been created with Vulkan 1.2,
+/// VkPhysicalDeviceVulkan12Features::bufferDeviceAddress and VkPhysicalDeviceFeatures::shaderInt64
+/// (and preferably shaderFloat64, which makes the projection's geometry exact; say so below).
+/// The renderer submits to `queue` and waits for its own fence; do not use the queue from another
+/// thread while a render call runs.
 struct ExternalVulkanDevice {
-  VkInstance instance = VK_NULL_HANDLE;
-  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
-  VkDevice device = VK_NULL_HANDLE;
-  VkQueue queue = VK_NULL_HANDLE;  // from a family with compute and timestamp support
-  uint32_t queue_family = 0;
-  bool shader_float64_enabled = false;
+  VkInstance instance = VK_NULL_HANDLE;               ///< the host's instance (Vulkan 1.2 or later)
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;  ///< the physical device `device` was made on
+  VkDevice device = VK_NULL_HANDLE;                   ///< the host's logical device
+  VkQueue queue = VK_NULL_HANDLE;                     ///< from a family with compute and timestamp support
+  uint32_t queue_family = 0;                          ///< the family `queue` belongs to
+  bool shader_float64_enabled = false;                ///< whether `device` was created with shaderFloat64 on
 };
 
-// A renderer on the host's device. RendererOptions::device and ::validation do not apply (the
-// host chose the device and its instance's layers). Throws std::invalid_argument for bad handles.
+/// A renderer on the host's device. RendererOptions::device and RendererOptions::validation do not apply (the
+/// host chose the device and its instance's layers). Throws std::invalid_argument for bad handles.
 TILESPLAT_API std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device,
                                                         const RendererOptions& options = {});
 
-// An image the caller owns, created on the same device as the renderer.
+/// An image the caller owns, created on the same device as the renderer.
 struct ExternalImage {
-  VkImage image = VK_NULL_HANDLE;
-  uint32_t width = 0, height = 0;  // must equal the camera's size
-  VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;  // the only format supported so far
-  // The layout the image is in when render_to_image is called; it is left in the same layout.
-  // The image needs VK_IMAGE_USAGE_TRANSFER_DST_BIT.
+  VkImage image = VK_NULL_HANDLE;  ///< the host's 2D image; mip level 0, array layer 0 is written
+  uint32_t width = 0;              ///< must equal the camera's width
+  uint32_t height = 0;             ///< must equal the camera's height
+  VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;  ///< the only format supported so far
+  /// The layout the image is in when render_to_image is called; it is left in the same layout
+  /// (an image handed over in VK_IMAGE_LAYOUT_UNDEFINED is left in VK_IMAGE_LAYOUT_GENERAL).
+  /// The image needs VK_IMAGE_USAGE_TRANSFER_DST_BIT.
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
 };
 
-// Renders a frame and writes premultiplied RGBA (colour over the background, A = 1 - T) into the
-// image. The work has completed on the GPU when the call returns. Throws std::invalid_argument
-// when the image does not match the camera or has an unsupported format.
+/// Renders a frame and writes premultiplied RGBA (colour over the background, A = 1 - T) into the
+/// image. The work has completed on the GPU when the call returns. Throws std::invalid_argument
+/// when the image does not match the camera or has an unsupported format.
 TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                                    const ExternalImage& target);
 
