@@ -3,12 +3,14 @@
 # Safe to run repeatedly; needs root (or sudo) only when something must be installed.
 # zlib, zstd, libwebp and libzip are the containers of the compressed splat formats (.spz, .sog).
 # xvfb and xauth give the viewer's tests a display (xvfb-run) on a machine without one.
+# doxygen builds the API reference (the docs target and its test); file is what cpack -G DEB asks
+# to find the binaries whose library dependencies it lists.
 # --fuzz adds clang and its compiler-rt (libFuzzer) for tests/fuzz/run.sh; the normal build needs neither.
 set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build pkg-config
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
-  glslang-tools spirv-tools
+  glslang-tools spirv-tools doxygen file
   libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev
   zlib1g-dev libzstd-dev libwebp-dev libzip-dev
   libgtest-dev googletest

@@ -6,6 +6,8 @@
 #   - the shared library exporting only the tilesplat:: API (nm -D), with its SONAME;
 #   - a consumer using add_subdirectory, with no C++ standard of its own, building no tilesplat tests;
 #   - every example's image equal, to the bit, to tilesplat-render's of the same view;
+#   - a Debian package (cpack -G DEB) of the shared build, installed with apt-get and used by an
+#     example built against /usr, then removed (as root, which CI is);
 #   - the example sort strategy (examples/custom_sort) built against each install, as a program that
 #     checks itself against the built-in radix sort and as a plugin of the installed tilesplat-bench.
 # usage: tests/install/check_install.sh BUILD_DIR   (a built static build with tests, as .ci/run makes)
@@ -85,6 +87,27 @@ if [[ -n $foreign ]]; then
   exit 1
 fi
 "$work/shared/bin/tilesplat-render" --version
+
+echo "== Debian package: cpack, apt-get install, an example against /usr =="
+(cd "$work/build-shared" && cpack -G DEB >"$work/cpack.log" 2>&1) || { cat "$work/cpack.log"; exit 1; }
+deb=$(ls "$work"/build-shared/tilesplat_*.deb)
+echo "$(basename "$deb"): $(dpkg-deb -f "$deb" Depends)"
+if [[ $(id -u) -ne 0 ]]; then
+  echo "not root: the package is built but not installed"
+elif dpkg-query -W -f="\${Status}" tilesplat 2>/dev/null | grep -q "install ok installed"; then
+  echo "a tilesplat package is installed already: not replacing it"
+else
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$deb" >"$work/apt.log" 2>&1 || { cat "$work/apt.log"; exit 1; }
+  trap 'apt-get purge -y -qq tilesplat >/dev/null 2>&1; rm -rf "$work"' EXIT
+  tilesplat-render --version
+  configure -S "$root/examples/render_exr" -B "$work/deb-render_exr"  # no prefix path: the package in /usr
+  cmake --build "$work/deb-render_exr" -j"$jobs" >/dev/null
+  ldd "$work/deb-render_exr/render_exr" | grep libtilesplat
+  "$work/deb-render_exr/render_exr" "$scene" "$cameras" 1 320 180 "$work/deb.exr"
+  "$compare" "$work/expected.exr" "$work/deb.exr"
+  apt-get purge -y -qq tilesplat >/dev/null
+  echo "package installed, used and removed"
+fi
 
 echo "== public headers include no OpenEXR, glm or JSON, and Vulkan only in vulkan_interop.h =="
 # (sort_strategy.h, the extension point for GPU sorts, reaches Vulkan through vulkan_interop.h.)
