@@ -98,7 +98,8 @@ elif dpkg-query -W -f="\${Status}" tilesplat 2>/dev/null | grep -q "install ok i
   echo "a tilesplat package is installed already: not replacing it"
 else
   DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$deb" >"$work/apt.log" 2>&1 || { cat "$work/apt.log"; exit 1; }
-  trap 'apt-get purge -y -qq tilesplat >/dev/null 2>&1; rm -rf "$work"' EXIT
+  # Purged on any failure below too (|| true: under set -e a failing trap command sets the exit status).
+  trap 'apt-get purge -y -qq tilesplat >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
   tilesplat-render --version
   configure -S "$root/examples/render_exr" -B "$work/deb-render_exr"  # no prefix path: the package in /usr
   cmake --build "$work/deb-render_exr" -j"$jobs" >/dev/null
@@ -106,6 +107,7 @@ else
   "$work/deb-render_exr/render_exr" "$scene" "$cameras" 1 320 180 "$work/deb.exr"
   "$compare" "$work/expected.exr" "$work/deb.exr"
   apt-get purge -y -qq tilesplat >/dev/null
+  trap 'rm -rf "$work"' EXIT
   echo "package installed, used and removed"
 fi
 
