@@ -16,6 +16,29 @@ namespace tilesplat {
 /// (x right, y down, z forward, the convention of the original trainer and COLMAP); pixel (i, j)
 /// has its centre at (i + 0.5, j + 0.5), row 0 at the top. A plain value, safe to copy between
 /// threads.
+/// How a host application's clip space maps onto its image, for Camera::from_matrices(). Both the
+/// Vulkan convention and the OpenGL one are named; anything else is a combination of the two fields.
+struct ClipSpace {
+  /// Where normalized device coordinate y = -1 lands.
+  enum class Y {
+    kDown,  ///< at the top row: Vulkan's framebuffer with a y-flipped projection (glm: proj[1][1] *= -1)
+    kUp,    ///< at the bottom row: OpenGL, and Vulkan drawn with a negative viewport height
+  };
+  /// The depth range of normalized device coordinates. Only depth images use it (the pinhole camera does
+  /// not depend on it); reversed-Z (near maps to 1) and an infinite far plane are read from the matrix.
+  enum class Depth {
+    kZeroToOne,      ///< Vulkan, Direct3D (glm with GLM_FORCE_DEPTH_ZERO_TO_ONE)
+    kMinusOneToOne,  ///< OpenGL
+  };
+  Y y = Y::kDown;                   ///< which way NDC y runs on the image
+  Depth depth = Depth::kZeroToOne;  ///< the NDC depth range
+
+  /// Vulkan with a y-flipped projection: y down, depth 0 to 1.
+  static ClipSpace vulkan() { return {Y::kDown, Depth::kZeroToOne}; }
+  /// OpenGL: y up, depth -1 to 1.
+  static ClipSpace opengl() { return {Y::kUp, Depth::kMinusOneToOne}; }
+};
+
 struct TILESPLAT_API Camera {
   int width = 0;   ///< image width in pixels
   int height = 0;  ///< image height in pixels
@@ -34,6 +57,23 @@ struct TILESPLAT_API Camera {
   double tan_half_fov_x() const { return width / (2.0 * fx); }
   /// tan(vertical fov / 2) = height / (2 fy).
   double tan_half_fov_y() const { return height / (2.0 * fy); }
+
+  /// The camera a host application renders with, from its matrices. Both are 4x4, **column-major**
+  /// (element (row r, column c) at [c * 4 + r], as glm and OpenGL store them), acting on column vectors:
+  /// clip = projection * view * world.
+  /// - `view` maps world to view space; it must be rigid (an orthonormal 3x3 block, last row 0 0 0 1). The
+  ///   view space may be right-handed looking down -z (OpenGL, glm::lookAt) or look down +z (the sign of
+  ///   the projection's w row says which); a mirrored view is allowed and renders mirrored.
+  /// - `projection` must be a pinhole perspective: clip w = +-view z (row 3 = 0 0 +-k 0), no skew and no
+  ///   shift of x or y by w. Off-centre frusta (an asymmetric glm::frustum) become a principal point away
+  ///   from the image centre. Standard or reversed-Z, finite or infinite far plane, any depth range.
+  /// - `width` and `height` are the image size in pixels; NDC [-1, 1] spans the whole image in x and y.
+  ///
+  /// The result is the OpenCV-axes camera that renders the same image: its x along the image's columns,
+  /// y down its rows, z forward. Throws std::invalid_argument naming what is wrong for a non-finite
+  /// element, a view that is not rigid, an orthographic or skewed projection, or a size that is not positive.
+  static Camera from_matrices(const std::array<double, 16>& view, const std::array<double, 16>& projection,
+                              int width, int height, ClipSpace clip = ClipSpace::vulkan());
 
   /// Member-wise equality: the same size, intrinsics and pose, to the bit.
   bool operator==(const Camera&) const = default;
