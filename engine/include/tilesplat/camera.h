@@ -12,10 +12,6 @@
 
 namespace tilesplat {
 
-/// A pinhole camera: an image size, intrinsics in pixels and a pose. Camera space has OpenCV axes
-/// (x right, y down, z forward, the convention of the original trainer and COLMAP); pixel (i, j)
-/// has its centre at (i + 0.5, j + 0.5), row 0 at the top. A plain value, safe to copy between
-/// threads.
 /// How a host application's clip space maps onto its image, for Camera::from_matrices(). Both the
 /// Vulkan convention and the OpenGL one are named; anything else is a combination of the two fields.
 struct ClipSpace {
@@ -39,6 +35,10 @@ struct ClipSpace {
   static ClipSpace opengl() { return {Y::kUp, Depth::kMinusOneToOne}; }
 };
 
+/// A pinhole camera: an image size, intrinsics in pixels and a pose. Camera space has OpenCV axes
+/// (x right, y down, z forward, the convention of the original trainer and COLMAP); pixel (i, j)
+/// has its centre at (i + 0.5, j + 0.5), row 0 at the top. A plain value, safe to copy between
+/// threads.
 struct TILESPLAT_API Camera {
   int width = 0;   ///< image width in pixels
   int height = 0;  ///< image height in pixels
