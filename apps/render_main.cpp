@@ -210,6 +210,7 @@ int run(int argc, char** argv) {
   exr_options.half = options.half;
   exr_options.alpha = !loaded.description || loaded.description->outputs.alpha;
   exr_options.attributes["commandLine"] = cli::command_line(kProgram, argc, argv);
+  exr_options.camera = loaded.camera;  // worldToCamera, worldToNDC and the exact camera
   try {
     tilesplat::write_exr(options.output, image, exr_options);
   } catch (const std::exception& error) {

@@ -290,6 +290,7 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, const
   } else {
     tilesplat::ExrWriteOptions exr;
     exr.alpha = !loaded.description || loaded.description->outputs.alpha;
+    exr.camera = viewer.camera();
     tilesplat::write_exr(path, image, exr);
   }
 }

@@ -461,6 +461,23 @@ TEST(CliRender, ExrRecordsTheBuildAndTheCommand) {
                                               " --width 32 --height 18 -o '" + exr.string() + "'");
 }
 
+TEST(CliRender, ExrRecordsTheCameraOfTheView) {
+  const auto out = fresh_output_dir();
+  const fs::path exr = out / "view2.exr";
+  const auto result =
+      run_exe(kRenderExe, {bundled_playbot().string(), "--cameras", bundled_playbot_cameras().string(),
+                           "--view", "2", "--width", "96", "--height", "54", "-o", exr.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto camera = tilesplat::read_exr_camera(exr);
+  ASSERT_TRUE(camera.has_value());
+  const auto views = tilesplat::load_cameras_json(bundled_playbot_cameras());
+  EXPECT_EQ(*camera, tilesplat::resize_camera(views.at(2).camera, 96, 54));
+  // Rendering the camera read back gives the file's image again.
+  const auto renderer = tilesplat::Renderer::create();
+  renderer->set_scene(tilesplat::load_scene(bundled_playbot()));
+  EXPECT_EQ(renderer->render(*camera).rgba, tilesplat::read_exr(exr).rgba);
+}
+
 TEST(CliProvenance, ColumnsFollowRecordsNotLinesInsideQuotedFields) {
   const tilesplat::BuildInfo build = tilesplat::build_info();
   const std::string values = std::string(",") + build.version + "," + build.git_commit + "," +

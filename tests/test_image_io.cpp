@@ -11,6 +11,7 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -19,6 +20,7 @@
 
 #include "image/atomic_file.h"
 #include "test_support.h"
+#include "tilesplat/camera.h"
 #include "tilesplat/image.h"
 #include "tilesplat/version.h"
 
@@ -26,8 +28,12 @@
 // OpenEXR itself when the test target has OpenEXR's include directories.
 #if __has_include(<ImfInputFile.h>)
 #include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfMatrixAttribute.h>
+#include <ImfOutputFile.h>
+#include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
 #define TILESPLAT_TEST_HAS_OPENEXR 1
 #else
@@ -274,7 +280,9 @@ TEST(ExrIo, FloatRoundTripIsBitExact) {
   image.rgba[5] = 1.0f + std::numeric_limits<float>::epsilon();
   image.depth[0] = 0.0f;
   image.depth[1] = 123456.789f;
-  image.splat_count[0] = std::numeric_limits<uint32_t>::max();
+  // Counts are stored as FLOAT (compositing tools read UINT channels as normalised values): exact up to
+  // 2^24, far above any real count (a pixel stops blending after at most ~2,350 splats of alpha >= 1/255).
+  image.splat_count[0] = 1u << 24;
 
   const fs::path path = fresh_dir() / "float.exr";
   write_exr(path, image);
@@ -319,12 +327,10 @@ TEST(ExrIo, WrittenFileListsExpectedChannels) {
 
   using Channels = std::vector<ExrChannelInfo>;
   // EXR stores channels sorted by name.
-  const Channels full_float = {
-      {"A", kExrFloat}, {"B", kExrFloat}, {"G", kExrFloat},
-      {"R", kExrFloat}, {"Z", kExrFloat}, {"splats", kExrUint}};
-  const Channels full_half = {
-      {"A", kExrHalf}, {"B", kExrHalf}, {"G", kExrHalf},
-      {"R", kExrHalf}, {"Z", kExrFloat}, {"splats", kExrUint}};
+  const Channels full_float = {{"A", kExrFloat}, {"B", kExrFloat}, {"G", kExrFloat},
+                               {"R", kExrFloat}, {"Z", kExrFloat}, {"splats", kExrFloat}};
+  const Channels full_half = {{"A", kExrHalf}, {"B", kExrHalf},  {"G", kExrHalf},
+                              {"R", kExrHalf}, {"Z", kExrFloat}, {"splats", kExrFloat}};
   const Channels colour = {{"A", kExrFloat}, {"B", kExrFloat}, {"G", kExrFloat}, {"R", kExrFloat}};
 
   const std::vector<std::pair<fs::path, Channels>> cases = {
@@ -416,10 +422,83 @@ TEST(ExrIo, RecordsProvenanceAndTheCallersAttributes) {
 #endif
 }
 
+// The camera an EXR records: exactly in tilesplat's attributes, and in OpenEXR's standard worldToCamera
+// (y up) and worldToNDC (top-left origin, image edges at 0 and 1) to single precision.
+TEST(ExrIo, CameraRoundTripsExactlyAndInOpenExrsConventions) {
+  const fs::path dir = fresh_dir();
+  Camera camera = look_at_camera({0.3, -1.2, -4.0}, {0.1, 0.2, 0.3}, {0, -1, 0}, 64, 48, 55.0);
+  camera.cx = 29.25;  // off-centre, so that the principal point is checked too
+  camera.cy = 26.5;
+  ExrWriteOptions options;
+  options.camera = camera;
+  const fs::path path = dir / "camera.exr";
+  write_exr(path, make_image(64, 48, true, true), options);
+  const std::optional<Camera> back = read_exr_camera(path);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(*back, camera);  // every double to the bit
+
+  // No camera given: none recorded. A missing file: an error naming it.
+  write_exr(dir / "none.exr", make_image(4, 3, false, false));
+  EXPECT_FALSE(read_exr_camera(dir / "none.exr").has_value());
+  EXPECT_EQ(error_message_of([&] { read_exr_camera(dir / "missing.exr"); }),
+            "cannot read " + (dir / "missing.exr").string() + ": the file does not exist");
+
+#if TILESPLAT_TEST_HAS_OPENEXR
+  const Imf::InputFile file(path.c_str());
+  const Imf::Header& header = file.header();
+  ASSERT_TRUE(Imf::hasWorldToCamera(header));
+  ASSERT_TRUE(Imf::hasWorldToNDC(header));
+  ASSERT_TRUE(Imf::hasChromaticities(header));
+  const Imf::Chromaticities rec709;
+  EXPECT_EQ(Imf::chromaticities(header).red, rec709.red);
+  EXPECT_EQ(Imf::chromaticities(header).white, rec709.white);
+  const Imath::M44f world_to_camera = Imf::worldToCamera(header);
+  const Imath::M44f world_to_ndc = Imf::worldToNDC(header);
+  for (const std::array<double, 3>& point :
+       {std::array<double, 3>{0.1, 0.2, 0.3}, {0.5, -0.4, 1.0}, {-0.7, 0.9, -0.2}}) {
+    const std::array<double, 3> expected = camera.to_camera(point);
+    const Imath::V3f world{float(point[0]), float(point[1]), float(point[2])};
+    Imath::V3f in_camera;
+    world_to_camera.multVecMatrix(world, in_camera);
+    EXPECT_NEAR(in_camera.x, expected[0], 1e-5);
+    EXPECT_NEAR(in_camera.y, -expected[1], 1e-5);  // OpenEXR's y is up
+    EXPECT_NEAR(in_camera.z, expected[2], 1e-5);
+    Imath::V3f ndc;
+    world_to_ndc.multVecMatrix(world, ndc);
+    const double px = camera.cx + camera.fx * expected[0] / expected[2];
+    const double py = camera.cy + camera.fy * expected[1] / expected[2];
+    EXPECT_NEAR(ndc.x, px / camera.width, 1e-5);
+    EXPECT_NEAR(ndc.y, py / camera.height, 1e-5);
+  }
+
+  // Some of the camera attributes but not all: an error naming the file and what is missing.
+  const fs::path incomplete = dir / "incomplete.exr";
+  {
+    Imf::Header partial(2, 2);
+    partial.channels().insert("R", Imf::Channel(Imf::FLOAT));
+    partial.channels().insert("G", Imf::Channel(Imf::FLOAT));
+    partial.channels().insert("B", Imf::Channel(Imf::FLOAT));
+    partial.insert("tilesplatRotation", Imf::M33dAttribute(Imath::M33d()));
+    std::vector<float> pixels(4, 0.5f);
+    Imf::FrameBuffer frame;
+    for (const char* channel : {"R", "G", "B"})
+      frame.insert(channel, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(pixels.data()), sizeof(float),
+                                       2 * sizeof(float)));
+    Imf::OutputFile out(incomplete.c_str(), partial);
+    out.setFrameBuffer(frame);
+    out.writePixels(2);
+  }
+  const std::string message = error_message_of([&] { read_exr_camera(incomplete); });
+  EXPECT_EQ(message.rfind("cannot read " + incomplete.string() + ": the camera attributes are incomplete", 0),
+            0u)
+      << message;
+#endif
+}
+
 TEST(ExrIo, AttributesTheWriterOwnsAreRejectedAndNothingIsWritten) {
   const fs::path dir = fresh_dir();
-  for (const std::string name :
-       {"", "channels", "dataWindow", "compression", "tilesplatVersion", "tilesplatAnything"}) {
+  for (const std::string name : {"", "channels", "dataWindow", "compression", "chromaticities", "worldToNDC",
+                                 "tilesplatVersion", "tilesplatAnything"}) {
     const fs::path path = dir / "rejected.exr";
     ExrWriteOptions options;
     options.attributes[name] = "x";

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,10 +35,16 @@ struct ExrWriteOptions {
   /// empty, one of the attributes the writer sets itself (the required EXR attributes, "compression",
   /// "channels", ...) or start with "tilesplat", which is reserved for the provenance below.
   std::map<std::string, std::string> attributes;
+  /// The camera the image was rendered with. Written as OpenEXR's standard `worldToCamera` and
+  /// `worldToNDC` (single-precision matrices in OpenEXR's conventions, which read_exr_camera() documents)
+  /// and, exactly, as tilesplat's own attributes, from which read_exr_camera() rebuilds it.
+  std::optional<Camera> camera;
 };
 
 /// Writes channels R G B A (A unless options.alpha is false), Z when depth is present, and "splats"
-/// when counts are present. Every file records which engine wrote it, as string attributes:
+/// (FLOAT, so that compositing tools read counts as numbers; exact up to 2^24) when counts are present.
+/// Every file carries `chromaticities` (linear Rec.709 primaries, D65 white: the renderer's RGB) and
+/// records which engine wrote it, as string attributes:
 /// "tilesplatVersion" (build_info().version), "tilesplatCommit" (when built from a checkout) and
 /// "tilesplatBuildType" (when set); then options.attributes.
 /// Atomic: the image goes to a temporary file beside `path` that is renamed over it only once
@@ -48,6 +55,20 @@ TILESPLAT_API void write_exr(const std::filesystem::path& path, const RenderImag
 /// Reads an EXR's R G B A (A = 1 when absent), Z and "splats" (each when present), any pixel type
 /// converted, any data window origin. Throws std::runtime_error naming the file.
 TILESPLAT_API RenderImage read_exr(const std::filesystem::path& path);
+
+/// The camera write_exr() recorded in an EXR (ExrWriteOptions::camera), rebuilt exactly from its
+/// double-precision attributes (`tilesplatRotation` M33d = Camera::rotation, `tilesplatPosition` V3d,
+/// `tilesplatFocalLength` V2d = (fx, fy), `tilesplatPrincipalPoint` V2d = (cx, cy), in pixels; the size is
+/// the data window's); std::nullopt when the file has none. The standard attributes written beside them
+/// follow OpenEXR's conventions, which differ from Camera's:
+/// - `worldToCamera` maps world points (row vectors, p * M, as Imath multiplies) into OpenEXR's camera space:
+///   x right, **y up**, z forward (left-handed, as RenderMan); tilesplat's camera space is y down, so the
+///   second axis is negated.
+/// - `worldToNDC` maps world points to NDC with (0, 0) at the top-left and (1, 1) at the bottom-right
+///   corner of the image (pixel edges, not centres): x_ndc = px / width, y_ndc = py / height after the
+///   division by w; its z is 1 / depth.
+/// Throws std::runtime_error naming the file when it cannot be read or its camera attributes are malformed.
+TILESPLAT_API std::optional<Camera> read_exr_camera(const std::filesystem::path& path);
 
 /// Every string attribute of an EXR's header, name -> value: the provenance write_exr records and
 /// whatever else the file carries. Throws std::runtime_error naming the file.

@@ -1,14 +1,18 @@
 // OpenEXR files of RenderImages: R G B A, optional Z (depth) and "splats" (per-pixel splat counts).
 #include <ImathBox.h>
 #include <ImfChannelList.h>
+#include <ImfChromaticities.h>
 #include <ImfCompression.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfMatrixAttribute.h>
 #include <ImfOutputFile.h>
 #include <ImfPixelType.h>
+#include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
 #include <ImfTestFile.h>
+#include <ImfVecAttribute.h>
 #include <half.h>
 
 #include <array>
@@ -54,10 +58,10 @@ void check_writable_image(const std::filesystem::path& path, const RenderImage& 
 // The attributes write_exr sets itself, which options.attributes may not replace: OpenEXR would
 // overwrite them with strings and write a file no reader opens.
 bool is_written_by_the_writer(const std::string& name) {
-  static const std::array<const char*, 11> kOwn = {
+  static const std::array<const char*, 14> kOwn = {
       "channels",         "compression",        "dataWindow",        "displayWindow", "lineOrder",
       "pixelAspectRatio", "screenWindowCenter", "screenWindowWidth", "tiles",         "type",
-      "version"};
+      "version",          "chromaticities",     "worldToCamera",     "worldToNDC"};
   for (const char* own : kOwn)
     if (name == own) return true;
   return name.rfind("tilesplat", 0) == 0;
@@ -72,6 +76,41 @@ void check_attributes(const std::filesystem::path& path, const ExrWriteOptions& 
           "cannot write " + path.string() + ": attribute '" + name +
           "' is set by the writer itself (names starting with 'tilesplat' are reserved)");
   }
+}
+
+// The camera in OpenEXR's standard attributes (documented at read_exr_camera) and exactly in tilesplat's.
+void add_camera_attributes(Imf::Header& header, const Camera& camera) {
+  // OpenEXR's camera space is tilesplat's with y negated (up instead of down). Imath multiplies row
+  // vectors, p * M, so M holds the camera axes as columns and the translation as its last row.
+  const double flip[3] = {1, -1, 1};
+  Imath::M44d world_to_camera;  // identity
+  for (int axis = 0; axis < 3; ++axis) {
+    double translation = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double r = flip[axis] * camera.rotation[size_t(axis) * 3 + size_t(k)];
+      world_to_camera[k][axis] = r;
+      translation -= r * camera.position[size_t(k)];
+    }
+    world_to_camera[3][axis] = translation;
+  }
+  // OpenEXR camera space (x, y up, z) to NDC: x = (fx x + cx z) / (width z), y = (-fy y + cy z) / (height z),
+  // z = 1 / z, from homogeneous w = z.
+  const double w = camera.width, h = camera.height;
+  const Imath::M44d camera_to_ndc(camera.fx / w, 0, 0, 0,   //
+                                  0, -camera.fy / h, 0, 0,  //
+                                  camera.cx / w, camera.cy / h, 0, 1, 0, 0, 1, 0);
+  const Imath::M44d world_to_ndc = world_to_camera * camera_to_ndc;
+  Imf::addWorldToCamera(header, Imath::M44f(world_to_camera));
+  Imf::addWorldToNDC(header, Imath::M44f(world_to_ndc));
+
+  Imath::M33d rotation;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) rotation[r][c] = camera.rotation[size_t(r) * 3 + size_t(c)];
+  header.insert("tilesplatRotation", Imf::M33dAttribute(rotation));
+  header.insert("tilesplatPosition",
+                Imf::V3dAttribute(Imath::V3d(camera.position[0], camera.position[1], camera.position[2])));
+  header.insert("tilesplatFocalLength", Imf::V2dAttribute(Imath::V2d(camera.fx, camera.fy)));
+  header.insert("tilesplatPrincipalPoint", Imf::V2dAttribute(Imath::V2d(camera.cx, camera.cy)));
 }
 
 // The provenance every file carries, then the caller's attributes.
@@ -191,6 +230,8 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
     add_string_attributes(header, options);
+    Imf::addChromaticities(header, Imf::Chromaticities());  // Rec. 709 primaries, D65 white
+    if (options.camera) add_camera_attributes(header, *options.camera);
     const Imath::Box2i data_window = header.dataWindow();
 
     Imf::FrameBuffer frame;
@@ -208,9 +249,12 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
       header.channels().insert(kDepthChannel, Imf::Channel(Imf::FLOAT));
       frame.insert(kDepthChannel, Imf::Slice::Make(Imf::FLOAT, image.depth.data(), data_window));
     }
+    // Counts as FLOAT: OpenImageIO (and the compositors on it) read a UINT channel as a normalised
+    // value, which shows every count as about 0. Floats hold every count up to 2^24 exactly.
+    const std::vector<float> splat_counts(image.splat_count.begin(), image.splat_count.end());
     if (!image.splat_count.empty()) {
-      header.channels().insert(kSplatCountChannel, Imf::Channel(Imf::UINT));
-      frame.insert(kSplatCountChannel, Imf::Slice::Make(Imf::UINT, image.splat_count.data(), data_window));
+      header.channels().insert(kSplatCountChannel, Imf::Channel(Imf::FLOAT));
+      frame.insert(kSplatCountChannel, Imf::Slice::Make(Imf::FLOAT, splat_counts.data(), data_window));
     }
 
     // Scoped so the file is complete and closed before write_file_atomically renames it.
@@ -222,6 +266,42 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
 
 RenderImage read_exr(const std::filesystem::path& path) {
   return with_file_named_in_errors(path, [&] { return read_exr_file(path); });
+}
+
+std::optional<Camera> read_exr_camera(const std::filesystem::path& path) {
+  return with_file_named_in_errors(path, [&]() -> std::optional<Camera> {
+    if (!Imf::isOpenExrFile(path.c_str())) throw std::runtime_error("not an OpenEXR file");
+    const Imf::InputFile file(path.c_str());
+    const Imf::Header& header = file.header();
+    const auto* rotation = header.findTypedAttribute<Imf::M33dAttribute>("tilesplatRotation");
+    const auto* position = header.findTypedAttribute<Imf::V3dAttribute>("tilesplatPosition");
+    const auto* focal = header.findTypedAttribute<Imf::V2dAttribute>("tilesplatFocalLength");
+    const auto* principal = header.findTypedAttribute<Imf::V2dAttribute>("tilesplatPrincipalPoint");
+    const int present =
+        (rotation != nullptr) + (position != nullptr) + (focal != nullptr) + (principal != nullptr);
+    if (present == 0) return std::nullopt;
+    if (present != 4)
+      throw std::runtime_error(
+          "the camera attributes are incomplete (tilesplatRotation, tilesplatPosition, "
+          "tilesplatFocalLength and tilesplatPrincipalPoint, of types m33d, v3d, v2d, v2d)");
+    Camera camera;
+    const Imath::Box2i window = header.dataWindow();
+    camera.width = window.max.x - window.min.x + 1;
+    camera.height = window.max.y - window.min.y + 1;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) camera.rotation[size_t(r) * 3 + size_t(c)] = rotation->value()[r][c];
+    for (int i = 0; i < 3; ++i) camera.position[size_t(i)] = position->value()[i];
+    camera.fx = focal->value().x;
+    camera.fy = focal->value().y;
+    camera.cx = principal->value().x;
+    camera.cy = principal->value().y;
+    try {
+      validate(camera);
+    } catch (const std::invalid_argument& error) {
+      throw std::runtime_error(std::string("its camera attributes describe an ") + error.what());
+    }
+    return camera;
+  });
 }
 
 std::map<std::string, std::string> read_exr_string_attributes(const std::filesystem::path& path) {
