@@ -1,5 +1,6 @@
 // tilesplat-render: renders one view of a scene to an EXR (and optionally a PNG preview).
 #include <array>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -28,6 +29,7 @@ struct RenderOptions {
   std::array<float, 3> background = {0, 0, 0};
   tilesplat::PreviewOptions preview;
   bool half = false;
+  tilesplat::ExrCompression compression = tilesplat::ExrCompression::kZip;
   bool no_depth = false;
   bool no_count = false;
   bool reference = false;
@@ -36,6 +38,27 @@ struct RenderOptions {
 };
 
 std::string single_quoted(const std::string& text) { return "'" + text + "'"; }
+
+// What the EXR's renderSettings attribute records: everything that changes the image.
+std::string settings_text(const tilesplat::RenderSettings& settings) {
+  std::string text = "sort=" + settings.sort;
+  text += " accuracy=" + tilesplat::to_string(settings.accuracy);
+  text += " antialiasing=" + tilesplat::to_string(settings.antialiasing);
+  text += " compositor=" + tilesplat::to_string(settings.compositor);
+  if (settings.compositor == tilesplat::Compositor::kStochastic)
+    text += " frames=" + std::to_string(settings.stochastic.frames) +
+            " seed=" + std::to_string(settings.stochastic.seed);
+  text += " lights=" + std::to_string(settings.lighting.lights.size());
+  text += " background=";
+  for (size_t c = 0; c < 3; ++c) {
+    char digits[32];
+    const auto end =
+        std::to_chars(digits, digits + sizeof(digits), settings.background[c]).ptr;  // shortest exact
+    if (c > 0) text += ',';
+    text.append(digits, end);
+  }
+  return text;
+}
 
 // Library writers name the file in their messages; this keeps that true whatever they say.
 std::string write_failure(const fs::path& path, const std::exception& error) {
@@ -94,6 +117,20 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                        throw cli::UsageError("--tone-map must be none, aces or reinhard, got " + single_quoted(text));
                    });
   parser.add_switch("--half", "store the EXR channels as 16-bit HALF instead of 32-bit FLOAT", &options.half);
+  parser.add_value(
+      "--exr-compression", "METHOD",
+      "zip (default, lossless), piz (lossless wavelet), dwaa (lossy on R G B, small files for review; A and "
+      "Z stay lossless), or none",
+      [&options](const std::string& text) {
+        using tilesplat::ExrCompression;
+        for (const ExrCompression c :
+             {ExrCompression::kZip, ExrCompression::kPiz, ExrCompression::kDwaa, ExrCompression::kNone})
+          if (text == tilesplat::to_string(c)) {
+            options.compression = c;
+            return;
+          }
+        throw cli::UsageError("--exr-compression must be zip, piz, dwaa or none, got " + single_quoted(text));
+      });
   parser.add_switch("--no-depth", "do not compute or store the depth channel (Z)", &options.no_depth);
   parser.add_switch("--no-count", "do not compute or store the per-pixel splat count", &options.no_count);
 
@@ -211,6 +248,10 @@ int run(int argc, char** argv) {
   exr_options.alpha = !loaded.description || loaded.description->outputs.alpha;
   exr_options.attributes["commandLine"] = cli::command_line(kProgram, argc, argv);
   exr_options.camera = loaded.camera;  // worldToCamera, worldToNDC and the exact camera
+  exr_options.compression = options.compression;
+  exr_options.attributes["scene"] = loaded.path.string();
+  exr_options.attributes["view"] = loaded.camera_description;
+  exr_options.attributes["renderSettings"] = settings_text(settings);
   try {
     tilesplat::write_exr(options.output, image, exr_options);
   } catch (const std::exception& error) {

@@ -472,10 +472,32 @@ TEST(CliRender, ExrRecordsTheCameraOfTheView) {
   ASSERT_TRUE(camera.has_value());
   const auto views = tilesplat::load_cameras_json(bundled_playbot_cameras());
   EXPECT_EQ(*camera, tilesplat::resize_camera(views.at(2).camera, 96, 54));
+  const auto attributes = tilesplat::read_exr_string_attributes(exr);
+  EXPECT_EQ(attributes.at("scene"), bundled_playbot().string());
+  EXPECT_TRUE(contains(attributes.at("view"), "view 2")) << attributes.at("view");
+  EXPECT_EQ(attributes.at("renderSettings"),
+            "sort=radix accuracy=reference antialiasing=classic compositor=sorted lights=0 background=0,0,0");
   // Rendering the camera read back gives the file's image again.
   const auto renderer = tilesplat::Renderer::create();
   renderer->set_scene(tilesplat::load_scene(bundled_playbot()));
   EXPECT_EQ(renderer->render(*camera).rgba, tilesplat::read_exr(exr).rgba);
+}
+
+TEST(CliRender, ExrCompressionFlagChoosesTheMethod) {
+  const auto out = fresh_output_dir();
+  for (const char* method : {"zip", "piz", "dwaa", "none"}) {
+    const fs::path exr = out / (std::string(method) + ".exr");
+    const auto result = run_exe(kRenderExe, {bundled_sh3().string(), "--width", "32", "--height", "18",
+                                             "--exr-compression", method, "--half", "-o", exr.string()});
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    EXPECT_EQ(tilesplat::read_exr(exr).width, 32) << method;
+  }
+  EXPECT_GT(fs::file_size(out / "none.exr"), fs::file_size(out / "zip.exr"));
+  const auto bad = run_exe(
+      kRenderExe, {bundled_sh3().string(), "--exr-compression", "lzma", "-o", (out / "bad.exr").string()});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_TRUE(contains(bad.err, "--exr-compression must be zip, piz, dwaa or none, got 'lzma'")) << bad.err;
+  EXPECT_FALSE(fs::exists(out / "bad.exr"));
 }
 
 TEST(CliProvenance, ColumnsFollowRecordsNotLinesInsideQuotedFields) {

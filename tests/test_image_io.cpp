@@ -495,6 +495,44 @@ TEST(ExrIo, CameraRoundTripsExactlyAndInOpenExrsConventions) {
 #endif
 }
 
+// Every compression method writes a file OpenEXR reads back; the lossless ones (and DWAA on FLOAT
+// channels) give the bits back, DWAA on HALF colour stays within a visually lossless error.
+TEST(ExrIo, EveryCompressionMethodWritesAReadableFile) {
+  const fs::path dir = fresh_dir();
+  const RenderImage image = make_image(40, 24, true, true);
+  const std::vector<std::pair<ExrCompression, int>> methods = {{ExrCompression::kZip, 3},
+                                                               {ExrCompression::kPiz, 4},
+                                                               {ExrCompression::kDwaa, 8},
+                                                               {ExrCompression::kNone, 0}};
+  for (const auto& [method, code] : methods) {
+    for (const bool half : {false, true}) {
+      const fs::path path = dir / (to_string(method) + (half ? "_half.exr" : ".exr"));
+      ExrWriteOptions options;
+      options.compression = method;
+      options.half = half;
+      write_exr(path, image, options);
+      EXPECT_EQ(parse_exr_header(path).compression, code) << path;
+      const RenderImage back = read_exr(path);
+      EXPECT_TRUE(same_bits(back.depth, image.depth)) << path;
+      EXPECT_EQ(back.splat_count, image.splat_count) << path;
+      const bool lossy = half || method == ExrCompression::kDwaa;
+      if (!lossy) {
+        EXPECT_TRUE(same_bits(back.rgba, image.rgba)) << path;
+        continue;
+      }
+      double worst_rgb = 0, worst_alpha = 0;
+      for (size_t i = 0; i < image.rgba.size(); ++i) {
+        const double error =
+            std::fabs(double(back.rgba[i]) - image.rgba[i]) / std::max(1.0, std::fabs(double(image.rgba[i])));
+        (i % 4 == 3 ? worst_alpha : worst_rgb) = std::max(i % 4 == 3 ? worst_alpha : worst_rgb, error);
+      }
+      EXPECT_LT(worst_rgb, method == ExrCompression::kDwaa ? 0.05 : 1e-3) << path;  // DWAA: lossy on R G B
+      EXPECT_LT(worst_alpha, half ? 1e-3 : 1e-300) << path;  // alpha: only half rounding
+    }
+  }
+  EXPECT_EQ(to_string(ExrCompression::kPiz), "piz");
+}
+
 TEST(ExrIo, AttributesTheWriterOwnsAreRejectedAndNothingIsWritten) {
   const fs::path dir = fresh_dir();
   for (const std::string name : {"", "channels", "dataWindow", "compression", "chromaticities", "worldToNDC",

@@ -27,6 +27,16 @@ struct RenderImage {
   size_t pixels() const { return size_t(width) * size_t(height); }
 };
 
+/// OpenEXR's compression methods that write_exr() offers.
+enum class ExrCompression {
+  kZip,   ///< lossless, 16 scanlines per block: the default, good on rendered images
+  kPiz,   ///< lossless wavelet: smaller files of noisy images, slower to write
+  kDwaa,  ///< lossy (DCT) on the R G B channels, small files for review; A, Z and counts stay lossless
+  kNone,  ///< uncompressed: the fastest to write and read
+};
+/// "zip", "piz", "dwaa", "none".
+TILESPLAT_API std::string to_string(ExrCompression compression);
+
 /// How write_exr() stores an image.
 struct ExrWriteOptions {
   bool half = false;  ///< store HALF instead of FLOAT channels
@@ -39,6 +49,7 @@ struct ExrWriteOptions {
   /// `worldToNDC` (single-precision matrices in OpenEXR's conventions, which read_exr_camera() documents)
   /// and, exactly, as tilesplat's own attributes, from which read_exr_camera() rebuilds it.
   std::optional<Camera> camera;
+  ExrCompression compression = ExrCompression::kZip;  ///< how the pixels are compressed
 };
 
 /// Writes channels R G B A (A unless options.alpha is false), Z when depth is present, and "splats"

@@ -113,6 +113,20 @@ void add_camera_attributes(Imf::Header& header, const Camera& camera) {
   header.insert("tilesplatPrincipalPoint", Imf::V2dAttribute(Imath::V2d(camera.cx, camera.cy)));
 }
 
+Imf::Compression openexr_compression(ExrCompression compression) {
+  switch (compression) {
+    case ExrCompression::kZip:
+      return Imf::ZIP_COMPRESSION;
+    case ExrCompression::kPiz:
+      return Imf::PIZ_COMPRESSION;
+    case ExrCompression::kDwaa:
+      return Imf::DWAA_COMPRESSION;
+    case ExrCompression::kNone:
+      return Imf::NO_COMPRESSION;
+  }
+  throw std::invalid_argument("unknown ExrCompression " + std::to_string(int(compression)));
+}
+
 // The provenance every file carries, then the caller's attributes.
 void add_string_attributes(Imf::Header& header, const ExrWriteOptions& options) {
   const BuildInfo build = build_info();
@@ -228,7 +242,7 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
 
   detail::write_file_atomically(path, [&](const std::filesystem::path& temp) {
     Imf::Header header(image.width, image.height);
-    header.compression() = Imf::ZIP_COMPRESSION;
+    header.compression() = openexr_compression(options.compression);
     add_string_attributes(header, options);
     Imf::addChromaticities(header, Imf::Chromaticities());  // Rec. 709 primaries, D65 white
     if (options.camera) add_camera_attributes(header, *options.camera);
@@ -266,6 +280,20 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
 
 RenderImage read_exr(const std::filesystem::path& path) {
   return with_file_named_in_errors(path, [&] { return read_exr_file(path); });
+}
+
+std::string to_string(ExrCompression compression) {
+  switch (compression) {
+    case ExrCompression::kZip:
+      return "zip";
+    case ExrCompression::kPiz:
+      return "piz";
+    case ExrCompression::kDwaa:
+      return "dwaa";
+    case ExrCompression::kNone:
+      return "none";
+  }
+  return "unknown";
 }
 
 std::optional<Camera> read_exr_camera(const std::filesystem::path& path) {
