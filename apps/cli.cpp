@@ -744,14 +744,16 @@ LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view
   LoadedScene loaded = load_scene_file(options.scene, options.strict, program);
   const SceneViews own = scene_views(loaded);
   NamedCamera named;
-  if (!options.cameras.empty()) {
-    named = view_camera(load_camera_views(options.cameras), options.view, options.cameras, options.width,
-                        options.height);
-  } else if (!own.views.empty()) {
-    if (options.orbit_given)
+  if (!options.cameras.empty() || !own.views.empty()) {
+    if (options.cameras.empty() && options.orbit_given)
       throw UsageError("--azimuth, --elevation, --fov and --distance apply only to the orbit camera, and " +
                        single_quoted(loaded.path.string()) + " has cameras of its own (pick one with --view)");
-    named = view_camera(own.views, options.view, own.file, options.width, options.height);
+    const std::vector<CameraView> views =
+        options.cameras.empty() ? own.views : load_camera_views(options.cameras);
+    named = view_camera(views, options.view, options.cameras.empty() ? own.file : fs::path(options.cameras),
+                        options.width, options.height);
+    loaded.view_index = options.view;
+    loaded.view_name = views[size_t(options.view)].name;  // in range: view_camera checked it
   } else {
     if (options.view_given)
       throw UsageError("--view needs cameras: " + single_quoted(loaded.path.string()) +

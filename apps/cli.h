@@ -198,6 +198,8 @@ struct LoadedScene {
   LoadReport report;
   Camera camera;
   std::string camera_description;  // "view 0 of cams.json" or "orbit azimuth 0 elevation 20 fov 50"
+  std::optional<int> view_index;   // the view's index in its cameras, when the camera is a view
+  std::string view_name;           // its img_name (may be empty); empty for the orbit camera
   double load_ms = 0;
 };
 

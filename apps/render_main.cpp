@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cli.h"
+#include "sha256.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
 #include "tilesplat/reference.h"
@@ -251,6 +252,11 @@ int run(int argc, char** argv) {
   exr_options.compression = options.compression;
   exr_options.attributes["scene"] = loaded.path.string();
   exr_options.attributes["view"] = loaded.camera_description;
+  if (loaded.view_index) {
+    exr_options.attributes["viewIndex"] = std::to_string(*loaded.view_index);
+    exr_options.attributes["viewName"] = loaded.view_name;
+  }
+  exr_options.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
   exr_options.attributes["renderSettings"] = settings_text(settings);
   try {
     tilesplat::write_exr(options.output, image, exr_options);

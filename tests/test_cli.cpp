@@ -12,6 +12,7 @@
 
 #include "cli.h"
 #include "process_support.h"
+#include "sha256.h"
 #include "test_support.h"
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
@@ -475,6 +476,10 @@ TEST(CliRender, ExrRecordsTheCameraOfTheView) {
   const auto attributes = tilesplat::read_exr_string_attributes(exr);
   EXPECT_EQ(attributes.at("scene"), bundled_playbot().string());
   EXPECT_TRUE(contains(attributes.at("view"), "view 2")) << attributes.at("view");
+  EXPECT_EQ(attributes.at("viewIndex"), "2");
+  EXPECT_EQ(attributes.at("viewName"), views.at(2).name);
+  EXPECT_EQ(attributes.at("sceneSha256"), cli::sha256_file_hex(bundled_playbot()));
+  EXPECT_EQ(attributes.at("sceneSha256").size(), 64u);
   EXPECT_EQ(attributes.at("renderSettings"),
             "sort=radix accuracy=reference antialiasing=classic compositor=sorted lights=0 background=0,0,0");
   // Rendering the camera read back gives the file's image again.
