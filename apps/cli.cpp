@@ -514,10 +514,12 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                     "fail on the first non-finite value in the scene (default: drop such Gaussians and report "
                     "them)",
                     &options.strict);
-  parser.add_string("--device", "NAME_OR_INDEX",
-                    "Vulkan device: an index from --list-devices or part of its name (default: "
-                    "$TILESPLAT_DEVICE, else the first discrete GPU, else the first device)",
-                    &options.device);
+  parser.add_string(
+      "--device", "INDEX|NAME|UUID",
+      "Vulkan device: an index from --list-devices, part of its name, or its UUID (on NVIDIA the GPU "
+      "UUID a scheduler assigns; default: $TILESPLAT_DEVICE, else the first discrete GPU, else the "
+      "first device)",
+      &options.device);
   parser.add_switch("--list-devices", "print the Vulkan devices with their indices and exit",
                     &options.list_devices);
   parser.add_switch("--validation",
@@ -614,7 +616,9 @@ void check_common_options(const ArgParser& parser, const CommonOptions& options)
 void print_devices() {
   const auto devices = list_devices();
   if (devices.empty()) throw std::runtime_error("no Vulkan devices found");
-  for (size_t i = 0; i < devices.size(); ++i) std::printf("%zu: %s\n", i, devices[i].c_str());
+  const auto uuids = list_device_uuids();
+  for (size_t i = 0; i < devices.size(); ++i)
+    std::printf("%zu: %s (uuid %s)\n", i, devices[i].c_str(), i < uuids.size() ? uuids[i].c_str() : "?");
 }
 
 LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view program) {

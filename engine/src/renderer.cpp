@@ -687,5 +687,8 @@ uint64_t Renderer::validation_messages() const { return impl_->ctx.validation_me
 std::vector<std::string> sort_strategies() { return available_sort_strategies(); }
 bool sort_strategy_is_exact(const std::string& name) { return sort_strategy_exact(name); }
 std::vector<std::string> list_devices() { return vk::Context::list_devices(); }
+std::vector<std::string> list_device_uuids() {
+  return vk::Context::list_device_uuids();
+}
 
 }  // namespace tilesplat

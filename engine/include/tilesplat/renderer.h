@@ -18,8 +18,10 @@ namespace tilesplat {
 /// How Renderer::create() sets up its device.
 struct RendererOptions {
   /// Which Vulkan device: "" = the environment variable TILESPLAT_DEVICE if set, else the first
-  /// discrete GPU, else the first device. Otherwise a device index ("1") or a case-insensitive
-  /// substring of the device name ("llvmpipe").
+  /// discrete GPU, else the first device. Otherwise a device index ("1"), the device's UUID
+  /// (list_device_uuids(); on NVIDIA the GPU UUID that CUDA, nvidia-smi and cluster schedulers report:
+  /// a "GPU-" prefix, dashes and case do not matter), or a case-insensitive substring of the device
+  /// name ("llvmpipe"). Vulkan ignores CUDA_VISIBLE_DEVICES: pass the UUID a scheduler assigned.
   std::string device;
   /// Enables VK_LAYER_KHRONOS_validation. Also enabled by TILESPLAT_VALIDATION=1. Messages are
   /// printed to stderr and counted in Renderer::validation_messages().
@@ -221,6 +223,9 @@ TILESPLAT_API bool sort_strategy_is_exact(const std::string& name);
 
 /// Lists the Vulkan devices this machine has, in the order RendererOptions::device indexes them.
 TILESPLAT_API std::vector<std::string> list_devices();
+/// The devices' UUIDs (VkPhysicalDeviceIDProperties::deviceUUID) as 8-4-4-4-12 lower-case hex, in the
+/// order of list_devices(). RendererOptions::device accepts them.
+TILESPLAT_API std::vector<std::string> list_device_uuids();
 
 /// The GPU renderer: a Vulkan device, the scene in device memory, and the compute passes of a frame
 /// (projection, key emission, sorts, tile ranges, composite). Not thread-safe: use one renderer from

@@ -89,7 +89,46 @@ std::string physical_device_name(VkPhysicalDevice device) {
   return props.deviceName;
 }
 
+// The device's UUID (VkPhysicalDeviceIDProperties::deviceUUID) as 8-4-4-4-12 lower-case hex. On
+// NVIDIA it is the GPU UUID CUDA and nvidia-smi report (they print it after "GPU-").
+std::string physical_device_uuid(VkPhysicalDevice device) {
+  VkPhysicalDeviceIDProperties id{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props.pNext = &id;
+  vkGetPhysicalDeviceProperties2(device, &props);
+  static constexpr char kDigits[] = "0123456789abcdef";
+  std::string text;
+  for (size_t i = 0; i < VK_UUID_SIZE; ++i) {
+    if (i == 4 || i == 6 || i == 8 || i == 10) text += '-';
+    text += kDigits[id.deviceUUID[i] >> 4];
+    text += kDigits[id.deviceUUID[i] & 15];
+  }
+  return text;
+}
+
+// The 32 hex digits of a selector that names a device by UUID ("GPU-" prefix and dashes optional,
+// any case), or "" when it is not a UUID.
+std::string uuid_digits(const std::string& selector) {
+  std::string text = lower(selector);
+  if (text.rfind("gpu-", 0) == 0) text = text.substr(4);
+  std::string digits;
+  for (const char c : text) {
+    if (c == '-') continue;
+    if (!std::isxdigit(static_cast<unsigned char>(c))) return "";
+    digits += c;
+  }
+  return digits.size() == 2 * VK_UUID_SIZE ? digits : "";
+}
+
 }  // namespace
+
+std::vector<std::string> Context::list_device_uuids() {
+  VkInstance instance = create_bare_instance(false);
+  std::vector<std::string> uuids;
+  for (VkPhysicalDevice d : enumerate_devices(instance)) uuids.push_back(physical_device_uuid(d));
+  vkDestroyInstance(instance, nullptr);
+  return uuids;
+}
 
 std::vector<std::string> Context::list_devices() {
   VkInstance instance = create_bare_instance(false);
@@ -220,14 +259,19 @@ void Context::pick_physical_device(const std::string& selector) {
     physical_device_ = *std::min_element(devices.begin(), devices.end(),
                                          [&](auto a, auto b) { return rank(a) < rank(b); });
   } else {
-    bool numeric = std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
+    const bool numeric =
+        std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
+    const std::string uuid = numeric ? std::string() : uuid_digits(selector);
     std::string names;
     for (size_t i = 0; i < devices.size(); ++i) {
-      std::string name = physical_device_name(devices[i]);
-      names += (i ? ", " : "") + std::to_string(i) + ": " + name;
+      const std::string name = physical_device_name(devices[i]);
+      const std::string device_uuid = physical_device_uuid(devices[i]);
+      names += (i ? ", " : "") + std::to_string(i) + ": " + name + " (" + device_uuid + ")";
       if (physical_device_) continue;
-      if (numeric ? std::stoul(selector) == i : lower(name).find(lower(selector)) != std::string::npos)
-        physical_device_ = devices[i];
+      const bool match = numeric         ? std::stoul(selector) == i
+                         : !uuid.empty() ? uuid_digits(device_uuid) == uuid
+                                         : lower(name).find(lower(selector)) != std::string::npos;
+      if (match) physical_device_ = devices[i];
     }
     if (!physical_device_)
       throw std::runtime_error("no Vulkan device matches '" + selector + "' (devices: " + names + ")");

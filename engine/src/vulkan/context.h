@@ -83,6 +83,8 @@ class Context {
   void count_upload(uint64_t bytes) { uploaded_bytes_ += bytes; }
 
   static std::vector<std::string> list_devices();
+  // The devices' UUIDs, 8-4-4-4-12 hex, in the order of list_devices().
+  static std::vector<std::string> list_device_uuids();
 
  private:
   static VKAPI_ATTR VkBool32 VKAPI_CALL debug_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
