@@ -146,11 +146,8 @@ std::string channel_names(const Imf::ChannelList& channels) {
 }
 
 // Throws plain std::runtime_errors (and OpenEXR's exceptions); read_exr adds the file name.
+// The caller (with_exr_file_named_in_errors) has checked that the file is OpenEXR.
 RenderImage read_exr_file(const std::filesystem::path& path) {
-  // isOpenExrFile gives a meaningful message for a file that is not EXR at all, where the
-  // InputFile constructor would report something about its internals.
-  if (!Imf::isOpenExrFile(path.c_str())) throw std::runtime_error("not an OpenEXR file");
-
   Imf::InputFile file(path.c_str());
   const Imf::Header& header = file.header();
   const Imath::Box2i data_window = header.dataWindow();
@@ -207,16 +204,19 @@ RenderImage read_exr_file(const std::filesystem::path& path) {
   return image;
 }
 
-// Runs read(), a reader of `path`, with the file named in every error: OpenEXR's messages
-// (Iex::BaseExc derives from std::exception) rarely name it.
+// Runs read(), a reader of the EXR file `path`, once the file exists and is OpenEXR, with the file
+// named in every error: OpenEXR's messages (Iex::BaseExc derives from std::exception) rarely name it.
 template <typename Read>
-auto with_file_named_in_errors(const std::filesystem::path& path, const Read& read) {
+auto with_exr_file_named_in_errors(const std::filesystem::path& path, const Read& read) {
   const std::string prefix = "cannot read " + path.string() + ": ";
   std::error_code status_error;
   const auto status = std::filesystem::status(path, status_error);
   if (!std::filesystem::exists(status)) throw std::runtime_error(prefix + "the file does not exist");
   if (std::filesystem::is_directory(status)) throw std::runtime_error(prefix + "it is a directory");
   try {
+    // isOpenExrFile gives a meaningful message for a file that is not EXR at all, where the
+    // InputFile constructor would report something about its internals.
+    if (!Imf::isOpenExrFile(path.c_str())) throw std::runtime_error("not an OpenEXR file");
     return read();
   } catch (const std::exception& error) {
     std::throw_with_nested(std::runtime_error(prefix + error.what()));
@@ -279,7 +279,7 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
 }
 
 RenderImage read_exr(const std::filesystem::path& path) {
-  return with_file_named_in_errors(path, [&] { return read_exr_file(path); });
+  return with_exr_file_named_in_errors(path, [&] { return read_exr_file(path); });
 }
 
 std::string to_string(ExrCompression compression) {
@@ -297,8 +297,7 @@ std::string to_string(ExrCompression compression) {
 }
 
 std::optional<Camera> read_exr_camera(const std::filesystem::path& path) {
-  return with_file_named_in_errors(path, [&]() -> std::optional<Camera> {
-    if (!Imf::isOpenExrFile(path.c_str())) throw std::runtime_error("not an OpenEXR file");
+  return with_exr_file_named_in_errors(path, [&]() -> std::optional<Camera> {
     const Imf::InputFile file(path.c_str());
     const Imf::Header& header = file.header();
     const auto* rotation = header.findTypedAttribute<Imf::M33dAttribute>("tilesplatRotation");
@@ -333,8 +332,7 @@ std::optional<Camera> read_exr_camera(const std::filesystem::path& path) {
 }
 
 std::map<std::string, std::string> read_exr_string_attributes(const std::filesystem::path& path) {
-  return with_file_named_in_errors(path, [&] {
-    if (!Imf::isOpenExrFile(path.c_str())) throw std::runtime_error("not an OpenEXR file");
+  return with_exr_file_named_in_errors(path, [&] {
     const Imf::InputFile file(path.c_str());
     std::map<std::string, std::string> attributes;
     for (auto attribute = file.header().begin(); attribute != file.header().end(); ++attribute)
