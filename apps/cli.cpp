@@ -1,5 +1,6 @@
 #include "cli.h"
 
+#include "tilesplat/camera_sets.h"
 #include "tilesplat/sort_strategy.h"
 #include "tilesplat/version.h"
 
@@ -436,7 +437,10 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                         SceneChoice scene_choice) {
   const OrbitParams orbit_defaults;
   const std::string cameras_help =
-      "take the camera from the trainer's cameras.json (default: an orbit camera framing the scene, see --azimuth)";
+      "take the camera from a camera set: the trainer's cameras.json, a nerfstudio/instant-ngp "
+      "transforms.json, "
+      "or a COLMAP sparse model (its folder, or its cameras/images .bin or .txt) (default: an orbit camera "
+      "framing the scene, see --azimuth)";
   if (scene_choice == SceneChoice::kOne) {
     parser.add_positional("SCENE.ply",
                           "the scene: a 3D Gaussian Splatting file (.ply, .compressed.ply, .splat, .spz, .sog, SOG meta.json, "
@@ -453,9 +457,9 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
 
   parser.section("camera");
   if (scene_choice == SceneChoice::kOne) {
-    parser.add_string("--cameras", "FILE.json", cameras_help, &options.cameras);
+    parser.add_string("--cameras", "CAMERAS", cameras_help, &options.cameras);
   } else {
-    parser.add_value("--cameras", "FILE.json",
+    parser.add_value("--cameras", "CAMERAS",
                      cameras_help + "; give it once for every SCENE, or once per SCENE in the same order",
                      [&options](const std::string& text) {
                        if (text.empty()) throw UsageError("--cameras expects a value, got an empty string");
@@ -695,10 +699,13 @@ bool any_scene_file(const CommonOptions& options) {
 }
 
 std::vector<CameraView> load_camera_views(const fs::path& path) {
-  require_input_file(path, "cameras");
+  std::error_code ec;
+  if (!fs::exists(path, ec))
+    throw std::runtime_error("cannot read cameras " + single_quoted(path.string()) +
+                             ": no such file or folder");
   std::vector<CameraView> views;
   try {
-    views = load_cameras_json(path);
+    views = load_camera_set(path);  // a cameras.json, a transforms.json or a COLMAP model
   } catch (const std::exception& error) {
     throw std::runtime_error(naming_file(path, error.what()));
   }
@@ -723,21 +730,24 @@ NamedCamera view_camera(const std::vector<CameraView>& views, int index, const f
   return named;
 }
 
+ImageSize orbit_image_size(int width, int height) {
+  const double aspect = double(kOrbitDefaultWidth) / double(kOrbitDefaultHeight);
+  if (width <= 0 && height <= 0) return {kOrbitDefaultWidth, kOrbitDefaultHeight};
+  if (height <= 0) return {width, static_cast<int>(std::max(1.0, std::round(double(width) / aspect)))};
+  if (width <= 0)
+    return {static_cast<int>(
+                std::min(double(kMaxImageSide) + 1, std::max(1.0, std::round(double(height) * aspect)))),
+            height};
+  return {width, height};
+}
+
 NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const OrbitParams& orbit) {
   if (loaded.scene.empty())
     throw std::runtime_error(single_quoted(loaded.path.string()) +
                              " has no Gaussians for the orbit camera to frame; pass --cameras FILE.json");
-  const double aspect = double(kOrbitDefaultWidth) / double(kOrbitDefaultHeight);
-  if (width <= 0 && height <= 0) {
-    width = kOrbitDefaultWidth;
-    height = kOrbitDefaultHeight;
-  } else if (height <= 0) {
-    height = static_cast<int>(std::max(1.0, std::round(double(width) / aspect)));
-  } else if (width <= 0) {
-    width = static_cast<int>(std::min(double(kMaxImageSide) + 1, std::max(1.0, std::round(double(height) * aspect))));
-  }
+  const ImageSize size = orbit_image_size(width, height);
   NamedCamera named;
-  named.camera = orbit_camera(loaded.scene, width, height, orbit);
+  named.camera = orbit_camera(loaded.scene, size.width, size.height, orbit);
   named.description = "orbit azimuth " + format_fixed(orbit.azimuth_deg, 1) + " elevation " +
                       format_fixed(orbit.elevation_deg, 1) + " fov " + format_fixed(orbit.vertical_fov_deg, 1);
   check_camera_size(named.camera);

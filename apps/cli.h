@@ -230,7 +230,8 @@ Lighting scene_lighting(const SceneEffects& effects);
 // leaves the settings as they are. Flags that override the scene file are applied after this.
 void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings);
 
-// The views of a cameras.json; throws std::runtime_error naming the file when it is missing,
+// The views of a camera set: a cameras.json, a transforms.json or a COLMAP model (folder or file;
+// tilesplat::load_camera_set). Throws std::runtime_error naming the file when it is missing,
 // malformed or has no views.
 std::vector<CameraView> load_camera_views(const std::filesystem::path& path);
 
@@ -242,6 +243,9 @@ struct NamedCamera {
 // An out-of-range index throws UsageError naming `flag`, the file and its number of views.
 NamedCamera view_camera(const std::vector<CameraView>& views, int index, const std::filesystem::path& cameras_path,
                         int width, int height, std::string_view flag = "--view");
+// The size of a camera of its own making (orbit, path) for --width W --height H (0: not given):
+// 1920x1080 by default, one side given keeps that aspect.
+ImageSize orbit_image_size(int width, int height);
 // The orbit camera framing the scene (which must not be empty) at width x height (0: see CommonOptions).
 NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const OrbitParams& orbit);
 

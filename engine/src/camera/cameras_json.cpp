@@ -5,13 +5,13 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
+#include "camera/rotation_check.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/scene.h"
 
@@ -19,8 +19,6 @@ namespace tilesplat {
 namespace {
 
 using nlohmann::json;
-
-constexpr double kOrthonormalTolerance = 1e-3;
 
 // Builds "FILE: entry N: MESSAGE" errors for one entry of the file.
 class EntryContext {
@@ -74,37 +72,15 @@ class EntryContext {
 std::array<double, 9> read_world_to_camera(const json& entry, const EntryContext& context) {
   const json& rows = context.field(entry, "rotation");
   if (!rows.is_array() || rows.size() != 3) context.fail("'rotation' must be a 3x3 array");
-  double camera_to_world[3][3];
+  std::array<double, 9> camera_to_world{};
   for (size_t r = 0; r < 3; ++r) {
     if (!rows[r].is_array() || rows[r].size() != 3) context.fail("'rotation' must be a 3x3 array");
     for (size_t c = 0; c < 3; ++c)
-      camera_to_world[r][c] =
-          context.finite_number(rows[r][c], "'rotation'[" + std::to_string(r) + "][" + std::to_string(c) + "]");
+      camera_to_world[r * 3 + c] = context.finite_number(
+          rows[r][c], "'rotation'[" + std::to_string(r) + "][" + std::to_string(c) + "]");
   }
-
-  double worst = 0;
-  for (size_t i = 0; i < 3; ++i)
-    for (size_t j = 0; j < 3; ++j) {
-      double column_dot = 0;
-      for (size_t k = 0; k < 3; ++k) column_dot += camera_to_world[k][i] * camera_to_world[k][j];
-      worst = std::max(worst, std::abs(column_dot - (i == j ? 1.0 : 0.0)));
-    }
-  if (!(worst <= kOrthonormalTolerance)) {
-    std::ostringstream message;
-    message << "'rotation' is not orthonormal (|R^T R - I| = " << worst << ", tolerance "
-            << kOrthonormalTolerance << ")";
-    context.fail(message.str());
-  }
-  const auto& m = camera_to_world;
-  const double determinant = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                             m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                             m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-  if (determinant < 0) context.fail("'rotation' is a reflection (determinant -1), not a rotation");
-
-  std::array<double, 9> world_to_camera{};
-  for (size_t r = 0; r < 3; ++r)
-    for (size_t c = 0; c < 3; ++c) world_to_camera[r * 3 + c] = camera_to_world[c][r];
-  return world_to_camera;
+  if (const auto problem = rotation_problem(camera_to_world)) context.fail("'rotation' " + *problem);
+  return transposed(camera_to_world);
 }
 
 CameraView read_entry(const json& entry, size_t index, const std::string& file) {

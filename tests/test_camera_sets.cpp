@@ -1,0 +1,328 @@
+// Camera sets where datasets keep them (COLMAP sparse models, binary and text; nerfstudio and
+// instant-ngp transforms.json) read as the same cameras as the trainer's cameras.json, and camera
+// paths through keyframes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "process_support.h"
+#include "test_support.h"
+#include "tilesplat/camera_path.h"
+#include "tilesplat/camera_sets.h"
+#include "tilesplat/image.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using tilesplat::Camera;
+using tilesplat::CameraView;
+using tilesplat::testing::fresh_output_dir;
+
+std::string error_of(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const std::exception& error) {
+    return error.what();
+  }
+  return "(no error)";
+}
+
+void expect_near_camera(const Camera& a, const Camera& b, double tolerance = 1e-9) {
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  EXPECT_NEAR(a.fx, b.fx, tolerance);
+  EXPECT_NEAR(a.fy, b.fy, tolerance);
+  EXPECT_NEAR(a.cx, b.cx, tolerance);
+  EXPECT_NEAR(a.cy, b.cy, tolerance);
+  for (size_t k = 0; k < 9; ++k) EXPECT_NEAR(a.rotation[k], b.rotation[k], tolerance) << k;
+  for (size_t k = 0; k < 3; ++k) EXPECT_NEAR(a.position[k], b.position[k], tolerance) << k;
+}
+
+// COLMAP's quaternion (w, x, y, z) of a world-to-camera rotation, and its translation t = -R c.
+std::array<double, 7> colmap_pose(const Camera& camera) {
+  const auto& r = camera.rotation;
+  // The largest of |w|, |x|, |y|, |z| first, the others from it (exact for half-turns too).
+  const double w2 = 1 + r[0] + r[4] + r[8], x2 = 1 + r[0] - r[4] - r[8], y2 = 1 - r[0] + r[4] - r[8],
+               z2 = 1 - r[0] - r[4] + r[8];
+  double w, x, y, z;
+  if (w2 >= std::max({x2, y2, z2})) {
+    w = std::sqrt(w2) / 2;
+    x = (r[7] - r[5]) / (4 * w), y = (r[2] - r[6]) / (4 * w), z = (r[3] - r[1]) / (4 * w);
+  } else if (x2 >= std::max(y2, z2)) {
+    x = std::sqrt(x2) / 2;
+    w = (r[7] - r[5]) / (4 * x), y = (r[1] + r[3]) / (4 * x), z = (r[2] + r[6]) / (4 * x);
+  } else if (y2 >= z2) {
+    y = std::sqrt(y2) / 2;
+    w = (r[2] - r[6]) / (4 * y), x = (r[1] + r[3]) / (4 * y), z = (r[5] + r[7]) / (4 * y);
+  } else {
+    z = std::sqrt(z2) / 2;
+    w = (r[3] - r[1]) / (4 * z), x = (r[2] + r[6]) / (4 * z), y = (r[5] + r[7]) / (4 * z);
+  }
+  std::array<double, 7> pose = {w, x, y, z, 0, 0, 0};
+  for (size_t row = 0; row < 3; ++row)
+    pose[4 + row] = -(r[row * 3] * camera.position[0] + r[row * 3 + 1] * camera.position[1] +
+                      r[row * 3 + 2] * camera.position[2]);
+  return pose;
+}
+
+template <typename T>
+void put(std::string& bytes, T value) {
+  bytes.append(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+// A COLMAP model of the views, each with its own PINHOLE camera, in COLMAP's binary and text layouts.
+void write_colmap(const std::vector<CameraView>& views, const fs::path& folder, bool binary) {
+  fs::create_directories(folder);
+  if (binary) {
+    std::string cameras, images;
+    put<uint64_t>(cameras, views.size());
+    put<uint64_t>(images, views.size());
+    // Written in reverse: the reader orders the views by image name, as the trainer does.
+    for (size_t i = views.size(); i-- > 0;) {
+      const Camera& c = views[i].camera;
+      put<int32_t>(cameras, int32_t(i + 1));
+      put<int32_t>(cameras, 1);  // PINHOLE
+      put<uint64_t>(cameras, uint64_t(c.width));
+      put<uint64_t>(cameras, uint64_t(c.height));
+      for (double p : {c.fx, c.fy, c.cx, c.cy}) put<double>(cameras, p);
+      put<int32_t>(images, int32_t(100 + i));
+      for (double p : colmap_pose(c)) put<double>(images, p);
+      put<int32_t>(images, int32_t(i + 1));
+      images += views[i].name;
+      images += '\0';
+      put<uint64_t>(images, 2);  // two 2D points, skipped by the reader
+      for (int k = 0; k < 2; ++k) {
+        put<double>(images, 1.5);
+        put<double>(images, 2.5);
+        put<int64_t>(images, -1);
+      }
+    }
+    std::ofstream(folder / "cameras.bin", std::ios::binary) << cameras;
+    std::ofstream(folder / "images.bin", std::ios::binary) << images;
+    return;
+  }
+  std::ofstream cameras(folder / "cameras.txt"), images(folder / "images.txt");
+  cameras.precision(17);
+  images.precision(17);
+  cameras
+      << "# Camera list with one line of data per camera:\n#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n";
+  images << "# Image list with two lines of data per image:\n";
+  for (size_t i = views.size(); i-- > 0;) {
+    const Camera& c = views[i].camera;
+    cameras << i + 1 << " PINHOLE " << c.width << " " << c.height << " " << c.fx << " " << c.fy << " " << c.cx
+            << " " << c.cy << "\n";
+    const auto pose = colmap_pose(c);
+    images << 100 + i;
+    for (double p : pose) images << " " << p;
+    images << " " << i + 1 << " " << views[i].name << "\n" << (i % 2 ? "1.5 2.5 -1 3.5 4.5 7\n" : "\n");
+  }
+}
+
+std::vector<CameraView> reference_views() {
+  return tilesplat::load_cameras_json(tilesplat::testing::bundled_playbot_cameras());
+}
+
+TEST(CameraSets, ColmapBinaryAndTextModelsReadAsTheSameCameras) {
+  const auto views = reference_views();
+  const fs::path out = fresh_output_dir();
+  for (const bool binary : {true, false}) {
+    const fs::path model = out / (binary ? "bin" : "txt") / "sparse" / "0";
+    write_colmap(views, model, binary);
+    // The dataset root (with sparse/0), the model folder and one of its files all name the model.
+    for (const fs::path& path :
+         {out / (binary ? "bin" : "txt"), model, model / (binary ? "images.bin" : "cameras.txt")}) {
+      const auto read = tilesplat::load_camera_set(path);
+      ASSERT_EQ(read.size(), views.size()) << path;
+      for (size_t i = 0; i < views.size(); ++i) {
+        EXPECT_EQ(read[i].name, views[i].name);
+        EXPECT_EQ(read[i].id, int(100 + i));
+        expect_near_camera(read[i].camera, views[i].camera);
+      }
+    }
+  }
+}
+
+TEST(CameraSets, ColmapDistortionTruncationAndMissingCamerasAreErrors) {
+  const auto views = reference_views();
+  const fs::path out = fresh_output_dir();
+  write_colmap(views, out / "radial", false);
+  std::ofstream(out / "radial" / "cameras.txt") << "1 SIMPLE_RADIAL 640 480 500 320 240 0.01\n";
+  EXPECT_NE(error_of([&] {
+              tilesplat::load_colmap_cameras(out / "radial");
+            }).find("uses the SIMPLE_RADIAL model, whose lens distortion the renderer cannot honour"),
+            std::string::npos);
+  std::ofstream(out / "radial" / "cameras.txt") << "7 PINHOLE 640 480 500 500 320 240\n";
+  EXPECT_NE(error_of([&] { tilesplat::load_colmap_cameras(out / "radial"); }).find("is not in cameras.txt"),
+            std::string::npos);
+
+  write_colmap(views, out / "cut", true);
+  const fs::path images = out / "cut" / "images.bin";
+  fs::resize_file(images, fs::file_size(images) - 30);
+  const std::string truncated = error_of([&] { tilesplat::load_colmap_cameras(out / "cut"); });
+  EXPECT_NE(truncated.find(images.string()), std::string::npos) << truncated;
+  EXPECT_NE(truncated.find("truncated"), std::string::npos) << truncated;
+  {
+    std::string huge;
+    put<uint64_t>(huge, uint64_t(1) << 60);
+    std::ofstream(out / "cut" / "cameras.bin", std::ios::binary) << huge;
+  }
+  EXPECT_NE(error_of([&] { tilesplat::load_colmap_cameras(out / "cut"); }).find("more than the file holds"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { tilesplat::load_colmap_cameras(out / "nothing"); }).find("not found"),
+            std::string::npos);
+}
+
+// transforms.json keeps camera-to-world in the OpenGL convention: the engine's y and z axes negated.
+std::string transforms_json(const std::vector<CameraView>& views, const std::string& extra_top = "") {
+  char number[64];
+  std::snprintf(number, sizeof number, "%.17g", views[0].camera.fx);
+  std::string text = "{" + extra_top + "\"fl_x\": " + number +
+                     ", \"w\": " + std::to_string(views[0].camera.width) +
+                     ", \"h\": " + std::to_string(views[0].camera.height) + ", \"frames\": [";
+  for (size_t i = 0; i < views.size(); ++i) {
+    const Camera& c = views[i].camera;
+    const auto& r = c.rotation;  // world-to-camera: camera-to-world is its transpose
+    text += std::string(i ? "," : "") + "{\"file_path\": \"images/" + views[i].name + "\", \"fl_y\": ";
+    std::snprintf(number, sizeof number, "%.17g", c.fy);
+    text += number;
+    text += ", \"transform_matrix\": [";
+    for (size_t row = 0; row < 3; ++row) {
+      const double values[4] = {r[0 * 3 + row], -r[1 * 3 + row], -r[2 * 3 + row], c.position[row]};
+      text += "[";
+      for (size_t col = 0; col < 4; ++col) {
+        std::snprintf(number, sizeof number, "%.17g", values[col]);
+        text += std::string(col ? ", " : "") + number;
+      }
+      text += "], ";
+    }
+    text += "[0, 0, 0, 1]]}";
+  }
+  return text + "]}";
+}
+
+TEST(CameraSets, TransformsJsonReadsAsTheSameCameras) {
+  auto views = reference_views();
+  for (auto& view : views) view.camera.fx = views[0].camera.fx;  // one shared fl_x at the top level
+  const fs::path out = fresh_output_dir();
+  std::ofstream(out / "transforms.json") << transforms_json(views);
+  const auto read = tilesplat::load_camera_set(out / "transforms.json");
+  ASSERT_EQ(read.size(), views.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    EXPECT_EQ(read[i].name, "images/" + views[i].name);
+    expect_near_camera(read[i].camera, views[i].camera, 1e-12);
+  }
+  // instant-ngp's camera_angle_x gives the focal length from the width.
+  std::ofstream(out / "ngp.json") << R"({"camera_angle_x": 1.5707963267948966, "w": 800, "h": 600, "frames": [
+      {"file_path": "a", "transform_matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,4],[0,0,0,1]]}]})";
+  const auto ngp = tilesplat::load_transforms_json(out / "ngp.json");
+  EXPECT_NEAR(ngp[0].camera.fx, 400, 1e-9);
+  EXPECT_NEAR(ngp[0].camera.fy, 400, 1e-9);
+  // Looking down -z in OpenGL is looking down +z in the engine's frame: the camera at z = 4 sees the origin.
+  EXPECT_NEAR(ngp[0].camera.to_camera({0, 0, 0})[2], 4, 1e-12);
+
+  std::ofstream(out / "distorted.json") << transforms_json(views, "\"k1\": 0.05, ");
+  EXPECT_NE(error_of([&] {
+              tilesplat::load_camera_set(out / "distorted.json");
+            }).find("frame 0: distortion coefficient k1 is not zero"),
+            std::string::npos);
+  std::ofstream(out / "fisheye.json") << transforms_json(views, "\"camera_model\": \"OPENCV_FISHEYE\", ");
+  EXPECT_NE(error_of([&] { tilesplat::load_camera_set(out / "fisheye.json"); }).find("OPENCV_FISHEYE"),
+            std::string::npos);
+  std::ofstream(out / "sizeless.json")
+      << R"({"fl_x": 500, "frames": [{"transform_matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]})";
+  EXPECT_NE(error_of([&] { tilesplat::load_camera_set(out / "sizeless.json"); }).find("missing 'w'"),
+            std::string::npos);
+}
+
+TEST(CameraSets, RendersFromEverySetAgree) {
+  // The same view read from the three formats renders the same image (the rotations differ by
+  // rounding only, far below what moves a pixel's value beyond float noise).
+  const auto views = reference_views();
+  const fs::path out = fresh_output_dir();
+  write_colmap(views, out / "colmap", true);
+  const auto from_colmap = tilesplat::load_camera_set(out / "colmap");
+  auto& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(tilesplat::load_scene(tilesplat::testing::bundled_playbot()));
+  const Camera json_camera = tilesplat::resize_camera(views[3].camera, 160, 90);
+  const Camera colmap_camera = tilesplat::resize_camera(from_colmap[3].camera, 160, 90);
+  const auto expected = renderer.render(json_camera);
+  const auto actual = renderer.render(colmap_camera);
+  const auto difference = tilesplat::compare_images(expected, actual);
+  EXPECT_GT(difference.psnr_db, 80.0);
+  EXPECT_LT(difference.max_abs, 1e-4);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(CameraPaths, KeysAreMetAndTheMotionIsSmooth) {
+  tilesplat::CameraPath path;
+  path.keys.resize(3);
+  path.keys[0].position = {0, 0, -4};
+  path.keys[1].position = {4, 0, 0};
+  path.keys[2].position = {0, 0, 4};
+  path.keys[1].vertical_fov_deg = 30;
+  for (auto& key : path.keys)
+    key.rotation = tilesplat::look_at_camera(key.position, {0, 0, 0}, {0, -1, 0}, 1, 1, 50).rotation;
+  const auto cameras = tilesplat::sample_camera_path(path, 9, 64, 32);
+  ASSERT_EQ(cameras.size(), 9u);
+  EXPECT_EQ(cameras[0].position, path.keys[0].position);
+  EXPECT_EQ(cameras[0].rotation, path.keys[0].rotation);
+  for (const int k : {0, 1, 2}) {
+    const Camera& at_key = cameras[size_t(k * 4)];
+    for (size_t i = 0; i < 3; ++i) EXPECT_NEAR(at_key.position[i], path.keys[size_t(k)].position[i], 1e-12);
+    for (size_t i = 0; i < 9; ++i) EXPECT_NEAR(at_key.rotation[i], path.keys[size_t(k)].rotation[i], 1e-12);
+    EXPECT_NEAR(at_key.tan_half_fov_y(),
+                std::tan(path.keys[size_t(k)].vertical_fov_deg * std::numbers::pi / 360), 1e-12);
+  }
+  // Between the keys every rotation is a rotation, and consecutive frames turn by similar angles.
+  for (const Camera& camera : cameras) {
+    const auto& r = camera.rotation;
+    for (size_t i = 0; i < 3; ++i)
+      EXPECT_NEAR(r[i * 3] * r[i * 3] + r[i * 3 + 1] * r[i * 3 + 1] + r[i * 3 + 2] * r[i * 3 + 2], 1, 1e-12);
+    // The slerp between look-at keys keeps the origin near the image centre.
+    const auto origin = camera.to_camera({0, 0, 0});
+    EXPECT_GT(origin[2], 0);
+  }
+  // A loop comes back to the first key after the last.
+  path.loop = true;
+  const Camera closing = tilesplat::camera_on_path(path, 1.0, 64, 32);
+  for (size_t i = 0; i < 3; ++i) EXPECT_NEAR(closing.position[i], path.keys[0].position[i], 1e-12);
+  EXPECT_THROW(tilesplat::camera_on_path(path, 1.5, 64, 32), std::invalid_argument);
+  path.keys.resize(1);
+  EXPECT_THROW(tilesplat::sample_camera_path(path, 3, 64, 32), std::invalid_argument);
+}
+
+TEST(CameraPaths, KeyframeFileMistakesNameTheKey) {
+  const fs::path out = fresh_output_dir();
+  auto error_for = [&](const std::string& text) {
+    std::ofstream(out / "keys.json") << text;
+    return error_of([&] { tilesplat::load_camera_path(out / "keys.json"); });
+  };
+  const std::string good = R"({"position": [0, 0, 4], "look_at": [0, 0, 0]})";
+  EXPECT_NE(error_for(R"({"keyframes": [)" + good + "]}").find("at least 2 keyframes, found 1"),
+            std::string::npos);
+  EXPECT_NE(error_for(R"({"keyframes": [)" + good + R"(, {"position": [1, 0, 4], "look_at": [1, 0, 4]}]})")
+                .find("keyframe 1: 'look_at' must differ from 'position'"),
+            std::string::npos);
+  EXPECT_NE(error_for(R"({"keyframes": [)" + good +
+                      R"(, {"position": [1, 0, 4], "rotation": [[2,0,0],[0,1,0],[0,0,1]]}]})")
+                .find("keyframe 1: 'rotation' is not orthonormal"),
+            std::string::npos);
+  EXPECT_NE(error_for(R"({"keyframes": [)" + good +
+                      R"(, {"position": [1, 0, 4], "look_at": [0, 0, 0], "fov": 180}]})")
+                .find("keyframe 1: 'fov' must be"),
+            std::string::npos);
+  EXPECT_NE(error_for(R"({"keyframes": [)" + good + R"(, {"position": [1, 0, 4]}]})").find("exactly one of"),
+            std::string::npos);
+  EXPECT_NE(error_for(R"([1, 2])").find("expected an object"), std::string::npos);
+  EXPECT_NE(error_for(R"({"keyframes": [)").find("invalid JSON"), std::string::npos);
+}
+
+}  // namespace
