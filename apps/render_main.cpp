@@ -1,16 +1,27 @@
-// tilesplat-render: renders one view of a scene to an EXR (and optionally a PNG preview).
+// tilesplat-render: renders a view of a scene to an EXR (and optionally a PNG preview), or many
+// frames in one process (the views of a camera set, an orbit, a keyframed path) with a manifest
+// that makes the run resumable and lets shards of it run as separate processes.
 #include <array>
 #include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <future>
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "cli.h"
+#include "frame_manifest.h"
+#include "frame_sequence.h"
+#include "progress.h"
 #include "sha256.h"
 #include "tilesplat/camera.h"
+#include "tilesplat/camera_path.h"
 #include "tilesplat/image.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/renderer.h"
@@ -36,6 +47,28 @@ struct RenderOptions {
   bool reference = false;
   int stochastic_frames = 0;  // --stochastic N: the sort-free compositor averaging N frames; 0 = sorted
   bool stats = false;
+  // Many frames in one run.
+  std::string views;      // --views: a selection of the camera set's views
+  int orbit_frames = 0;   // --orbit N
+  std::string path_file;  // --path KEYFRAMES.json
+  int path_frames = 0;    // --frames N (with --path)
+  std::optional<std::string> shard;
+  std::optional<int> shard_count;
+  bool force = false;
+  bool quiet = false;
+  std::string merge_folder;  // --merge-manifests
+};
+
+// One image the run writes.
+struct Frame {
+  int frame = 0;   // its position in the run's sequence (what shards split)
+  int number = 0;  // the number in its file name: the view index, or the frame of an orbit or path
+  tilesplat::Camera camera;
+  std::string description;  // "view 3 (img_3) of cameras.json", "orbit frame 5 of 100", ...
+  std::optional<int> view_index;
+  std::string view_name;
+  fs::path exr;
+  fs::path png;  // empty: no preview
 };
 
 std::string single_quoted(const std::string& text) { return "'" + text + "'"; }
@@ -151,20 +184,378 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                     "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
                     "intersections, retries",
                     &options.stats);
+
+  parser.section("many frames (one process; -o and --png then take a frame number: out/view_%04d.exr)");
+  parser.add_string(
+      "--views", "SELECTION",
+      "render these views of the cameras: all, a list such as 0,3,8-11, or every:K (0, K, 2K, ...; "
+      "every:8 is the 3DGS evaluation split); the frame number is the view index",
+      &options.views);
+  parser.add_int("--orbit", "N",
+                 "render N frames around the scene (from --azimuth, 360/N degrees apart, at --elevation, "
+                 "--fov, --distance)",
+                 &options.orbit_frames, 1, 1000000);
+  parser.add_string("--path", "KEYS.json",
+                    "render --frames N frames along a keyframed camera path (Catmull-Rom positions, slerped "
+                    "rotations; the format is docs/camera-paths.md)",
+                    &options.path_file);
+  parser.add_int("--frames", "N", "how many frames --path renders", &options.path_frames, 1, 1000000);
+  parser.add_value("--shard", "I/N",
+                   "render only frames k with k mod N == I (default: from a Slurm job array's "
+                   "SLURM_ARRAY_TASK_ID/COUNT/MIN, or a Kubernetes Indexed Job's JOB_COMPLETION_INDEX)",
+                   [&options](const std::string& text) { options.shard = text; });
+  parser.add_value("--shard-count", "N",
+                   "the number of shards of a Kubernetes Indexed Job (its completions; default: "
+                   "TILESPLAT_SHARD_COUNT)",
+                   [&options](const std::string& text) {
+                     options.shard_count = cli::parse_int("--shard-count", text, 1, 1000000);
+                   });
+  parser.add_switch("--force",
+                    "render every frame again, even those the manifest lists as done with matching files",
+                    &options.force);
+  parser.add_switch("--quiet", "no progress bar or progress lines (errors and warnings still print)",
+                    &options.quiet);
+  parser.add_string("--merge-manifests", "FOLDER",
+                    "check that the shards' manifests in FOLDER cover every frame exactly once with intact "
+                    "files, and write their union to FOLDER/manifest.jsonl (no rendering)",
+                    &options.merge_folder);
+}
+
+// Whether the flags ask for a sequence of frames rather than one view.
+bool renders_sequence(const cli::ArgParser& parser) {
+  return parser.seen("--views") || parser.seen("--orbit") || parser.seen("--path");
+}
+
+// The flag mistakes of a many-frame run, before anything is loaded.
+void check_sequence_flags(const cli::ArgParser& parser, const RenderOptions& options) {
+  const int sources = int(parser.seen("--views")) + int(parser.seen("--orbit")) + int(parser.seen("--path"));
+  if (sources > 1)
+    throw cli::UsageError("--views, --orbit and --path each choose the frames: give one of them");
+  if (parser.seen("--frames") != parser.seen("--path"))
+    throw cli::UsageError(parser.seen("--path")
+                              ? "--path needs --frames N: how many frames to render along it"
+                              : "--frames applies to --path KEYS.json");
+  if (!renders_sequence(parser)) {
+    for (const char* flag : {"--shard", "--shard-count", "--force"})
+      if (parser.seen(flag))
+        throw cli::UsageError(std::string(flag) + " applies to many frames (--views, --orbit or --path)");
+    return;
+  }
+  if (parser.seen("--view"))
+    throw cli::UsageError("--view renders one view; --views chooses several, not both");
+  if (!options.common.cameras.empty() && !parser.seen("--views"))
+    throw cli::UsageError(
+        "--cameras gives the views that --views chooses from; --orbit and --path make their own");
+  if (parser.seen("--path"))
+    for (const char* orbit_flag : {"--azimuth", "--elevation", "--fov", "--distance"})
+      if (parser.seen(orbit_flag))
+        throw cli::UsageError(std::string(orbit_flag) +
+                              " shapes the orbit; the keyframes of --path set the camera");
+  if (options.stats)
+    throw cli::UsageError(
+        "--stats prints one frame's statistics; with many frames the manifest records each one's GPU ms");
+  if (parser.seen("--shard-count") && parser.seen("--shard"))
+    throw cli::UsageError("--shard-count is for Kubernetes Indexed Jobs; --shard I/N names the count itself");
+}
+
+std::string png_settings_text(const tilesplat::PreviewOptions& preview) {
+  return "exposure=" + cli::format_fixed(preview.exposure_stops, 3) +
+         " tone_map=" + tilesplat::to_string(preview.tone_map);
+}
+
+// The frames of a many-frame run, in order, with their files.
+std::vector<Frame> plan_sequence(const cli::ArgParser& parser, const RenderOptions& options,
+                                 const cli::LoadedScene& loaded) {
+  const cli::CommonOptions& common = options.common;
+  std::vector<Frame> frames;
+  if (parser.seen("--views")) {
+    const cli::SceneViews own = cli::scene_views(loaded);
+    if (common.cameras.empty() && own.views.empty())
+      throw cli::UsageError("--views needs cameras: " + single_quoted(loaded.path.string()) +
+                            " has none of its own, and no --cameras was given");
+    const std::vector<tilesplat::CameraView> views =
+        common.cameras.empty() ? own.views : cli::load_camera_views(common.cameras);
+    const fs::path file = common.cameras.empty() ? own.file : fs::path(common.cameras);
+    for (const int view :
+         cli::parse_view_selection("--views", options.views, static_cast<int>(views.size()))) {
+      const cli::NamedCamera named =
+          cli::view_camera(views, view, file, common.width, common.height, "--views");
+      frames.push_back({static_cast<int>(frames.size()),
+                        view,
+                        named.camera,
+                        named.description,
+                        view,
+                        views[size_t(view)].name,
+                        {},
+                        {}});
+    }
+  } else {
+    const cli::ImageSize size = cli::orbit_image_size(common.width, common.height);
+    std::vector<tilesplat::Camera> cameras;
+    std::string what;
+    if (parser.seen("--orbit")) {
+      if (loaded.scene.empty())
+        throw std::runtime_error(single_quoted(loaded.path.string()) +
+                                 " has no Gaussians for --orbit to frame");
+      cameras =
+          tilesplat::orbit_cameras(loaded.scene, options.orbit_frames, size.width, size.height, common.orbit);
+      what = "orbit";
+    } else {
+      tilesplat::CameraPath path;
+      try {
+        path = tilesplat::load_camera_path(options.path_file);
+      } catch (const std::exception& error) {
+        throw std::runtime_error("cannot read --path: " + cli::one_line(error.what()));
+      }
+      cameras = tilesplat::sample_camera_path(path, options.path_frames, size.width, size.height);
+      what = "path " + fs::path(options.path_file).filename().string();
+    }
+    for (size_t f = 0; f < cameras.size(); ++f)
+      frames.push_back({static_cast<int>(f),
+                        static_cast<int>(f),
+                        cameras[f],
+                        what + " frame " + std::to_string(f) + " of " + std::to_string(cameras.size()),
+                        {},
+                        {},
+                        {},
+                        {}});
+  }
+
+  for (const auto& [flag, pattern] : {std::pair{"-o", options.output}, std::pair{"--png", options.png}})
+    if (!pattern.empty() && frames.size() > 1 && !cli::has_frame_number(pattern))
+      throw cli::UsageError(std::string(flag) + " " + single_quoted(pattern) +
+                            " has no frame number for the " + std::to_string(frames.size()) +
+                            " frames: write it as %04d (e.g. out/view_%04d.exr)");
+  for (Frame& frame : frames) {
+    frame.exr = cli::frame_file("-o", options.output, frame.number);
+    if (!options.png.empty()) frame.png = cli::frame_file("--png", options.png, frame.number);
+  }
+  return frames;
+}
+
+// The manifest entry a finished frame gets (bytes and checksums filled when it is written).
+cli::ManifestEntry manifest_entry(const Frame& frame, int frame_count, const fs::path& folder,
+                                  const std::string& settings) {
+  cli::ManifestEntry entry;
+  entry.frame = frame.frame;
+  entry.frames = frame_count;
+  entry.number = frame.number;
+  entry.camera = frame.description;
+  entry.width = frame.camera.width;
+  entry.height = frame.camera.height;
+  entry.file = frame.exr.lexically_relative(folder).string();
+  if (!frame.png.empty()) entry.png = frame.png.lexically_relative(folder).string();
+  entry.settings = settings;
+  return entry;
+}
+
+// The frames whose manifest line matches this run's frame (same file, camera, size and settings)
+// and whose files are intact. A later line of the same frame overrides an earlier one.
+std::map<int, cli::ManifestEntry> finished_frames(const std::vector<Frame>& frames, const fs::path& folder,
+                                                  const std::string& settings, const cli::Shard& shard) {
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) return {};
+  std::map<int, cli::ManifestEntry> latest;
+  for (const cli::ManifestLine& line : cli::read_manifests(folder)) {
+    const cli::ManifestEntry& entry = line.entry;
+    if (entry.frames != static_cast<int>(frames.size()) || !shard.takes(entry.frame)) continue;
+    const cli::ManifestEntry wanted =
+        manifest_entry(frames[size_t(entry.frame)], static_cast<int>(frames.size()), folder, settings);
+    if (entry.file == wanted.file && entry.png == wanted.png && entry.camera == wanted.camera &&
+        entry.width == wanted.width && entry.height == wanted.height && entry.settings == wanted.settings &&
+        entry.number == wanted.number)
+      latest[entry.frame] = entry;
+  }
+  std::map<int, cli::ManifestEntry> finished;
+  for (const auto& [frame, entry] : latest)
+    if (cli::files_match(folder, entry)) finished.emplace(frame, entry);  // else rendered again
+  return finished;
+}
+
+// What every frame of the run shares: the settings, the EXR and preview options and attributes.
+struct FrameWriter {
+  tilesplat::ExrWriteOptions exr;
+  tilesplat::PreviewOptions preview;
+
+  // Writes the EXR, then the preview (a preview must never exist without the image it previews).
+  void write(const Frame& frame, const tilesplat::RenderImage& image) const {
+    tilesplat::ExrWriteOptions options = exr;
+    options.camera = frame.camera;  // worldToCamera, worldToNDC and the exact camera
+    options.attributes["view"] = frame.description;
+    if (frame.view_index) {
+      options.attributes["viewIndex"] = std::to_string(*frame.view_index);
+      options.attributes["viewName"] = frame.view_name;
+    }
+    try {
+      tilesplat::write_exr(frame.exr, image, options);
+    } catch (const std::exception& error) {
+      throw std::runtime_error(write_failure(frame.exr, error));
+    }
+    if (frame.png.empty()) return;
+    try {
+      tilesplat::write_png_preview(frame.png, image, preview);
+    } catch (const std::exception& error) {
+      throw std::runtime_error(write_failure(frame.png, error));
+    }
+  }
+};
+
+// Renders one camera with the GPU renderer or the float64 reference; `gpu_ms` gets the frame's time.
+class FrameRenderer {
+ public:
+  FrameRenderer(const RenderOptions& options, const tilesplat::GaussianScene& scene) : scene_(scene) {
+    if (options.reference) return;
+    renderer_ = tilesplat::Renderer::create(cli::renderer_options(options.common));
+    renderer_->set_scene(scene);
+  }
+
+  tilesplat::RenderImage render(const tilesplat::Camera& camera, const tilesplat::RenderSettings& settings) {
+    tilesplat::RenderImage image;
+    if (renderer_) {
+      image = renderer_->render(camera, settings);
+      gpu_ms_ = renderer_->last_frame_stats().gpu_ms;
+      cpu_ms_ = renderer_->last_frame_stats().cpu_ms;
+    } else {
+      const auto start = std::chrono::steady_clock::now();
+      image = tilesplat::render_reference(scene_, camera, settings);
+      cpu_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      gpu_ms_ = 0;
+    }
+    if (image.width != camera.width || image.height != camera.height ||
+        image.rgba.size() != image.pixels() * 4)
+      throw std::runtime_error("the renderer returned a " + std::to_string(image.width) + "x" +
+                               std::to_string(image.height) + " image for a " + std::to_string(camera.width) +
+                               "x" + std::to_string(camera.height) + " camera");
+    if (!settings.depth) image.depth.clear();
+    if (!settings.splat_count) image.splat_count.clear();
+    return image;
+  }
+
+  double gpu_ms() const { return gpu_ms_; }
+  double cpu_ms() const { return cpu_ms_; }
+  tilesplat::Renderer* gpu() const { return renderer_.get(); }
+
+ private:
+  const tilesplat::GaussianScene& scene_;
+  std::unique_ptr<tilesplat::Renderer> renderer_;
+  double gpu_ms_ = 0, cpu_ms_ = 0;
+};
+
+cli::FrameProgress::Style progress_style(bool quiet) {
+  if (quiet) return cli::FrameProgress::Style::kQuiet;
+  return cli::stderr_is_terminal() ? cli::FrameProgress::Style::kBar : cli::FrameProgress::Style::kLines;
+}
+
+std::optional<std::string> environment(const char* name) {
+  const char* value = std::getenv(name);
+  if (value == nullptr || *value == '\0') return std::nullopt;
+  return std::string(value);
+}
+
+// Renders the shard's frames that are not done yet. Frame i + 1 renders while frame i is encoded
+// and written on another thread; its manifest line is appended once its files are complete.
+int render_sequence(const RenderOptions& options, const std::vector<Frame>& frames, const cli::Shard& shard,
+                    const cli::LoadedScene& loaded, const tilesplat::RenderSettings& settings,
+                    const FrameWriter& writer, const std::string& settings_line) {
+  fs::path folder = frames.front().exr.parent_path();
+  if (folder.empty()) folder = ".";
+  const int frame_count = static_cast<int>(frames.size());
+  const auto finished = options.force ? std::map<int, cli::ManifestEntry>{}
+                                      : finished_frames(frames, folder, settings_line, shard);
+  std::vector<const Frame*> to_render;
+  int in_shard = 0;
+  for (const Frame& frame : frames) {
+    if (!shard.takes(frame.frame)) continue;
+    ++in_shard;
+    if (!finished.count(frame.frame)) to_render.push_back(&frame);
+  }
+  if (!options.quiet) {
+    std::string line = std::string(kProgram) + ": ";
+    if (shard.count > 1)
+      line += "shard " + std::to_string(shard.index) + "/" + std::to_string(shard.count) + " (" +
+              shard.source + "): ";
+    line +=
+        std::to_string(in_shard) + (shard.count > 1 ? " of " + std::to_string(frame_count) : "") + " frames";
+    if (!finished.empty())
+      line +=
+          ", " + std::to_string(finished.size()) + " already done (manifest and checksums match), skipped";
+    std::fprintf(stderr, "%s\n", line.c_str());
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<double> gpu_ms;
+  if (!to_render.empty()) {
+    cli::ManifestAppender manifest(folder / cli::manifest_file_name(shard));
+    FrameRenderer renderer(options, loaded.scene);
+    cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()), progress_style(options.quiet));
+    std::future<void> writing;
+    for (const Frame* frame : to_render) {
+      tilesplat::RenderImage image = renderer.render(frame->camera, settings);
+      cli::ManifestEntry entry = manifest_entry(*frame, frame_count, folder, settings_line);
+      entry.gpu_ms = renderer.gpu() ? renderer.gpu_ms() : renderer.cpu_ms();
+      gpu_ms.push_back(entry.gpu_ms);
+      if (writing.valid()) writing.get();  // rethrows the previous frame's write failure
+      writing = std::async(std::launch::async,
+                           [&writer, &manifest, &progress, frame, entry, image = std::move(image)]() mutable {
+                             writer.write(*frame, image);
+                             entry.bytes = fs::file_size(frame->exr);
+                             entry.sha256 = cli::sha256_file_hex(frame->exr);
+                             if (!frame->png.empty()) entry.png_sha256 = cli::sha256_file_hex(frame->png);
+                             entry.resident_mib = double(cli::resident_memory_bytes()) / (1024.0 * 1024.0);
+                             manifest.append(entry);
+                             progress.frame_done();
+                           });
+    }
+    writing.get();
+    progress.finish();
+    if (renderer.gpu())
+      if (const auto messages = renderer.gpu()->validation_messages(); messages > 0)
+        cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!options.quiet) {
+    std::string line = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
+                       std::to_string(to_render.size()) + " frames rendered";
+    if (!finished.empty()) line += ", " + std::to_string(finished.size()) + " skipped";
+    if (!to_render.empty())
+      line += " in " + cli::format_fixed(seconds, 1) + " s (" +
+              cli::format_fixed(double(to_render.size()) / seconds, 2) + " frames/s, " +
+              (options.reference ? "CPU reference " : "GPU ") + "median " +
+              cli::format_fixed(cli::median(gpu_ms), 2) + " ms)";
+    line += " -> " + (folder / cli::manifest_file_name(shard)).string();
+    std::fprintf(stderr, "%s\n", line.c_str());
+  }
+  return cli::kExitOk;
+}
+
+int merge(const cli::ArgParser& parser, const RenderOptions& options) {
+  if (!options.common.scene.empty())
+    throw cli::UsageError("--merge-manifests FOLDER merges what the shards wrote and takes no SCENE");
+  (void)parser;
+  const cli::MergeResult result = cli::merge_manifests(options.merge_folder);
+  std::fprintf(stderr, "%s: %zu shard manifests cover all %zu frames exactly once, files intact -> %s\n",
+               kProgram, result.manifests, result.frames, result.merged.string().c_str());
+  return cli::kExitOk;
 }
 
 int run(int argc, char** argv) {
   cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
   RenderOptions options;
-  cli::ArgParser parser(kProgram, "tilesplat-render SCENE.ply|SCENE.json -o OUT.exr [options]",
-                        "Renders one view of a 3D Gaussian Splatting scene with the Vulkan compute renderer "
-                        "and writes it as an EXR. The camera comes from the trainer's cameras.json "
-                        "(--cameras, --view), from the scene file's cameras (--view), or orbits the scene "
-                        "(--azimuth, --elevation, --fov). A scene file's background and outputs apply unless "
-                        "--background, --no-depth or --no-count say otherwise.");
+  cli::ArgParser parser(
+      kProgram, "tilesplat-render SCENE.ply|SCENE.json -o OUT.exr [options]",
+      "Renders a view of a 3D Gaussian Splatting scene with the Vulkan compute renderer "
+      "and writes it as an EXR. The camera comes from a camera set (--cameras: the "
+      "trainer's cameras.json, a transforms.json or a COLMAP model; --view), from the scene "
+      "file's cameras (--view), or orbits the scene (--azimuth, --elevation, --fov). "
+      "--views, --orbit N and --path render many frames in one process, resumably "
+      "(out/manifest.jsonl) and in shards (--shard). A scene file's background and outputs "
+      "apply unless --background, --no-depth or --no-count say otherwise.");
   add_render_options(parser, options);
   if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
+  if (parser.seen("--merge-manifests")) return merge(parser, options);
   cli::check_common_options(parser, options.common);
+  check_sequence_flags(parser, options);
+  const bool sequence = renders_sequence(parser);
   if (options.output.empty()) throw cli::UsageError("missing -o OUT.exr: where to write the image (see --help)");
   if (!cli::has_extension(options.output, ".exr"))
     throw cli::UsageError("-o expects an .exr file, got " + single_quoted(options.output) +
@@ -185,11 +576,33 @@ int run(int argc, char** argv) {
       if (parser.seen(gpu_flag))
         cli::print_warning(kProgram, std::string(gpu_flag) + " has no effect with --reference (CPU renderer)");
   }
+  const cli::Shard shard =
+      sequence ? cli::resolve_shard(options.shard, options.shard_count, environment) : cli::Shard{};
   // Fail before the (possibly long) load and render when the outputs cannot be written.
-  cli::check_output_path(options.output, "-o");
-  if (!options.png.empty()) cli::check_output_path(options.png, "--png");
+  if (sequence)
+    for (const auto& [flag, pattern] : {std::pair{"-o", options.output}, std::pair{"--png", options.png}}) {
+      if (pattern.empty()) continue;
+      cli::frame_file(flag, pattern, 0);  // throws for a malformed pattern
+      if (cli::has_frame_number(fs::path(pattern).parent_path().string()))
+        throw cli::UsageError(
+            std::string(flag) + " " + single_quoted(pattern) +
+            ": the frame number belongs in the file name, not the folder (the folder holds the "
+            "manifest)");
+    }
+  cli::check_output_path(sequence ? cli::frame_file("-o", options.output, 0) : options.output, "-o");
+  if (!options.png.empty())
+    cli::check_output_path(sequence ? cli::frame_file("--png", options.png, 0) : options.png, "--png");
 
-  const cli::LoadedScene loaded = cli::load_scene_and_camera(options.common, kProgram);
+  cli::LoadedScene loaded = sequence
+                                ? cli::load_scene_file(options.common.scene, options.common.strict, kProgram)
+                                : cli::load_scene_and_camera(options.common, kProgram);
+  std::vector<Frame> frames;
+  if (sequence) {
+    frames = plan_sequence(parser, options, loaded);
+  } else {
+    frames.push_back({0, loaded.view_index.value_or(0), loaded.camera, loaded.camera_description,
+                      loaded.view_index, loaded.view_name, options.output, options.png});
+  }
 
   tilesplat::RenderSettings settings;
   if (!options.common.sorts.empty()) settings.sort = options.common.sorts.front();
@@ -204,74 +617,51 @@ int run(int argc, char** argv) {
     settings.compositor = tilesplat::Compositor::kStochastic;
     settings.stochastic.frames = static_cast<uint32_t>(options.stochastic_frames);
   }
-  tilesplat::PreviewOptions preview;
+  FrameWriter writer;
   if (loaded.description) {
-    preview.exposure_stops = loaded.description->effects.exposure_stops;
-    preview.tone_map = loaded.description->effects.tone_map;
+    writer.preview.exposure_stops = loaded.description->effects.exposure_stops;
+    writer.preview.tone_map = loaded.description->effects.tone_map;
   }
-  if (parser.seen("--exposure")) preview.exposure_stops = options.preview.exposure_stops;
-  if (parser.seen("--tone-map")) preview.tone_map = options.preview.tone_map;
+  if (parser.seen("--exposure")) writer.preview.exposure_stops = options.preview.exposure_stops;
+  if (parser.seen("--tone-map")) writer.preview.tone_map = options.preview.tone_map;
+  writer.exr.half = options.half;
+  writer.exr.alpha = !loaded.description || loaded.description->outputs.alpha;
+  writer.exr.attributes["commandLine"] = cli::command_line(kProgram, argc, argv);
+  writer.exr.compression = options.compression;
+  writer.exr.attributes["scene"] = loaded.path.string();
+  writer.exr.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
+  writer.exr.attributes["renderSettings"] = settings_text(settings);
 
-  tilesplat::RenderImage image;
+  if (sequence) {
+    // Everything besides the camera that makes two runs' files differ, for the manifest.
+    std::string settings_line = settings_text(settings) + " exr=" + (options.half ? "half" : "float") + "," +
+                                tilesplat::to_string(options.compression) + (writer.exr.alpha ? ",A" : "") +
+                                (settings.depth ? ",Z" : "") + (settings.splat_count ? ",splats" : "");
+    if (!options.png.empty()) settings_line += " png=" + png_settings_text(writer.preview);
+    return render_sequence(options, frames, shard, loaded, settings, writer, settings_line);
+  }
+
+  const Frame& frame = frames.front();
+  FrameRenderer renderer(options, loaded.scene);
+  const tilesplat::RenderImage image = renderer.render(frame.camera, settings);
   std::string timing;
-  if (options.reference) {
-    const auto start = std::chrono::steady_clock::now();
-    image = tilesplat::render_reference(loaded.scene, loaded.camera, settings);
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    timing = "CPU reference " + cli::format_fixed(ms, 1) + " ms";
+  if (const tilesplat::Renderer* gpu = renderer.gpu()) {
+    const tilesplat::FrameStats& stats = gpu->last_frame_stats();
+    timing = "GPU " + cli::format_fixed(stats.gpu_ms, 2) + " ms, frame " +
+             cli::format_fixed(stats.cpu_ms, 2) + " ms";
+    if (options.stats) print_frame_stats(stats, gpu->device_info());
+    if (const auto messages = gpu->validation_messages(); messages > 0)
+      cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
+  } else {
+    timing = "CPU reference " + cli::format_fixed(renderer.cpu_ms(), 1) + " ms";
     if (options.stats) {
-      print_row("cpu reference", cli::format_fixed(ms, 3), "ms");
+      print_row("cpu reference", cli::format_fixed(renderer.cpu_ms(), 3), "ms");
       print_row("gaussians", std::to_string(loaded.scene.size()), "");
     }
-  } else {
-    const auto renderer = tilesplat::Renderer::create(cli::renderer_options(options.common));
-    renderer->set_scene(loaded.scene);
-    image = renderer->render(loaded.camera, settings);
-    const tilesplat::FrameStats& stats = renderer->last_frame_stats();
-    timing = "GPU " + cli::format_fixed(stats.gpu_ms, 2) + " ms, frame " + cli::format_fixed(stats.cpu_ms, 2) +
-             " ms";
-    if (options.stats) print_frame_stats(stats, renderer->device_info());
-    if (const auto messages = renderer->validation_messages(); messages > 0)
-      cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
   }
-  if (image.width != loaded.camera.width || image.height != loaded.camera.height ||
-      image.rgba.size() != image.pixels() * 4)
-    throw std::runtime_error("the renderer returned a " + std::to_string(image.width) + "x" +
-                             std::to_string(image.height) + " image for a " + std::to_string(loaded.camera.width) +
-                             "x" + std::to_string(loaded.camera.height) + " camera");
-  if (!settings.depth) image.depth.clear();
-  if (!settings.splat_count) image.splat_count.clear();
-
-  // The EXR first: a preview must never exist without the image it previews.
-  tilesplat::ExrWriteOptions exr_options;
-  exr_options.half = options.half;
-  exr_options.alpha = !loaded.description || loaded.description->outputs.alpha;
-  exr_options.attributes["commandLine"] = cli::command_line(kProgram, argc, argv);
-  exr_options.camera = loaded.camera;  // worldToCamera, worldToNDC and the exact camera
-  exr_options.compression = options.compression;
-  exr_options.attributes["scene"] = loaded.path.string();
-  exr_options.attributes["view"] = loaded.camera_description;
-  if (loaded.view_index) {
-    exr_options.attributes["viewIndex"] = std::to_string(*loaded.view_index);
-    exr_options.attributes["viewName"] = loaded.view_name;
-  }
-  exr_options.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
-  exr_options.attributes["renderSettings"] = settings_text(settings);
-  try {
-    tilesplat::write_exr(options.output, image, exr_options);
-  } catch (const std::exception& error) {
-    throw std::runtime_error(write_failure(options.output, error));
-  }
+  writer.write(frame, image);
   std::string written = options.output;
-  if (!options.png.empty()) {
-    try {
-      tilesplat::write_png_preview(options.png, image, preview);
-    } catch (const std::exception& error) {
-      throw std::runtime_error(write_failure(options.png, error));
-    }
-    written += ", " + options.png;
-  }
+  if (!options.png.empty()) written += ", " + options.png;
 
   std::fflush(stdout);
   const std::string summary = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
