@@ -628,6 +628,9 @@ int run(int argc, char** argv) {
   writer.exr.alpha = !loaded.description || loaded.description->outputs.alpha;
   writer.exr.attributes["commandLine"] = cli::command_line(kProgram, argc, argv);
   writer.exr.compression = options.compression;
+  // Empty pixels far away, for depth compositing; with a background, an opaque frame (docs: README).
+  writer.exr.empty_depth = tilesplat::kFarDepth;
+  writer.exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
   writer.exr.attributes["scene"] = loaded.path.string();
   writer.exr.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
   writer.exr.attributes["renderSettings"] = settings_text(settings);

@@ -317,6 +317,29 @@ TEST(ExrIo, HalfRoundTripKeepsHalfPrecisionAndExactDepth) {
   EXPECT_EQ(back.splat_count, image.splat_count);
 }
 
+TEST(ExrIo, EmptyPixelsGetTheFarDepthAndAnOpaqueFrameAlphaOne) {
+  RenderImage image = make_image(5, 4, true, false);
+  image.rgba[3] = 0.0f;  // pixel 0 shows nothing: the renderer leaves its depth 0
+  image.depth[0] = 0.0f;
+  image.rgba[7] = 0.25f;  // pixel 1 is partly covered: its depth stays
+  ExrWriteOptions options;
+  options.empty_depth = tilesplat::kFarDepth;
+  options.opaque_alpha = true;
+  const fs::path path = fresh_dir() / "far.exr";
+  write_exr(path, image, options);
+  const RenderImage back = read_exr(path);
+  EXPECT_EQ(back.depth[0], tilesplat::kFarDepth);
+  for (size_t i = 1; i < image.pixels(); ++i) EXPECT_EQ(back.depth[i], image.depth[i]) << i;
+  for (size_t i = 0; i < image.pixels(); ++i) {
+    EXPECT_EQ(back.rgba[4 * i + 3], 1.0f) << i;
+    for (size_t c = 0; c < 3; ++c) EXPECT_EQ(back.rgba[4 * i + c], image.rgba[4 * i + c]) << i;
+  }
+  // By default the file holds the image as it is.
+  write_exr(path, image);
+  EXPECT_TRUE(same_bits(read_exr(path).rgba, image.rgba));
+  EXPECT_EQ(read_exr(path).depth[0], 0.0f);
+}
+
 TEST(ExrIo, WrittenFileListsExpectedChannels) {
   const fs::path dir = fresh_dir();
   const RenderImage full = make_image(4, 3, true, true);

@@ -144,7 +144,16 @@ TEST(RenderSequence, OrbitAndPathFramesEqualRendersOfTheirCameras) {
   renderer.set_scene(scene);
   auto expect_frame = [&](const fs::path& file, const tilesplat::Camera& camera) {
     EXPECT_EQ(tilesplat::read_exr_camera(file), camera) << file;
-    const tilesplat::RenderImage expected = renderer.render(camera);
+    tilesplat::RenderImage expected = renderer.render(camera);
+    // The files put empty pixels far away (tilesplat::kFarDepth) for depth compositing.
+    size_t empty = 0;
+    for (size_t i = 0; i < expected.pixels(); ++i)
+      if (expected.rgba[4 * i + 3] == 0.0f) {
+        EXPECT_EQ(expected.depth[i], 0.0f);
+        expected.depth[i] = tilesplat::kFarDepth;
+        ++empty;
+      }
+    EXPECT_GT(empty, 0u) << file << " shows no background: the test checks nothing of empty pixels";
     const tilesplat::RenderImage written = tilesplat::read_exr(file);
     EXPECT_TRUE(expected.rgba == written.rgba) << file;
     EXPECT_TRUE(expected.depth == written.depth) << file;
@@ -301,6 +310,37 @@ TEST(RenderSequence, FourShardsMergeIntoTheUnshardedRun) {
   const auto damaged = render({"--merge-manifests", sharded.string()});
   EXPECT_EQ(damaged.exit_code, 1);
   EXPECT_TRUE(contains(damaged.err, "do not match their manifest's checksum: 6")) << damaged.err;
+}
+
+TEST(RenderSequence, ExrIsValidPremultipliedOverABackgroundAndEmptyPixelsAreFar) {
+  const fs::path out = fresh_output_dir();
+  const std::string scene = tilesplat::testing::bundled_sh3().string();
+  for (const char* background : {"0,0,0", "1,0.5,0.25"}) {
+    const fs::path exr = out / (std::string(background) + ".exr");
+    const auto result =
+        render({scene, "--width", "64", "--height", "36", "--background", background, "-o", exr.string()});
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+  }
+  const tilesplat::RenderImage black = tilesplat::read_exr(out / "0,0,0.exr");
+  const tilesplat::RenderImage coloured = tilesplat::read_exr(out / "1,0.5,0.25.exr");
+  size_t empty = 0, partial = 0;
+  for (size_t i = 0; i < black.pixels(); ++i) {
+    const float alpha = black.rgba[4 * i + 3];
+    if (alpha == 0.0f) {
+      ++empty;
+      EXPECT_EQ(black.depth[i], tilesplat::kFarDepth) << "pixel " << i;
+      EXPECT_EQ(coloured.rgba[4 * i + 0], 1.0f);  // the background alone
+    } else {
+      EXPECT_LT(black.depth[i], 1e3f) << "pixel " << i;
+    }
+    if (alpha > 0.0f && alpha < 1.0f) ++partial;
+    // Over black: R G B are the splats' premultiplied colours; over a colour, the frame is opaque
+    // and R G B hold the background where the splats let it through.
+    EXPECT_EQ(coloured.rgba[4 * i + 3], 1.0f) << "pixel " << i;
+    EXPECT_NEAR(coloured.rgba[4 * i + 0], black.rgba[4 * i + 0] + (1 - alpha) * 1.0f, 1e-6) << "pixel " << i;
+  }
+  EXPECT_GT(empty, 0u);
+  EXPECT_GT(partial, 0u);
 }
 
 TEST(RenderSequence, ShardComesFromSlurmOrAnIndexedJob) {

@@ -50,7 +50,19 @@ struct ExrWriteOptions {
   /// and, exactly, as tilesplat's own attributes, from which read_exr_camera() rebuilds it.
   std::optional<Camera> camera;
   ExrCompression compression = ExrCompression::kZip;  ///< how the pixels are compressed
+  /// The Z written where no splat was blended (alpha 0), where a RenderImage's depth is 0. Depth
+  /// compositing (a Z merge, a Z defocus) takes 0 for a surface at the camera; a far value puts empty
+  /// pixels behind everything. tilesplat-render writes kFarDepth.
+  float empty_depth = 0;
+  /// Write A = 1 everywhere. For an image rendered over a non-black background, whose R G B already
+  /// hold the background: the file is then a valid premultiplied image of an opaque frame
+  /// (tilesplat-render does so whenever the background is not black).
+  bool opaque_alpha = false;
 };
+
+/// Blender's Z for pixels that show no surface: finite, so that filters and resampling stay finite,
+/// and far beyond any scene.
+inline constexpr float kFarDepth = 1e10f;
 
 /// Writes channels R G B A (A unless options.alpha is false), Z when depth is present, and "splats"
 /// (FLOAT, so that compositing tools read counts as numbers; exact up to 2^24) when counts are present.

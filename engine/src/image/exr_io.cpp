@@ -229,15 +229,32 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
   check_writable_image(path, image);
   check_attributes(path, options);
 
+  // What the file holds where the options change the image: A = 1 for an opaque frame, and the
+  // far value in Z where nothing was blended.
+  const std::vector<float>* rgba = &image.rgba;
+  std::vector<float> opaque_rgba;
+  if (options.opaque_alpha) {
+    opaque_rgba = image.rgba;
+    for (size_t i = 3; i < opaque_rgba.size(); i += 4) opaque_rgba[i] = 1.0f;
+    rgba = &opaque_rgba;
+  }
+  const std::vector<float>* depth = &image.depth;
+  std::vector<float> depth_with_empty;
+  if (options.empty_depth != 0 && !image.depth.empty()) {
+    depth_with_empty = image.depth;
+    for (size_t i = 0; i < depth_with_empty.size(); ++i)
+      if (image.rgba[4 * i + 3] == 0.0f) depth_with_empty[i] = options.empty_depth;
+    depth = &depth_with_empty;
+  }
+
   const Imf::PixelType colour_type = options.half ? Imf::HALF : Imf::FLOAT;
   std::vector<Imath::half> rgba_half;
   if (options.half) {
-    rgba_half.reserve(image.rgba.size());
-    for (const float value : image.rgba) rgba_half.emplace_back(value);
+    rgba_half.reserve(rgba->size());
+    for (const float value : *rgba) rgba_half.emplace_back(value);
   }
-  const char* colour_data =
-      options.half ? reinterpret_cast<const char*>(rgba_half.data())
-                   : reinterpret_cast<const char*>(image.rgba.data());
+  const char* colour_data = options.half ? reinterpret_cast<const char*>(rgba_half.data())
+                                         : reinterpret_cast<const char*>(rgba->data());
   const size_t colour_value_bytes = options.half ? sizeof(Imath::half) : sizeof(float);
 
   detail::write_file_atomically(path, [&](const std::filesystem::path& temp) {
@@ -261,7 +278,7 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
     // centimetres apart at tens of metres.
     if (!image.depth.empty()) {
       header.channels().insert(kDepthChannel, Imf::Channel(Imf::FLOAT));
-      frame.insert(kDepthChannel, Imf::Slice::Make(Imf::FLOAT, image.depth.data(), data_window));
+      frame.insert(kDepthChannel, Imf::Slice::Make(Imf::FLOAT, depth->data(), data_window));
     }
     // Counts as FLOAT: OpenImageIO (and the compositors on it) read a UINT channel as a normalised
     // value, which shows every count as about 0. Floats hold every count up to 2^24 exactly.
