@@ -6,6 +6,8 @@
 # doxygen builds the API reference (the docs target and its test); file is what cpack -G DEB asks
 # to find the binaries whose library dependencies it lists.
 # --fuzz adds clang and its compiler-rt (libFuzzer) for tests/fuzz/run.sh; the normal build needs neither.
+# --cluster adds Slurm (slurm-wlm: slurmctld, slurmd, sbatch) and munge for tests/cluster/slurm_test.sh,
+# which runs a one-node cluster of its own; nothing is configured or started here.
 set -euo pipefail
 pkgs=(
   build-essential cmake ninja-build pkg-config
@@ -16,9 +18,12 @@ pkgs=(
   libgtest-dev googletest
   xvfb xauth
 )
-if [ "${1:-}" = "--fuzz" ]; then
-  pkgs+=(clang libclang-rt-dev)
-fi
+case "${1:-}" in
+  --fuzz) pkgs+=(clang libclang-rt-dev) ;;
+  --cluster) pkgs+=(slurm-wlm munge) ;;
+  "") ;;
+  *) echo "setup: unknown option '$1' (--fuzz or --cluster)" >&2; exit 2 ;;
+esac
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
