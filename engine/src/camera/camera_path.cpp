@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "camera/json_file.h"
 #include "camera/rotation_check.h"
 
 namespace tilesplat {
@@ -143,22 +144,15 @@ void check_size(int width, int height) {
 
 CameraPath load_camera_path(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw SceneError(file + ": cannot open file");
-  json document;
-  try {
-    document = json::parse(stream);
-  } catch (const json::exception& error) {
-    throw SceneError(file + ": invalid JSON: " + error.what());
-  }
-  if (!document.is_object() || !document.contains("keyframes") || !document["keyframes"].is_array())
+  const json document = parse_json_file(path);
+  if (!document.is_object() || !document.contains("keyframes") || !document.at("keyframes").is_array())
     throw SceneError(file + ": expected an object with a \"keyframes\" array (docs/camera-paths.md)");
   CameraPath camera_path;
   if (const auto loop = document.find("loop"); loop != document.end()) {
     if (!loop->is_boolean()) throw SceneError(file + ": 'loop' must be true or false");
     camera_path.loop = loop->get<bool>();
   }
-  const json& keys = document["keyframes"];
+  const json& keys = document.at("keyframes");
   for (size_t index = 0; index < keys.size(); ++index)
     camera_path.keys.push_back(read_keyframe(keys[index], file, index));
   if (camera_path.keys.size() < 2)

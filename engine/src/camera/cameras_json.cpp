@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "camera/json_file.h"
 #include "camera/rotation_check.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/scene.h"
@@ -122,17 +123,7 @@ CameraView read_entry(const json& entry, size_t index, const std::string& file) 
 
 std::vector<CameraView> load_cameras_json(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw SceneError(file + ": cannot open file");
-
-  json document;
-  try {
-    document = json::parse(stream);
-  } catch (const json::exception& error) {
-    // The parser's message carries the line and column (or the overflowing number literal).
-    throw SceneError(file + ": invalid JSON: " + error.what());
-  }
-
+  const json document = parse_json_file(path);
   if (!document.is_array()) throw SceneError(file + ": expected a JSON array of cameras");
   if (document.empty()) throw SceneError(file + ": the camera list is empty");
 

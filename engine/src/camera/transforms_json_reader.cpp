@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "camera/json_file.h"
 #include "camera/rotation_check.h"
 #include "tilesplat/camera_sets.h"
 
@@ -16,16 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-json parse_json_file(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw SceneError(path.string() + ": cannot open file");
-  try {
-    return json::parse(stream);
-  } catch (const json::exception& error) {
-    throw SceneError(path.string() + ": invalid JSON: " + error.what());
-  }
-}
 
 // The intrinsics a frame inherits from the top level unless it gives its own.
 class FrameFields {
