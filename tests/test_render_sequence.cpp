@@ -19,6 +19,7 @@
 #include "cli.h"
 #include "frame_manifest.h"
 #include "process_support.h"
+#include "progress.h"
 #include "test_support.h"
 #include "tilesplat/camera_path.h"
 #include "tilesplat/image.h"
@@ -84,6 +85,9 @@ TEST(RenderSequence, AllViewsInOneProcessEqualSingleViewRenders) {
                            "--png", (out / "view_%04d.png").string()});
   ASSERT_EQ(all.exit_code, 0) << all.err;
   EXPECT_TRUE(contains(all.err, "8 frames rendered")) << all.err;
+  // stderr is not a terminal here: progress comes as plain lines (at least the last one), no bar.
+  EXPECT_TRUE(contains(all.err, "tilesplat-render: 8/8 frames, ")) << all.err;
+  EXPECT_FALSE(contains(all.err, "\r")) << all.err;
   const auto entries = manifest_entries(out);
   ASSERT_EQ(entries.size(), 8u);
   for (int view = 0; view < 8; ++view) {
@@ -394,6 +398,20 @@ TEST(RenderSequence, ViewSelectionsAndFramePatterns) {
   EXPECT_THROW(cli::frame_file("-o", "a_%s.exr", 1), cli::UsageError);
   EXPECT_THROW(cli::frame_file("-o", "a_%d_%d.exr", 1), cli::UsageError);
   EXPECT_EQ(cli::describe_frames({9, 1, 2, 3, 7}), "1-3, 7, 9");
+}
+
+TEST(RenderSequence, ProgressSaysFramesRateAndTimeLeft) {
+  EXPECT_EQ(cli::format_duration(17.4), "17 s");
+  EXPECT_EQ(cli::format_duration(62), "1:02");
+  EXPECT_EQ(cli::format_duration(3723), "1:02:03");
+  cli::FrameProgress progress("tilesplat-render", 4, cli::FrameProgress::Style::kQuiet);
+  EXPECT_EQ(progress.status(), "0/4 frames");
+  progress.frame_done();
+  const std::string status = progress.status();
+  EXPECT_TRUE(status.starts_with("1/4 frames, ")) << status;
+  EXPECT_TRUE(contains(status, " frames/s, ETA ")) << status;
+  for (int f = 0; f < 3; ++f) progress.frame_done();
+  EXPECT_FALSE(contains(progress.status(), "ETA")) << progress.status();
 }
 
 TEST(RenderSequence, MistakesFailBeforeAnyFrameIsRendered) {
