@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <numbers>
 
 #include "cli.h"
 #include "tilesplat/scene_description.h"
@@ -88,6 +89,30 @@ Lighting bench_lighting(const GaussianScene& scene) {
   return lighting;
 }
 
+DepthConvention bench_depth_convention() {
+  constexpr double kNear = 0.05, kFar = 200;
+  DepthConvention convention;  // d = a + b / z with d(near) = 0 and d(far) = 1
+  convention.a = kFar / (kFar - kNear);
+  convention.b = -kFar * kNear / (kFar - kNear);
+  return convention;
+}
+
+std::vector<float> plane_through_scene(const GaussianScene& scene, const Camera& camera,
+                                       const DepthConvention& convention) {
+  const Bounds bounds = compute_bounds(scene);
+  const double centre = camera.to_camera({bounds.center[0], bounds.center[1], bounds.center[2]})[2];
+  const double nx = std::sin(35 * std::numbers::pi / 180), nz = std::cos(35 * std::numbers::pi / 180);
+  std::vector<float> depth(size_t(camera.width) * size_t(camera.height));
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const double rx = (x + 0.5 - camera.cx) / camera.fx;  // the pixel's ray is (rx, ry, 1)
+      const double t = nz * centre / (nx * rx + nz);        // where n . (t r) = n . (0, 0, centre)
+      depth[size_t(y) * size_t(camera.width) + size_t(x)] =
+          t > 0 ? float(convention.window_depth(t)) : float(convention.far_depth());
+    }
+  return depth;
+}
+
 std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& base_settings) {
   RenderSettings base = base_settings;
   base.accuracy.sh_degree_cap = 3;
@@ -123,11 +148,15 @@ std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& bas
   add("+depth +splat count", SceneVariant::kScene, [](RenderSettings& s) { s.depth = s.splat_count = true; });
   // Not an effect but the other side of the sort's cost: no depth sort, one hashed sample per pixel.
   // (The modes that reorder by depth have no stochastic form.)
-  if (base.accuracy.depth_key_bits == 32 && base.accuracy.resort_window == 0)
+  if (base.accuracy.depth_key_bits == 32 && base.accuracy.resort_window == 0) {
     add("stochastic, 1 frame", SceneVariant::kScene, [](RenderSettings& s) {
       s.compositor = Compositor::kStochastic;
       s.stochastic.frames = 1;
     });
+    // A host's depth in (a plane through the scene) and out; "no host depth" is the base row.
+    add("host depth in + out (a plane through the scene)", SceneVariant::kScene, [](RenderSettings&) {});
+    rows.back().host_plane = true;
+  }
   return rows;
 }
 
@@ -149,6 +178,11 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
     renderers.emplace(row.scene_variant, std::move(renderer));
   }
 
+  // The host's plane as each view sees it, for the host depth rows.
+  std::vector<std::vector<float>> planes;
+  for (const Camera& view : options.views)
+    planes.push_back(plane_through_scene(scene, view, bench_depth_convention()));
+
   const int total = work_units(rows, options);
   int done = 0;
   // samples[row][view][pass name] and frame times, over the repeats.
@@ -164,6 +198,7 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
       settings.sort = options.sort;
       settings.reuse_lists = false;  // whole frames: consecutive rows often share the camera and lists
       for (size_t v = 0; v < options.views.size(); ++v) {
+        if (rows[r].host_plane) settings.host = HostDepth{bench_depth_convention(), planes[v], true, 0.5f};
         renderer.render(options.views[v], settings);
         const FrameStats& stats = renderer.last_frame_stats();
         if (frame == 0 && v == 0) rows[r].device_bytes = stats.device_bytes;

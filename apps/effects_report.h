@@ -37,6 +37,9 @@ struct Row {
   std::string name;  // "sh1", "lights 2", "mip", "+depth", ...
   SceneVariant scene_variant = SceneVariant::kScene;
   RenderSettings settings;
+  // Depth-test against a host's plane through the scene (plane_through_scene) and write depth out;
+  // settings.host is filled per view.
+  bool host_plane = false;
   // Measured: medians over the repeats, then over the views.
   double frame_ms = 0;
   std::vector<PassTiming> passes;
@@ -62,6 +65,14 @@ struct Run {
 Run measure(const RendererOptions& renderer_options, const GaussianScene& scene, std::vector<Row>& rows,
             const Options& options, const std::function<void(int, int, const std::string&)>& progress);
 int work_units(const std::vector<Row>& rows, const Options& options);
+
+// A host's depth image of a plane through the scene's centre, tilted 35 degrees about the camera's y
+// axis: what a host that drew a wall cutting the scene leaves in its depth buffer (window depths in
+// `convention`; its far value where the plane is behind the camera).
+std::vector<float> plane_through_scene(const GaussianScene& scene, const Camera& camera,
+                                       const DepthConvention& convention);
+// The convention the bench's host plane uses: a Vulkan projection with near 0.05 and far 200.
+DepthConvention bench_depth_convention();
 
 // Two lights that reach most of the scene: a directional light from above and the camera's side,
 // and a point light near the scene's centre, scaled to its extent.

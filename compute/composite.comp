@@ -19,6 +19,11 @@
 // 65535 loop iterations, which a tile of ~60k faint splats reaches: there the host sets a chunk size
 // that stays within the limit (GPUs use one chunk). Chunk 0 records the longest list that did not
 // fit, and the host re-renders the frame with enough chunks.
+//
+// A host's depth (HOST_DEPTH): a splat blends into a pixel only in front of the surface the host drew
+// there (its view depth in host_z, +inf where none), which is opaque. SURFACE_DEPTH writes the view
+// depth of the splat at which a pixel's alpha first reaches surface_alpha (0 where it never does),
+// which the host turns into its own depth convention. Both off, the pipeline is the one without them.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "tile_coverage.glsl"
@@ -32,6 +37,8 @@ layout(constant_id = 2) const uint PIXELS_PER_INVOCATION = 1;  // 1, 2, 4, 8 or 
 layout(constant_id = 4) const float ALPHA_MIN = 1.0 / 255.0;
 layout(constant_id = 5) const float ALPHA_INV = 255.0;  // 1 / ALPHA_MIN, as the tile coverage uses it
 layout(constant_id = 6) const float T_MIN = 1e-4;
+layout(constant_id = 7) const bool HOST_DEPTH = false;
+layout(constant_id = 8) const bool SURFACE_DEPTH = false;
 
 layout(push_constant) uniform Push {
   Vec4Array splats;
@@ -40,8 +47,10 @@ layout(push_constant) uniform Push {
   Vec4Array out_rgba;
   FloatArray out_depth;
   UintArray out_count;
-  Vec4Array state;     // 2 vec4 per pixel between chunks: (colour, T), (depth sum, weight sum, blended, 0)
+  Vec4Array state;     // 2 vec4 per pixel between chunks: (colour, T), (depth sum, weight sum, blended, surface z)
   UintArray counters;  // COUNTER_MAX_TILE_PAIRS
+  FloatArray host_z;     // HOST_DEPTH: per pixel, the host's surface as view depth (+inf: none)
+  FloatArray surface_z;  // SURFACE_DEPTH: per pixel, the depth at which alpha reached surface_alpha
   vec4 background;
   uint width;
   uint height;
@@ -49,6 +58,7 @@ layout(push_constant) uniform Push {
   uint chunk_start;  // position in each tile's list where this dispatch starts
   uint chunk_size;   // splats per tile this dispatch blends at most
   uint last_chunk;   // 1: write the outputs whatever is left
+  float surface_alpha;
 } pc;
 
 const uint P = PIXELS_PER_INVOCATION;
@@ -70,6 +80,8 @@ vec3 colour[P];
 float depth_sum[P];
 float weight_sum[P];
 uint blended[P];
+float host_z[P];   // HOST_DEPTH
+float surface[P];  // SURFACE_DEPTH: 0 until the pixel's alpha reaches surface_alpha
 uint my_done = 0;  // pixels of this invocation that are done
 
 // Blends staged splat j into the invocation's pixels first .. first + count - 1 (indices into its
@@ -92,7 +104,7 @@ uint blend_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
     float dy = mean_a_b.y - (float(local_y0 + p) + 0.5);
     float power = k0 + dy * (k1 + c_opacity_depth_r.x * dy);
     float alpha = min(0.99, c_opacity_depth_r.y * exp(power));
-    bool hit = T[p] > 0.0 && alpha >= ALPHA_MIN;
+    bool hit = T[p] > 0.0 && alpha >= ALPHA_MIN && (!HOST_DEPTH || c_opacity_depth_r.z < host_z[p]);
     float next_T = T[p] * (1.0 - alpha);
     bool finish = hit && next_T < T_MIN;  // done, and this splat is NOT blended (reference)
     bool blend = hit && !finish;
@@ -100,6 +112,8 @@ uint blend_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
     colour[p] += rgb * w;
     depth_sum[p] += c_opacity_depth_r.z * w;
     weight_sum[p] += w;
+    if (SURFACE_DEPTH)
+      surface[p] = blend && surface[p] == 0.0 && 1.0 - next_T >= pc.surface_alpha ? c_opacity_depth_r.z : surface[p];
     T[p] = blend ? next_T : (finish ? -T[p] : T[p]);
     blended[p] += blend ? 1u : 0u;
     finished += finish ? 1u : 0u;
@@ -134,6 +148,8 @@ void main() {
     depth_sum[p] = 0.0;
     weight_sum[p] = 0.0;
     blended[p] = 0;
+    surface[p] = 0.0;
+    if (HOST_DEPTH) host_z[p] = outside ? 0.0 : pc.host_z.v[(py0 + p) * pc.width + px];
     if (resume && !outside) {
       uint i = (py0 + p) * pc.width + px;
       vec4 colour_T = pc.state.v[2 * i];
@@ -143,6 +159,7 @@ void main() {
       depth_sum[p] = sums.x;
       weight_sum[p] = sums.y;
       blended[p] = floatBitsToUint(sums.z);
+      surface[p] = sums.w;
     }
     my_done += T[p] < 0.0 ? 1u : 0u;
   }
@@ -216,12 +233,13 @@ void main() {
     uint i = py * pc.width + px;
     if (!write_outputs) {
       pc.state.v[2 * i] = vec4(colour[p], T[p]);
-      pc.state.v[2 * i + 1] = vec4(depth_sum[p], weight_sum[p], uintBitsToFloat(blended[p]), 0.0);
+      pc.state.v[2 * i + 1] = vec4(depth_sum[p], weight_sum[p], uintBitsToFloat(blended[p]), surface[p]);
       continue;
     }
     float transmittance = abs(T[p]);
     pc.out_rgba.v[i] = vec4(colour[p] + transmittance * pc.background.rgb, 1.0 - transmittance);
     if (WRITE_DEPTH) pc.out_depth.v[i] = weight_sum[p] > 0.0 ? depth_sum[p] / weight_sum[p] : 0.0;
     if (WRITE_COUNT) pc.out_count.v[i] = blended[p];
+    if (SURFACE_DEPTH) pc.surface_z.v[i] = surface[p];
   }
 }

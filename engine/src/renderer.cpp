@@ -13,7 +13,6 @@
 // accuracy modes, antialiasing, lighting and compositor) runs the composite alone on the lists left
 // in the buffers (FrameStats::reused_sorted_lists).
 #include "tilesplat/renderer.h"
-#include "tilesplat/vulkan_interop.h"
 
 #include <algorithm>
 #include <bit>
@@ -26,6 +25,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "host_depth.h"
 #include "passes/composite_pass.h"
 #include "passes/composite_resort_pass.h"
 #include "passes/depth_quantize_pass.h"
@@ -38,6 +38,7 @@
 #include "passes/tile_ranges_pass.h"
 #include "sort/sort_strategy.h"
 #include "tilesplat/reference.h"
+#include "tilesplat/vulkan_interop.h"
 #include "vulkan/context.h"
 #include "vulkan/gpu_timer.h"
 #include "vulkan/vk_check.h"
@@ -157,11 +158,29 @@ struct Renderer::Impl {
 
   uint64_t device_bytes() const {
     uint64_t bytes = 0;
-    for (const vk::Buffer* b :
-         {&scene.positions, &scene.log_scales, &scene.rotations, &scene.opacity_logits, &scene.sh, &scene.sh_half,
-          &scene.covariances_half, &scene.normals, &projected.splats, &projected.rects, &projected.tile_counts, &projected.offsets,
-          &projected.depth_offsets, &projected.big_splats, &projected.ray_depth, &ranges, &composite_state, &outputs.rgba, &outputs.depth, &outputs.count,
-          &counters})
+    for (const vk::Buffer* b : {&scene.positions,
+                                &scene.log_scales,
+                                &scene.rotations,
+                                &scene.opacity_logits,
+                                &scene.sh,
+                                &scene.sh_half,
+                                &scene.covariances_half,
+                                &scene.normals,
+                                &projected.splats,
+                                &projected.rects,
+                                &projected.tile_counts,
+                                &projected.offsets,
+                                &projected.depth_offsets,
+                                &projected.big_splats,
+                                &projected.ray_depth,
+                                &ranges,
+                                &composite_state,
+                                &outputs.rgba,
+                                &outputs.depth,
+                                &outputs.count,
+                                &host_view_depth,
+                                &host_surface_depth,
+                                &counters})
       bytes += b->size();
     bytes += projected.depth_order.bytes() + keys.bytes();
     bytes += prefix_sum.device_bytes();
@@ -249,7 +268,7 @@ struct Renderer::Impl {
       else
         composite.record(stream.cmd(), projected.splats, tile_lists, ranges, outputs, settings.background,
                          settings.depth, settings.splat_count, cutoffs,
-                         {composite_chunks, composite_state, counters.address()});
+                         {composite_chunks, composite_state, counters.address()}, host_surface(settings));
       timer.mark(stream.cmd(), "composite");
     }
     stream.finish();
@@ -378,12 +397,52 @@ struct Renderer::Impl {
     bool operator==(const ListKey&) const = default;
   };
 
+  // The host's depth image as view depths (+inf where it drew nothing) in host_view_depth, and room
+  // for the surface depth the composite writes; both released when a frame has no host depth.
+  void upload_host_depth(const RenderSettings& settings, size_t pixels) {
+    const HostDepth* host = settings.host ? &*settings.host : nullptr;
+    if (!host || host->depth.empty()) {
+      host_view_depth.reset();
+    } else {
+      const std::vector<float> view_depth = host_view_depths(*host);
+      if (host_view_depth.size() != pixels * sizeof(float))
+        host_view_depth = vk::Buffer(ctx, pixels * sizeof(float), vk::MemoryUse::Device, "host view depth");
+      vk::upload(ctx, host_view_depth, view_depth.data(), pixels * sizeof(float));
+    }
+    if (!host || !host->write_depth)
+      host_surface_depth.reset();
+    else if (host_surface_depth.size() != pixels * sizeof(float))
+      host_surface_depth =
+          vk::Buffer(ctx, pixels * sizeof(float), vk::MemoryUse::Device, "host surface depth");
+  }
+
+  CompositePass::HostSurface host_surface(const RenderSettings& settings) const {
+    CompositePass::HostSurface surface;
+    if (!settings.host) return surface;
+    if (host_view_depth.size() > 0) surface.view_depth = &host_view_depth;
+    if (host_surface_depth.size() > 0) surface.surface_depth = &host_surface_depth;
+    surface.surface_alpha = settings.host->alpha_threshold;
+    return surface;
+  }
+
+  // RenderImage::host_depth: the composite's surface view depths in the host's convention, the host's
+  // own depth (or its far value) where the splats' alpha never reached the threshold.
+  void read_host_depth(const HostDepth& host, std::vector<float>& out, size_t pixels) {
+    read_output(host_surface_depth, out, pixels);
+    const float far = float(host.convention.far_depth());
+    for (size_t i = 0; i < pixels; ++i)
+      out[i] = out[i] > 0.0f ? float(host.convention.window_depth(out[i]))
+                             : (host.depth.empty() ? far : host.depth[i]);
+  }
+
   // Renders into the output buffers, growing the key buffers and re-rendering on overflow, and
   // fills the frame statistics (all but cpu_ms).
   void render_frame(const Camera& camera, const RenderSettings& settings) {
     check_camera(camera, ctx.limits(), ctx.is_cpu_device());
     validate(settings.accuracy);
     validate_compositor(settings);
+    validate_host_depth(settings, camera);
+    upload_host_depth(settings, size_t(camera.width) * size_t(camera.height));
     SortStrategy& sorter = sort(settings.sort);
     ensure_outputs(uint32_t(camera.width), uint32_t(camera.height), settings.depth, settings.splat_count);
 
@@ -501,6 +560,8 @@ struct Renderer::Impl {
   uint32_t composite_chunks = 1;
   uint32_t stochastic_chunks = 1;  // the same for the stochastic composite
   vk::Buffer composite_state;  // per-pixel state between a composite's dispatches (chunks, samples)
+  vk::Buffer host_view_depth;  // RenderSettings::host: the host's surfaces as view depth, per pixel
+  vk::Buffer host_surface_depth;  // and the view depth at which the splats' alpha reached its threshold
   FrameStats stats;
   // The tile lists in the buffers: what they were built for (none after set_scene or a frame that
   // failed), and where the tile sort or binning left them.
@@ -576,6 +637,8 @@ RenderImage Renderer::render(const Camera& camera, const RenderSettings& setting
   r.read_output(r.outputs.rgba, image.rgba, pixels * 4);
   if (settings.depth) r.read_output(r.outputs.depth, image.depth, pixels);
   if (settings.splat_count) r.read_output(r.outputs.count, image.splat_count, pixels);
+  if (settings.host && settings.host->write_depth)
+    r.read_host_depth(*settings.host, image.host_depth, pixels);
   r.stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return image;
 }
@@ -594,6 +657,11 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
                                 std::to_string(camera.width) + "x" + std::to_string(camera.height));
   if (target.format != VK_FORMAT_R32G32B32A32_SFLOAT)
     throw std::invalid_argument("render_to_image: only VK_FORMAT_R32G32B32A32_SFLOAT images are supported");
+  if (settings.host && settings.host->write_depth)
+    throw std::invalid_argument(
+        "render_to_image: HostDepth::write_depth has no depth image to write into yet; render() returns it "
+        "in "
+        "RenderImage::host_depth");
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings);
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {

@@ -79,6 +79,31 @@ struct TILESPLAT_API Camera {
   bool operator==(const Camera&) const = default;
 };
 
+/// How a host's depth buffer holds depth. A pinhole projection stores, for a point at view depth z
+/// (its distance along the camera's forward axis, Camera's z), the window-space depth
+/// d = a + b / z that the host's depth test compares: in [0, 1] with Vulkan's viewport depth range
+/// 0..1 or OpenGL's glDepthRange(0, 1). Standard (d grows with z, b < 0) and reversed-Z (d falls,
+/// b > 0) projections, with a finite or an infinite far plane, all have this form.
+struct TILESPLAT_API DepthConvention {
+  double a = 1;   ///< the depth of a point at infinity
+  double b = -1;  ///< the scale of 1 / z
+
+  /// The convention of a host's projection matrix, column-major as Camera::from_matrices takes it,
+  /// in its clip space (ClipSpace::Depth kMinusOneToOne maps NDC [-1, 1] to window [0, 1]).
+  /// Throws std::invalid_argument for a projection that is not a pinhole's (clip w not +-view z) or
+  /// whose depth does not vary with z.
+  static DepthConvention from_projection(const std::array<double, 16>& projection,
+                                         ClipSpace clip = ClipSpace::vulkan());
+
+  /// The window depth of view depth z > 0.
+  double window_depth(double z) const { return a + b / z; }
+  /// The view depth of window depth d; +infinity where d lies at or beyond infinity (the cleared far
+  /// value of an infinite projection, say).
+  double view_depth(double d) const;
+  /// The window depth where the host drew nothing as far as the splats are concerned: a, within [0, 1].
+  double far_depth() const;
+};
+
 /// Throws std::invalid_argument ("invalid camera: ...", saying what) for a camera no renderer can use:
 /// a size that is not positive, focal lengths that are not positive and finite, or a non-finite
 /// principal point, rotation or position. Both renderers call it; device limits are checked on top.

@@ -22,6 +22,9 @@ struct RenderImage {
   std::vector<float> depth;           ///< 1 per pixel: expected view depth of the blended splats
                                       ///< (sum w z / sum w), 0 where nothing was blended; may be empty
   std::vector<uint32_t> splat_count;  ///< 1 per pixel: splats blended; may be empty
+  /// 1 per pixel, in the host's depth convention, when RenderSettings::host asks for it
+  /// (HostDepth::write_depth); else empty.
+  std::vector<float> host_depth;
 
   /// width * height.
   size_t pixels() const { return size_t(width) * size_t(height); }

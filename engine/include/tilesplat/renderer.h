@@ -5,6 +5,8 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -150,6 +152,26 @@ struct StochasticSettings {
   bool operator==(const StochasticSettings&) const = default;
 };
 
+/// Splats inside a host's 3D world (docs/embedding.md): the host's depth image in, and a depth the
+/// host can test its later geometry against out. Only the sorted compositor without per-pixel
+/// re-sorting honours it (other compositors throw std::invalid_argument).
+struct HostDepth {
+  /// How the host's depth values relate to view depth (DepthConvention::from_projection of the
+  /// projection it drew with).
+  DepthConvention convention;
+  /// The host's depth image: width x height window depths, row-major, row 0 the top row of the image
+  /// (as RenderImage), of the surface the host drew at each pixel, or its cleared far value. A splat
+  /// blends into a pixel only when its view depth (as a float) is less than the surface's: the surface
+  /// is opaque. Empty: no depth in, every splat blends. Not owned: it must stay valid during the
+  /// render. A NaN, or a size other than width x height, throws std::invalid_argument.
+  std::span<const float> depth;
+  /// Fill RenderImage::host_depth: per pixel, in the host's convention, the depth of the splat at which
+  /// the accumulated alpha (1 - T) first reaches `alpha_threshold` (0.5: the median depth of the 3DGS
+  /// papers), or, where it never does, the host's own depth (its far value without a depth image).
+  bool write_depth = false;
+  float alpha_threshold = 0.5f;  ///< in (0, 1]
+};
+
 /// Everything that changes how one frame is rendered.
 struct RenderSettings {
   std::array<float, 3> background = {0, 0, 0};         ///< linear RGB behind the splats: C + T * background
@@ -165,6 +187,9 @@ struct RenderSettings {
   /// the buffers (FrameStats::reused_sorted_lists). false: always build them, as a benchmark timing
   /// whole frames of one camera needs.
   bool reuse_lists = true;
+  /// Depth-test the splats against a host's depth image, and give the host a depth back. Unset (the
+  /// default): neither, and the composite is the one without them (a specialization constant).
+  std::optional<HostDepth> host;
 };
 
 /// The GPU time of one pass of a frame.

@@ -45,8 +45,10 @@ struct ExternalImage {
 };
 
 /// Renders a frame and writes premultiplied RGBA (colour over the background, A = 1 - T) into the
-/// image. The work has completed on the GPU when the call returns. Throws std::invalid_argument
-/// when the image does not match the camera or has an unsupported format.
+/// image. The work has completed on the GPU when the call returns. RenderSettings::host depth-tests
+/// the splats against a host's depth values given in host memory (HostDepth::depth); its depth out
+/// (HostDepth::write_depth) is render()'s only, for now. Throws std::invalid_argument when the image
+/// does not match the camera or has an unsupported format, or for write_depth.
 TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                                    const ExternalImage& target);
 

@@ -1,7 +1,9 @@
 // Camera::from_matrices: a host application's view and projection matrices as the pinhole camera of
 // the trainer's convention (OpenCV axes), so that a host renders splats with the camera it already has.
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -108,6 +110,43 @@ Camera Camera::from_matrices(const Matrix& view, const Matrix& projection, int w
     camera.position[size_t(column)] = centre;
   }
   return camera;
+}
+
+}  // namespace tilesplat
+
+namespace tilesplat {
+
+DepthConvention DepthConvention::from_projection(const std::array<double, 16>& projection, ClipSpace clip) {
+  auto at = [&](int row, int column) { return projection[size_t(column) * 4 + size_t(row)]; };
+  for (double value : projection)
+    if (!std::isfinite(value))
+      throw std::invalid_argument("DepthConvention::from_projection: a non-finite entry");
+  // Clip w = w_z z_view and the camera's z = sign(w_z) z_view (Camera::from_matrices), so NDC depth
+  // = (z_z z_view + z_w) / (w_z z_view) = z_z / w_z + (z_w / |w_z|) / z.
+  const double w_z = at(3, 2);
+  if (w_z == 0 || at(3, 3) != 0)
+    throw std::invalid_argument(
+        "DepthConvention::from_projection: not a pinhole projection (clip w must be +-view z)");
+  const double z_w = at(2, 3);
+  if (z_w == 0)
+    throw std::invalid_argument("DepthConvention::from_projection: depth does not vary with view depth");
+  DepthConvention convention;
+  convention.a = at(2, 2) / w_z;
+  convention.b = z_w / std::fabs(w_z);
+  if (clip.depth == ClipSpace::Depth::kMinusOneToOne) {  // window depth = (NDC + 1) / 2
+    convention.a = 0.5 * (convention.a + 1.0);
+    convention.b = 0.5 * convention.b;
+  }
+  return convention;
+}
+
+double DepthConvention::view_depth(double d) const {
+  const double z = b / (d - a);
+  return z > 0 ? z : std::numeric_limits<double>::infinity();  // at or beyond infinity: no surface
+}
+
+double DepthConvention::far_depth() const {
+  return std::clamp(a, 0.0, 1.0);
 }
 
 }  // namespace tilesplat

@@ -15,9 +15,12 @@ namespace tilesplat {
 namespace {
 struct CompositePush {
   VkDeviceAddress splats, sorted_indices, ranges, out_rgba, out_depth, out_count, state, counters;
+  VkDeviceAddress host_z, surface_z;
   float background[4];
   uint32_t width, height, tiles_x, chunk_start, chunk_size, last_chunk;
+  float surface_alpha;
 };
+static_assert(sizeof(CompositePush) <= 128, "Vulkan guarantees 128 bytes of push constants");
 
 // llvmpipe ends any shader invocation after 65535 loop iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS),
 // silently. A 16-pixel column spends at most ~800 per batch of 256 splats (staging, listing, two
@@ -51,9 +54,11 @@ CompositePass::CompositePass(vk::Context& ctx)
       chunk_splats_(composite_chunk_splats(ctx)) {}
 
 void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
-                           const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
-                           bool write_depth, bool write_count, const Cutoffs& cutoffs, const Chunks& chunks) {
-  auto key = std::make_tuple(write_depth, write_count, cutoffs);
+                           const vk::Buffer& ranges, OutputBuffers& out,
+                           const std::array<float, 3>& background, bool write_depth, bool write_count,
+                           const Cutoffs& cutoffs, const Chunks& chunks, const HostSurface& host) {
+  const bool host_depth = host.view_depth != nullptr, surface_depth = host.surface_depth != nullptr;
+  auto key = std::make_tuple(write_depth, write_count, cutoffs, host_depth, surface_depth);
   auto it = pipelines_.find(key);
   if (it == pipelines_.end()) {
     const float alpha_inv = coverage_alpha_inv(cutoffs.alpha);
@@ -65,7 +70,9 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                                                 {3, kTileSize / pixels_per_invocation_},
                                                 {4, std::bit_cast<uint32_t>(cutoffs.alpha)},
                                                 {5, std::bit_cast<uint32_t>(alpha_inv)},
-                                                {6, std::bit_cast<uint32_t>(cutoffs.transmittance)}}))
+                                                {6, std::bit_cast<uint32_t>(cutoffs.transmittance)},
+                                                {7, host_depth ? 1u : 0u},
+                                                {8, surface_depth ? 1u : 0u}}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
@@ -82,13 +89,16 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                        write_count ? out.count.address() : 0,
                        chunks.count > 1 ? chunks.state.address() : 0,
                        chunks.counters,
+                       host_depth ? host.view_depth->address() : 0,
+                       surface_depth ? host.surface_depth->address() : 0,
                        {background[0], background[1], background[2], 0.0f},
                        out.width,
                        out.height,
                        tiles_x,
                        chunk * chunk_splats_,
                        chunk_splats_,
-                       chunk + 1 == chunks.count ? 1u : 0u};
+                       chunk + 1 == chunks.count ? 1u : 0u,
+                       host.surface_alpha};
     it->second.bind(cmd, push);
     it->second.dispatch(cmd, tiles_x, tiles_y);
   }

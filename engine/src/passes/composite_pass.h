@@ -45,9 +45,17 @@ class CompositePass {
     const vk::Buffer& state;
     VkDeviceAddress counters = 0;
   };
+  // A host's depth (RenderSettings::host): the surface per pixel as view depth in, the depth at which
+  // alpha reaches surface_alpha out. Null buffers: that half is off (and its pipeline the one without).
+  struct HostSurface {
+    const vk::Buffer* view_depth = nullptr;     // float per pixel, +inf where the host drew nothing
+    const vk::Buffer* surface_depth = nullptr;  // float per pixel, written
+    float surface_alpha = 0.5f;
+  };
   void record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
               const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
-              bool write_depth, bool write_count, const Cutoffs& cutoffs, const Chunks& chunks);
+              bool write_depth, bool write_count, const Cutoffs& cutoffs, const Chunks& chunks,
+              const HostSurface& host);
   uint32_t chunks_for(uint64_t longest_tile_list) const;
   static VkDeviceSize state_bytes(uint32_t width, uint32_t height) { return VkDeviceSize(width) * height * 32; }
 
@@ -55,7 +63,8 @@ class CompositePass {
   vk::Context& ctx_;
   uint32_t pixels_per_invocation_;
   uint32_t chunk_splats_;  // splats per tile and dispatch
-  std::map<std::tuple<bool, bool, Cutoffs>, vk::ComputePipeline> pipelines_;  // by outputs and cut-offs
+  // By outputs (depth, count), cut-offs and host depth (in, out).
+  std::map<std::tuple<bool, bool, Cutoffs, bool, bool>, vk::ComputePipeline> pipelines_;
 };
 
 }  // namespace tilesplat

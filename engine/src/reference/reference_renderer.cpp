@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "host_depth.h"
 #include "lighting.h"
 #include "tilesplat/reference.h"
 
@@ -325,6 +326,11 @@ ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const C
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings) {
   validate(camera);
   check_scene(scene);
+  validate_host_depth(settings, camera);
+  // A host's surfaces, as view depths: a splat blends only in front of them (RenderSettings::host).
+  const std::vector<float> host_z = settings.host ? host_view_depths(*settings.host) : std::vector<float>{};
+  const bool surface_out = settings.host && settings.host->write_depth;
+  const double surface_alpha = surface_out ? settings.host->alpha_threshold : 0.0;
   const size_t n = scene.size();
 
   const PreparedLighting lighting = prepare_lighting(settings.lighting);  // validates
@@ -381,6 +387,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
   image.rgba.assign(image.pixels() * 4, 0.0f);
   if (settings.depth) image.depth.assign(image.pixels(), 0.0f);
   if (settings.splat_count) image.splat_count.assign(image.pixels(), 0);
+  if (surface_out) image.host_depth.assign(image.pixels(), 0.0f);
 
   const double background[3] = {settings.background[0], settings.background[1], settings.background[2]};
   const size_t width = size_t(camera.width);
@@ -398,7 +405,9 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
             double transmittance = 1.0;
             double color[3] = {0, 0, 0};
             double depth_sum = 0, weight_sum = 0;
+            double surface = 0;  // the depth at which 1 - T reached the host's threshold; 0: never
             uint32_t blended = 0;
+            const float surface_z = host_z.empty() ? 0.0f : host_z[py * width + px];
             for (const uint32_t* it = list_begin; it != list_end; ++it) {
               const Splat& splat = splats[*it];
               const double dx = splat.mean[0] - pixel_x;
@@ -408,6 +417,8 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
               if (power > 0) continue;
               const double alpha = std::min(kMaxAlpha, splat.opacity * std::exp(power));
               if (alpha < kMinAlpha) continue;
+              // Behind (or at) the host's opaque surface; compared as the float depths the GPU sorts on.
+              if (!host_z.empty() && !(static_cast<float>(splat.depth) < surface_z)) continue;
               const double next_transmittance = transmittance * (1 - alpha);
               if (next_transmittance < kMinTransmittance) break;
               const double weight = alpha * transmittance;
@@ -415,6 +426,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
               depth_sum += weight * splat.depth;
               weight_sum += weight;
               transmittance = next_transmittance;
+              if (surface_out && surface == 0 && 1 - transmittance >= surface_alpha) surface = splat.depth;
               ++blended;
             }
             const size_t pixel = py * width + px;
@@ -423,6 +435,13 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
             image.rgba[pixel * 4 + 3] = static_cast<float>(1.0 - transmittance);
             if (settings.depth) image.depth[pixel] = weight_sum > 0 ? static_cast<float>(depth_sum / weight_sum) : 0.0f;
             if (settings.splat_count) image.splat_count[pixel] = blended;
+            if (surface_out) {
+              const HostDepth& host = *settings.host;
+              image.host_depth[pixel] =
+                  surface > 0 ? static_cast<float>(host.convention.window_depth(surface))
+                              : (host.depth.empty() ? static_cast<float>(host.convention.far_depth())
+                                                    : host.depth[pixel]);
+            }
           }
       }
   });

@@ -1,0 +1,20 @@
+// RenderSettings::host, as both renderers (the GPU's and the float64 reference) read it.
+#pragma once
+
+#include <vector>
+
+#include "tilesplat/camera.h"
+#include "tilesplat/renderer.h"
+
+namespace tilesplat {
+
+// Throws std::invalid_argument ("host depth: ...") for a compositor or mode that does not honour
+// it, a convention that is not one, a threshold outside (0, 1], or a depth image of the wrong size or
+// with a NaN.
+void validate_host_depth(const RenderSettings& settings, const Camera& camera);
+
+// The host's depth image as the view depths both renderers compare splats with: float, +inf where
+// the host's value lies at or beyond infinity. Empty for no depth image.
+std::vector<float> host_view_depths(const HostDepth& host);
+
+}  // namespace tilesplat

@@ -1,0 +1,252 @@
+// Splats inside a host's world: a host's depth image cuts the splats (only those in front of its
+// opaque surface blend), and the depth where their alpha reaches a threshold comes back in the host's
+// convention; the GPU held to the float64 reference.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "effects_report.h"
+#include "process_support.h"
+#include "test_support.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/image.h"
+#include "tilesplat/reference.h"
+#include "tilesplat/renderer.h"
+
+namespace {
+
+using tilesplat::Camera;
+using tilesplat::DepthConvention;
+using tilesplat::HostDepth;
+using tilesplat::RenderSettings;
+
+std::string error_of(const std::function<void()>& action) {
+  try {
+    action();
+  } catch (const std::invalid_argument& error) {
+    return error.what();
+  }
+  return "(no std::invalid_argument)";
+}
+
+// A Vulkan projection (glm::perspectiveRH_ZO with its y flipped) with near and far planes, column-major.
+std::array<double, 16> vulkan_projection(double near, double far, bool reversed) {
+  std::array<double, 16> p{};
+  p[0] = 1;
+  p[5] = -1;
+  p[11] = -1;  // clip w = -z_view
+  if (!reversed) {
+    p[10] = far / (near - far);
+    p[14] = far * near / (near - far);
+  } else {  // reversed-Z, infinite far: d = near / z
+    p[10] = 0;
+    p[14] = near;
+  }
+  return p;
+}
+
+TEST(HostDepth, ConventionsOfTheProjectionsHostsUse) {
+  const DepthConvention standard = DepthConvention::from_projection(vulkan_projection(0.1, 100, false));
+  EXPECT_NEAR(standard.window_depth(0.1), 0.0, 1e-12);
+  EXPECT_NEAR(standard.window_depth(100), 1.0, 1e-12);
+  EXPECT_NEAR(standard.view_depth(standard.window_depth(7.5)), 7.5, 1e-9);
+  EXPECT_EQ(standard.far_depth(), 1.0);
+  const DepthConvention reversed = DepthConvention::from_projection(vulkan_projection(0.1, 0, true));
+  EXPECT_NEAR(reversed.window_depth(0.1), 1.0, 1e-12);
+  EXPECT_EQ(reversed.view_depth(0.0), std::numeric_limits<double>::infinity());  // the cleared far value
+  EXPECT_EQ(reversed.far_depth(), 0.0);
+  // OpenGL: NDC depth in [-1, 1], the depth buffer (window depth) in [0, 1].
+  std::array<double, 16> gl = vulkan_projection(0.5, 50, false);
+  gl[5] = 1;
+  gl[10] = -(50 + 0.5) / (50 - 0.5);
+  gl[14] = -2 * 50 * 0.5 / (50 - 0.5);
+  const DepthConvention opengl = DepthConvention::from_projection(gl, tilesplat::ClipSpace::opengl());
+  EXPECT_NEAR(opengl.window_depth(0.5), 0.0, 1e-12);
+  EXPECT_NEAR(opengl.window_depth(50), 1.0, 1e-12);
+  std::array<double, 16> orthographic = vulkan_projection(0.1, 100, false);
+  orthographic[11] = 0;
+  orthographic[15] = 1;
+  EXPECT_NE(error_of([&] { DepthConvention::from_projection(orthographic); }).find("not a pinhole"),
+            std::string::npos);
+}
+
+struct Views {
+  tilesplat::GaussianScene scene;
+  std::vector<Camera> cameras;
+};
+const Views& playbot_views() {
+  static const Views views = [] {
+    Views v;
+    v.scene = tilesplat::load_scene(tilesplat::testing::bundled_playbot());
+    const auto all = tilesplat::load_cameras_json(tilesplat::testing::bundled_playbot_cameras());
+    for (int view : {0, 3})
+      v.cameras.push_back(tilesplat::resize_camera(all.at(size_t(view)).camera, 480, 270));
+    return v;
+  }();
+  return views;
+}
+
+// A host's wall through the scene (the effects bench's plane, tilted 35 degrees about the camera's y).
+std::vector<float> tilted_plane(const Views& views, const Camera& camera, const DepthConvention& convention) {
+  return tilesplat::effects::plane_through_scene(views.scene, camera, convention);
+}
+
+TEST(HostDepth, TiltedPlaneThroughARealSceneMatchesTheReference) {
+  const Views& views = playbot_views();
+  auto& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(views.scene);
+  const DepthConvention convention = DepthConvention::from_projection(vulkan_projection(0.05, 200, false));
+  for (const Camera& camera : views.cameras) {
+    const std::vector<float> plane = tilted_plane(views, camera, convention);
+    RenderSettings settings;
+    settings.host = HostDepth{convention, plane, true, 0.5f};
+    const tilesplat::RenderImage gpu = renderer.render(camera, settings);
+    const tilesplat::RenderImage reference = tilesplat::render_reference(views.scene, camera, settings);
+    const tilesplat::ImageDifference difference = tilesplat::compare_images(gpu, reference);
+    EXPECT_GE(difference.psnr_db, 60.0);
+    EXPECT_LE(difference.max_abs, 2e-3) << "at (" << difference.worst_x << ", " << difference.worst_y << ")";
+    EXPECT_LE(difference.max_abs_alpha, 2e-3);
+
+    // The plane hides part of the scene: the cut image differs from the uncut one, and is darker.
+    const tilesplat::RenderImage uncut = renderer.render(camera);
+    EXPECT_GT(tilesplat::compare_images(gpu, uncut).max_abs, 0.1);
+    double cut_alpha = 0, uncut_alpha = 0;
+    for (size_t i = 0; i < gpu.pixels(); ++i)
+      cut_alpha += gpu.rgba[4 * i + 3], uncut_alpha += uncut.rgba[4 * i + 3];
+    EXPECT_LT(cut_alpha, 0.95 * uncut_alpha);
+
+    // Depth out, in the host's convention: the splat's depth where alpha reached 0.5, else the plane.
+    ASSERT_EQ(gpu.host_depth.size(), gpu.pixels());
+    size_t reached = 0, differ = 0;
+    for (size_t i = 0; i < gpu.pixels(); ++i) {
+      if (gpu.host_depth[i] != plane[i]) ++reached;
+      if (std::abs(gpu.host_depth[i] - reference.host_depth[i]) > 1e-6f) ++differ;
+      EXPECT_LE(gpu.host_depth[i], plane[i])
+          << "pixel " << i << ": the splats' surface lies behind the host's";
+    }
+    std::printf(
+        "host depth, a tilted plane: PSNR %.1f dB, max abs %.2g (alpha %.2g); depth out reached at %zu of "
+        "%zu "
+        "pixels, %zu differ from the reference by more than 1e-6\n",
+        difference.psnr_db, difference.max_abs, difference.max_abs_alpha, reached, gpu.pixels(), differ);
+    EXPECT_GT(reached, gpu.pixels() / 20) << "too few pixels reach alpha 0.5 for the test to mean anything";
+    EXPECT_EQ(differ, 0u) << "pixels whose depth out differs from the reference by more than float rounding";
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(HostDepth, SurfaceInFrontOfEverySplatLeavesExactlyNothing) {
+  const Views& views = playbot_views();
+  auto& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(views.scene);
+  const DepthConvention convention = DepthConvention::from_projection(vulkan_projection(0.001, 100, false));
+  const Camera& camera = views.cameras[0];
+  // A wall at view depth 0.01, nearer than the renderer's near plane (0.2): no splat is in front of it.
+  const std::vector<float> wall(size_t(camera.width) * size_t(camera.height),
+                                float(convention.window_depth(0.01)));
+  RenderSettings settings;
+  settings.host = HostDepth{convention, wall, true, 0.5f};
+  const tilesplat::RenderImage image = renderer.render(camera, settings);
+  for (size_t i = 0; i < image.rgba.size(); ++i) ASSERT_EQ(image.rgba[i], 0.0f) << "value " << i;
+  for (size_t i = 0; i < image.pixels(); ++i) {
+    ASSERT_EQ(image.splat_count[i], 0u);
+    ASSERT_EQ(image.host_depth[i], wall[i]);  // the host's own depth where the splats never reach
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(HostDepth, ClearedFarDepthChangesNothing) {
+  const Views& views = playbot_views();
+  auto& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(views.scene);
+  const Camera& camera = views.cameras[1];
+  const tilesplat::RenderImage plain = renderer.render(camera);
+  // Reversed-Z with an infinite far plane, cleared to 0: every splat is in front of it.
+  const DepthConvention convention = DepthConvention::from_projection(vulkan_projection(0.1, 0, true));
+  const std::vector<float> cleared(size_t(camera.width) * size_t(camera.height), 0.0f);
+  RenderSettings settings;
+  settings.host = HostDepth{convention, cleared, true, 0.5f};
+  const tilesplat::RenderImage with_host = renderer.render(camera, settings);
+  EXPECT_TRUE(with_host.rgba == plain.rgba);
+  EXPECT_TRUE(with_host.depth == plain.depth);
+  EXPECT_TRUE(with_host.splat_count == plain.splat_count);
+  // Depth out without a depth image in: the splats' median depth, or the far value.
+  settings.host->depth = {};
+  const tilesplat::RenderImage out_only = renderer.render(camera, settings);
+  const tilesplat::RenderImage reference = tilesplat::render_reference(views.scene, camera, settings);
+  EXPECT_TRUE(out_only.rgba == plain.rgba);
+  size_t far = 0, differ = 0;
+  for (size_t i = 0; i < out_only.pixels(); ++i) {
+    far += out_only.host_depth[i] == 0.0f ? 1u : 0u;
+    differ += std::abs(out_only.host_depth[i] - reference.host_depth[i]) > 1e-6f ? 1u : 0u;
+  }
+  EXPECT_GT(far, 0u);
+  EXPECT_LT(far, out_only.pixels());
+  EXPECT_EQ(differ, 0u);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(HostDepth, EveryCompositeLayoutAgreesBitForBit) {
+  const Views& views = playbot_views();
+  const Camera& camera = views.cameras[0];
+  const DepthConvention convention = DepthConvention::from_projection(vulkan_projection(0.05, 200, false));
+  const std::vector<float> plane = tilted_plane(views, camera, convention);
+  RenderSettings settings;
+  settings.host = HostDepth{convention, plane, true, 0.5f};
+  tilesplat::testing::expect_composite_layouts_identical(views.scene, camera, settings);
+}
+
+TEST(HostDepth, InvalidDepthImagesAndSettingsAreClearErrors) {
+  const Views& views = playbot_views();
+  auto& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(views.scene);
+  const Camera& camera = views.cameras[0];
+  const DepthConvention convention = DepthConvention::from_projection(vulkan_projection(0.05, 200, false));
+  std::vector<float> depth(size_t(camera.width) * size_t(camera.height), 0.5f);
+  RenderSettings settings;
+  auto gpu_and_reference = [&](const std::string& expected) {
+    EXPECT_NE(error_of([&] { renderer.render(camera, settings); }).find(expected), std::string::npos)
+        << expected;
+    EXPECT_NE(error_of([&] { tilesplat::render_reference(views.scene, camera, settings); }).find(expected),
+              std::string::npos)
+        << expected;
+  };
+  const std::vector<float> short_image(100, 0.5f);
+  settings.host = HostDepth{convention, short_image, false, 0.5f};
+  gpu_and_reference("host depth: the depth image has 100 values, the camera's image 480x270 needs 129600");
+  depth[481] = std::numeric_limits<float>::quiet_NaN();
+  settings.host = HostDepth{convention, depth, false, 0.5f};
+  gpu_and_reference("host depth: the depth image is NaN at pixel (1, 1)");
+  depth[481] = 0.5f;
+  settings.host = HostDepth{convention, depth, true, 0.0f};
+  gpu_and_reference("alpha_threshold must be in (0, 1]");
+  settings.host = HostDepth{convention, depth, false, 0.5f};
+  settings.compositor = tilesplat::Compositor::kStochastic;
+  gpu_and_reference("the stochastic compositor does not depth-test");
+  settings.compositor = tilesplat::Compositor::kSorted;
+  settings.host->convention.b = 0;
+  gpu_and_reference("the depth convention must have finite a and b");
+  // The renderer still renders after the errors.
+  settings.host->convention = convention;
+  EXPECT_EQ(renderer.render(camera, settings).width, 480);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(HostDepth, EffectsTableHasTheHostDepthRowBesideTheBase) {
+  const auto result =
+      tilesplat::testing::run_process("", TILESPLAT_BENCH_EXE,
+                                      {tilesplat::testing::bundled_sh3().string(), "--effects", "--width",
+                                       "64", "--height", "36", "--warmup", "0", "--repeat", "1"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("host depth in + out (a plane through the scene)"), std::string::npos)
+      << result.out;
+  EXPECT_NE(result.out.find("base (all off, SH3)"), std::string::npos) << result.out;  // no host depth
+  EXPECT_EQ(result.err.find("validation messages"), std::string::npos) << result.err;
+}
+
+}  // namespace
