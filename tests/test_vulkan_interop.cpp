@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <functional>
 #include <stdexcept>
+#include <vector>
 
+#include "effects_report.h"
 #include "test_support.h"
 #include "tilesplat/vulkan_interop.h"
 
@@ -36,8 +39,10 @@ class HostApplication : public ::testing::Test {
     ici.ppEnabledExtensionNames = &ext;
     HOST_CHECK(vkCreateInstance(&ici, nullptr, &instance));
     VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+    mci.messageSeverity =
+        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mci.messageType =
+        VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
     mci.pfnUserCallback = count_messages;
     mci.pUserData = &messages;
     auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
@@ -147,8 +152,8 @@ TEST_F(HostApplication, RendersOnTheHostDeviceIntoTheHostImage) {
   HOST_CHECK(vkCreateBuffer(device, &bci, nullptr, &readback));
   vkGetBufferMemoryRequirements(device, readback, &req);
   mai.allocationSize = req.size;
-  mai.memoryTypeIndex =
-      memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+  mai.memoryTypeIndex = memory_type(
+      req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
   VkDeviceMemory readback_memory = VK_NULL_HANDLE;
   HOST_CHECK(vkAllocateMemory(device, &mai, nullptr, &readback_memory));
   HOST_CHECK(vkBindBufferMemory(device, readback, readback_memory, 0));
@@ -193,8 +198,8 @@ TEST_F(HostApplication, RendersOnTheHostDeviceIntoTheHostImage) {
   to_src.srcQueueFamilyIndex = to_src.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   to_src.image = image;
   to_src.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                       nullptr, 1, &to_src);
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr,
+                       0, nullptr, 1, &to_src);
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
   region.imageExtent = {200, 120, 1};
@@ -202,8 +207,8 @@ TEST_F(HostApplication, RendersOnTheHostDeviceIntoTheHostImage) {
   VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
   to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr,
-                       0, nullptr);
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                       nullptr, 0, nullptr);
   HOST_CHECK(vkEndCommandBuffer(cmd));
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
@@ -223,6 +228,170 @@ TEST_F(HostApplication, RendersOnTheHostDeviceIntoTheHostImage) {
   vkFreeMemory(device, readback_memory, nullptr);
   vkDestroyImage(device, image, nullptr);
   vkFreeMemory(device, image_memory, nullptr);
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
+// A host that drew a wall into its D32 depth buffer: the splats are cut by it, and their depth is
+// written into the same buffer for what the host draws next.
+TEST_F(HostApplication, DepthImageCutsTheSplatsAndReceivesTheirDepth) {
+  constexpr uint32_t kWidth = 160, kHeight = 90;
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const Camera camera =
+      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
+  const DepthConvention convention = effects::bench_depth_convention();
+  const std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+
+  struct Image {
+    VkImage image = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+  };
+  auto make_image = [&](VkFormat format, VkImageUsageFlags usage) {
+    VkImageCreateInfo ici{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    ici.imageType = VK_IMAGE_TYPE_2D;
+    ici.format = format;
+    ici.extent = {kWidth, kHeight, 1};
+    ici.mipLevels = ici.arrayLayers = 1;
+    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ici.usage = usage | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    Image made;
+    EXPECT_EQ(vkCreateImage(device, &ici, nullptr, &made.image), VK_SUCCESS);
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(device, made.image, &req);
+    VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    mai.allocationSize = req.size;
+    mai.memoryTypeIndex = memory_type(req.memoryTypeBits, 0);
+    EXPECT_EQ(vkAllocateMemory(device, &mai, nullptr, &made.memory), VK_SUCCESS);
+    EXPECT_EQ(vkBindImageMemory(device, made.image, made.memory, 0), VK_SUCCESS);
+    return made;
+  };
+  const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0);
+  const Image depth = make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+
+  // A host-visible buffer for the wall going in and the images coming out.
+  const VkDeviceSize bytes = VkDeviceSize(kWidth) * kHeight * 16;
+  VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bci.size = bytes;
+  bci.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  VkBuffer staging = VK_NULL_HANDLE;
+  HOST_CHECK(vkCreateBuffer(device, &bci, nullptr, &staging));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device, staging, &req);
+  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = memory_type(
+      req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+  VkDeviceMemory staging_memory = VK_NULL_HANDLE;
+  HOST_CHECK(vkAllocateMemory(device, &mai, nullptr, &staging_memory));
+  HOST_CHECK(vkBindBufferMemory(device, staging, staging_memory, 0));
+  void* mapped = nullptr;
+  HOST_CHECK(vkMapMemory(device, staging_memory, 0, bytes, 0, &mapped));
+
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.queueFamilyIndex = family;
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  HOST_CHECK(vkCreateCommandPool(device, &pci, nullptr, &pool));
+  auto submit = [&](const std::function<void(VkCommandBuffer)>& record) {
+    VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cai.commandPool = pool;
+    cai.commandBufferCount = 1;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    ASSERT_EQ(vkAllocateCommandBuffers(device, &cai, &cmd), VK_SUCCESS);
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    ASSERT_EQ(vkBeginCommandBuffer(cmd, &begin), VK_SUCCESS);
+    record(cmd);
+    ASSERT_EQ(vkEndCommandBuffer(cmd), VK_SUCCESS);
+    VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    info.commandBufferCount = 1;
+    info.pCommandBuffers = &cmd;
+    ASSERT_EQ(vkQueueSubmit(queue, 1, &info, VK_NULL_HANDLE), VK_SUCCESS);
+    ASSERT_EQ(vkQueueWaitIdle(queue), VK_SUCCESS);
+    vkFreeCommandBuffers(device, pool, 1, &cmd);
+  };
+  auto barrier = [](VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout from,
+                    VkImageLayout to) {
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.oldLayout = from;
+    b.newLayout = to;
+    b.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {aspect, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
+                         nullptr, 0, nullptr, 1, &b);
+  };
+  VkBufferImageCopy region{};
+  region.imageExtent = {kWidth, kHeight, 1};
+  // The host "draws" its wall: the depth image ends in the layout a host keeps a depth buffer in.
+  std::memcpy(mapped, wall.data(), wall.size() * sizeof(float));
+  submit([&](VkCommandBuffer cmd) {
+    barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+    vkCmdCopyBufferToImage(cmd, staging, depth.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+            VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+  });
+
+  RenderSettings settings;
+  settings.host = HostDepth{convention, {}, true, 0.5f};
+  RenderImage expected;
+  {
+    auto renderer = create_renderer(external());
+    renderer->set_scene(scene);
+    const ExternalImage target{colour.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT,
+                               VK_IMAGE_LAYOUT_UNDEFINED};
+    const ExternalDepthImage host_depth{depth.image, kWidth, kHeight, VK_FORMAT_D32_SFLOAT,
+                                        VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+    render_to_image(*renderer, camera, settings, target, host_depth);
+    // What render() gives for the same wall in host memory.
+    RenderSettings in_memory = settings;
+    in_memory.host->depth = wall;
+    expected = renderer->render(camera, in_memory);
+    // Mistakes: no host settings, depth values given twice, an UNDEFINED depth image.
+    EXPECT_THROW(render_to_image(*renderer, camera, {}, target, host_depth), std::invalid_argument);
+    EXPECT_THROW(render_to_image(*renderer, camera, in_memory, target, host_depth), std::invalid_argument);
+    ExternalDepthImage undefined = host_depth;
+    undefined.layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    EXPECT_THROW(render_to_image(*renderer, camera, settings, target, undefined), std::invalid_argument);
+    EXPECT_THROW(render_to_image(*renderer, camera, settings, target), std::invalid_argument);  // write_depth
+  }
+
+  // Read both images back as the host would.
+  std::vector<float> rgba(size_t(kWidth) * kHeight * 4), depth_after(size_t(kWidth) * kHeight);
+  submit([&](VkCommandBuffer cmd) {
+    barrier(cmd, colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
+            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    vkCmdCopyImageToBuffer(cmd, colour.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging, 1, &region);
+  });
+  std::memcpy(rgba.data(), mapped, rgba.size() * sizeof(float));
+  submit([&](VkCommandBuffer cmd) {
+    barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+    vkCmdCopyImageToBuffer(cmd, depth.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging, 1, &region);
+  });
+  std::memcpy(depth_after.data(), mapped, depth_after.size() * sizeof(float));
+  EXPECT_EQ(rgba, expected.rgba);
+  EXPECT_EQ(depth_after, expected.host_depth);
+  size_t nearer = 0;
+  for (size_t i = 0; i < wall.size(); ++i) {
+    EXPECT_LE(depth_after[i], wall[i]) << "pixel " << i;
+    nearer += depth_after[i] < wall[i] ? 1u : 0u;
+  }
+  EXPECT_GT(nearer, wall.size() / 20) << "the splats wrote their depth at too few pixels to mean anything";
+
+  vkUnmapMemory(device, staging_memory);
+  vkDestroyCommandPool(device, pool, nullptr);
+  vkDestroyBuffer(device, staging, nullptr);
+  vkFreeMemory(device, staging_memory, nullptr);
+  for (const Image& image : {colour, depth}) {
+    vkDestroyImage(device, image.image, nullptr);
+    vkFreeMemory(device, image.memory, nullptr);
+  }
   EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
 }
 

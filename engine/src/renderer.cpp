@@ -647,9 +647,26 @@ std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device, co
   return std::unique_ptr<Renderer>(new Renderer(std::make_unique<Renderer::Impl>(options, device)));
 }
 
-void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
-                     const ExternalImage& target) {
-  Renderer::Impl& r = *renderer.impl_;
+namespace {
+
+void image_barrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout from,
+                   VkImageLayout to, VkAccessFlags src_access, VkAccessFlags dst_access) {
+  VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  b.oldLayout = from;
+  b.newLayout = to;
+  b.srcAccessMask = src_access;
+  b.dstAccessMask = dst_access;
+  b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = image;
+  b.subresourceRange = {aspect, 0, 1, 0, 1};
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
+                       nullptr, 0, nullptr, 1, &b);
+}
+
+constexpr VkAccessFlags kAnyAccess = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+
+void check_target(const ExternalImage& target, const Camera& camera) {
   if (target.image == VK_NULL_HANDLE) throw std::invalid_argument("render_to_image: no image");
   if (target.width != uint32_t(camera.width) || target.height != uint32_t(camera.height))
     throw std::invalid_argument("render_to_image: image is " + std::to_string(target.width) + "x" +
@@ -657,39 +674,97 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
                                 std::to_string(camera.width) + "x" + std::to_string(camera.height));
   if (target.format != VK_FORMAT_R32G32B32A32_SFLOAT)
     throw std::invalid_argument("render_to_image: only VK_FORMAT_R32G32B32A32_SFLOAT images are supported");
+}
+
+// Copies `buffer` into mip 0, layer 0 of `image` (aspect), leaving the image in `layout` (GENERAL
+// for an image handed over UNDEFINED, which cannot be a destination layout).
+void copy_buffer_to_image(VkCommandBuffer cmd, const vk::Buffer& buffer, VkImage image,
+                          VkImageAspectFlags aspect, VkImageLayout layout, uint32_t width, uint32_t height) {
+  image_barrier(cmd, image, aspect, layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_MEMORY_WRITE_BIT,
+                VK_ACCESS_TRANSFER_WRITE_BIT);
+  VkBufferImageCopy region{};
+  region.imageSubresource = {aspect, 0, 0, 1};
+  region.imageExtent = {width, height, 1};
+  vkCmdCopyBufferToImage(cmd, buffer.handle(), image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  const VkImageLayout final_layout = layout == VK_IMAGE_LAYOUT_UNDEFINED ? VK_IMAGE_LAYOUT_GENERAL : layout;
+  image_barrier(cmd, image, aspect, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout,
+                VK_ACCESS_TRANSFER_WRITE_BIT, kAnyAccess);
+}
+
+}  // namespace
+
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                     const ExternalImage& target) {
+  Renderer::Impl& r = *renderer.impl_;
+  check_target(target, camera);
   if (settings.host && settings.host->write_depth)
     throw std::invalid_argument(
-        "render_to_image: HostDepth::write_depth has no depth image to write into yet; render() returns it "
-        "in "
-        "RenderImage::host_depth");
+        "render_to_image: HostDepth::write_depth needs the host's depth image to write into: pass an "
+        "ExternalDepthImage");
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings);
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    auto transition = [&](VkImageLayout from, VkImageLayout to, VkAccessFlags src_access, VkAccessFlags dst_access) {
-      VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-      b.oldLayout = from;
-      b.newLayout = to;
-      b.srcAccessMask = src_access;
-      b.dstAccessMask = dst_access;
-      b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      b.image = target.image;
-      b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-      vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
-                           nullptr, 0, nullptr, 1, &b);
-    };
-    transition(target.layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_MEMORY_WRITE_BIT,
-               VK_ACCESS_TRANSFER_WRITE_BIT);
+    copy_buffer_to_image(cmd, r.outputs.rgba, target.image, VK_IMAGE_ASPECT_COLOR_BIT, target.layout,
+                         target.width, target.height);
+  });
+  r.stats.cpu_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                     const ExternalImage& target, const ExternalDepthImage& depth) {
+  Renderer::Impl& r = *renderer.impl_;
+  check_target(target, camera);
+  auto fail = [](const std::string& why) {
+    throw std::invalid_argument("render_to_image: depth image: " + why);
+  };
+  if (depth.image == VK_NULL_HANDLE) fail("no image");
+  if (depth.width != target.width || depth.height != target.height)
+    fail(std::to_string(depth.width) + "x" + std::to_string(depth.height) + " but the colour image is " +
+         std::to_string(target.width) + "x" + std::to_string(target.height));
+  if (depth.format != VK_FORMAT_D32_SFLOAT && depth.format != VK_FORMAT_R32_SFLOAT)
+    fail("only VK_FORMAT_D32_SFLOAT and VK_FORMAT_R32_SFLOAT are supported");
+  if (depth.layout == VK_IMAGE_LAYOUT_UNDEFINED)
+    fail("its layout is UNDEFINED, so it holds no depth to test against");
+  if (!settings.host) fail("RenderSettings::host must say the image's depth convention");
+  if (!settings.host->depth.empty())
+    fail("RenderSettings::host already has depth values; the image replaces them");
+  const VkImageAspectFlags aspect =
+      depth.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+  const auto start = std::chrono::steady_clock::now();
+
+  // The host's depth, through host memory, into the same path as HostDepth::depth.
+  const size_t pixels = size_t(depth.width) * depth.height;
+  vk::Buffer readback(r.ctx, pixels * sizeof(float), vk::MemoryUse::Readback, "host depth image (readback)");
+  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    image_barrier(cmd, depth.image, aspect, depth.layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, kAnyAccess,
+                  VK_ACCESS_TRANSFER_READ_BIT);
     VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.imageExtent = {target.width, target.height, 1};
-    vkCmdCopyBufferToImage(cmd, r.outputs.rgba.handle(), target.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+    region.imageSubresource = {aspect, 0, 0, 1};
+    region.imageExtent = {depth.width, depth.height, 1};
+    vkCmdCopyImageToBuffer(cmd, depth.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.handle(), 1,
                            &region);
-    // UNDEFINED cannot be a destination layout: an image handed over undefined is left GENERAL.
-    const VkImageLayout final_layout =
-        target.layout == VK_IMAGE_LAYOUT_UNDEFINED ? VK_IMAGE_LAYOUT_GENERAL : target.layout;
-    transition(VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout, VK_ACCESS_TRANSFER_WRITE_BIT,
-               VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT);
+    image_barrier(cmd, depth.image, aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, depth.layout,
+                  VK_ACCESS_TRANSFER_READ_BIT, kAnyAccess);
+  });
+  std::vector<float> window_depth(pixels);
+  std::memcpy(window_depth.data(), readback.mapped(), pixels * sizeof(float));
+  RenderSettings with_depth = settings;
+  with_depth.host->depth = window_depth;
+  r.render_frame(camera, with_depth);
+
+  vk::Buffer depth_out;
+  if (settings.host->write_depth) {
+    std::vector<float> out;
+    r.read_host_depth(*with_depth.host, out, pixels);
+    depth_out = vk::Buffer(r.ctx, pixels * sizeof(float), vk::MemoryUse::Upload, "host depth image (upload)");
+    std::memcpy(depth_out.mapped(), out.data(), pixels * sizeof(float));
+  }
+  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    copy_buffer_to_image(cmd, r.outputs.rgba, target.image, VK_IMAGE_ASPECT_COLOR_BIT, target.layout,
+                         target.width, target.height);
+    if (depth_out)
+      copy_buffer_to_image(cmd, depth_out, depth.image, aspect, depth.layout, depth.width, depth.height);
   });
   r.stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

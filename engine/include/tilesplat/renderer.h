@@ -238,6 +238,7 @@ struct DeviceInfo {
 
 struct ExternalVulkanDevice;  // tilesplat/vulkan_interop.h
 struct ExternalImage;
+struct ExternalDepthImage;
 
 /// Names of the available sort strategies, default first.
 TILESPLAT_API std::vector<std::string> sort_strategies();
@@ -309,6 +310,8 @@ class TILESPLAT_API Renderer {
   std::unique_ptr<Impl> impl_;
   friend std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice&, const RendererOptions&);
   friend void render_to_image(Renderer&, const Camera&, const RenderSettings&, const ExternalImage&);
+  friend void render_to_image(Renderer&, const Camera&, const RenderSettings&, const ExternalImage&,
+                              const ExternalDepthImage&);
 };
 
 }  // namespace tilesplat

@@ -44,12 +44,37 @@ struct ExternalImage {
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
 };
 
+/// A host's depth image for render_to_image, created on the renderer's device: the depth buffer it
+/// drew its meshes into, in the convention of RenderSettings::host.
+struct ExternalDepthImage {
+  VkImage image = VK_NULL_HANDLE;  ///< the host's 2D image; mip level 0, array layer 0
+  uint32_t width = 0;              ///< must equal the camera's width
+  uint32_t height = 0;             ///< must equal the camera's height
+  /// VK_FORMAT_D32_SFLOAT (its depth aspect) or VK_FORMAT_R32_SFLOAT (a depth the host copied out).
+  VkFormat format = VK_FORMAT_D32_SFLOAT;
+  /// The layout the image is in when render_to_image is called and is left in (not UNDEFINED: its
+  /// contents are read). It needs VK_IMAGE_USAGE_TRANSFER_SRC_BIT, and VK_IMAGE_USAGE_TRANSFER_DST_BIT
+  /// when HostDepth::write_depth writes the splats' depth into it.
+  VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL;
+};
+
 /// Renders a frame and writes premultiplied RGBA (colour over the background, A = 1 - T) into the
 /// image. The work has completed on the GPU when the call returns. RenderSettings::host depth-tests
 /// the splats against a host's depth values given in host memory (HostDepth::depth); its depth out
-/// (HostDepth::write_depth) is render()'s only, for now. Throws std::invalid_argument when the image
-/// does not match the camera or has an unsupported format, or for write_depth.
+/// (HostDepth::write_depth) needs the overload below, with a depth image. Throws
+/// std::invalid_argument when the image does not match the camera or has an unsupported format, or
+/// for write_depth.
 TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                                    const ExternalImage& target);
+
+/// The same, depth-tested against the host's depth image: settings.host must be set (its convention,
+/// write_depth, alpha_threshold) without depth values of its own, as the image provides them. The
+/// splats blend only in front of the image's surfaces; with write_depth, the image then holds the
+/// splats' depth where their alpha reached the threshold and keeps the host's elsewhere, so that
+/// geometry drawn afterwards is hidden behind dense splats. The depth goes through host memory (the
+/// call blocks, as the one above). Throws std::invalid_argument for a missing or mismatched image, an
+/// unsupported format or layout, or settings.host unset or with depth values.
+TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                                   const ExternalImage& target, const ExternalDepthImage& depth);
 
 }  // namespace tilesplat
