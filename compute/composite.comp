@@ -39,6 +39,9 @@ layout(constant_id = 5) const float ALPHA_INV = 255.0;  // 1 / ALPHA_MIN, as the
 layout(constant_id = 6) const float T_MIN = 1e-4;
 layout(constant_id = 7) const bool HOST_DEPTH = false;
 layout(constant_id = 8) const bool SURFACE_DEPTH = false;
+// The lists are in exact depth order (32-bit depth keys): a pixel is done at the first splat behind its
+// host surface, as every later one is behind it too. Same image, less work behind the host's walls.
+layout(constant_id = 9) const bool HOST_DEPTH_SORTED = false;
 
 layout(push_constant) uniform Push {
   Vec4Array splats;
@@ -104,9 +107,11 @@ uint blend_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
     float dy = mean_a_b.y - (float(local_y0 + p) + 0.5);
     float power = k0 + dy * (k1 + c_opacity_depth_r.x * dy);
     float alpha = min(0.99, c_opacity_depth_r.y * exp(power));
-    bool hit = T[p] > 0.0 && alpha >= ALPHA_MIN && (!HOST_DEPTH || c_opacity_depth_r.z < host_z[p]);
+    bool behind = HOST_DEPTH && !(c_opacity_depth_r.z < host_z[p]);
+    bool hit = T[p] > 0.0 && alpha >= ALPHA_MIN && !behind;
     float next_T = T[p] * (1.0 - alpha);
-    bool finish = hit && next_T < T_MIN;  // done, and this splat is NOT blended (reference)
+    bool finish = (hit && next_T < T_MIN)  // done, and this splat is NOT blended (reference)
+                  || (HOST_DEPTH_SORTED && T[p] > 0.0 && behind);
     bool blend = hit && !finish;
     float w = blend ? alpha * T[p] : 0.0;
     colour[p] += rgb * w;

@@ -422,6 +422,7 @@ struct Renderer::Impl {
     if (host_view_depth.size() > 0) surface.view_depth = &host_view_depth;
     if (host_surface_depth.size() > 0) surface.surface_depth = &host_surface_depth;
     surface.surface_alpha = settings.host->alpha_threshold;
+    surface.exact_depth_order = settings.accuracy.depth_key_bits == 32;
     return surface;
   }
 

@@ -58,7 +58,8 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                            const std::array<float, 3>& background, bool write_depth, bool write_count,
                            const Cutoffs& cutoffs, const Chunks& chunks, const HostSurface& host) {
   const bool host_depth = host.view_depth != nullptr, surface_depth = host.surface_depth != nullptr;
-  auto key = std::make_tuple(write_depth, write_count, cutoffs, host_depth, surface_depth);
+  const bool host_depth_sorted = host_depth && host.exact_depth_order;
+  auto key = std::make_tuple(write_depth, write_count, cutoffs, host_depth, surface_depth, host_depth_sorted);
   auto it = pipelines_.find(key);
   if (it == pipelines_.end()) {
     const float alpha_inv = coverage_alpha_inv(cutoffs.alpha);
@@ -72,7 +73,8 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                                                 {5, std::bit_cast<uint32_t>(alpha_inv)},
                                                 {6, std::bit_cast<uint32_t>(cutoffs.transmittance)},
                                                 {7, host_depth ? 1u : 0u},
-                                                {8, surface_depth ? 1u : 0u}}))
+                                                {8, surface_depth ? 1u : 0u},
+                                                {9, host_depth_sorted ? 1u : 0u}}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);

@@ -51,6 +51,7 @@ class CompositePass {
     const vk::Buffer* view_depth = nullptr;     // float per pixel, +inf where the host drew nothing
     const vk::Buffer* surface_depth = nullptr;  // float per pixel, written
     float surface_alpha = 0.5f;
+    bool exact_depth_order = false;  // 32-bit depth keys: a pixel is done at its first splat behind the host
   };
   void record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
               const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
@@ -63,8 +64,8 @@ class CompositePass {
   vk::Context& ctx_;
   uint32_t pixels_per_invocation_;
   uint32_t chunk_splats_;  // splats per tile and dispatch
-  // By outputs (depth, count), cut-offs and host depth (in, out).
-  std::map<std::tuple<bool, bool, Cutoffs, bool, bool>, vk::ComputePipeline> pipelines_;
+  // By outputs (depth, count), cut-offs and host depth (in, out, in exact depth order).
+  std::map<std::tuple<bool, bool, Cutoffs, bool, bool, bool>, vk::ComputePipeline> pipelines_;
 };
 
 }  // namespace tilesplat
