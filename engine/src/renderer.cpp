@@ -31,6 +31,7 @@
 #include "passes/depth_quantize_pass.h"
 #include "passes/frame_counters.h"
 #include "passes/key_emission_pass.h"
+#include "passes/pack_colour_pass.h"
 #include "passes/prefix_sum_pass.h"
 #include "passes/projection_pass.h"
 #include "passes/stochastic_composite_pass.h"
@@ -99,6 +100,10 @@ void validate_compositor(const RenderSettings& settings) {
          std::to_string(settings.stochastic.frames));
 }
 
+// Copies a buffer into an image of the host's, from and back to its layout (defined with render_to_image).
+void copy_buffer_to_image(VkCommandBuffer cmd, const vk::Buffer& buffer, VkImage image,
+                          VkImageAspectFlags aspect, VkImageLayout layout, uint32_t width, uint32_t height);
+
 template <typename T>
 vk::Buffer make_buffer(vk::Context& ctx, size_t count, const char* name) {
   return vk::Buffer(ctx, VkDeviceSize(count) * sizeof(T), vk::MemoryUse::Device, name);
@@ -119,6 +124,7 @@ struct Renderer::Impl {
         key_emission(ctx),
         tile_ranges(ctx),
         composite(ctx),
+        pack_colour(ctx),
         composite_resort(ctx),
         stochastic_composite(ctx),
         counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "frame counters") {}
@@ -180,6 +186,7 @@ struct Renderer::Impl {
                                 &outputs.count,
                                 &host_view_depth,
                                 &host_surface_depth,
+                                &packed_colour,
                                 &counters})
       bytes += b->size();
     bytes += projected.depth_order.bytes() + keys.bytes();
@@ -426,6 +433,23 @@ struct Renderer::Impl {
     return surface;
   }
 
+  // The frame's colour into the host's image: as it is for RGBA32F, else packed into the image's
+  // texel format first (pack_colour.comp).
+  void copy_colour_to_image(VkCommandBuffer cmd, const ExternalImage& target) {
+    const vk::Buffer* source = &outputs.rgba;
+    if (target.format != VK_FORMAT_R32G32B32A32_SFLOAT) {
+      const VkDeviceSize bytes =
+          VkDeviceSize(target.width) * target.height * PackColourPass::texel_bytes(target.format);
+      if (packed_colour.size() < bytes)
+        packed_colour = vk::Buffer(ctx, bytes, vk::MemoryUse::Device, "packed colour (render_to_image)");
+      pack_colour.record(cmd, target.format, outputs.rgba, packed_colour, target.width, target.height);
+      vk::barrier(cmd);  // the packing's writes before the copy's reads
+      source = &packed_colour;
+    }
+    copy_buffer_to_image(cmd, *source, target.image, VK_IMAGE_ASPECT_COLOR_BIT, target.layout, target.width,
+                         target.height);
+  }
+
   // RenderImage::host_depth: the composite's surface view depths in the host's convention, the host's
   // own depth (or its far value) where the splats' alpha never reached the threshold.
   void read_host_depth(const HostDepth& host, std::vector<float>& out, size_t pixels) {
@@ -547,6 +571,7 @@ struct Renderer::Impl {
   KeyEmissionPass key_emission;
   TileRangesPass tile_ranges;
   CompositePass composite;
+  PackColourPass pack_colour;  // render_to_image into a colour image of another format than RGBA32F
   CompositeResortPass composite_resort;
   StochasticCompositePass stochastic_composite;
   std::map<std::string, std::unique_ptr<SortStrategy>> sorts;
@@ -561,6 +586,7 @@ struct Renderer::Impl {
   uint32_t composite_chunks = 1;
   uint32_t stochastic_chunks = 1;  // the same for the stochastic composite
   vk::Buffer composite_state;  // per-pixel state between a composite's dispatches (chunks, samples)
+  vk::Buffer packed_colour;    // render_to_image: the frame in the host image's texel format
   vk::Buffer host_view_depth;  // RenderSettings::host: the host's surfaces as view depth, per pixel
   vk::Buffer host_surface_depth;  // and the view depth at which the splats' alpha reached its threshold
   FrameStats stats;
@@ -673,8 +699,10 @@ void check_target(const ExternalImage& target, const Camera& camera) {
     throw std::invalid_argument("render_to_image: image is " + std::to_string(target.width) + "x" +
                                 std::to_string(target.height) + " but the camera renders " +
                                 std::to_string(camera.width) + "x" + std::to_string(camera.height));
-  if (target.format != VK_FORMAT_R32G32B32A32_SFLOAT)
-    throw std::invalid_argument("render_to_image: only VK_FORMAT_R32G32B32A32_SFLOAT images are supported");
+  if (target.format != VK_FORMAT_R32G32B32A32_SFLOAT && PackColourPass::texel_bytes(target.format) == 0)
+    throw std::invalid_argument(
+        "render_to_image: the colour image must be VK_FORMAT_R32G32B32A32_SFLOAT, R16G16B16A16_SFLOAT, "
+        "R8G8B8A8_UNORM or R8G8B8A8_SRGB");
 }
 
 // Copies `buffer` into mip 0, layer 0 of `image` (aspect), leaving the image in `layout` (GENERAL
@@ -704,10 +732,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
         "ExternalDepthImage");
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings);
-  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    copy_buffer_to_image(cmd, r.outputs.rgba, target.image, VK_IMAGE_ASPECT_COLOR_BIT, target.layout,
-                         target.width, target.height);
-  });
+  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) { r.copy_colour_to_image(cmd, target); });
   r.stats.cpu_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -762,8 +787,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
     std::memcpy(depth_out.mapped(), out.data(), pixels * sizeof(float));
   }
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    copy_buffer_to_image(cmd, r.outputs.rgba, target.image, VK_IMAGE_ASPECT_COLOR_BIT, target.layout,
-                         target.width, target.height);
+    r.copy_colour_to_image(cmd, target);
     if (depth_out)
       copy_buffer_to_image(cmd, depth_out, depth.image, aspect, depth.layout, depth.width, depth.height);
   });

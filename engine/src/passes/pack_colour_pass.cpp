@@ -1,0 +1,52 @@
+#include "passes/pack_colour_pass.h"
+
+#include <stdexcept>
+
+namespace tilesplat {
+
+namespace {
+struct PackColourPush {
+  VkDeviceAddress rgba, packed;
+  uint32_t width, height;
+};
+
+// pack_colour.comp's FORMAT.
+uint32_t shader_format(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+      return 0;
+    case VK_FORMAT_R8G8B8A8_UNORM:
+      return 1;
+    case VK_FORMAT_R8G8B8A8_SRGB:
+      return 2;
+    default:
+      throw std::logic_error("pack_colour: unsupported format");
+  }
+}
+}  // namespace
+
+uint32_t PackColourPass::texel_bytes(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+      return 8;
+    case VK_FORMAT_R8G8B8A8_UNORM:
+    case VK_FORMAT_R8G8B8A8_SRGB:
+      return 4;
+    default:
+      return 0;
+  }
+}
+
+void PackColourPass::record(VkCommandBuffer cmd, VkFormat format, const vk::Buffer& rgba,
+                            const vk::Buffer& packed, uint32_t width, uint32_t height) {
+  auto it = pipelines_.find(format);
+  if (it == pipelines_.end())
+    it = pipelines_
+             .emplace(format, vk::ComputePipeline(ctx_, "pack_colour", sizeof(PackColourPush),
+                                                  {{0, shader_format(format)}}))
+             .first;
+  it->second.bind(cmd, PackColourPush{rgba.address(), packed.address(), width, height});
+  it->second.dispatch(cmd, vk::div_ceil(width, 16), vk::div_ceil(height, 16));
+}
+
+}  // namespace tilesplat
