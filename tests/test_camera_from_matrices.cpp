@@ -177,22 +177,14 @@ TEST(CameraFromMatrices, HostProjectionOfAPointLandsWhereTheCameraPutsIt) {
   }
 }
 
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const std::invalid_argument& error) {
-    return error.what();
-  }
-  return "(no std::invalid_argument)";
-}
-
 TEST(CameraFromMatrices, NonPinholeAndBrokenMatricesAreRejectedNamingWhy) {
   Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, 64, 36);
   const Convention& gl = conventions().front();
   const Matrix view = view_matrix(camera, true);
   const Matrix projection = projection_matrix(camera, gl, 0.1, 100.0);
   const auto error = [&](Matrix v, Matrix p, int width = 64, int height = 36) {
-    return error_of([&] { Camera::from_matrices(v, p, width, height, gl.clip); });
+    return tilesplat::testing::error_of<std::invalid_argument>(
+        [&] { Camera::from_matrices(v, p, width, height, gl.clip); });
   };
   const auto has = [](const std::string& message, const std::string& part) {
     return message.find(part) != std::string::npos;

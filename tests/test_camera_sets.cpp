@@ -26,15 +26,6 @@ using tilesplat::Camera;
 using tilesplat::CameraView;
 using tilesplat::testing::fresh_output_dir;
 
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const std::exception& error) {
-    return error.what();
-  }
-  return "(no error)";
-}
-
 void expect_near_camera(const Camera& a, const Camera& b, double tolerance = 1e-9) {
   EXPECT_EQ(a.width, b.width);
   EXPECT_EQ(a.height, b.height);
@@ -155,18 +146,21 @@ TEST(CameraSets, ColmapDistortionTruncationAndMissingCamerasAreErrors) {
   const fs::path out = fresh_output_dir();
   write_colmap(views, out / "radial", false);
   std::ofstream(out / "radial" / "cameras.txt") << "1 SIMPLE_RADIAL 640 480 500 320 240 0.01\n";
-  EXPECT_NE(error_of([&] {
+  EXPECT_NE(tilesplat::testing::error_of([&] {
               tilesplat::load_colmap_cameras(out / "radial");
             }).find("uses the SIMPLE_RADIAL model, whose lens distortion the renderer cannot honour"),
             std::string::npos);
   std::ofstream(out / "radial" / "cameras.txt") << "7 PINHOLE 640 480 500 500 320 240\n";
-  EXPECT_NE(error_of([&] { tilesplat::load_colmap_cameras(out / "radial"); }).find("is not in cameras.txt"),
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              tilesplat::load_colmap_cameras(out / "radial");
+            }).find("is not in cameras.txt"),
             std::string::npos);
 
   write_colmap(views, out / "cut", true);
   const fs::path images = out / "cut" / "images.bin";
   fs::resize_file(images, fs::file_size(images) - 30);
-  const std::string truncated = error_of([&] { tilesplat::load_colmap_cameras(out / "cut"); });
+  const std::string truncated =
+      tilesplat::testing::error_of([&] { tilesplat::load_colmap_cameras(out / "cut"); });
   EXPECT_NE(truncated.find(images.string()), std::string::npos) << truncated;
   EXPECT_NE(truncated.find("truncated"), std::string::npos) << truncated;
   {
@@ -174,9 +168,13 @@ TEST(CameraSets, ColmapDistortionTruncationAndMissingCamerasAreErrors) {
     put<uint64_t>(huge, uint64_t(1) << 60);
     std::ofstream(out / "cut" / "cameras.bin", std::ios::binary) << huge;
   }
-  EXPECT_NE(error_of([&] { tilesplat::load_colmap_cameras(out / "cut"); }).find("more than the file holds"),
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              tilesplat::load_colmap_cameras(out / "cut");
+            }).find("more than the file holds"),
             std::string::npos);
-  EXPECT_NE(error_of([&] { tilesplat::load_colmap_cameras(out / "nothing"); }).find("not found"),
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              tilesplat::load_colmap_cameras(out / "nothing");
+            }).find("not found"),
             std::string::npos);
 }
 
@@ -229,16 +227,20 @@ TEST(CameraSets, TransformsJsonReadsAsTheSameCameras) {
   EXPECT_NEAR(ngp[0].camera.to_camera({0, 0, 0})[2], 4, 1e-12);
 
   std::ofstream(out / "distorted.json") << transforms_json(views, "\"k1\": 0.05, ");
-  EXPECT_NE(error_of([&] {
+  EXPECT_NE(tilesplat::testing::error_of([&] {
               tilesplat::load_camera_set(out / "distorted.json");
             }).find("frame 0: distortion coefficient k1 is not zero"),
             std::string::npos);
   std::ofstream(out / "fisheye.json") << transforms_json(views, "\"camera_model\": \"OPENCV_FISHEYE\", ");
-  EXPECT_NE(error_of([&] { tilesplat::load_camera_set(out / "fisheye.json"); }).find("OPENCV_FISHEYE"),
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              tilesplat::load_camera_set(out / "fisheye.json");
+            }).find("OPENCV_FISHEYE"),
             std::string::npos);
   std::ofstream(out / "sizeless.json")
       << R"({"fl_x": 500, "frames": [{"transform_matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]})";
-  EXPECT_NE(error_of([&] { tilesplat::load_camera_set(out / "sizeless.json"); }).find("missing 'w'"),
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              tilesplat::load_camera_set(out / "sizeless.json");
+            }).find("missing 'w'"),
             std::string::npos);
 }
 
@@ -303,7 +305,7 @@ TEST(CameraPaths, KeyframeFileMistakesNameTheKey) {
   const fs::path out = fresh_output_dir();
   auto error_for = [&](const std::string& text) {
     std::ofstream(out / "keys.json") << text;
-    return error_of([&] { tilesplat::load_camera_path(out / "keys.json"); });
+    return tilesplat::testing::error_of([&] { tilesplat::load_camera_path(out / "keys.json"); });
   };
   const std::string good = R"({"position": [0, 0, 4], "look_at": [0, 0, 0]})";
   EXPECT_NE(error_for(R"({"keyframes": [)" + good + "]}").find("at least 2 keyframes, found 1"),

@@ -25,15 +25,6 @@ using tilesplat::DepthConvention;
 using tilesplat::HostDepth;
 using tilesplat::RenderSettings;
 
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const std::invalid_argument& error) {
-    return error.what();
-  }
-  return "(no std::invalid_argument)";
-}
-
 // A Vulkan projection (glm::perspectiveRH_ZO with its y flipped) with near and far planes, column-major.
 std::array<double, 16> vulkan_projection(double near, double far, bool reversed) {
   std::array<double, 16> p{};
@@ -71,7 +62,9 @@ TEST(HostDepth, ConventionsOfTheProjectionsHostsUse) {
   std::array<double, 16> orthographic = vulkan_projection(0.1, 100, false);
   orthographic[11] = 0;
   orthographic[15] = 1;
-  EXPECT_NE(error_of([&] { DepthConvention::from_projection(orthographic); }).find("not a pinhole"),
+  EXPECT_NE(tilesplat::testing::error_of<std::invalid_argument>([&] {
+              DepthConvention::from_projection(orthographic);
+            }).find("not a pinhole"),
             std::string::npos);
 }
 
@@ -210,9 +203,14 @@ TEST(HostDepth, InvalidDepthImagesAndSettingsAreClearErrors) {
   std::vector<float> depth(size_t(camera.width) * size_t(camera.height), 0.5f);
   RenderSettings settings;
   auto gpu_and_reference = [&](const std::string& expected) {
-    EXPECT_NE(error_of([&] { renderer.render(camera, settings); }).find(expected), std::string::npos)
+    EXPECT_NE(tilesplat::testing::error_of<std::invalid_argument>([&] {
+                renderer.render(camera, settings);
+              }).find(expected),
+              std::string::npos)
         << expected;
-    EXPECT_NE(error_of([&] { tilesplat::render_reference(views.scene, camera, settings); }).find(expected),
+    EXPECT_NE(tilesplat::testing::error_of<std::invalid_argument>([&] {
+                tilesplat::render_reference(views.scene, camera, settings);
+              }).find(expected),
               std::string::npos)
         << expected;
   };

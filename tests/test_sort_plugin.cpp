@@ -37,15 +37,6 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-std::string error_of(const std::function<void()>& action) {
-  try {
-    action();
-  } catch (const std::exception& error) {
-    return error.what();
-  }
-  return "(no exception)";
-}
-
 TEST(SortPlugin, ExampleProgramMatchesTheBuiltInRadixSort) {
   const ProcessResult result =
       run_process("", TILESPLAT_CUSTOM_SORT_EXE, {bundled_playbot().string(), "160", "90"});
@@ -133,18 +124,20 @@ TEST(SortPlugin, LoadsIntoTheProcessAndSortsLikeRadix) {
 TEST(SortPlugin, LoadingErrorsNameTheFile) {
   const fs::path dir = fresh_output_dir();
   const fs::path missing = dir / "missing.so";
-  EXPECT_EQ(error_of([&] { tilesplat::load_sort_plugin(missing); }),
+  EXPECT_EQ(tilesplat::testing::error_of([&] { tilesplat::load_sort_plugin(missing); }),
             "cannot load sort plugin " + missing.string() + ": the file does not exist");
-  EXPECT_EQ(error_of([&] { tilesplat::load_sort_plugin(dir); }),
+  EXPECT_EQ(tilesplat::testing::error_of([&] { tilesplat::load_sort_plugin(dir); }),
             "cannot load sort plugin " + dir.string() + ": it is not a regular file");
   const fs::path text = dir / "text.so";
   std::ofstream(text) << "not a shared object\n";
-  const std::string not_elf = error_of([&] { tilesplat::load_sort_plugin(text); });
+  const std::string not_elf = tilesplat::testing::error_of([&] { tilesplat::load_sort_plugin(text); });
   EXPECT_EQ(not_elf.rfind("cannot load sort plugin " + text.string() + ": ", 0), 0u) << not_elf;
-  EXPECT_EQ(error_of([&] { tilesplat::load_sort_plugin(TILESPLAT_PLUGIN_WITHOUT_ENTRY); }),
-            std::string("cannot load sort plugin ") + TILESPLAT_PLUGIN_WITHOUT_ENTRY +
-                ": it exports no function tilesplat_sort_plugin_v1 (declare it extern \"C\" and visible)");
-  EXPECT_EQ(error_of([&] { tilesplat::load_sort_plugin(TILESPLAT_PLUGIN_REGISTERING_NOTHING); }),
+  EXPECT_EQ(
+      tilesplat::testing::error_of([&] { tilesplat::load_sort_plugin(TILESPLAT_PLUGIN_WITHOUT_ENTRY); }),
+      std::string("cannot load sort plugin ") + TILESPLAT_PLUGIN_WITHOUT_ENTRY +
+          ": it exports no function tilesplat_sort_plugin_v1 (declare it extern \"C\" and visible)");
+  EXPECT_EQ(tilesplat::testing::error_of(
+                [&] { tilesplat::load_sort_plugin(TILESPLAT_PLUGIN_REGISTERING_NOTHING); }),
             std::string("cannot load sort plugin ") + TILESPLAT_PLUGIN_REGISTERING_NOTHING +
                 ": it registered no sort strategy");
   EXPECT_THROW(tilesplat::load_sort_plugin(missing), std::runtime_error);
@@ -163,13 +156,13 @@ TEST(SortPlugin, RegistrationRejectsBadNames) {
   const auto factory = [](const tilesplat::SortDevice&) -> std::unique_ptr<tilesplat::ExternalSortStrategy> {
     throw std::runtime_error("never made");
   };
-  EXPECT_EQ(error_of([&] { tilesplat::register_sort_strategy("", factory); }),
+  EXPECT_EQ(tilesplat::testing::error_of([&] { tilesplat::register_sort_strategy("", factory); }),
             "a sort strategy needs a name");
-  EXPECT_EQ(error_of([&] { tilesplat::register_sort_strategy("a,b", factory); }),
+  EXPECT_EQ(tilesplat::testing::error_of([&] { tilesplat::register_sort_strategy("a,b", factory); }),
             "sort strategy name 'a,b' contains a comma or whitespace (names are listed comma-separated)");
-  EXPECT_EQ(error_of([&] { tilesplat::register_sort_strategy("radix", factory); }),
+  EXPECT_EQ(tilesplat::testing::error_of([&] { tilesplat::register_sort_strategy("radix", factory); }),
             "a sort strategy named 'radix' is already registered");
-  EXPECT_EQ(error_of([&] { tilesplat::register_sort_strategy("no-factory", nullptr); }),
+  EXPECT_EQ(tilesplat::testing::error_of([&] { tilesplat::register_sort_strategy("no-factory", nullptr); }),
             "sort strategy 'no-factory' has no factory");
   EXPECT_THROW(tilesplat::register_sort_strategy("radix", factory), std::invalid_argument);
 
@@ -177,7 +170,10 @@ TEST(SortPlugin, RegistrationRejectsBadNames) {
   tilesplat::register_sort_strategy("throws-on-creation", factory);
   EXPECT_EQ(tilesplat::sort_strategies().back(), "throws-on-creation");
   auto& renderer = tilesplat::testing::validated_renderer();
-  EXPECT_EQ(error_of([&] { renderer.sort_keys("throws-on-creation", {3, 1, 2}, 8); }), "never made");
+  EXPECT_EQ(tilesplat::testing::error_of([&] {
+              renderer.sort_keys("throws-on-creation", {3, 1, 2}, 8);
+            }),
+            "never made");
   EXPECT_EQ(renderer.sort_keys("radix", {3, 1, 2}, 8).order, (std::vector<uint32_t>{1, 2, 0}));
 }
 

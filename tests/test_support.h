@@ -1,6 +1,7 @@
 // Helpers shared by the tests: where scenes live, and a renderer with validation that fails on messages.
 #pragma once
 
+#include <exception>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -13,9 +14,9 @@ namespace tilesplat::testing {
 
 // The small real scenes bundled in this repository (always present).
 std::filesystem::path bundled_scene_dir();
-std::filesystem::path bundled_playbot();      // scenes/playbot_lod3/playbot_lod3_31000_sh2.ply
+std::filesystem::path bundled_playbot();  // scenes/playbot_lod3/playbot_lod3_31000_sh2.ply
 std::filesystem::path bundled_playbot_cameras();
-std::filesystem::path bundled_sh3();          // scenes/playcanvas_test/playcanvas_test_64_sh3.ply
+std::filesystem::path bundled_sh3();  // scenes/playcanvas_test/playcanvas_test_64_sh3.ply
 std::filesystem::path bundled_sh3_cameras();
 
 // ../shared/scenes, or $TILESPLAT_SHARED_SCENES. Empty path when absent: callers GTEST_SKIP().
@@ -35,11 +36,23 @@ Renderer& validated_renderer();
 void expect_composite_layouts_identical(const GaussianScene& scene, const Camera& camera,
                                         const RenderSettings& settings = {});
 
+// The message of the exception of type E (or derived) that `action` throws, for tests of error
+// messages; "(no exception)" when it throws none. An exception of another type escapes to the test.
+template <typename E = std::exception, typename Action>
+std::string error_of(Action&& action) {
+  try {
+    action();
+  } catch (const E& error) {
+    return error.what();
+  }
+  return "(no exception)";
+}
+
 }  // namespace tilesplat::testing
 
 // Skips the test, visibly, when ../shared/scenes is not available.
-#define TILESPLAT_REQUIRE_SHARED_SCENES()                                                       \
-  do {                                                                                          \
-    if (::tilesplat::testing::shared_scenes().empty())                                         \
+#define TILESPLAT_REQUIRE_SHARED_SCENES()                                                                  \
+  do {                                                                                                     \
+    if (::tilesplat::testing::shared_scenes().empty())                                                     \
       GTEST_SKIP() << "shared scenes not found: set TILESPLAT_SHARED_SCENES or -DTILESPLAT_SHARED_SCENES"; \
   } while (0)
