@@ -485,8 +485,9 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
   const auto start = std::chrono::steady_clock::now();
   std::vector<double> gpu_ms;
   if (!to_render.empty()) {
-    cli::ManifestAppender manifest(folder / cli::manifest_file_name(shard));
+    // The device first: a run that cannot create it leaves no (empty) manifest behind.
     FrameRenderer renderer(options, loaded.scene);
+    cli::ManifestAppender manifest(folder / cli::manifest_file_name(shard));
     cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()), progress_style(options.quiet));
     std::future<void> writing;
     for (const Frame* frame : to_render) {
@@ -528,10 +529,9 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
   return cli::kExitOk;
 }
 
-int merge(const cli::ArgParser& parser, const RenderOptions& options) {
+int merge(const RenderOptions& options) {
   if (!options.common.scene.empty())
     throw cli::UsageError("--merge-manifests FOLDER merges what the shards wrote and takes no SCENE");
-  (void)parser;
   const cli::MergeResult result = cli::merge_manifests(options.merge_folder);
   std::fprintf(stderr, "%s: %zu shard manifests cover all %zu frames exactly once, files intact -> %s\n",
                kProgram, result.manifests, result.frames, result.merged.string().c_str());
@@ -552,7 +552,7 @@ int run(int argc, char** argv) {
       "apply unless --background, --no-depth or --no-count say otherwise.");
   add_render_options(parser, options);
   if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
-  if (parser.seen("--merge-manifests")) return merge(parser, options);
+  if (parser.seen("--merge-manifests")) return merge(options);
   cli::check_common_options(parser, options.common);
   check_sequence_flags(parser, options);
   const bool sequence = renders_sequence(parser);

@@ -451,6 +451,11 @@ TEST(RenderSequence, MistakesFailBeforeAnyFrameIsRendered) {
     expect_one_error_line(result, "tilesplat-render");
     EXPECT_TRUE(contains(result.err, c.message)) << result.err;
   }
+  // A device that cannot be created fails before the manifest is opened.
+  const auto no_device =
+      run_process("env TILESPLAT_DEVICE=no-such-device ", kRenderExe, {scene, "--orbit", "2", "-o", pattern});
+  EXPECT_EQ(no_device.exit_code, 1) << no_device.err;
+  EXPECT_TRUE(contains(no_device.err, "no Vulkan device matches 'no-such-device'")) << no_device.err;
   // Nothing was written: no frame, no manifest.
   std::vector<std::string> left;
   for (const auto& item : fs::directory_iterator(out)) left.push_back(item.path().filename().string());
