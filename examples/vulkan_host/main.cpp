@@ -1,6 +1,9 @@
-// A host application that owns the Vulkan objects: it creates the instance, device, queue and a
-// colour image, lends them to tilesplat (tilesplat/vulkan_interop.h), which renders a view into the
-// image, then copies the image back and saves it as EXR.
+// A host application that owns the Vulkan objects: it creates the instance, device, queue, a colour
+// image and a depth buffer, lends them to tilesplat (tilesplat/vulkan_interop.h), which renders a view
+// into the image, depth-tested against the depth buffer and writing the splats' depth into it, then
+// copies the image back and saves it as EXR. Here the host has drawn no meshes (its depth buffer is
+// cleared to the far plane), so the image is the plain render, and the splats' depth is what a mesh
+// drawn next would be tested against.
 //
 //   vulkan_host SCENE CAMERAS.json VIEW WIDTH HEIGHT OUT.exr
 #include <tilesplat/camera.h>
@@ -8,6 +11,7 @@
 #include <tilesplat/scene.h>
 #include <tilesplat/vulkan_interop.h>
 
+#include <array>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -131,7 +135,7 @@ int main(int argc, char** argv) {
     const auto width = uint32_t(camera.width), height = uint32_t(camera.height);
     Host host;
 
-    // The host's colour target, in the one format render_to_image writes so far.
+    // The host's colour target (render_to_image also writes RGBA16F and RGBA8 UNORM/sRGB images).
     VkImageCreateInfo image_info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     image_info.imageType = VK_IMAGE_TYPE_2D;
     image_info.format = VK_FORMAT_R32G32B32A32_SFLOAT;
@@ -152,15 +156,64 @@ int main(int argc, char** argv) {
     check(vkAllocateMemory(host.device, &allocate, nullptr, &image_memory), "vkAllocateMemory");
     check(vkBindImageMemory(host.device, image, image_memory, 0), "vkBindImageMemory");
 
+    // The host's depth buffer, cleared to the far plane as before drawing its meshes; their projection
+    // (Vulkan clip space, near 0.1, far 1000) says how it holds depth.
+    image_info.format = VK_FORMAT_D32_SFLOAT;
+    image_info.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                       VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    VkImage depth = VK_NULL_HANDLE;
+    check(vkCreateImage(host.device, &image_info, nullptr, &depth), "vkCreateImage");
+    vkGetImageMemoryRequirements(host.device, depth, &needs);
+    allocate.allocationSize = needs.size;
+    allocate.memoryTypeIndex = host.memory_type(needs.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    VkDeviceMemory depth_memory = VK_NULL_HANDLE;
+    check(vkAllocateMemory(host.device, &allocate, nullptr, &depth_memory), "vkAllocateMemory");
+    check(vkBindImageMemory(host.device, depth, depth_memory, 0), "vkBindImageMemory");
+    auto depth_layout = [&](VkCommandBuffer commands, VkImageLayout from, VkImageLayout to) {
+      VkImageMemoryBarrier barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+      barrier.oldLayout = from;
+      barrier.newLayout = to;
+      barrier.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
+      barrier.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+      barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      barrier.image = depth;
+      barrier.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+      vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                           0, 0, nullptr, 0, nullptr, 1, &barrier);
+    };
+    host.run_once([&](VkCommandBuffer commands) {
+      depth_layout(commands, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+      const VkClearDepthStencilValue far_plane{1.0f, 0};
+      const VkImageSubresourceRange range{VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+      vkCmdClearDepthStencilImage(commands, depth, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &far_plane, 1,
+                                  &range);
+      depth_layout(commands, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                   VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+    });
+    constexpr double kNear = 0.1, kFar = 1000;
+    std::array<double, 16> projection{};  // column-major; only its depth rows matter here
+    projection[0] = projection[5] = 1;
+    projection[10] = kFar / (kNear - kFar);
+    projection[11] = -1;
+    projection[14] = kFar * kNear / (kNear - kFar);
+
     {
       // The renderer borrows the host's handles and never destroys them.
       const auto renderer = tilesplat::create_renderer(
           {host.instance, host.physical, host.device, host.queue, host.family, host.float64});
       renderer->set_scene(scene);
-      // An UNDEFINED image is left in GENERAL layout; an image in any other layout stays in it.
+      // Splats behind the host's depth do not blend; where their alpha reaches 0.5 their depth is written
+      // into the depth buffer. An UNDEFINED colour image is left in GENERAL layout; an image in any other
+      // layout (the depth buffer's included) stays in it.
+      tilesplat::RenderSettings settings;
+      settings.host = tilesplat::HostDepth{tilesplat::DepthConvention::from_projection(projection),
+                                           {},
+                                           /*write_depth=*/true,
+                                           /*alpha_threshold=*/0.5f};
       tilesplat::render_to_image(
-          *renderer, camera, {},
-          {image, width, height, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_LAYOUT_UNDEFINED});
+          *renderer, camera, settings,
+          {image, width, height, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_LAYOUT_UNDEFINED},
+          {depth, width, height, VK_FORMAT_D32_SFLOAT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL});
     }
 
     // The host reads its image back (in an application it would sample or blend it instead).
@@ -203,11 +256,31 @@ int main(int argc, char** argv) {
     vkUnmapMemory(host.device, readback_memory);
     tilesplat::write_exr(argv[6], result);
 
+    // The depth buffer now holds the splats' depth where they are dense, for the meshes drawn next.
+    host.run_once([&](VkCommandBuffer commands) {
+      depth_layout(commands, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+      VkBufferImageCopy region{};
+      region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+      region.imageExtent = {width, height, 1};
+      vkCmdCopyImageToBuffer(commands, depth, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback, 1, &region);
+    });
+    std::vector<float> depth_values(size_t(width) * height);
+    check(vkMapMemory(host.device, readback_memory, 0, bytes, 0, &mapped), "vkMapMemory");
+    std::memcpy(depth_values.data(), mapped, depth_values.size() * sizeof(float));
+    vkUnmapMemory(host.device, readback_memory);
+    size_t covered = 0;
+    for (const float value : depth_values) covered += value < 1.0f ? 1u : 0u;
+
     vkDestroyBuffer(host.device, readback, nullptr);
     vkFreeMemory(host.device, readback_memory, nullptr);
     vkDestroyImage(host.device, image, nullptr);
     vkFreeMemory(host.device, image_memory, nullptr);
-    std::printf("rendered %ux%u into the host's image -> %s\n", width, height, argv[6]);
+    vkDestroyImage(host.device, depth, nullptr);
+    vkFreeMemory(host.device, depth_memory, nullptr);
+    std::printf(
+        "rendered %ux%u into the host's image -> %s; the splats wrote their depth at %zu of %zu pixels\n",
+        width, height, argv[6], covered, depth_values.size());
   } catch (const std::exception& error) {
     std::fprintf(stderr, "vulkan_host: %s\n", error.what());
     return 1;
