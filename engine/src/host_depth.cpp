@@ -38,4 +38,9 @@ std::vector<float> host_view_depths(const HostDepth& host) {
   return view_depth;
 }
 
+float host_depth_out(const HostDepth& host, double surface_z, size_t pixel) {
+  if (surface_z > 0) return float(host.convention.window_depth(surface_z));
+  return host.depth.empty() ? float(host.convention.far_depth()) : host.depth[pixel];
+}
+
 }  // namespace tilesplat

@@ -17,4 +17,9 @@ void validate_host_depth(const RenderSettings& settings, const Camera& camera);
 // the host's value lies at or beyond infinity. Empty for no depth image.
 std::vector<float> host_view_depths(const HostDepth& host);
 
+// RenderImage::host_depth at `pixel`, from the view depth at which the splats' alpha reached the
+// threshold there (0: never): that depth in the host's convention, else the host's own depth (its
+// far value without a depth image).
+float host_depth_out(const HostDepth& host, double surface_z, size_t pixel);
+
 }  // namespace tilesplat

@@ -454,10 +454,7 @@ struct Renderer::Impl {
   // own depth (or its far value) where the splats' alpha never reached the threshold.
   void read_host_depth(const HostDepth& host, std::vector<float>& out, size_t pixels) {
     read_output(host_surface_depth, out, pixels);
-    const float far = float(host.convention.far_depth());
-    for (size_t i = 0; i < pixels; ++i)
-      out[i] = out[i] > 0.0f ? float(host.convention.window_depth(out[i]))
-                             : (host.depth.empty() ? far : host.depth[i]);
+    for (size_t i = 0; i < pixels; ++i) out[i] = host_depth_out(host, out[i], i);
   }
 
   // Renders into the output buffers, growing the key buffers and re-rendering on overflow, and

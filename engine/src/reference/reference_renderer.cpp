@@ -435,13 +435,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
             image.rgba[pixel * 4 + 3] = static_cast<float>(1.0 - transmittance);
             if (settings.depth) image.depth[pixel] = weight_sum > 0 ? static_cast<float>(depth_sum / weight_sum) : 0.0f;
             if (settings.splat_count) image.splat_count[pixel] = blended;
-            if (surface_out) {
-              const HostDepth& host = *settings.host;
-              image.host_depth[pixel] =
-                  surface > 0 ? static_cast<float>(host.convention.window_depth(surface))
-                              : (host.depth.empty() ? static_cast<float>(host.convention.far_depth())
-                                                    : host.depth[pixel]);
-            }
+            if (surface_out) image.host_depth[pixel] = host_depth_out(*settings.host, surface, pixel);
           }
       }
   });
