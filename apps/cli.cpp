@@ -754,20 +754,22 @@ NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const O
   return named;
 }
 
+SceneViews camera_views(const CommonOptions& options, const LoadedScene& loaded) {
+  if (options.cameras.empty()) return scene_views(loaded);
+  return {load_camera_views(options.cameras), options.cameras};
+}
+
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program) {
   LoadedScene loaded = load_scene_file(options.scene, options.strict, program);
-  const SceneViews own = scene_views(loaded);
+  const SceneViews cameras = camera_views(options, loaded);
   NamedCamera named;
-  if (!options.cameras.empty() || !own.views.empty()) {
+  if (!cameras.views.empty()) {
     if (options.cameras.empty() && options.orbit_given)
       throw UsageError("--azimuth, --elevation, --fov and --distance apply only to the orbit camera, and " +
                        single_quoted(loaded.path.string()) + " has cameras of its own (pick one with --view)");
-    const std::vector<CameraView> views =
-        options.cameras.empty() ? own.views : load_camera_views(options.cameras);
-    named = view_camera(views, options.view, options.cameras.empty() ? own.file : fs::path(options.cameras),
-                        options.width, options.height);
+    named = view_camera(cameras.views, options.view, cameras.file, options.width, options.height);
     loaded.view_index = options.view;
-    loaded.view_name = views[size_t(options.view)].name;  // in range: view_camera checked it
+    loaded.view_name = cameras.views[size_t(options.view)].name;  // in range: view_camera checked it
   } else {
     if (options.view_given)
       throw UsageError("--view needs cameras: " + single_quoted(loaded.path.string()) +

@@ -220,6 +220,9 @@ struct SceneViews {
   std::filesystem::path file;
 };
 SceneViews scene_views(const LoadedScene& loaded);
+// The views a run picks from: those of --cameras (loaded) when given, else the scene file's own.
+// No views when neither has any.
+SceneViews camera_views(const CommonOptions& options, const LoadedScene& loaded);
 
 // A scene file's lights and ambient as the renderer's Lighting (off when the file has no lights).
 Lighting scene_lighting(const SceneEffects& effects);

@@ -269,13 +269,12 @@ std::vector<Frame> plan_sequence(const cli::ArgParser& parser, const RenderOptio
   const cli::CommonOptions& common = options.common;
   std::vector<Frame> frames;
   if (parser.seen("--views")) {
-    const cli::SceneViews own = cli::scene_views(loaded);
-    if (common.cameras.empty() && own.views.empty())
+    const cli::SceneViews cameras = cli::camera_views(common, loaded);
+    if (cameras.views.empty())
       throw cli::UsageError("--views needs cameras: " + single_quoted(loaded.path.string()) +
                             " has none of its own, and no --cameras was given");
-    const std::vector<tilesplat::CameraView> views =
-        common.cameras.empty() ? own.views : cli::load_camera_views(common.cameras);
-    const fs::path file = common.cameras.empty() ? own.file : fs::path(common.cameras);
+    const std::vector<tilesplat::CameraView>& views = cameras.views;
+    const fs::path& file = cameras.file;
     for (const int view :
          cli::parse_view_selection("--views", options.views, static_cast<int>(views.size()))) {
       const cli::NamedCamera named =
