@@ -25,6 +25,7 @@
 // depth of the splat at which a pixel's alpha first reaches surface_alpha (0 where it never does),
 // which the host turns into its own depth convention. Both off, the pipeline is the one without them.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "common.glsl"
 #include "tile_coverage.glsl"
 #include "composite_reach.glsl"
@@ -64,6 +65,29 @@ layout(push_constant) uniform Push {
   float surface_alpha;
 } pc;
 
+#ifdef TS_TEXEL_BUFFERS
+// The CPU-driver variant (composite_texel): the splat records, the sorted list and the outputs go
+// through texel buffers, which llvmpipe reads and writes with SIMD gathers and scatters, where a load
+// or store at a per-invocation address is a loop over the SIMD lanes per component (vk::
+// texel_buffers_wanted). The same buffers as the push constants' addresses; nothing else differs.
+layout(set = 0, binding = 0) uniform samplerBuffer splat_texels;
+layout(set = 0, binding = 1) uniform usamplerBuffer sorted_index_texels;
+layout(set = 0, binding = 2, rgba32f) uniform writeonly imageBuffer rgba_texels;
+layout(set = 0, binding = 3, r32f) uniform writeonly imageBuffer depth_texels;
+layout(set = 0, binding = 4, r32ui) uniform writeonly uimageBuffer count_texels;
+vec4 splat_vec4(uint g, uint k) { return texelFetch(splat_texels, int(SPLAT_VEC4S * g + k)); }
+uint sorted_index(uint i) { return texelFetch(sorted_index_texels, int(i)).x; }
+void write_rgba(uint i, vec4 rgba) { imageStore(rgba_texels, int(i), rgba); }
+void write_depth(uint i, float depth) { imageStore(depth_texels, int(i), vec4(depth)); }
+void write_count(uint i, uint count) { imageStore(count_texels, int(i), uvec4(count)); }
+#else
+vec4 splat_vec4(uint g, uint k) { return pc.splats.v[SPLAT_VEC4S * g + k]; }
+uint sorted_index(uint i) { return pc.sorted_indices.v[i]; }
+void write_rgba(uint i, vec4 rgba) { pc.out_rgba.v[i] = rgba; }
+void write_depth(uint i, float depth) { pc.out_depth.v[i] = depth; }
+void write_count(uint i, uint count) { pc.out_count.v[i] = count; }
+#endif
+
 const uint P = PIXELS_PER_INVOCATION;
 const uint BATCH = 256;
 const uint TILE_PIXELS = TILE_SIZE * TILE_SIZE;
@@ -73,7 +97,10 @@ const uint TILE_PIXELS = TILE_SIZE * TILE_SIZE;
 // power = A' dx^2 + B' dx dy + C' dy^2), opacity, view depth and colour.
 shared u64vec4 s_packed_a[BATCH];  // (mean x, mean y), (A', B'), (C', opacity), (depth, red)
 shared uint64_t s_packed_b[BATCH];  // (green, blue)
-shared uint s_reach[BATCH];  // bit 16 h + x: the splat reaches column x in rows [8 h, 8 h + 7] (composite_reach.glsl)
+// Bit 16 h + x of splat j's reach, s_reach[j / 4][j % 4]: the splat reaches column x in rows
+// [8 h, 8 h + 7] (composite_reach.glsl). Four to an element, so that the CPU layout reads eight per
+// pair of loads.
+shared uvec4 s_reach[BATCH / 4];
 shared uint s_done_pixels;
 
 // The invocation's pixels, front to back state. A pixel that is done keeps its final transmittance
@@ -185,20 +212,20 @@ void main() {
     if (s_done_pixels == TILE_PIXELS) break;
     uint batch_size = min(BATCH, list_end - batch_start);
     for (uint k = thread; k < batch_size; k += threads) {
-      uint g = pc.sorted_indices.v[batch_start + k];
-      vec4 mdo = pc.splats.v[SPLAT_VEC4S * g + 0];
-      vec4 conic = pc.splats.v[SPLAT_VEC4S * g + 1];
-      vec4 colour_lo = pc.splats.v[SPLAT_VEC4S * g + 2];
+      uint g = sorted_index(batch_start + k);
+      vec4 mdo = splat_vec4(g, 0);
+      vec4 conic = splat_vec4(g, 1);
+      vec4 colour_lo = splat_vec4(g, 2);
       vec2 local_mean = vec2((mdo.x - tile_origin.x) + conic.w, (mdo.y - tile_origin.y) + colour_lo.w);
       s_packed_a[k] = u64vec4(pack64(floatBitsToUint(local_mean)), pack64(floatBitsToUint(vec2(-0.5 * conic.x, -conic.y))),
                               pack64(floatBitsToUint(vec2(-0.5 * conic.z, mdo.w))), pack64(floatBitsToUint(vec2(mdo.z, colour_lo.r))));
       s_packed_b[k] = pack64(floatBitsToUint(colour_lo.gb));
-      s_reach[k] = splat_reach(local_mean, mdo.w, pc.splats.v[SPLAT_VEC4S * g + 3], ALPHA_INV);
+      s_reach[k / 4][k % 4] = splat_reach(local_mean, mdo.w, splat_vec4(g, 3), ALPHA_INV);
     }
     barrier();
     if (P == 1) {
       for (uint j = 0; my_done < P && j < batch_size; ++j) {
-        if ((s_reach[j] & my_bits) != 0) my_done += blend_splat(j, local_x, local_y0, 0, P);
+        if ((s_reach[j / 4][j % 4] & my_bits) != 0) my_done += blend_splat(j, local_x, local_y0, 0, P);
       }
     } else if (P < 16) {
       // CPU drivers run both sides of every branch, so skipping a splat is only real when the
@@ -208,7 +235,7 @@ void main() {
       uint n = 0;
       for (uint j = 0; j < batch_size; ++j) {
         list[n] = j;
-        n += (s_reach[j] & my_bits) != 0 ? 1u : 0u;
+        n += (s_reach[j / 4][j % 4] & my_bits) != 0 ? 1u : 0u;
       }
       for (uint k = 0; my_done < P && k < n; ++k) my_done += blend_splat(list[k], local_x, local_y0, 0, P);
     } else {
@@ -216,12 +243,18 @@ void main() {
       // reaching only rows 0-7 (or 8-15) of this column is evaluated on those 8 pixels alone.
       uint top[BATCH], bottom[BATCH];
       uint n_top = 0, n_bottom = 0;
-      for (uint j = 0; j < batch_size; ++j) {
-        uint reach = s_reach[j] >> local_x;
-        top[n_top] = j;
-        bottom[n_bottom] = j;
-        n_top += reach & 1u;
-        n_bottom += (reach >> 16) & 1u;
+      // Eight reaches per step: on CPU drivers each shared-memory read is a loop over the SIMD lanes.
+      // Entries past batch_size are stale but never counted.
+      for (uint j0 = 0; j0 < batch_size; j0 += 8) {
+        uvec4 reach_lo = s_reach[j0 / 4], reach_hi = s_reach[j0 / 4 + 1];
+        [[unroll]] for (uint i = 0; i < 8; ++i) {
+          uint reach = (i < 4 ? reach_lo[i] : reach_hi[i - 4]) >> local_x;
+          reach = j0 + i < batch_size ? reach : 0u;
+          top[n_top] = j0 + i;
+          bottom[n_bottom] = j0 + i;
+          n_top += reach & 1u;
+          n_bottom += (reach >> 16) & 1u;
+        }
       }
       for (uint k = 0; top_done < 8 && k < n_top; ++k) top_done += blend_splat(top[k], local_x, local_y0, 0, 8);
       for (uint k = 0; bottom_done < 8 && k < n_bottom; ++k)
@@ -242,9 +275,9 @@ void main() {
       continue;
     }
     float transmittance = abs(T[p]);
-    pc.out_rgba.v[i] = vec4(colour[p] + transmittance * pc.background.rgb, 1.0 - transmittance);
-    if (WRITE_DEPTH) pc.out_depth.v[i] = weight_sum[p] > 0.0 ? depth_sum[p] / weight_sum[p] : 0.0;
-    if (WRITE_COUNT) pc.out_count.v[i] = blended[p];
+    write_rgba(i, vec4(colour[p] + transmittance * pc.background.rgb, 1.0 - transmittance));
+    if (WRITE_DEPTH) write_depth(i, weight_sum[p] > 0.0 ? depth_sum[p] / weight_sum[p] : 0.0);
+    if (WRITE_COUNT) write_count(i, blended[p]);
     if (SURFACE_DEPTH) pc.surface_z.v[i] = surface[p];
   }
 }

@@ -19,7 +19,7 @@ void main() {
     uint start = block * block_keys();
     uint end = min(start + block_keys(), n);
     for (uint k = start + gl_SubgroupInvocationID; k < end; k += gl_SubgroupSize)
-      atomicAdd(s_counts[gl_SubgroupID * RADIX + digit_of(load_key(pc.keys_in, k))], 1u);
+      atomicAdd(s_counts[gl_SubgroupID * RADIX + digit_of(radix_load_key(k))], 1u);
   }
   barrier();
 

@@ -36,7 +36,7 @@ void main() {
   for (uint base = start; base < end; base += gl_SubgroupSize) {
     uint k = base + gl_SubgroupInvocationID;
     bool valid = k < end;
-    uint64_t key = valid ? load_key(pc.keys_in, k) : uint64_t(0);
+    uint64_t key = valid ? radix_load_key(k) : uint64_t(0);
     uint digit = digit_of(key);
     uvec4 peers = subgroupBallot(valid);
     for (uint b = 0; b < 8; ++b) {
@@ -50,8 +50,7 @@ void main() {
     subgroupMemoryBarrierShared();
     subgroupBarrier();  // every lane has read its offset before the last lane of each group bumps it
     if (valid) {
-      store_key(pc.keys_out, dst, key);
-      pc.values_out.v[dst] = pc.values_in.v[k];
+      radix_store(dst, key, radix_load_value(k));
       if (rank == group - 1) s_offsets[my + digit] += group;
     }
     subgroupMemoryBarrierShared();

@@ -54,15 +54,22 @@ Renderer& validated_renderer() {
 void expect_composite_layouts_identical(const GaussianScene& scene, const Camera& camera,
                                         const RenderSettings& settings) {
   std::vector<RenderImage> images;
-  for (const char* pixels : {"1", "4", "16"}) {
-    ::setenv("TILESPLAT_COMPOSITE_PIXELS", pixels, 1);
+  struct Layout {
+    const char* pixels;         // TILESPLAT_COMPOSITE_PIXELS
+    const char* texel_buffers;  // TILESPLAT_TEXEL_BUFFERS
+  };
+  for (const Layout& layout : {Layout{"1", "0"}, Layout{"4", "1"}, Layout{"16", "0"}, Layout{"16", "1"}}) {
+    ::setenv("TILESPLAT_COMPOSITE_PIXELS", layout.pixels, 1);
+    ::setenv("TILESPLAT_TEXEL_BUFFERS", layout.texel_buffers, 1);
     RendererOptions options;
     options.validation = true;
     auto renderer = Renderer::create(options);
     ::unsetenv("TILESPLAT_COMPOSITE_PIXELS");
+    ::unsetenv("TILESPLAT_TEXEL_BUFFERS");
     renderer->set_scene(scene);
     images.push_back(renderer->render(camera, settings));
-    EXPECT_EQ(renderer->validation_messages(), 0u) << pixels << " pixels per invocation";
+    EXPECT_EQ(renderer->validation_messages(), 0u)
+        << layout.pixels << " pixels per invocation, texel buffers " << layout.texel_buffers;
   }
   for (size_t k = 1; k < images.size(); ++k) {
     EXPECT_EQ(images[k].rgba, images[0].rgba) << "layout " << k;

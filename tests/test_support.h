@@ -30,9 +30,10 @@ std::filesystem::path temp_dir();
 Renderer& validated_renderer();
 
 // The composite picks a 16-pixel column per invocation on CPU drivers and one pixel per invocation
-// on GPUs (TILESPLAT_COMPOSITE_PIXELS overrides it). Renders the scene once in each layout (16, 4
-// and 1 pixels per invocation), each with a fresh validated renderer, and expects them to agree bit
-// for bit (rgba, depth, splat counts) and the validation layer to stay silent.
+// on GPUs (TILESPLAT_COMPOSITE_PIXELS overrides it), and CPU drivers read and write through texel
+// buffers (TILESPLAT_TEXEL_BUFFERS overrides it). Renders the scene once in each layout (1 pixel per
+// invocation; 4 with texel buffers; 16 without and with), each with a fresh validated renderer, and
+// expects them to agree bit for bit (rgba, depth, splat counts) and the validation layer to stay silent.
 void expect_composite_layouts_identical(const GaussianScene& scene, const Camera& camera,
                                         const RenderSettings& settings = {});
 

@@ -27,6 +27,12 @@ static_assert(sizeof(CompositePush) <= 128, "Vulkan guarantees 128 bytes of push
 // bands; composite_stochastic.comp has the same loops), so 8192 splats (32 batches, ~26k iterations)
 // leave a wide margin.
 constexpr uint32_t kCpuDriverChunkSplats = 8192;
+
+// composite_texel's bindings: splat records and the sorted list in, colour, depth and count out.
+const std::vector<VkDescriptorType> kTexelBindings = {
+    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
 }  // namespace
 
 // On CPU drivers every shared-memory read is a scalar load per SIMD lane: there one invocation
@@ -51,7 +57,10 @@ uint32_t composite_chunk_splats(const vk::Context& ctx) {
 CompositePass::CompositePass(vk::Context& ctx)
     : ctx_(ctx),
       pixels_per_invocation_(composite_pixels_per_invocation(ctx)),
-      chunk_splats_(composite_chunk_splats(ctx)) {}
+      chunk_splats_(composite_chunk_splats(ctx)),
+      texel_buffers_(pixels_per_invocation_ > 1 && vk::texel_buffers_wanted(ctx)) {
+  if (texel_buffers_) unused_output_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "composite unused output");
+}
 
 void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
                            const vk::Buffer& ranges, OutputBuffers& out,
@@ -59,12 +68,26 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                            const Cutoffs& cutoffs, const Chunks& chunks, const HostSurface& host) {
   const bool host_depth = host.view_depth != nullptr, surface_depth = host.surface_depth != nullptr;
   const bool host_depth_sorted = host_depth && host.exact_depth_order;
-  auto key = std::make_tuple(write_depth, write_count, cutoffs, host_depth, surface_depth, host_depth_sorted);
+  // Texel views in binding order (composite.comp, TS_TEXEL_BUFFERS); none where a buffer has more
+  // texels than the device allows, and then this frame takes the address path.
+  std::vector<VkBufferView> views;
+  if (texel_buffers_) {
+    views = {splats.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
+             sorted_indices.texel_view(VK_FORMAT_R32_UINT, 4),
+             out.rgba.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
+             (write_depth ? out.depth : unused_output_).texel_view(VK_FORMAT_R32_SFLOAT, 4),
+             (write_count ? out.count : unused_output_).texel_view(VK_FORMAT_R32_UINT, 4)};
+    if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
+  }
+  const bool texel = !views.empty();
+  auto key =
+      std::make_tuple(write_depth, write_count, cutoffs, host_depth, surface_depth, host_depth_sorted, texel);
   auto it = pipelines_.find(key);
   if (it == pipelines_.end()) {
     const float alpha_inv = coverage_alpha_inv(cutoffs.alpha);
     it = pipelines_
-             .emplace(key, vk::ComputePipeline(ctx_, "composite", sizeof(CompositePush),
+             .emplace(key, vk::ComputePipeline(ctx_, texel ? "composite_texel" : "composite",
+                                               sizeof(CompositePush),
                                                {{0, write_depth ? 1u : 0u},
                                                 {1, write_count ? 1u : 0u},
                                                 {2, pixels_per_invocation_},
@@ -74,7 +97,8 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                                                 {6, std::bit_cast<uint32_t>(cutoffs.transmittance)},
                                                 {7, host_depth ? 1u : 0u},
                                                 {8, surface_depth ? 1u : 0u},
-                                                {9, host_depth_sorted ? 1u : 0u}}))
+                                                {9, host_depth_sorted ? 1u : 0u}},
+                                               texel ? kTexelBindings : std::vector<VkDescriptorType>{}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
@@ -102,6 +126,7 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                        chunk + 1 == chunks.count ? 1u : 0u,
                        host.surface_alpha};
     it->second.bind(cmd, push);
+    if (texel) it->second.push_texel_views(cmd, views);
     it->second.dispatch(cmd, tiles_x, tiles_y);
   }
 }

@@ -64,8 +64,10 @@ class CompositePass {
   vk::Context& ctx_;
   uint32_t pixels_per_invocation_;
   uint32_t chunk_splats_;  // splats per tile and dispatch
-  // By outputs (depth, count), cut-offs and host depth (in, out, in exact depth order).
-  std::map<std::tuple<bool, bool, Cutoffs, bool, bool, bool>, vk::ComputePipeline> pipelines_;
+  bool texel_buffers_;     // the CPU layout reads and writes through texel buffers (composite_texel)
+  vk::Buffer unused_output_;  // the texel binding of an output that is off
+  // By outputs (depth, count), cut-offs, host depth (in, out, in exact depth order) and texel buffers.
+  std::map<std::tuple<bool, bool, Cutoffs, bool, bool, bool, bool>, vk::ComputePipeline> pipelines_;
 };
 
 }  // namespace tilesplat

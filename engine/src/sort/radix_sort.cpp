@@ -29,6 +29,13 @@ struct PassPush {
   VkDeviceAddress keys_in, values_in, keys_out, values_out, histogram, digit_totals, state;
   uint32_t shift, pad;
 };
+// The texel variants' bindings (radix_common.glsl): keys and values in; narrow keys, wide keys and
+// values out.
+const std::vector<VkDescriptorType> kTexelBindings = {
+    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
+
 struct ScanPush {
   VkDeviceAddress histogram, digit_totals, state;
 };
@@ -44,7 +51,8 @@ uint32_t workgroup_subgroups(const vk::Context& ctx) {
 RadixSort::RadixSort(vk::Context& ctx)
     : ctx_(ctx),
       subgroups_per_workgroup_(workgroup_subgroups(ctx)),
-      block_keys_(ctx.limits().subgroup_size * kStepsPerBlock) {
+      block_keys_(ctx.limits().subgroup_size * kStepsPerBlock),
+      texel_buffers_(vk::texel_buffers_wanted(ctx)) {
   const uint32_t sg = ctx.limits().subgroup_size;
   setup_ = vk::ComputePipeline(ctx, "radix_setup", sizeof(SetupPush));
   scan_pass_ = vk::ComputePipeline(ctx, "radix_scan", sizeof(ScanPush),
@@ -54,7 +62,14 @@ RadixSort::RadixSort(vk::Context& ctx)
         {0, sg * subgroups_per_workgroup_}, {1, subgroups_per_workgroup_}, {3, wide}};
     histogram_pass_[wide] = vk::ComputePipeline(ctx, "radix_histogram", sizeof(PassPush), spec);
     scatter_pass_[wide] = vk::ComputePipeline(ctx, "radix_scatter", sizeof(PassPush), spec);
+    if (texel_buffers_) {
+      histogram_texel_pass_[wide] =
+          vk::ComputePipeline(ctx, "radix_histogram_texel", sizeof(PassPush), spec, kTexelBindings);
+      scatter_texel_pass_[wide] =
+          vk::ComputePipeline(ctx, "radix_scatter_texel", sizeof(PassPush), spec, kTexelBindings);
+    }
   }
+  if (texel_buffers_) unused_keys_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "radix unused key view");
   digit_totals_ = vk::Buffer(ctx, kRadix * sizeof(uint32_t), vk::MemoryUse::Device, "radix digit totals");
 }
 
@@ -87,14 +102,30 @@ bool RadixSort::record(vk::CommandStream& stream, SortInput& input) {
     const auto [keys_in, values_in, keys_out, values_out] = kb.pass(in_alt);
     PassPush push{keys_in.address(),    values_in.address(),     keys_out.address(), values_out.address(),
                   histogram_.address(), digit_totals_.address(), state,              p * kDigitBits, 0};
-    histogram_pass_[wide].bind(cmd, push);
-    histogram_pass_[wide].dispatch_indirect(cmd, input.state.handle(), args_offset);
+    // Texel views in binding order; none where a buffer has more texels than the device allows, and
+    // then the address variants run.
+    std::vector<VkBufferView> views;
+    if (texel_buffers_) {
+      const VkFormat key_format = wide ? VK_FORMAT_R32G32_UINT : VK_FORMAT_R32_UINT;
+      views = {keys_in.texel_view(key_format, kb.key_bytes()), values_in.texel_view(VK_FORMAT_R32_UINT, 4),
+               (wide ? unused_keys_ : keys_out).texel_view(VK_FORMAT_R32_UINT, 4),
+               (wide ? keys_out : unused_keys_).texel_view(VK_FORMAT_R32G32_UINT, 8),
+               values_out.texel_view(VK_FORMAT_R32_UINT, 4)};
+      if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
+    }
+    const vk::ComputePipeline& histogram_pass =
+        views.empty() ? histogram_pass_[wide] : histogram_texel_pass_[wide];
+    const vk::ComputePipeline& scatter_pass = views.empty() ? scatter_pass_[wide] : scatter_texel_pass_[wide];
+    histogram_pass.bind(cmd, push);
+    if (!views.empty()) histogram_pass.push_texel_views(cmd, views);
+    histogram_pass.dispatch_indirect(cmd, input.state.handle(), args_offset);
     vk::barrier(cmd);
     scan_pass_.bind(cmd, ScanPush{histogram_.address(), digit_totals_.address(), state});
     scan_pass_.dispatch(cmd, kRadix / kScanDigitsPerWorkgroup);
     vk::barrier(cmd);
-    scatter_pass_[wide].bind(cmd, push);
-    scatter_pass_[wide].dispatch_indirect(cmd, input.state.handle(), args_offset);
+    scatter_pass.bind(cmd, push);
+    if (!views.empty()) scatter_pass.push_texel_views(cmd, views);
+    scatter_pass.dispatch_indirect(cmd, input.state.handle(), args_offset);
     vk::barrier(cmd);
     in_alt = !in_alt;
   }

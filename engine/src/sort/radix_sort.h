@@ -27,6 +27,10 @@ class RadixSort final : public SortStrategy {
   uint32_t block_keys_;
   vk::ComputePipeline setup_, scan_pass_;
   vk::ComputePipeline histogram_pass_[2], scatter_pass_[2];  // [wide keys]
+  // CPU drivers: the same passes through texel buffers (radix_common.glsl, TS_TEXEL_BUFFERS).
+  bool texel_buffers_;
+  vk::ComputePipeline histogram_texel_pass_[2], scatter_texel_pass_[2];  // [wide keys]
+  vk::Buffer unused_keys_;  // the texel binding of the key width a pass does not write
   vk::Buffer histogram_;
   vk::Buffer digit_totals_;
 };

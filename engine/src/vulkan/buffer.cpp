@@ -1,5 +1,6 @@
 #include "vulkan/buffer.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "vulkan/vk_check.h"
@@ -17,7 +18,8 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, MemoryUse use, std::string name)
   info.size = size;
   info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
-               VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+               VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT |
+               VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   TS_VK_CHECK(vkCreateBuffer(ctx.device(), &info, nullptr, &buffer_));
 
@@ -69,12 +71,29 @@ Buffer& Buffer::operator=(Buffer&& other) noexcept {
     address_ = std::exchange(other.address_, 0);
     mapped_ = std::exchange(other.mapped_, nullptr);
     name_ = std::move(other.name_);
+    texel_views_ = std::exchange(other.texel_views_, {});
   }
   return *this;
 }
 
+VkBufferView Buffer::texel_view(VkFormat format, uint32_t texel_bytes) const {
+  for (const auto& [f, view] : texel_views_)
+    if (f == format) return view;
+  if (!ctx_ || size_ / texel_bytes > ctx_->limits().max_texel_buffer_elements) return VK_NULL_HANDLE;
+  VkBufferViewCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+  info.buffer = buffer_;
+  info.format = format;
+  info.range = (std::max<VkDeviceSize>(size_, texel_bytes) / texel_bytes) * texel_bytes;
+  VkBufferView view = VK_NULL_HANDLE;
+  TS_VK_CHECK(vkCreateBufferView(ctx_->device(), &info, nullptr, &view));
+  texel_views_.emplace_back(format, view);
+  return view;
+}
+
 void Buffer::reset() {
   if (!ctx_) return;
+  for (const auto& [format, view] : texel_views_) vkDestroyBufferView(ctx_->device(), view, nullptr);
+  texel_views_.clear();
   if (buffer_) vkDestroyBuffer(ctx_->device(), buffer_, nullptr);
   if (memory_) vkFreeMemory(ctx_->device(), memory_, nullptr);  // unmaps implicitly
   buffer_ = VK_NULL_HANDLE;

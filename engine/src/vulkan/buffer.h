@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "vulkan/context.h"
 
@@ -39,6 +41,9 @@ class Buffer {
   void* mapped() const { return mapped_; }
   template <typename T>
   T* mapped_as() const { return static_cast<T*>(mapped_); }
+  // The whole buffer as texel buffer of `format` (texel_bytes per texel), made on first use and kept
+  // as long as the buffer; VK_NULL_HANDLE where it has more texels than the device allows.
+  VkBufferView texel_view(VkFormat format, uint32_t texel_bytes) const;
 
  private:
   Context* ctx_ = nullptr;
@@ -48,6 +53,7 @@ class Buffer {
   VkDeviceAddress address_ = 0;
   void* mapped_ = nullptr;
   std::string name_;
+  mutable std::vector<std::pair<VkFormat, VkBufferView>> texel_views_;
 };
 
 // Copies host data into a Device buffer: directly when it is mapped, else through a staging buffer.

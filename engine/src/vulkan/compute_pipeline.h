@@ -1,5 +1,7 @@
-// A compute pipeline built from one embedded shader. Shaders take all their inputs through push
-// constants (buffer device addresses and scalars), so there are no descriptor sets to manage.
+// A compute pipeline built from one embedded shader. Shaders take their inputs through push
+// constants (buffer device addresses and scalars). The CPU-driver layouts of a few passes also read
+// and write texel buffers (see texel_buffers_wanted): those views go in with push descriptors, set 0
+// binding i, so there are still no descriptor sets to manage.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -20,8 +22,11 @@ struct SpecConstant {
 class ComputePipeline {
  public:
   ComputePipeline() = default;
+  // texel_bindings: the descriptor type of set 0 binding i (VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER or
+  // _STORAGE_TEXEL_BUFFER); needs Context::features().push_descriptor.
   ComputePipeline(Context& ctx, const std::string& shader, uint32_t push_constant_bytes,
-                  const std::vector<SpecConstant>& spec = {});
+                  const std::vector<SpecConstant>& spec = {},
+                  const std::vector<VkDescriptorType>& texel_bindings = {});
   ~ComputePipeline() { reset(); }
   ComputePipeline(ComputePipeline&& other) noexcept { *this = std::move(other); }
   ComputePipeline& operator=(ComputePipeline&& other) noexcept;
@@ -37,10 +42,14 @@ class ComputePipeline {
   void bind_raw(VkCommandBuffer cmd, const void* data, uint32_t size) const;
   void dispatch(VkCommandBuffer cmd, uint32_t groups_x, uint32_t groups_y = 1, uint32_t groups_z = 1) const;
   void dispatch_indirect(VkCommandBuffer cmd, VkBuffer args, VkDeviceSize offset) const;
+  // Points binding i at views[i], one view per texel binding; after bind().
+  void push_texel_views(VkCommandBuffer cmd, const std::vector<VkBufferView>& views) const;
 
  private:
   Context* ctx_ = nullptr;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  std::vector<VkDescriptorType> texel_bindings_;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
   uint32_t push_constant_bytes_ = 0;
   std::string name_;
@@ -49,6 +58,13 @@ class ComputePipeline {
 // Makes every earlier compute/transfer write visible to every later compute/transfer/indirect read.
 // The passes form a strict chain, so one full barrier between them is both correct and cheap.
 void barrier(VkCommandBuffer cmd);
+
+// Whether the CPU-driver layouts read and write through texel buffers: llvmpipe turns a load or store
+// at a per-invocation buffer address into a loop over the SIMD lanes, one per component, while texel
+// fetches and image stores are SIMD gathers and scatters (docs/benchmarks.md, "Where the time goes on
+// the CPU driver"). A CPU device with push descriptors; TILESPLAT_TEXEL_BUFFERS=0 or 1 overrides it,
+// so that the tests hold both layouts to the same images.
+bool texel_buffers_wanted(const Context& ctx);
 
 inline uint32_t div_ceil(uint64_t a, uint64_t b) { return uint32_t((a + b - 1) / b); }
 

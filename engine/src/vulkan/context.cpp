@@ -307,6 +307,7 @@ void Context::read_device_properties() {
   limits_.max_workgroup_count_x = props.limits.maxComputeWorkGroupCount[0];
   limits_.max_image_dimension_2d = props.limits.maxImageDimension2D;
   limits_.timestamp_period_ns = props.limits.timestampPeriod;
+  limits_.max_texel_buffer_elements = props.limits.maxTexelBufferElements;
 
   VkPhysicalDeviceMaintenance3Properties maint3{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
   VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
@@ -361,12 +362,28 @@ void Context::create_device() {
   queue_info.queueFamilyIndex = queue_family_;
   queue_info.queueCount = 1;
   queue_info.pQueuePriorities = &priority;
+  // Push descriptors carry the texel-buffer views of the CPU-driver layouts (ComputePipeline).
+  uint32_t extension_count = 0;
+  vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &extension_count, nullptr);
+  std::vector<VkExtensionProperties> available(extension_count);
+  vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &extension_count, available.data());
+  std::vector<const char*> extensions;
+  for (const auto& e : available)
+    if (std::string_view(e.extensionName) == VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME)
+      extensions.push_back(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   info.pNext = &want;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue_info;
+  info.enabledExtensionCount = uint32_t(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
   TS_VK_CHECK(vkCreateDevice(physical_device_, &info, nullptr, &device_));
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  if (!extensions.empty())
+    cmd_push_descriptor_set_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
+        vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
+  features_.push_descriptor = cmd_push_descriptor_set_ != nullptr;
 }
 
 void Context::create_command_objects() {

@@ -26,6 +26,7 @@ struct DeviceLimits {
   uint32_t max_workgroup_count_x = 0;
   uint32_t max_image_dimension_2d = 0;
   uint64_t max_allocation_size = 0;
+  uint32_t max_texel_buffer_elements = 0;
   double timestamp_period_ns = 0;
   uint32_t timestamp_valid_bits = 0;
 };
@@ -33,6 +34,7 @@ struct DeviceLimits {
 // Optional features the engine uses when present.
 struct DeviceFeatures {
   bool shader_float64 = false;  // exact float64 depth keys (else float32: rare order swaps)
+  bool push_descriptor = false;  // VK_KHR_push_descriptor: texel-buffer layouts of the CPU-driver passes
 };
 
 // Owns (or, for a host application, borrows) a VkInstance and VkDevice with one compute queue.
@@ -57,6 +59,8 @@ class Context {
   const std::string& driver_name() const { return driver_name_; }
   // A CPU implementation (lavapipe, SwiftShader): passes pick CPU-friendly layouts.
   bool is_cpu_device() const { return is_cpu_; }
+  // vkCmdPushDescriptorSetKHR when features().push_descriptor, else null.
+  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set() const { return cmd_push_descriptor_set_; }
 
   // Index of a memory type with all `required` flags (and `preferred` ones when possible).
   uint32_t find_memory_type(uint32_t type_bits, VkMemoryPropertyFlags required,
@@ -114,6 +118,7 @@ class Context {
   std::string device_name_;
   std::string driver_name_;
   bool is_cpu_ = false;
+  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set_ = nullptr;
   std::atomic<uint64_t> validation_messages_{0};
   std::atomic<uint64_t> uploaded_bytes_{0};
 };
