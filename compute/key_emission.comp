@@ -34,12 +34,46 @@ layout(push_constant) uniform Push {
   uint tiles;
 } pc;
 
+#ifdef TS_TEXEL_BUFFERS
+// The CPU-driver variant (key_emission_texel): the per-Gaussian inputs and the pairs through texel
+// buffers, which llvmpipe reads and writes with SIMD gathers and scatters, where a load or store at a
+// per-invocation address is a loop over the SIMD lanes (vk::texel_buffers_wanted). Narrow keys are
+// R32_UINT texels, wide ones R32G32_UINT (low word first); the same buffers as the addresses.
+layout(set = 0, binding = 0) uniform samplerBuffer splat_texels;
+layout(set = 0, binding = 1) uniform usamplerBuffer rect_texels;
+layout(set = 0, binding = 2) uniform usamplerBuffer tile_count_texels;
+layout(set = 0, binding = 3) uniform usamplerBuffer offset_texels;
+layout(set = 0, binding = 4, r32ui) uniform writeonly uimageBuffer narrow_key_texels;
+layout(set = 0, binding = 5, rg32ui) uniform writeonly uimageBuffer wide_key_texels;
+layout(set = 0, binding = 6, r32ui) uniform writeonly uimageBuffer value_texels;
+vec4 splat_vec4(uint i, uint k) { return texelFetch(splat_texels, int(SPLAT_VEC4S * i + k)); }
+uvec2 rect_of(uint i) { return texelFetch(rect_texels, int(i)).xy; }
+uint tile_count_of(uint i) { return texelFetch(tile_count_texels, int(i)).x; }
+uint offset_of(uint i) { return texelFetch(offset_texels, int(i)).x; }
+void write_pair(uint slot, uint64_t key, uint value) {
+  if (WIDE_KEYS)
+    imageStore(wide_key_texels, int(slot), uvec4(unpack32(key), 0u, 0u));
+  else
+    imageStore(narrow_key_texels, int(slot), uvec4(uint(key)));
+  imageStore(value_texels, int(slot), uvec4(value));
+}
+#else
+vec4 splat_vec4(uint i, uint k) { return pc.splats.v[SPLAT_VEC4S * i + k]; }
+uvec2 rect_of(uint i) { return pc.rects.v[i]; }
+uint tile_count_of(uint i) { return pc.tile_counts.v[i]; }
+uint offset_of(uint i) { return pc.offsets.v[i]; }
+void write_pair(uint slot, uint64_t key, uint value) {
+  store_key(pc.keys, slot, key);
+  pc.values.v[slot] = value;
+}
+#endif
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= pc.count) return;
-  uint n = pc.tile_counts.v[i];
+  uint n = tile_count_of(i);
   if (n == 0) return;
-  uint offset = pc.offsets.v[i];
+  uint offset = offset_of(i);
   if (uint64_t(offset) + n > pc.capacity) return;  // overflow: the frame is re-run with larger buffers
   // A splat over thousands of tiles would keep one invocation busy while its neighbours idle, and
   // on llvmpipe a loop past 65535 iterations is silently cut short: such splats are handed to a
@@ -48,19 +82,18 @@ void main() {
     pc.big_splats.v[atomicAdd(pc.counters.v[COUNTER_BIG_SPLATS], 1u)] = i;
     return;
   }
-  uvec2 rect = pc.rects.v[i];
+  uvec2 rect = rect_of(i);
   uvec2 lo = uvec2(rect.x & 0xffffu, rect.x >> 16);
   uvec2 hi = uvec2(rect.y & 0xffffu, rect.y >> 16);
-  vec4 mdo = pc.splats.v[SPLAT_VEC4S * i];
-  vec4 cov_det = pc.splats.v[SPLAT_VEC4S * i + 3];
+  vec4 mdo = splat_vec4(i, 0);
+  vec4 cov_det = splat_vec4(i, 3);
   float tau = coverage_tau(mdo.w, ALPHA_INV);
   uint end = offset + n;
   uint64_t depth_bits = WIDE_KEYS ? uint64_t(pc.depth_keys.v[i]) : uint64_t(0);
   for (uint ty = lo.y; ty < hi.y; ++ty) {
     uvec2 span = SQUARE_TILES ? uvec2(lo.x, hi.x) : row_span(mdo.xy, cov_det, tau, ty, lo, hi);
     for (uint tx = span.x; tx < span.y && offset < end; ++tx) {
-      store_key(pc.keys, offset, uint64_t(ty * pc.tiles_x + tx) << (WIDE_KEYS ? 32 : 0) | depth_bits);
-      pc.values.v[offset] = i;
+      write_pair(offset, uint64_t(ty * pc.tiles_x + tx) << (WIDE_KEYS ? 32 : 0) | depth_bits, i);
       ++offset;
     }
   }
@@ -68,7 +101,6 @@ void main() {
   // slot defined even if a driver's arithmetic differed: a tile id past the grid sorts last and is
   // ignored by the tile-range pass.
   for (; offset < end; ++offset) {
-    store_key(pc.keys, offset, uint64_t(pc.tiles) << (WIDE_KEYS ? 32 : 0));
-    pc.values.v[offset] = i;
+    write_pair(offset, uint64_t(pc.tiles) << (WIDE_KEYS ? 32 : 0), i);
   }
 }

@@ -51,7 +51,6 @@ layout(constant_id = 10) const bool COMPENSATE_OPACITY = false;
 // splat uses its shortest axis. The lights are data, not constants: changing them rebuilds nothing.
 layout(constant_id = 11) const bool LIGHTING = false;
 layout(constant_id = 12) const bool FILE_NORMALS = false;
-#include "sh.glsl"
 
 // Camera, written by the host each frame. Doubles are stored as bit pairs so that the float32
 // variant's SPIR-V needs no Float64 capability.
@@ -101,6 +100,67 @@ layout(push_constant) uniform Push {
   uint count;
 } pc;
 
+#ifdef TS_TEXEL_BUFFERS
+// The CPU-driver variant (projection_texel): the Gaussians' attributes in and the projected records out
+// through texel buffers, which llvmpipe reads and writes with SIMD gathers and scatters, where a load or
+// store at a per-invocation address is a loop over the SIMD lanes per component (vk::
+// texel_buffers_wanted). The same buffers as the push constants' addresses; nothing else differs.
+layout(set = 0, binding = 0) uniform samplerBuffer position_texels;   // R32_SFLOAT
+layout(set = 0, binding = 1) uniform samplerBuffer log_scale_texels;  // R32_SFLOAT
+layout(set = 0, binding = 2) uniform samplerBuffer rotation_texels;   // R32G32B32A32_SFLOAT
+layout(set = 0, binding = 3) uniform samplerBuffer opacity_texels;    // R32_SFLOAT
+layout(set = 0, binding = 4) uniform usamplerBuffer sh_texels;        // R32_UINT: float bits or half pairs
+layout(set = 0, binding = 5, rgba32f) uniform writeonly imageBuffer splat_texels;
+layout(set = 0, binding = 6, rg32ui) uniform writeonly uimageBuffer rect_texels;
+layout(set = 0, binding = 7, r32ui) uniform writeonly uimageBuffer tile_count_texels;
+layout(set = 0, binding = 8, r32ui) uniform writeonly uimageBuffer depth_key_texels;
+layout(set = 0, binding = 9, r32ui) uniform writeonly uimageBuffer depth_value_texels;
+vec3 position_of(uint i) {
+  return vec3(texelFetch(position_texels, int(3 * i)).x, texelFetch(position_texels, int(3 * i + 1)).x,
+              texelFetch(position_texels, int(3 * i + 2)).x);
+}
+vec3 log_scale_of(uint i) {
+  return vec3(texelFetch(log_scale_texels, int(3 * i)).x, texelFetch(log_scale_texels, int(3 * i + 1)).x,
+              texelFetch(log_scale_texels, int(3 * i + 2)).x);
+}
+vec4 quaternion_of(uint i) { return texelFetch(rotation_texels, int(i)); }
+float opacity_logit_of(uint i) { return texelFetch(opacity_texels, int(i)).x; }
+uint sh_word(uint64_t sh, uint i) { return texelFetch(sh_texels, int(i)).x; }
+void write_projected(uint i, vec4 record[SPLAT_VEC4S], uvec2 rect, bool touched) {
+  if (touched) {
+    for (uint k = 0; k < SPLAT_VEC4S; ++k) imageStore(splat_texels, int(SPLAT_VEC4S * i + k), record[k]);
+    imageStore(rect_texels, int(i), uvec4(rect, 0u, 0u));
+  }
+}
+void write_tile_count(uint i, uint touched) { imageStore(tile_count_texels, int(i), uvec4(touched)); }
+void write_depth_pair(uint i, uint key) {
+  imageStore(depth_key_texels, int(i), uvec4(key));
+  imageStore(depth_value_texels, int(i), uvec4(i));
+}
+#else
+vec3 position_of(uint i) { return vec3(pc.positions.v[3 * i], pc.positions.v[3 * i + 1], pc.positions.v[3 * i + 2]); }
+vec3 log_scale_of(uint i) { return vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2]); }
+vec4 quaternion_of(uint i) {
+  return vec4(pc.rotations.v[4 * i], pc.rotations.v[4 * i + 1], pc.rotations.v[4 * i + 2], pc.rotations.v[4 * i + 3]);
+}
+float opacity_logit_of(uint i) { return pc.opacity_logits.v[i]; }
+uint sh_word(uint64_t sh, uint i) { return UintArray(sh).v[i]; }
+void write_projected(uint i, vec4 record[SPLAT_VEC4S], uvec2 rect, bool touched) {
+  if (touched) {
+    for (uint k = 0; k < SPLAT_VEC4S; ++k) pc.splats.v[SPLAT_VEC4S * i + k] = record[k];
+    pc.rects.v[i] = rect;
+  }
+}
+void write_tile_count(uint i, uint touched) { pc.tile_counts.v[i] = touched; }
+void write_depth_pair(uint i, uint key) {
+  pc.depth_keys.v[i] = key;
+  pc.depth_values.v[i] = i;
+}
+#endif
+
+#include "sh.glsl"  // after sh_word
+
+
 #ifndef TS_FP32_PROJECTION
 real to_real(uvec2 bits) { return packDouble2x32(bits); }
 #endif
@@ -111,8 +171,7 @@ bool is_finite(real v) { return !isnan(v) && !isinf(v); }
 // quaternion, the identity (whether or not the device flushes denormals on load: the reference
 // decides the same way).
 realmat3 rotation_of(uint i) {
-  real4 q = real4(pc.rotations.v[4 * i], pc.rotations.v[4 * i + 1], pc.rotations.v[4 * i + 2],
-                  pc.rotations.v[4 * i + 3]);
+  real4 q = real4(quaternion_of(i));
   real largest = max(max(abs(q.x), abs(q.y)), max(abs(q.z), abs(q.w)));
   q = largest >= real(FLT_MIN) ? q / sqrt(dot(q, q)) : real4(1, 0, 0, 0);  // doubles: no overflow
   real w = q.x, x = q.y, y = q.z, z = q.w;
@@ -138,7 +197,7 @@ real3 lighting_normal(uint i, real3 rel) {
     }
   }
   if (!from_file) {
-    vec3 s = vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2]);
+    vec3 s = log_scale_of(i);
     int axis = s.x <= s.y && s.x <= s.z ? 0 : (s.y <= s.z ? 1 : 2);
     n = rotation_of(i)[axis];
   }
@@ -197,7 +256,7 @@ void write_ray_depth(uint i, real3 mu, realmat3 S) {
 // Returns the tiles touched (0 = culled) and fills the splat record.
 uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   CameraParams cam = pc.camera;
-  real3 world = real3(pc.positions.v[3 * i], pc.positions.v[3 * i + 1], pc.positions.v[3 * i + 2]);
+  real3 world = real3(position_of(i));
   real3 rel = world - real3(to_real(cam.centre[0]), to_real(cam.centre[1]), to_real(cam.centre[2]));
   realmat3 W;  // column-major: W[c][r] = rotation[r][c]
   for (int r = 0; r < 3; ++r)
@@ -216,7 +275,7 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
     sigma = realmat3(xx_xy.x, xx_xy.y, xz_yy.x, xx_xy.y, xz_yy.y, yz_zz.x, xz_yy.x, yz_zz.x, yz_zz.y);
   } else {
     // exp has no float64 overload in GLSL; its float32 rounding is far below what changes a decision.
-    real3 s = real3(exp(vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2])));
+    real3 s = real3(exp(log_scale_of(i)));
     RS = rotation_of(i) * realmat3(s.x, 0, 0, 0, s.y, 0, 0, 0, s.z);
   }
 
@@ -262,7 +321,7 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
     return 0;
 
   // A NaN logit has no opacity (min(0.99, NaN) would draw it opaque): culled. +-inf are 1 and 0.
-  float logit = pc.opacity_logits.v[i];
+  float logit = opacity_logit_of(i);
   if (isnan(logit)) return 0;
   float opacity = 1.0 / (1.0 + exp(-logit));
   if (COMPENSATE_OPACITY) opacity *= float(sqrt(max(real(2.5e-5), max(det_unfiltered, real(0.0)) / det)));
@@ -339,18 +398,14 @@ void main() {
     vec4 record[SPLAT_VEC4S];
     uvec2 rect;
     touched = project(i, record, rect);
-    if (touched > 0) {
-      for (uint k = 0; k < SPLAT_VEC4S; ++k) pc.splats.v[SPLAT_VEC4S * i + k] = record[k];
-      pc.rects.v[i] = rect;
-    }
-    pc.tile_counts.v[i] = touched;
+    write_projected(i, record, rect, touched > 0);
+    write_tile_count(i, touched);
     // View depth > near > 0, so its IEEE bits order like unsigned integers; their top 24 bits too.
     // 16-bit keys are made by depth_quantize.comp once the visible range is known: here the float
     // bits. Culled Gaussians touch no tile; they sort last only to keep the visible ones together.
     uint depth_bits = floatBitsToUint(record[0].z);
     uint key = DEPTH_KEY_BITS == 24 ? depth_bits >> 8 : depth_bits;
-    pc.depth_keys.v[i] = touched > 0 ? key : (DEPTH_KEY_BITS == 24 ? 0xffffffu : 0xffffffffu);
-    pc.depth_values.v[i] = i;
+    write_depth_pair(i, touched > 0 ? key : (DEPTH_KEY_BITS == 24 ? 0xffffffu : 0xffffffffu));
     depth_near = touched > 0 ? depth_bits : 0xffffffffu;
     depth_far = touched > 0 ? depth_bits : 0u;
   }

@@ -11,17 +11,16 @@ const float SH_C3[7] = float[7](-0.5900435899266435, 2.890611442640554, -0.45704
 
 // The including shader declares SH_COEFFS (coefficients stored per Gaussian: the scene's, which may
 // be more than the evaluated degree uses) and SH_HALF (stored as packed 16-bit floats, two a uint).
+// It also declares sh_word(sh, i): word i of the coefficients (a float's bits, or two halves).
 vec3 sh_coeff(uint64_t sh, uint base, uint k) {
   uint o = base + 3 * k;
   if (SH_HALF) {
-    UintArray words = UintArray(sh);
     // Three consecutive halves start on either half of a word.
-    vec2 w0 = unpackHalf2x16(words.v[o >> 1]);
-    vec2 w1 = unpackHalf2x16(words.v[(o >> 1) + 1]);
+    vec2 w0 = unpackHalf2x16(sh_word(sh, o >> 1));
+    vec2 w1 = unpackHalf2x16(sh_word(sh, (o >> 1) + 1));
     return (o & 1u) == 0u ? vec3(w0, w1.x) : vec3(w0.y, w1);
   }
-  FloatArray values = FloatArray(sh);
-  return vec3(values.v[o], values.v[o + 1], values.v[o + 2]);
+  return uintBitsToFloat(uvec3(sh_word(sh, o), sh_word(sh, o + 1), sh_word(sh, o + 2)));
 }
 
 // degree is a specialization constant at every call site, so the unused bands compile away.

@@ -1,5 +1,6 @@
 #include "passes/key_emission_pass.h"
 
+#include <algorithm>
 #include <bit>
 #include <utility>
 #include <vector>
@@ -17,6 +18,14 @@ struct ScatterPush {
   VkDeviceAddress depth_order, depth_offsets, offsets;
   uint32_t count, pad;
 };
+// key_emission_texel's bindings: splat records, rects, tile counts and offsets in; narrow keys, wide
+// keys and values out.
+const std::vector<VkDescriptorType> kTexelBindings = {
+    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
+
 // key_emission.comp and key_emission_big.comp.
 struct EmitPush {
   VkDeviceAddress splats, rects, tile_counts, offsets, keys, values, depth_keys, big_splats, counters;
@@ -27,7 +36,11 @@ struct EmitPush {
 KeyEmissionPass::KeyEmissionPass(vk::Context& ctx)
     : ctx_(ctx),
       frame_setup_(ctx, "frame_setup", sizeof(SetupPush)),
-      scatter_offsets_(ctx, "scatter_offsets", sizeof(ScatterPush)) {}
+      scatter_offsets_(ctx, "scatter_offsets", sizeof(ScatterPush)),
+      texel_buffers_(vk::texel_buffers_wanted(ctx)) {
+  if (texel_buffers_)
+    unused_keys_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "key emission unused key view");
+}
 
 void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer* depth_order,
                              KeyBuffers& keys, uint32_t gaussians, uint32_t tiles_x, uint32_t tiles,
@@ -41,14 +54,32 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
     scatter_offsets_.dispatch(cmd, vk::div_ceil(gaussians, 256));
   }
   vk::barrier(cmd);
-  const auto variant = std::make_tuple(keys.wide_keys, square_tiles, alpha_inv);
+  // Texel views in binding order (key_emission.comp, TS_TEXEL_BUFFERS); none where a buffer has more
+  // texels than the device allows, and then this frame takes the address path.
+  std::vector<VkBufferView> views;
+  if (texel_buffers_) {
+    const bool wide = keys.wide_keys;
+    views = {projected.splats.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
+             projected.rects.texel_view(VK_FORMAT_R32G32_UINT, 8),
+             projected.tile_counts.texel_view(VK_FORMAT_R32_UINT, 4),
+             projected.offsets.texel_view(VK_FORMAT_R32_UINT, 4),
+             (wide ? unused_keys_ : keys.keys).texel_view(VK_FORMAT_R32_UINT, 4),
+             (wide ? keys.keys : unused_keys_).texel_view(VK_FORMAT_R32G32_UINT, 8),
+             keys.values.texel_view(VK_FORMAT_R32_UINT, 4)};
+    if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
+  }
+  const bool texel = !views.empty();
+  const auto variant = std::make_tuple(keys.wide_keys, square_tiles, alpha_inv, texel);
   auto it = emit_keys_.find(variant);
   if (it == emit_keys_.end()) {
     const std::vector<vk::SpecConstant> spec = {
         {0, keys.wide_keys}, {1, square_tiles}, {2, std::bit_cast<uint32_t>(alpha_inv)}};
+    auto emit = texel
+                    ? vk::ComputePipeline(ctx_, "key_emission_texel", sizeof(EmitPush), spec, kTexelBindings)
+                    : vk::ComputePipeline(ctx_, "key_emission", sizeof(EmitPush), spec);
     it = emit_keys_
-             .emplace(variant, std::make_pair(vk::ComputePipeline(ctx_, "key_emission", sizeof(EmitPush), spec),
-                                              vk::ComputePipeline(ctx_, "key_emission_big", sizeof(EmitPush), spec)))
+             .emplace(variant, std::make_pair(std::move(emit), vk::ComputePipeline(ctx_, "key_emission_big",
+                                                                                   sizeof(EmitPush), spec)))
              .first;
   }
   const auto& [emit_keys, emit_big_splat_keys] = it->second;
@@ -57,6 +88,7 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
                       projected.depth_order.keys.address(), projected.big_splats.address(), counters,
                       gaussians, tiles_x, keys.capacity, tiles};
   emit_keys.bind(cmd, push);
+  if (texel) emit_keys.push_texel_views(cmd, views);
   emit_keys.dispatch(cmd, vk::div_ceil(gaussians, 256));
   vk::barrier(cmd);
   emit_big_splat_keys.bind(cmd, push);

@@ -31,8 +31,12 @@ class KeyEmissionPass {
   vk::Context& ctx_;
   vk::ComputePipeline frame_setup_;
   vk::ComputePipeline scatter_offsets_;
-  // key_emission and key_emission_big, by (wide keys, square, alpha_inv).
-  std::map<std::tuple<bool, bool, float>, std::pair<vk::ComputePipeline, vk::ComputePipeline>> emit_keys_;
+  // key_emission (or key_emission_texel) and key_emission_big, by (wide keys, square, alpha_inv,
+  // texel buffers).
+  std::map<std::tuple<bool, bool, float, bool>, std::pair<vk::ComputePipeline, vk::ComputePipeline>>
+      emit_keys_;
+  bool texel_buffers_;      // CPU drivers: key_emission_texel (vk::texel_buffers_wanted)
+  vk::Buffer unused_keys_;  // the texel binding of the key width a frame does not write
 };
 
 }  // namespace tilesplat

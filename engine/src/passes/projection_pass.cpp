@@ -13,6 +13,14 @@
 namespace tilesplat {
 
 namespace {
+// projection_texel's bindings: positions, log-scales, rotations, opacities and SH in; splat records,
+// rects, tile counts, depth keys and depth values out.
+const std::vector<VkDescriptorType> kTexelBindings = {
+    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
 
 // Mirrors CameraParams in compute/projection.comp.
 struct CameraParams {
@@ -69,7 +77,8 @@ ProjectionPass::ProjectionPass(vk::Context& ctx)
     : ctx_(ctx),
       camera_params_(ctx, sizeof(CameraParams), vk::MemoryUse::Upload, "camera params"),
       pack_sh_half_(ctx, "pack_sh_half", sizeof(PackShPush)),
-      pack_covariance_half_(ctx, "pack_covariance_half", sizeof(PackCovariancePush)) {}
+      pack_covariance_half_(ctx, "pack_covariance_half", sizeof(PackCovariancePush)),
+      texel_buffers_(vk::texel_buffers_wanted(ctx) && ctx.features().shader_float64) {}
 
 void ProjectionPass::set_camera(const Camera& camera) {
   CameraParams p{};
@@ -116,8 +125,8 @@ void ProjectionPass::set_lighting(const Lighting& lighting, SceneBuffers& scene)
   vk::upload(ctx_, light_params_, data.data(), bytes);
 }
 
-const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant& v) {
-  auto it = pipelines_.find(v);
+const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant& v, bool texel) {
+  auto it = pipelines_.find(std::make_pair(v, texel));
   if (it == pipelines_.end()) {
     const uint32_t stored_coeffs = uint32_t((v.stored_sh_degree + 1) * (v.stored_sh_degree + 1));
     const std::vector<vk::SpecConstant> spec = {
@@ -128,8 +137,14 @@ const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant&
         {8, v.ray_depth},                   {9, v.dilation_tenths},
         {10, v.compensate_opacity},         {11, v.lighting},
         {12, v.file_normals}};
-    const char* shader = ctx_.features().shader_float64 ? "projection" : "projection_fp32";
-    it = pipelines_.emplace(v, vk::ComputePipeline(ctx_, shader, sizeof(ProjectionPush), spec)).first;
+    const char* shader = texel                            ? "projection_texel"
+                         : ctx_.features().shader_float64 ? "projection"
+                                                          : "projection_fp32";
+    it = pipelines_
+             .emplace(std::make_pair(v, texel),
+                      vk::ComputePipeline(ctx_, shader, sizeof(ProjectionPush), spec,
+                                          texel ? kTexelBindings : std::vector<VkDescriptorType>{}))
+             .first;
   }
   return it->second;
 }
@@ -178,8 +193,25 @@ void ProjectionPass::record(VkCommandBuffer cmd, const SceneBuffers& scene, Proj
                       variant.lighting ? light_params_.address() : 0,
                       scene.count,
                       0};
-  const auto& pipeline = pipeline_for(variant);
+  // Texel views in binding order (projection.comp, TS_TEXEL_BUFFERS); none where a buffer has more
+  // texels than the device allows, and then this frame takes the address path.
+  std::vector<VkBufferView> views;
+  if (texel_buffers_) {
+    views = {scene.positions.texel_view(VK_FORMAT_R32_SFLOAT, 4),
+             scene.log_scales.texel_view(VK_FORMAT_R32_SFLOAT, 4),
+             scene.rotations.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
+             scene.opacity_logits.texel_view(VK_FORMAT_R32_SFLOAT, 4),
+             sh.texel_view(VK_FORMAT_R32_UINT, 4),
+             out.splats.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
+             out.rects.texel_view(VK_FORMAT_R32G32_UINT, 8),
+             out.tile_counts.texel_view(VK_FORMAT_R32_UINT, 4),
+             out.depth_order.keys.texel_view(VK_FORMAT_R32_UINT, 4),
+             out.depth_order.values.texel_view(VK_FORMAT_R32_UINT, 4)};
+    if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
+  }
+  const auto& pipeline = pipeline_for(variant, !views.empty());
   pipeline.bind(cmd, push);
+  if (!views.empty()) pipeline.push_texel_views(cmd, views);
   pipeline.dispatch(cmd, vk::div_ceil(scene.count, 256));
 }
 

@@ -3,6 +3,7 @@
 
 #include <map>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "passes/key_buffers.h"
@@ -84,13 +85,15 @@ class ProjectionPass {
               const ProjectionVariant& variant);
 
  private:
-  const vk::ComputePipeline& pipeline_for(const ProjectionVariant& variant);
+  const vk::ComputePipeline& pipeline_for(const ProjectionVariant& variant, bool texel);
   vk::Context& ctx_;
   vk::Buffer camera_params_;
   vk::Buffer light_params_;  // LightParams of compute/projection.comp; grown to the most lights seen
-  std::map<ProjectionVariant, vk::ComputePipeline> pipelines_;  // specialization constants per variant
+  // Specialization constants per variant, and whether through texel buffers (projection_texel).
+  std::map<std::pair<ProjectionVariant, bool>, vk::ComputePipeline> pipelines_;
   vk::ComputePipeline pack_sh_half_;
   vk::ComputePipeline pack_covariance_half_;
+  bool texel_buffers_;  // CPU drivers with float64: projection_texel (vk::texel_buffers_wanted)
 };
 
 }  // namespace tilesplat
