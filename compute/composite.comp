@@ -92,11 +92,49 @@ const uint P = PIXELS_PER_INVOCATION;
 const uint BATCH = 256;
 const uint TILE_PIXELS = TILE_SIZE * TILE_SIZE;
 
-// A staged splat, ready to evaluate (two 64-bit reads, where CPU drivers pay per read): its mean
-// relative to the tile origin, A' = -A/2, B' = -B, C' = -C/2 of its conic (exact scalings, so
-// power = A' dx^2 + B' dx dy + C' dy^2), opacity, view depth and colour.
+// A splat ready to evaluate: its mean relative to the tile origin, A' = -A/2, B' = -B, C' = -C/2 of
+// its conic (exact scalings, so power = A' dx^2 + B' dx dy + C' dy^2), opacity, view depth and colour.
+void splat_params(vec4 mdo, vec4 conic, vec4 colour_lo, vec2 tile_origin, out vec4 mean_a_b,
+                  out vec4 c_opacity_depth_r, out vec3 rgb) {
+  vec2 local_mean = vec2((mdo.x - tile_origin.x) + conic.w, (mdo.y - tile_origin.y) + colour_lo.w);
+  mean_a_b = vec4(local_mean, -0.5 * conic.x, -conic.y);
+  c_opacity_depth_r = vec4(-0.5 * conic.z, mdo.w, mdo.z, colour_lo.r);
+  rgb = colour_lo.rgb;
+}
+
+#ifdef TS_TEXEL_BUFFERS
+// The lists hold the splats' indices, staged four to an element (read eight per pair of loads), and
+// a blend reads the splat's record through the texel buffer: a SIMD gather, where a shared-memory
+// read at a per-invocation index is a loop over the SIMD lanes.
+shared uvec4 s_index[BATCH / 4];
+void stage_splat(uint k, uint g, vec4 mdo, vec4 conic, vec4 colour_lo, vec2 tile_origin) { s_index[k / 4][k % 4] = g; }
+uvec4 staged_entries(uint j4) { return s_index[j4]; }  // the list entries of staged splats 4 j4 .. 4 j4 + 3
+void entry_params(uint g, vec2 tile_origin, out vec4 mean_a_b, out vec4 c_opacity_depth_r, out vec3 rgb) {
+  splat_params(splat_vec4(g, 0), splat_vec4(g, 1), splat_vec4(g, 2), tile_origin, mean_a_b, c_opacity_depth_r, rgb);
+}
+#else
+// The lists hold positions in the batch; the staged splats are packed in two 64-bit reads, where
+// CPU drivers pay per read.
 shared u64vec4 s_packed_a[BATCH];  // (mean x, mean y), (A', B'), (C', opacity), (depth, red)
 shared uint64_t s_packed_b[BATCH];  // (green, blue)
+void stage_splat(uint k, uint g, vec4 mdo, vec4 conic, vec4 colour_lo, vec2 tile_origin) {
+  vec4 mean_a_b, c_opacity_depth_r;
+  vec3 rgb;
+  splat_params(mdo, conic, colour_lo, tile_origin, mean_a_b, c_opacity_depth_r, rgb);
+  s_packed_a[k] = u64vec4(pack64(floatBitsToUint(mean_a_b.xy)), pack64(floatBitsToUint(mean_a_b.zw)),
+                          pack64(floatBitsToUint(c_opacity_depth_r.xy)), pack64(floatBitsToUint(c_opacity_depth_r.zw)));
+  s_packed_b[k] = pack64(floatBitsToUint(rgb.gb));
+}
+uvec4 staged_entries(uint j4) { return uvec4(4 * j4) + uvec4(0, 1, 2, 3); }
+void entry_params(uint j, vec2 tile_origin, out vec4 mean_a_b, out vec4 c_opacity_depth_r, out vec3 rgb) {
+  u64vec4 a = s_packed_a[j];
+  uint64_t b = s_packed_b[j];
+  mean_a_b = vec4(uintBitsToFloat(unpack32(a.x)), uintBitsToFloat(unpack32(a.y)));
+  c_opacity_depth_r = vec4(uintBitsToFloat(unpack32(a.z)), uintBitsToFloat(unpack32(a.w)));
+  rgb = vec3(c_opacity_depth_r.w, uintBitsToFloat(unpack32(b)));
+}
+#endif
+uint staged_entry(uint j) { return staged_entries(j / 4)[j % 4]; }
 // Bit 16 h + x of splat j's reach, s_reach[j / 4][j % 4]: the splat reaches column x in rows
 // [8 h, 8 h + 7] (composite_reach.glsl). Four to an element, so that the CPU layout reads eight per
 // pair of loads.
@@ -114,17 +152,15 @@ float host_z[P];   // HOST_DEPTH
 float surface[P];  // SURFACE_DEPTH: 0 until the pixel's alpha reaches surface_alpha
 uint my_done = 0;  // pixels of this invocation that are done
 
-// Blends staged splat j into the invocation's pixels first .. first + count - 1 (indices into its
-// column; the call sites pass constants, so the register arrays stay statically indexed) and
-// returns how many of them finished. Branch-free: a no-op (w = 0, T unchanged) leaves every sum
-// bit-identical, and selects are cheaper than the lane-mask bookkeeping a CPU driver does for a
-// divergent branch.
-uint blend_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
-  u64vec4 a = s_packed_a[j];
-  uint64_t b = s_packed_b[j];
-  vec4 mean_a_b = vec4(uintBitsToFloat(unpack32(a.x)), uintBitsToFloat(unpack32(a.y)));
-  vec4 c_opacity_depth_r = vec4(uintBitsToFloat(unpack32(a.z)), uintBitsToFloat(unpack32(a.w)));
-  vec3 rgb = vec3(c_opacity_depth_r.w, uintBitsToFloat(unpack32(b)));
+// Blends the staged splat of list entry `entry` (staged_entry) into the invocation's pixels first ..
+// first + count - 1 (indices into its column; the call sites pass constants, so the register arrays
+// stay statically indexed) and returns how many of them finished. Branch-free: a no-op (w = 0, T
+// unchanged) leaves every sum bit-identical, and selects are cheaper than the lane-mask bookkeeping a
+// CPU driver does for a divergent branch.
+uint blend_splat(uint entry, vec2 tile_origin, uint local_x, uint local_y0, uint first, uint count) {
+  vec4 mean_a_b, c_opacity_depth_r;
+  vec3 rgb;
+  entry_params(entry, tile_origin, mean_a_b, c_opacity_depth_r, rgb);
   float dx = mean_a_b.x - (float(local_x) + 0.5);
   // power = k0 + dy (k1 + C' dy): the dx terms are the same for the whole column.
   float k0 = mean_a_b.z * dx * dx;
@@ -216,16 +252,15 @@ void main() {
       vec4 mdo = splat_vec4(g, 0);
       vec4 conic = splat_vec4(g, 1);
       vec4 colour_lo = splat_vec4(g, 2);
+      stage_splat(k, g, mdo, conic, colour_lo, tile_origin);
       vec2 local_mean = vec2((mdo.x - tile_origin.x) + conic.w, (mdo.y - tile_origin.y) + colour_lo.w);
-      s_packed_a[k] = u64vec4(pack64(floatBitsToUint(local_mean)), pack64(floatBitsToUint(vec2(-0.5 * conic.x, -conic.y))),
-                              pack64(floatBitsToUint(vec2(-0.5 * conic.z, mdo.w))), pack64(floatBitsToUint(vec2(mdo.z, colour_lo.r))));
-      s_packed_b[k] = pack64(floatBitsToUint(colour_lo.gb));
       s_reach[k / 4][k % 4] = splat_reach(local_mean, mdo.w, splat_vec4(g, 3), ALPHA_INV);
     }
     barrier();
     if (P == 1) {
       for (uint j = 0; my_done < P && j < batch_size; ++j) {
-        if ((s_reach[j / 4][j % 4] & my_bits) != 0) my_done += blend_splat(j, local_x, local_y0, 0, P);
+        if ((s_reach[j / 4][j % 4] & my_bits) != 0)
+          my_done += blend_splat(staged_entry(j), tile_origin, local_x, local_y0, 0, P);
       }
     } else if (P < 16) {
       // CPU drivers run both sides of every branch, so skipping a splat is only real when the
@@ -234,10 +269,10 @@ void main() {
       uint list[BATCH];
       uint n = 0;
       for (uint j = 0; j < batch_size; ++j) {
-        list[n] = j;
+        list[n] = staged_entry(j);
         n += (s_reach[j / 4][j % 4] & my_bits) != 0 ? 1u : 0u;
       }
-      for (uint k = 0; my_done < P && k < n; ++k) my_done += blend_splat(list[k], local_x, local_y0, 0, P);
+      for (uint k = 0; my_done < P && k < n; ++k) my_done += blend_splat(list[k], tile_origin, local_x, local_y0, 0, P);
     } else {
       // A column of 16 spans both row bands of the reach mask: one list per band, so that a splat
       // reaching only rows 0-7 (or 8-15) of this column is evaluated on those 8 pixels alone.
@@ -247,18 +282,21 @@ void main() {
       // Entries past batch_size are stale but never counted.
       for (uint j0 = 0; j0 < batch_size; j0 += 8) {
         uvec4 reach_lo = s_reach[j0 / 4], reach_hi = s_reach[j0 / 4 + 1];
+        uvec4 entry_lo = staged_entries(j0 / 4), entry_hi = staged_entries(j0 / 4 + 1);
         [[unroll]] for (uint i = 0; i < 8; ++i) {
           uint reach = (i < 4 ? reach_lo[i] : reach_hi[i - 4]) >> local_x;
+          uint entry = i < 4 ? entry_lo[i] : entry_hi[i - 4];
           reach = j0 + i < batch_size ? reach : 0u;
-          top[n_top] = j0 + i;
-          bottom[n_bottom] = j0 + i;
+          top[n_top] = entry;
+          bottom[n_bottom] = entry;
           n_top += reach & 1u;
           n_bottom += (reach >> 16) & 1u;
         }
       }
-      for (uint k = 0; top_done < 8 && k < n_top; ++k) top_done += blend_splat(top[k], local_x, local_y0, 0, 8);
+      for (uint k = 0; top_done < 8 && k < n_top; ++k)
+        top_done += blend_splat(top[k], tile_origin, local_x, local_y0, 0, 8);
       for (uint k = 0; bottom_done < 8 && k < n_bottom; ++k)
-        bottom_done += blend_splat(bottom[k], local_x, local_y0, 8, 8);
+        bottom_done += blend_splat(bottom[k], tile_origin, local_x, local_y0, 8, 8);
       my_done = top_done + bottom_done;
     }
     if (my_done > published_done) atomicAdd(s_done_pixels, my_done - published_done);
