@@ -63,6 +63,8 @@ layout(buffer_reference, std430, buffer_reference_align = 8) buffer CameraParams
   uvec2 clip[4];
   uvec4 grid;                // tiles x, tiles y, width, height
 };
+// The same as uvec2 words (camera_word): where each field starts.
+const uint CAMERA_ROTATION = 0, CAMERA_CENTRE = 9, CAMERA_FOCAL = 12, CAMERA_CLIP = 16, CAMERA_GRID = 20;
 
 // The frame's lights, written by the host (ProjectionPass::set_lighting) in float64 from the same
 // prepared values as the reference's (engine/src/lighting.h). Doubles as bit pairs, as above.
@@ -115,6 +117,8 @@ layout(set = 0, binding = 6, rg32ui) uniform writeonly uimageBuffer rect_texels;
 layout(set = 0, binding = 7, r32ui) uniform writeonly uimageBuffer tile_count_texels;
 layout(set = 0, binding = 8, r32ui) uniform writeonly uimageBuffer depth_key_texels;
 layout(set = 0, binding = 9, r32ui) uniform writeonly uimageBuffer depth_value_texels;
+layout(set = 0, binding = 10) uniform usamplerBuffer camera_texels;  // R32G32_UINT: CameraParams' uvec2s
+uvec2 camera_word(uint k) { return texelFetch(camera_texels, int(k)).xy; }
 vec3 position_of(uint i) {
   return vec3(texelFetch(position_texels, int(3 * i)).x, texelFetch(position_texels, int(3 * i + 1)).x,
               texelFetch(position_texels, int(3 * i + 2)).x);
@@ -138,6 +142,7 @@ void write_depth_pair(uint i, uint key) {
   imageStore(depth_value_texels, int(i), uvec4(i));
 }
 #else
+uvec2 camera_word(uint k) { return Uvec2Array(pc.camera).v[k]; }
 vec3 position_of(uint i) { return vec3(pc.positions.v[3 * i], pc.positions.v[3 * i + 1], pc.positions.v[3 * i + 2]); }
 vec3 log_scale_of(uint i) { return vec3(pc.log_scales.v[3 * i], pc.log_scales.v[3 * i + 1], pc.log_scales.v[3 * i + 2]); }
 vec4 quaternion_of(uint i) {
@@ -255,14 +260,13 @@ void write_ray_depth(uint i, real3 mu, realmat3 S) {
 
 // Returns the tiles touched (0 = culled) and fills the splat record.
 uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
-  CameraParams cam = pc.camera;
   real3 world = real3(position_of(i));
-  real3 rel = world - real3(to_real(cam.centre[0]), to_real(cam.centre[1]), to_real(cam.centre[2]));
+  real3 rel = world - real3(to_real(camera_word(CAMERA_CENTRE)), to_real(camera_word(CAMERA_CENTRE + 1)), to_real(camera_word(CAMERA_CENTRE + 2)));
   realmat3 W;  // column-major: W[c][r] = rotation[r][c]
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) W[c][r] = to_real(cam.rotation[3 * r + c]);
+    for (int c = 0; c < 3; ++c) W[c][r] = to_real(camera_word(CAMERA_ROTATION + 3 * r + c));
   real3 t = W * rel;
-  if (!(t.z > to_real(cam.clip[2])) || !is_finite(t.x) || !is_finite(t.y) || !is_finite(t.z)) return 0;
+  if (!(t.z > to_real(camera_word(CAMERA_CLIP + 2))) || !is_finite(t.x) || !is_finite(t.y) || !is_finite(t.z)) return 0;
 
   // The 3D shape: R S from the log scales and quaternion (reference), or the covariance itself,
   // precomputed on the host and stored in 16 bits (COV_HALF, as web viewers do).
@@ -279,10 +283,10 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
     RS = rotation_of(i) * realmat3(s.x, 0, 0, 0, s.y, 0, 0, 0, s.z);
   }
 
-  real fx = to_real(cam.focal_principal[0]), fy = to_real(cam.focal_principal[1]);
-  real cx = to_real(cam.focal_principal[2]), cy = to_real(cam.focal_principal[3]);
+  real fx = to_real(camera_word(CAMERA_FOCAL)), fy = to_real(camera_word(CAMERA_FOCAL + 1));
+  real cx = to_real(camera_word(CAMERA_FOCAL + 2)), cy = to_real(camera_word(CAMERA_FOCAL + 3));
   real inv_z = 1.0 / t.z;
-  real limit_x = to_real(cam.clip[0]), limit_y = to_real(cam.clip[1]);
+  real limit_x = to_real(camera_word(CAMERA_CLIP)), limit_y = to_real(camera_word(CAMERA_CLIP + 1));
   real tx = clamp(t.x * inv_z, -limit_x, limit_x) * t.z;
   real ty = clamp(t.y * inv_z, -limit_y, limit_y) * t.z;
   // The 2x3 Jacobian's rows, applied to the world-to-camera rotation and then to R S:
@@ -331,7 +335,7 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   real sigmas = OPACITY_EXTENT ? real(min(sqrt(max(2.0 * log(ALPHA_INV * opacity), 0.0)), 3.33)) : 3.0;
   real radius = ceil(sigmas * sqrt(lambda));
   if (!is_finite(radius)) return 0;
-  real2 grid = real2(cam.grid.xy);
+  real2 grid = real2(camera_word(CAMERA_GRID));
   // Clamp before converting: a huge radius must not overflow the integer rect.
   real2 rect_min = clamp(floor((mean - radius) / real(TILE_SIZE)), real2(0.0), grid);
   real2 rect_max = clamp(floor((mean + radius + real(TILE_SIZE - 1)) / real(TILE_SIZE)), real2(0.0), grid);

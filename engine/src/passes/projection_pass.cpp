@@ -14,13 +14,14 @@ namespace tilesplat {
 
 namespace {
 // projection_texel's bindings: positions, log-scales, rotations, opacities and SH in; splat records,
-// rects, tile counts, depth keys and depth values out.
+// rects, tile counts, depth keys and depth values out; the camera in (its uvec2 words).
 const std::vector<VkDescriptorType> kTexelBindings = {
     VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
     VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
     VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
     VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
-    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER};
 
 // Mirrors CameraParams in compute/projection.comp.
 struct CameraParams {
@@ -206,7 +207,8 @@ void ProjectionPass::record(VkCommandBuffer cmd, const SceneBuffers& scene, Proj
              out.rects.texel_view(VK_FORMAT_R32G32_UINT, 8),
              out.tile_counts.texel_view(VK_FORMAT_R32_UINT, 4),
              out.depth_order.keys.texel_view(VK_FORMAT_R32_UINT, 4),
-             out.depth_order.values.texel_view(VK_FORMAT_R32_UINT, 4)};
+             out.depth_order.values.texel_view(VK_FORMAT_R32_UINT, 4),
+             camera_params_.texel_view(VK_FORMAT_R32G32_UINT, 8)};
     if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
   }
   const auto& pipeline = pipeline_for(variant, !views.empty());
