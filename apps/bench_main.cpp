@@ -19,6 +19,7 @@
 #include "cli.h"
 #include "effects_report.h"
 #include "formats_report.h"
+#include "scaling_report.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
@@ -50,6 +51,8 @@ struct BenchOptions {
   bool accuracy = false;  // --accuracy: the error/time report
   bool effects = false;   // --effects: the per-effect cost table
   bool formats = false;   // --formats: what each file of a scene costs against its lossless PLY
+  bool scaling = false;   // --scaling: frame time and memory against Gaussian count and image size
+  int tile_copies = 0;    // --tile-copies N: with --scaling, also N copies of the largest scene
   std::string markdown;
   tilesplat::accuracy::CameraPath path = tilesplat::accuracy::CameraPath::kPan;
   int path_frames = 6;
@@ -727,9 +730,10 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     "along a short camera path from the first view (--path) and the view consistency under a turn "
                     "(--consistency-angle); --plot draws the Pareto charts",
                     &options.accuracy);
-  parser.add_string("--markdown", "FILE.md",
-                    "with --accuracy, --effects or --formats: also write the report as Markdown tables",
-                    &options.markdown);
+  parser.add_string(
+      "--markdown", "FILE.md",
+      "with --accuracy, --effects, --formats or --scaling: also write the report as Markdown tables",
+      &options.markdown);
   parser.add_value("--path", "dolly|pan|orbit",
                    "with --accuracy: the camera path the popping is measured on, from the first view: 'pan' "
                    "(turning in place, default), 'orbit' (around the scene centre) or 'dolly' (sideways; "
@@ -777,6 +781,24 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                     "the first and the middle view of --cameras, else two orbit views); --markdown, --csv and --plot "
                     "(bytes per Gaussian against PSNR) write the report",
                     &options.formats);
+
+  parser.section("scaling report");
+  parser.add_switch(
+      "--scaling",
+      "measure how the frame's cost and device memory grow: every SCENE from the orbit camera that "
+      "frames it at every size of --resolutions (default 960x540,1920x1080,2560x1440,3840x2160), "
+      "GPU time per pass, pairs and device memory, then a non-negative least-squares fit of each "
+      "pass's time and of the memory per Gaussian, per pair and per pixel; --markdown, --csv and "
+      "--plot (PLOT.svg time against Gaussians, PLOT_pixels.svg against image size, PLOT_memory.svg) "
+      "write the report",
+      &options.scaling);
+  parser.add_value(
+      "--tile-copies", "N",
+      "with --scaling: also measure a scene of N copies of the largest SCENE side by side (2 to 64), "
+      "for Gaussian counts no file has",
+      [&options](const std::string& text) {
+        options.tile_copies = cli::parse_int("--tile-copies", text, 2, 64);
+      });
 
   parser.section("sort micro-benchmark");
   parser.add_switch("--sort-bench",
@@ -1234,6 +1256,75 @@ int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options
   return cli::kExitOk;
 }
 
+// "PLOT.svg" -> "PLOT_SUFFIX.svg": the scaling report's second and third charts.
+std::string plot_with_suffix(const std::string& plot, const std::string& suffix) {
+  return plot.substr(0, plot.size() - 4) + "_" + suffix + ".svg";
+}
+
+int run_scaling_report(const cli::ArgParser& parser, const BenchOptions& options) {
+  for (const char* flag : {"--json", "--view", "--views", "--orbit", "--cameras", "--width", "--height"})
+    if (parser.seen(flag))
+      throw cli::UsageError(std::string(flag) +
+                            " does not apply to --scaling (it measures each scene from the "
+                            "orbit camera that frames it, at every --resolutions size)");
+  if (options.common.sorts.size() > 1) throw cli::UsageError("--scaling measures with one --sort strategy");
+  check_outputs(options, scene_and_camera_inputs(options));
+  tilesplat::scaling::Options scaling_options;
+  const std::vector<cli::ImageSize> sizes =
+      options.resolutions.empty()
+          ? std::vector<cli::ImageSize>{{960, 540}, {1920, 1080}, {2560, 1440}, {3840, 2160}}
+          : options.resolutions;
+  for (const cli::ImageSize& size : sizes) scaling_options.sizes.push_back({size.width, size.height});
+  scaling_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
+  scaling_options.repeat = options.repeat;
+  if (!options.common.sorts.empty()) scaling_options.sort = options.common.sorts.front();
+
+  std::vector<tilesplat::scaling::Scene> scenes;
+  for (const std::string& file : options.common.scenes) {
+    cli::LoadedScene loaded = cli::load_scene_file(file, options.common.strict, kProgram);
+    if (loaded.scene.empty()) throw cli::UsageError("'" + file + "' has no Gaussians to measure");
+    std::printf("scene   %s: %s\n", loaded.path.filename().string().c_str(),
+                cli::describe_scene(loaded.scene).c_str());
+    scenes.push_back({loaded.path.filename().string(), std::move(loaded.scene)});
+  }
+  if (options.tile_copies > 0) {
+    const auto largest = std::max_element(scenes.begin(), scenes.end(), [](const auto& a, const auto& b) {
+      return a.scene.size() < b.scene.size();
+    });
+    tilesplat::scaling::Scene tiled{largest->name + " x" + std::to_string(options.tile_copies) + " (tiled)",
+                                    tilesplat::scaling::tile_scene(largest->scene, options.tile_copies)};
+    std::printf("scene   %s: %s\n", tiled.name.c_str(), cli::describe_scene(tiled.scene).c_str());
+    scenes.push_back(std::move(tiled));
+  }
+  std::fflush(stdout);
+  tilesplat::scaling::Run run;
+  {
+    Progress progress(tilesplat::scaling::work_units(scenes, scaling_options), cli::stderr_is_terminal());
+    run = tilesplat::scaling::measure(
+        cli::renderer_options(options.common), scenes, scaling_options,
+        [&](int done, int, const std::string& what) { progress.update(done, what); });
+  }
+  const std::vector<tilesplat::scaling::Fit> fits = tilesplat::scaling::fit(run.points);
+  std::printf("device  %s (driver %s)\n\n%s", run.device.name.c_str(), run.device.driver.c_str(),
+              tilesplat::scaling::text_report(run, fits).c_str());
+  std::fflush(stdout);
+  std::vector<std::pair<std::string, std::function<std::string()>>> files = {
+      {options.markdown, [&] { return tilesplat::scaling::markdown(run, fits, options.command); }},
+      {options.csv,
+       [&] { return cli::with_provenance_columns(tilesplat::scaling::csv(run), options.command); }},
+      {options.plot, [&] { return tilesplat::scaling::svg_time_vs_gaussians(run); }}};
+  if (!options.plot.empty()) {
+    files.push_back({plot_with_suffix(options.plot, "pixels"),
+                     [&] { return tilesplat::scaling::svg_time_vs_pixels(run); }});
+    files.push_back(
+        {plot_with_suffix(options.plot, "memory"), [&] { return tilesplat::scaling::svg_memory(run); }});
+  }
+  const std::string written = write_outputs(files, run.validation_messages);
+  std::fprintf(stderr, "%s: scaling, %zu scenes x %zu sizes%s\n", kProgram, scenes.size(),
+               scaling_options.sizes.size(), written.c_str());
+  return cli::kExitOk;
+}
+
 // The views the format report compares images at: those asked for, else two that see the scene
 // from different sides (the first and the middle view of its cameras, or two opposite orbit views).
 std::vector<Case> plan_format_views(const cli::ArgParser& parser, BenchOptions options, const BenchScene& reference) {
@@ -1310,12 +1401,14 @@ int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options
 void check_frame_options(const cli::ArgParser& parser, const BenchOptions& options) {
   for (const char* flag : {"--sort-sizes", "--key-bits"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --sort-bench");
-  if (int(options.accuracy) + int(options.effects) + int(options.formats) > 1)
-    throw cli::UsageError("--accuracy, --effects and --formats are separate runs");
+  if (int(options.accuracy) + int(options.effects) + int(options.formats) + int(options.scaling) > 1)
+    throw cli::UsageError("--accuracy, --effects, --formats and --scaling are separate runs");
+  if (parser.seen("--tile-copies") && !options.scaling)
+    throw cli::UsageError("--tile-copies applies only with --scaling");
   if (!options.accuracy) {
     if (parser.seen("--path-frames")) throw cli::UsageError("--path-frames applies only with --accuracy");
-    if (parser.seen("--markdown") && !options.effects && !options.formats)
-      throw cli::UsageError("--markdown applies only with --accuracy, --effects or --formats");
+    if (parser.seen("--markdown") && !options.effects && !options.formats && !options.scaling)
+      throw cli::UsageError("--markdown applies only with --accuracy, --effects, --formats or --scaling");
     if (options.common.modes.size() > 1)
       throw cli::UsageError("several --mode combinations are compared by --accuracy; the frame benchmark takes one");
   }
@@ -1357,6 +1450,7 @@ int run(int argc, char** argv) {
   if (options.accuracy) return run_accuracy_report(parser, options);
   if (options.effects) return run_effects_report(parser, options);
   if (options.formats) return run_formats_report(parser, options);
+  if (options.scaling) return run_scaling_report(parser, options);
   check_outputs(options, scene_and_camera_inputs(options));
 
   std::vector<std::string> sorts = options.common.sorts;

@@ -71,11 +71,18 @@ TEST(CliBench, HelpListsEveryFlag) {
   const auto result = run_exe(kBenchExe, {"--help"});
   EXPECT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(contains(result.out, "usage: tilesplat-bench")) << result.out;
-  for (const char* flag : {"--warmup", "--repeat", "--csv", "--json", "--plot", "--cameras", "--view", "--views",
-                           "--orbit", "--resolutions", "--width", "--height", "--azimuth", "--elevation", "--fov",
-                           "--distance", "--strict", "--device", "--list-devices", "--sort", "--validation", "--help",
-                           "SCENE.ply...", "--sort-bench", "--sort-sizes", "--key-bits", "--effects", "--antialiasing",
-                           "--accuracy", "--path", "--path-frames", "--path-step", "--consistency-angle"})
+  for (const char* flag : {"--warmup",       "--repeat",     "--csv",
+                           "--json",         "--plot",       "--cameras",
+                           "--view",         "--views",      "--orbit",
+                           "--resolutions",  "--width",      "--height",
+                           "--azimuth",      "--elevation",  "--fov",
+                           "--distance",     "--strict",     "--device",
+                           "--list-devices", "--sort",       "--validation",
+                           "--help",         "SCENE.ply...", "--sort-bench",
+                           "--sort-sizes",   "--key-bits",   "--effects",
+                           "--antialiasing", "--accuracy",   "--path",
+                           "--path-frames",  "--path-step",  "--consistency-angle",
+                           "--scaling",      "--tile-copies"})
     EXPECT_TRUE(contains(result.out, flag)) << "--help does not mention " << flag << "\n" << result.out;
 }
 
