@@ -144,6 +144,31 @@ std::string markdown_row(const std::vector<std::string>& cells) {
   return out + "\n";
 }
 
+// One line per pass and one for the frame: the median GPU time of the points `chosen` picks, against
+// x_of(point), in the order of x.
+std::string per_pass_chart(const Run& run, const std::string& title, const std::string& x_label,
+                           plot::Scale x_scale, const std::function<bool(const Point&)>& chosen,
+                           const std::function<double(const Point&)>& x_of) {
+  plot::LineChart chart;
+  chart.title = title;
+  chart.subtitle = run.device.name;
+  chart.x_label = x_label;
+  chart.y_label = "median GPU time (ms)";
+  chart.x_scale = x_scale;
+  chart.y_scale = plot::Scale::kLog10;
+  std::vector<std::string> names = pass_names(run.points);
+  names.push_back("gpu frame");
+  for (size_t i = 0; i < names.size(); ++i) {
+    const bool frame = names[i] == "gpu frame";
+    plot::LineSeries series{names[i], i, frame ? 1u : 0u, {}};
+    for (const Point& p : run.points)
+      if (chosen(p)) series.points.emplace_back(x_of(p), frame ? p.frame_ms : pass_ms(p, names[i]));
+    std::sort(series.points.begin(), series.points.end());
+    chart.series.push_back(std::move(series));
+  }
+  return plot::line_chart_svg(chart);
+}
+
 }  // namespace
 
 GaussianScene tile_scene(const GaussianScene& scene, int copies) {
@@ -343,51 +368,18 @@ std::string csv(const Run& run) {
 
 std::string svg_time_vs_gaussians(const Run& run) {
   const Size size = reference_size(run.points);
-  plot::LineChart chart;
-  chart.title = "GPU time per pass against Gaussian count, " + size_text(size);
-  chart.subtitle = run.device.name;
-  chart.x_label = "Gaussians";
-  chart.y_label = "median GPU time (ms)";
-  chart.x_scale = plot::Scale::kLog10;
-  chart.y_scale = plot::Scale::kLog10;
-  std::vector<std::string> names = pass_names(run.points);
-  names.push_back("gpu frame");
-  for (size_t i = 0; i < names.size(); ++i) {
-    plot::LineSeries series{names[i], i, names[i] == "gpu frame" ? 1u : 0u, {}};
-    std::vector<const Point*> at_size;
-    for (const Point& p : run.points)
-      if (p.size.width == size.width && p.size.height == size.height) at_size.push_back(&p);
-    std::sort(at_size.begin(), at_size.end(),
-              [](const Point* a, const Point* b) { return a->gaussians < b->gaussians; });
-    for (const Point* p : at_size)
-      series.points.emplace_back(double(p->gaussians),
-                                 names[i] == "gpu frame" ? p->frame_ms : pass_ms(*p, names[i]));
-    chart.series.push_back(std::move(series));
-  }
-  return plot::line_chart_svg(chart);
+  return per_pass_chart(
+      run, "GPU time per pass against Gaussian count, " + size_text(size), "Gaussians", plot::Scale::kLog10,
+      [&](const Point& p) { return p.size.width == size.width && p.size.height == size.height; },
+      [](const Point& p) { return double(p.gaussians); });
 }
 
 std::string svg_time_vs_pixels(const Run& run) {
   const std::string scene = largest_scene(run.points);
-  plot::LineChart chart;
-  chart.title = "GPU time per pass against image size, " + scene;
-  chart.subtitle = run.device.name;
-  chart.x_label = "megapixels";
-  chart.y_label = "median GPU time (ms)";
-  chart.x_scale = plot::Scale::kLog2;
-  chart.y_scale = plot::Scale::kLog10;
-  std::vector<std::string> names = pass_names(run.points);
-  names.push_back("gpu frame");
-  for (size_t i = 0; i < names.size(); ++i) {
-    plot::LineSeries series{names[i], i, names[i] == "gpu frame" ? 1u : 0u, {}};
-    for (const Point& p : run.points)
-      if (p.scene == scene)
-        series.points.emplace_back(double(p.size.pixels()) / 1e6,
-                                   names[i] == "gpu frame" ? p.frame_ms : pass_ms(p, names[i]));
-    std::sort(series.points.begin(), series.points.end());
-    chart.series.push_back(std::move(series));
-  }
-  return plot::line_chart_svg(chart);
+  return per_pass_chart(
+      run, "GPU time per pass against image size, " + scene, "megapixels", plot::Scale::kLog2,
+      [&](const Point& p) { return p.scene == scene; },
+      [](const Point& p) { return double(p.size.pixels()) / 1e6; });
 }
 
 std::string svg_memory(const Run& run) {

@@ -9,17 +9,11 @@
 # Defaults: build/, the 500k-Gaussian playbot of ../shared/scenes with its cameras, 1920x1080 views,
 # 480x270 orbit frames. Prints a Markdown table; the outputs go to a temporary folder, removed after.
 set -euo pipefail
-cd "$(dirname "$0")/../.."
-build="${1:-build}"
-shared="${TILESPLAT_SHARED_SCENES:-$(cd .. && pwd)/shared/scenes}"
-scene="${2:-$shared/playbot_lod0_500000_sh2.ply}"
-cameras="${3:-$shared/cameras/playbot_lod0_500000_sh2.json}"
+source "$(dirname "$0")/bench_paths.sh"
 size="${4:-1920x1080}"
 orbit_size="${5:-480x270}"
 render="$build/apps/tilesplat-render"
-for file in "$render" "$scene" "$cameras"; do
-  [ -e "$file" ] || { echo "sequence_throughput: $file not found" >&2; exit 1; }
-done
+require_files sequence_throughput "$render" "$scene" "$cameras"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 now() { date +%s.%N; }

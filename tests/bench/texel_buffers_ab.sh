@@ -10,16 +10,10 @@
 # Defaults: build/, the 500k-Gaussian playbot of ../shared/scenes with its cameras, 3 rounds. Prints one
 # Markdown table row per run.
 set -euo pipefail
-cd "$(dirname "$0")/../.."
-build="${1:-build}"
-shared="${TILESPLAT_SHARED_SCENES:-$(cd .. && pwd)/shared/scenes}"
-scene="${2:-$shared/playbot_lod0_500000_sh2.ply}"
-cameras="${3:-$shared/cameras/playbot_lod0_500000_sh2.json}"
+source "$(dirname "$0")/bench_paths.sh"
 rounds="${4:-3}"
 bench="$build/apps/tilesplat-bench"
-for file in "$bench" "$scene" "$cameras"; do
-  [ -e "$file" ] || { echo "texel_buffers_ab: $file not found" >&2; exit 1; }
-done
+require_files texel_buffers_ab "$bench" "$scene" "$cameras"
 echo "texel_buffers_ab: $(basename "$scene"), $rounds rounds; $("$bench" --version)" >&2
 
 # The median column of a metric row of the frame table.
