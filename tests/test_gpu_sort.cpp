@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <numeric>
 #include <random>
 
@@ -56,6 +57,23 @@ TEST(GpuSort, FullWidthAndNarrowKeys) {
     expect_sorted_like_stable_sort(strategy, random_keys(30000, 32, 12), 32);
     expect_sorted_like_stable_sort(strategy, random_keys(30000, 9, 13), 9);
   }
+}
+
+// CPU drivers sort through texel buffers (vk::texel_buffers_wanted), GPUs through buffer addresses:
+// on lavapipe both layouts run here, at the block boundaries and with many equal keys, and must give
+// the stable order, with the validation layer silent.
+TEST(GpuSort, RadixTexelAndAddressLayoutsBothSortStably) {
+  for (const char* texel_buffers : {"0", "1"}) {
+    ::setenv("TILESPLAT_TEXEL_BUFFERS", texel_buffers, 1);
+    const auto sorter = make_sort_strategy("radix", sort_test_context());
+    ::unsetenv("TILESPLAT_TEXEL_BUFFERS");
+    const std::string label = std::string("radix, texel buffers ") + texel_buffers;
+    for (const auto& [keys, bits] :
+         {std::pair{random_keys(2049, 32, 31), 32u}, std::pair{random_keys(300000, 32, 32), 32u},
+          std::pair{random_keys(300000, 64, 33), 64u}, std::pair{random_keys(100000, 45, 34, 3), 45u}})
+      expect_stable_order(keys, sort_on_device(*sorter, keys, bits), label + " bits=" + std::to_string(bits));
+  }
+  EXPECT_EQ(sort_test_context().validation_messages(), 0u);
 }
 
 TEST(PrefixSum, MatchesExclusiveScanAtBlockBoundaries) {
