@@ -55,6 +55,27 @@ layout(push_constant) uniform Push {
   uint seed;
 } pc;
 
+#ifdef TS_TEXEL_BUFFERS
+// The CPU-driver variant (composite_stochastic_texel): the splat records, the binned list and the
+// outputs through texel buffers, as composite.comp's (vk::texel_buffers_wanted).
+layout(set = 0, binding = 0) uniform samplerBuffer splat_texels;
+layout(set = 0, binding = 1) uniform usamplerBuffer index_texels;
+layout(set = 0, binding = 2, rgba32f) uniform writeonly imageBuffer rgba_texels;
+layout(set = 0, binding = 3, r32f) uniform writeonly imageBuffer depth_texels;
+layout(set = 0, binding = 4, r32ui) uniform writeonly uimageBuffer count_texels;
+vec4 splat_vec4(uint g, uint k) { return texelFetch(splat_texels, int(SPLAT_VEC4S * g + k)); }
+uint binned_index(uint i) { return texelFetch(index_texels, int(i)).x; }
+void write_rgba(uint i, vec4 rgba) { imageStore(rgba_texels, int(i), rgba); }
+void write_depth(uint i, float depth) { imageStore(depth_texels, int(i), vec4(depth)); }
+void write_count(uint i, uint count) { imageStore(count_texels, int(i), uvec4(count)); }
+#else
+vec4 splat_vec4(uint g, uint k) { return pc.splats.v[SPLAT_VEC4S * g + k]; }
+uint binned_index(uint i) { return pc.indices.v[i]; }
+void write_rgba(uint i, vec4 rgba) { pc.out_rgba.v[i] = rgba; }
+void write_depth(uint i, float depth) { pc.out_depth.v[i] = depth; }
+void write_count(uint i, uint count) { pc.out_count.v[i] = count; }
+#endif
+
 const uint P = PIXELS_PER_INVOCATION;
 const uint BATCH = 256;
 const uint64_t NONE = 0xffffffffffffffffUL;  // no splat kept (above every (depth, index) key)
@@ -134,17 +155,17 @@ void main() {
     barrier();  // the previous batch is fully consumed
     uint batch_size = min(BATCH, list_end - batch_start);
     for (uint k = thread; k < batch_size; k += threads) {
-      uint g = pc.indices.v[batch_start + k];
-      vec4 mdo = pc.splats.v[SPLAT_VEC4S * g + 0];
-      vec4 conic = pc.splats.v[SPLAT_VEC4S * g + 1];
-      float mean_y_lo = pc.splats.v[SPLAT_VEC4S * g + 2].w;
+      uint g = binned_index(batch_start + k);
+      vec4 mdo = splat_vec4(g, 0);
+      vec4 conic = splat_vec4(g, 1);
+      float mean_y_lo = splat_vec4(g, 2).w;
       vec2 local_mean = vec2((mdo.x - tile_origin.x) + conic.w, (mdo.y - tile_origin.y) + mean_y_lo);
       s_splat[k] = u64vec4(pack64(floatBitsToUint(local_mean)),
                            pack64(floatBitsToUint(vec2(-0.5 * conic.x, -conic.y))),
                            pack64(floatBitsToUint(vec2(-0.5 * conic.z, mdo.w))),
                            pack64(uvec2(g, floatBitsToUint(mdo.z))));  // depth bits << 32 | index
       s_hash[k] = hash32(g);
-      s_reach[k] = splat_reach(local_mean, mdo.w, pc.splats.v[SPLAT_VEC4S * g + 3], ALPHA_INV);
+      s_reach[k] = splat_reach(local_mean, mdo.w, splat_vec4(g, 3), ALPHA_INV);
     }
     barrier();
     if (P == 1) {
@@ -187,7 +208,7 @@ void main() {
     float depth_sum = first_sample ? 0.0 : pc.state.v[2 * i + 1].x;
     if (best[p] != NONE) {
       uint g = uint(best[p]);
-      sums += vec4(pc.splats.v[SPLAT_VEC4S * g + 2].rgb, 1.0);
+      sums += vec4(splat_vec4(g, 2).rgb, 1.0);
       depth_sum += uintBitsToFloat(uint(best[p] >> 32));
     }
     if (!last_sample) {
@@ -196,8 +217,8 @@ void main() {
       continue;
     }
     float n = float(pc.samples);
-    pc.out_rgba.v[i] = vec4((sums.rgb + (n - sums.w) * pc.background.rgb) / n, sums.w / n);
-    if (WRITE_DEPTH) pc.out_depth.v[i] = sums.w > 0.0 ? depth_sum / sums.w : 0.0;
-    if (WRITE_COUNT) pc.out_count.v[i] = list_length;
+    write_rgba(i, vec4((sums.rgb + (n - sums.w) * pc.background.rgb) / n, sums.w / n));
+    if (WRITE_DEPTH) write_depth(i, sums.w > 0.0 ? depth_sum / sums.w : 0.0);
+    if (WRITE_COUNT) write_count(i, list_length);
   }
 }

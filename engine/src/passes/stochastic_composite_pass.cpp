@@ -1,5 +1,6 @@
 #include "passes/stochastic_composite_pass.h"
 
+#include <algorithm>
 #include <bit>
 #include <stdexcept>
 
@@ -16,12 +17,22 @@ struct StochasticPush {
   uint32_t width, height, tiles_x, chunk_start, chunk_size, last_chunk, sample_index, samples, seed, pad;
 };
 static_assert(sizeof(StochasticPush) == 120);
+
+// composite_stochastic_texel's bindings: splat records and the binned list in, colour, depth and count out.
+const std::vector<VkDescriptorType> kTexelBindings = {
+    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
+    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
 }  // namespace
 
 StochasticCompositePass::StochasticCompositePass(vk::Context& ctx)
     : ctx_(ctx),
       pixels_per_invocation_(composite_pixels_per_invocation(ctx)),
-      chunk_splats_(composite_chunk_splats(ctx)) {}
+      chunk_splats_(composite_chunk_splats(ctx)),
+      texel_buffers_(pixels_per_invocation_ > 1 && vk::texel_buffers_wanted(ctx)) {
+  if (texel_buffers_)
+    unused_output_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "stochastic composite unused output");
+}
 
 void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer& splats,
                                      const vk::Buffer& binned_indices, const vk::Buffer& ranges, OutputBuffers& out,
@@ -32,17 +43,32 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer
   const bool with_state = needs_state(samples.count, chunks.count);
   if (with_state && chunks.state.size() < state_bytes(out.width, out.height))
     throw std::logic_error("stochastic composite: the state buffer is smaller than the image");
-  auto key = std::make_tuple(write_depth, write_count, alpha_cutoff);
+  // Texel views in binding order (composite_stochastic.comp, TS_TEXEL_BUFFERS); none where a buffer has
+  // more texels than the device allows, and then this frame takes the address path.
+  std::vector<VkBufferView> views;
+  if (texel_buffers_) {
+    views = {splats.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
+             binned_indices.texel_view(VK_FORMAT_R32_UINT, 4),
+             out.rgba.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
+             (write_depth ? out.depth : unused_output_).texel_view(VK_FORMAT_R32_SFLOAT, 4),
+             (write_count ? out.count : unused_output_).texel_view(VK_FORMAT_R32_UINT, 4)};
+    if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
+  }
+  const bool texel = !views.empty();
+  auto key = std::make_tuple(write_depth, write_count, alpha_cutoff, texel);
   auto it = pipelines_.find(key);
   if (it == pipelines_.end()) {
     it = pipelines_
-             .emplace(key, vk::ComputePipeline(ctx_, "composite_stochastic", sizeof(StochasticPush),
-                                               {{0, write_depth ? 1u : 0u},
-                                                {1, write_count ? 1u : 0u},
-                                                {2, pixels_per_invocation_},
-                                                {3, kTileSize / pixels_per_invocation_},
-                                                {4, std::bit_cast<uint32_t>(alpha_cutoff)},
-                                                {5, std::bit_cast<uint32_t>(coverage_alpha_inv(alpha_cutoff))}}))
+             .emplace(key,
+                      vk::ComputePipeline(ctx_, texel ? "composite_stochastic_texel" : "composite_stochastic",
+                                          sizeof(StochasticPush),
+                                          {{0, write_depth ? 1u : 0u},
+                                           {1, write_count ? 1u : 0u},
+                                           {2, pixels_per_invocation_},
+                                           {3, kTileSize / pixels_per_invocation_},
+                                           {4, std::bit_cast<uint32_t>(alpha_cutoff)},
+                                           {5, std::bit_cast<uint32_t>(coverage_alpha_inv(alpha_cutoff))}},
+                                          texel ? kTexelBindings : std::vector<VkDescriptorType>{}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
@@ -72,6 +98,7 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer
                           samples.seed,
                           0};
       it->second.bind(stream.cmd(), push);
+      if (texel) it->second.push_texel_views(stream.cmd(), views);
       it->second.dispatch(stream.cmd(), tiles_x, tiles_y);
     }
   }

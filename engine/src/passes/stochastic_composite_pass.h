@@ -40,7 +40,10 @@ class StochasticCompositePass {
   vk::Context& ctx_;
   uint32_t pixels_per_invocation_;
   uint32_t chunk_splats_;  // splats per tile and dispatch
-  std::map<std::tuple<bool, bool, float>, vk::ComputePipeline> pipelines_;  // by outputs and alpha cut-off
+  bool texel_buffers_;  // the CPU layout reads and writes through texel buffers (composite_stochastic_texel)
+  vk::Buffer unused_output_;  // the texel binding of an output that is off
+  // By outputs, alpha cut-off and texel buffers.
+  std::map<std::tuple<bool, bool, float, bool>, vk::ComputePipeline> pipelines_;
 };
 
 }  // namespace tilesplat
