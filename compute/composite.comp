@@ -6,7 +6,9 @@
 // Each invocation owns a column of PIXELS_PER_INVOCATION pixels. GPUs use 1 (256 invocations, one
 // per pixel). CPU drivers such as lavapipe use 16: there a shared-memory read costs a scalar load per
 // SIMD lane, so reading each splat once and blending it into 16 pixels held in registers is 5-10x
-// faster, and the workgroup has 2 SIMD groups instead of 32 to switch between at each barrier.
+// faster, and the workgroup has 2 SIMD groups instead of 32 to switch between at each barrier. Their
+// variant composite_texel (TS_TEXEL_BUFFERS) also reads the records and writes the outputs through
+// texel buffers and stages only the splats' indices (see there).
 //
 // Each staged splat also carries its reach: the columns its alpha >= 1/255 ellipse meets in rows
 // 0-7 and in rows 8-15. Pixels outside would be no-ops (the reference skips them too). GPUs simply
@@ -43,6 +45,9 @@ layout(constant_id = 8) const bool SURFACE_DEPTH = false;
 // The lists are in exact depth order (32-bit depth keys): a pixel is done at the first splat behind its
 // host surface, as every later one is behind it too. Same image, less work behind the host's walls.
 layout(constant_id = 9) const bool HOST_DEPTH_SORTED = false;
+// The tiles' lists are blended in more than one dispatch (see above). Off, the state loads and stores
+// compile away: CPU drivers run both sides of a branch, so even skipped they cost loops over the lanes.
+layout(constant_id = 10) const bool CHUNKED = true;
 
 layout(push_constant) uniform Push {
   Vec4Array splats;
@@ -201,13 +206,13 @@ void main() {
 
   uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
   uint list_length = range.y - range.x;
-  bool resume = pc.chunk_start > 0;
+  bool resume = CHUNKED && pc.chunk_start > 0;
   if (resume && list_length <= pc.chunk_start) return;  // an earlier chunk finished this tile
   if (!resume && list_length > pc.chunk_size && thread == 0)
     atomicMax(pc.counters.v[COUNTER_MAX_TILE_PAIRS], list_length);
   uint list_begin = range.x + pc.chunk_start;
   uint list_end = list_length - pc.chunk_start <= pc.chunk_size ? range.y : list_begin + pc.chunk_size;
-  bool write_outputs = list_end == range.y || pc.last_chunk != 0;
+  bool write_outputs = !CHUNKED || list_end == range.y || pc.last_chunk != 0;
 
   for (uint p = 0; p < P; ++p) {
     bool outside = px >= pc.width || py0 + p >= pc.height;

@@ -80,8 +80,9 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
     if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
   }
   const bool texel = !views.empty();
-  auto key =
-      std::make_tuple(write_depth, write_count, cutoffs, host_depth, surface_depth, host_depth_sorted, texel);
+  const bool chunked = chunks.count > 1;
+  auto key = std::make_tuple(write_depth, write_count, cutoffs, host_depth, surface_depth, host_depth_sorted,
+                             texel, chunked);
   auto it = pipelines_.find(key);
   if (it == pipelines_.end()) {
     const float alpha_inv = coverage_alpha_inv(cutoffs.alpha);
@@ -97,7 +98,8 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                                                 {6, std::bit_cast<uint32_t>(cutoffs.transmittance)},
                                                 {7, host_depth ? 1u : 0u},
                                                 {8, surface_depth ? 1u : 0u},
-                                                {9, host_depth_sorted ? 1u : 0u}},
+                                                {9, host_depth_sorted ? 1u : 0u},
+                                                {10, chunked ? 1u : 0u}},
                                                texel ? kTexelBindings : std::vector<VkDescriptorType>{}))
              .first;
   }

@@ -66,8 +66,9 @@ class CompositePass {
   uint32_t chunk_splats_;  // splats per tile and dispatch
   bool texel_buffers_;     // the CPU layout reads and writes through texel buffers (composite_texel)
   vk::Buffer unused_output_;  // the texel binding of an output that is off
-  // By outputs (depth, count), cut-offs, host depth (in, out, in exact depth order) and texel buffers.
-  std::map<std::tuple<bool, bool, Cutoffs, bool, bool, bool, bool>, vk::ComputePipeline> pipelines_;
+  // By outputs (depth, count), cut-offs, host depth (in, out, in exact depth order), texel buffers and
+  // whether a tile's list takes more than one dispatch.
+  std::map<std::tuple<bool, bool, Cutoffs, bool, bool, bool, bool, bool>, vk::ComputePipeline> pipelines_;
 };
 
 }  // namespace tilesplat
