@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "test_support.h"
@@ -231,6 +233,19 @@ TEST(GpuRenderer, CompositeLayoutsGiveIdenticalImages) {
   GaussianScene scene = load_scene(testing::bundled_playbot());
   Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(2).camera, 333, 187);
   testing::expect_composite_layouts_identical(scene, camera);
+}
+
+// The layout overrides are read when the renderer is made; a value they do not know is an error
+// naming the variable, not a silent default.
+TEST(GpuRenderer, LayoutOverridesRejectUnknownValues) {
+  ::setenv("TILESPLAT_TEXEL_BUFFERS", "yes", 1);
+  const std::string texel = testing::error_of<std::invalid_argument>([] { Renderer::create({}); });
+  ::unsetenv("TILESPLAT_TEXEL_BUFFERS");
+  EXPECT_EQ(texel, "TILESPLAT_TEXEL_BUFFERS must be 0 or 1, got 'yes'");
+  ::setenv("TILESPLAT_COMPOSITE_PIXELS", "3", 1);
+  const std::string pixels = testing::error_of<std::invalid_argument>([] { Renderer::create({}); });
+  ::unsetenv("TILESPLAT_COMPOSITE_PIXELS");
+  EXPECT_EQ(pixels, "TILESPLAT_COMPOSITE_PIXELS must be 1, 2, 4, 8 or 16, got '3'");
 }
 
 }  // namespace
