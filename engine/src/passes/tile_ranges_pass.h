@@ -15,7 +15,9 @@ class TileRangesPass {
               const vk::Buffer& counters, VkDeviceSize ranges_args_offset, uint32_t tiles);
 
  private:
-  vk::ComputePipeline pipeline_[2];  // [wide keys]
+  bool texel_buffers_;                     // CPU drivers: tile_ranges_texel (vk::texel_buffers_wanted)
+  vk::ComputePipeline pipeline_[2];        // [wide keys]
+  vk::ComputePipeline texel_pipeline_[2];  // [wide keys]
 };
 
 }  // namespace tilesplat
