@@ -38,8 +38,12 @@ KeyEmissionPass::KeyEmissionPass(vk::Context& ctx)
       frame_setup_(ctx, "frame_setup", sizeof(SetupPush)),
       scatter_offsets_(ctx, "scatter_offsets", sizeof(ScatterPush)),
       texel_buffers_(vk::texel_buffers_wanted(ctx)) {
-  if (texel_buffers_)
-    unused_keys_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "key emission unused key view");
+  if (!texel_buffers_) return;
+  unused_keys_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "key emission unused key view");
+  scatter_offsets_texel_ =
+      vk::ComputePipeline(ctx, "scatter_offsets_texel", sizeof(ScatterPush), {},
+                          {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+                           VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER});
 }
 
 void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer* depth_order,
@@ -49,9 +53,18 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
   frame_setup_.bind(cmd, SetupPush{counters, keys.capacity, 0});
   frame_setup_.dispatch(cmd, 1);
   if (depth_order) {
-    scatter_offsets_.bind(cmd, ScatterPush{depth_order->address(), projected.depth_offsets.address(),
-                                           projected.offsets.address(), gaussians, 0});
-    scatter_offsets_.dispatch(cmd, vk::div_ceil(gaussians, 256));
+    std::vector<VkBufferView> views;
+    if (texel_buffers_) {
+      views = {depth_order->texel_view(VK_FORMAT_R32_UINT, 4),
+               projected.depth_offsets.texel_view(VK_FORMAT_R32_UINT, 4),
+               projected.offsets.texel_view(VK_FORMAT_R32_UINT, 4)};
+      if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
+    }
+    const vk::ComputePipeline& scatter = views.empty() ? scatter_offsets_ : scatter_offsets_texel_;
+    scatter.bind(cmd, ScatterPush{depth_order->address(), projected.depth_offsets.address(),
+                                  projected.offsets.address(), gaussians, 0});
+    if (!views.empty()) scatter.push_texel_views(cmd, views);
+    scatter.dispatch(cmd, vk::div_ceil(gaussians, 256));
   }
   vk::barrier(cmd);
   // Texel views in binding order (key_emission.comp, TS_TEXEL_BUFFERS); none where a buffer has more

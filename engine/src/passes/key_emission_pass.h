@@ -37,6 +37,7 @@ class KeyEmissionPass {
       emit_keys_;
   bool texel_buffers_;      // CPU drivers: key_emission_texel (vk::texel_buffers_wanted)
   vk::Buffer unused_keys_;  // the texel binding of the key width a frame does not write
+  vk::ComputePipeline scatter_offsets_texel_;  // CPU drivers: scatter_offsets through texel buffers
 };
 
 }  // namespace tilesplat
