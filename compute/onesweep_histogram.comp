@@ -23,6 +23,13 @@ layout(push_constant) uniform Push {
 #include "sort_keys.glsl"
 #include "onesweep_common.glsl"
 
+#ifdef TS_TEXEL_BUFFERS
+#include "sort_key_texels.glsl"  // onesweep_histogram_texel: the keys through binding 0
+uint64_t histogram_load_key(uint i) { return texel_load_key(i); }
+#else
+uint64_t histogram_load_key(uint i) { return load_key(pc.keys, i); }
+#endif
+
 shared uint s_counts[MAX_PASSES * RADIX];
 shared bool s_last;
 
@@ -39,7 +46,7 @@ void main() {
   uint start = part * PARTITION_KEYS;
   uint end = min(start + PARTITION_KEYS, n);
   for (uint k = start + lid; k < end; k += wg) {
-    uint64_t key = load_key(pc.keys, k);
+    uint64_t key = histogram_load_key(k);
     for (uint p = 0; p < pc.passes; ++p) atomicAdd(s_counts[p * RADIX + digit_at(key, 8 * p)], 1u);
   }
   barrier();

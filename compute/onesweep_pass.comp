@@ -36,6 +36,18 @@ layout(push_constant) uniform Push {
 #include "sort_keys.glsl"
 #include "onesweep_common.glsl"
 
+#ifdef TS_TEXEL_BUFFERS
+#include "sort_key_texels.glsl"  // onesweep_pass_texel
+uint64_t pass_load_key(uint i) { return texel_load_key(i); }
+void pass_store(uint dst, uint k) { texel_store_pair(dst, texel_load_key(k), texel_load_value(k)); }
+#else
+uint64_t pass_load_key(uint i) { return load_key(pc.keys_in, i); }
+void pass_store(uint dst, uint k) {
+  store_key(pc.keys_out, dst, load_key(pc.keys_in, k));
+  pc.values_out.v[dst] = pc.values_in.v[k];
+}
+#endif
+
 const uint WG = gl_WorkGroupSize.x;
 const uint PARTITION_KEYS = WG * KEYS_PER_LANE;
 const uint DIGITS_PER_LANE = (RADIX + WG - 1) / WG;  // digits each lane owns in the look-back
@@ -72,7 +84,7 @@ void count_partition(uint q, uint n) {
   uint start = q * PARTITION_KEYS;
   uint end = min(start + PARTITION_KEYS, n);
   for (uint k = start + gl_LocalInvocationIndex; k < end; k += WG)
-    atomicAdd(s_fallback[digit_at(load_key(pc.keys_in, k), pc.shift)], 1u);
+    atomicAdd(s_fallback[digit_at(pass_load_key(k), pc.shift)], 1u);
   barrier();
 }
 
@@ -95,7 +107,7 @@ void main() {
   for (uint j = 0; j < KEYS_PER_LANE; ++j) {
     uint k = first + j * gl_SubgroupSize;
     bool valid = k < n;
-    uint64_t key = valid ? load_key(pc.keys_in, k) : uint64_t(0);
+    uint64_t key = valid ? pass_load_key(k) : uint64_t(0);
     uint digit = digit_at(key, pc.shift);
     uvec4 peers = digit_peers(digit, valid);
     uint rank = ballot_count(peers & gl_SubgroupLtMask);
@@ -196,7 +208,6 @@ void main() {
     if (r == NO_KEY) continue;
     uint k = first + j * gl_SubgroupSize;
     uint dst = s_counts[my + (r >> 16)] + (r & 0xffffu);
-    store_key(pc.keys_out, dst, load_key(pc.keys_in, k));
-    pc.values_out.v[dst] = pc.values_in.v[k];
+    pass_store(dst, k);
   }
 }

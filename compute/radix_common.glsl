@@ -28,28 +28,10 @@ uint block_keys() { return pc.state.v[RADIX_BLOCK_KEYS]; }
 uint digit_of(uint64_t key) { return uint(key >> pc.shift) & (RADIX - 1); }
 
 #ifdef TS_TEXEL_BUFFERS
-// The CPU-driver variants (radix_histogram_texel, radix_scatter_texel): keys and values through texel
-// buffers, which llvmpipe reads and writes with SIMD gathers and scatters, where a load or store at
-// a per-invocation address is a loop over the SIMD lanes (vk::texel_buffers_wanted). Narrow keys are
-// R32_UINT texels, wide ones R32G32_UINT (low word first, as in memory); the same buffers as the
-// push constants' addresses.
-layout(set = 0, binding = 0) uniform usamplerBuffer keys_in_texels;
-layout(set = 0, binding = 1) uniform usamplerBuffer values_in_texels;
-layout(set = 0, binding = 2, r32ui) uniform writeonly uimageBuffer narrow_keys_out_texels;
-layout(set = 0, binding = 3, rg32ui) uniform writeonly uimageBuffer wide_keys_out_texels;
-layout(set = 0, binding = 4, r32ui) uniform writeonly uimageBuffer values_out_texels;
-uint64_t radix_load_key(uint i) {
-  uvec2 words = texelFetch(keys_in_texels, int(i)).xy;
-  return WIDE_KEYS ? pack64(words) : uint64_t(words.x);
-}
-uint radix_load_value(uint i) { return texelFetch(values_in_texels, int(i)).x; }
-void radix_store(uint i, uint64_t key, uint value) {
-  if (WIDE_KEYS)
-    imageStore(wide_keys_out_texels, int(i), uvec4(unpack32(key), 0u, 0u));
-  else
-    imageStore(narrow_keys_out_texels, int(i), uvec4(uint(key)));
-  imageStore(values_out_texels, int(i), uvec4(value));
-}
+#include "sort_key_texels.glsl"
+uint64_t radix_load_key(uint i) { return texel_load_key(i); }
+uint radix_load_value(uint i) { return texel_load_value(i); }
+void radix_store(uint i, uint64_t key, uint value) { texel_store_pair(i, key, value); }
 #else
 uint64_t radix_load_key(uint i) { return load_key(pc.keys_in, i); }
 uint radix_load_value(uint i) { return pc.values_in.v[i]; }

@@ -46,6 +46,30 @@ struct KeyBuffers {
     return from_alt ? Pass{keys_alt, values_alt, keys, values} : Pass{keys, values, keys_alt, values_alt};
   }
 
+  // The texel-buffer views of a pass for the sorts' CPU-driver variants (compute/sort_key_texels.glsl):
+  // keys and values in; narrow keys, wide keys and values out, with `unused` (any small buffer) in the
+  // key width the pass does not write. Empty where a buffer has more texels than the device allows.
+  std::vector<VkBufferView> texel_views(bool from_alt, const vk::Buffer& unused) const {
+    const Pass p = pass(from_alt);
+    const VkFormat key_format = wide_keys ? VK_FORMAT_R32G32_UINT : VK_FORMAT_R32_UINT;
+    std::vector<VkBufferView> views = {p.keys_in.texel_view(key_format, key_bytes()),
+                                       p.values_in.texel_view(VK_FORMAT_R32_UINT, 4),
+                                       (wide_keys ? unused : p.keys_out).texel_view(VK_FORMAT_R32_UINT, 4),
+                                       (wide_keys ? p.keys_out : unused).texel_view(VK_FORMAT_R32G32_UINT, 8),
+                                       p.values_out.texel_view(VK_FORMAT_R32_UINT, 4)};
+    for (VkBufferView view : views)
+      if (view == VK_NULL_HANDLE) return {};
+    return views;
+  }
+  // The descriptor types of those views, in binding order.
+  static const std::vector<VkDescriptorType>& texel_bindings() {
+    static const std::vector<VkDescriptorType> types = {
+        VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+        VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
+        VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
+    return types;
+  }
+
   // Host-side keys in and out of this layout (the caller guarantees narrow keys fit 32 bits).
   std::vector<uint8_t> pack_keys(const std::vector<uint64_t>& host) const {
     std::vector<uint8_t> bytes(host.size() * key_bytes());

@@ -62,7 +62,9 @@ uint32_t spin_limit_from_environment() {
 constexpr uint32_t kCpuDriverMaxSpin = 16384;
 
 OnesweepSort::OnesweepSort(vk::Context& ctx, std::optional<uint32_t> spin_limit)
-    : ctx_(ctx), spin_limit_(spin_limit ? *spin_limit : spin_limit_from_environment()) {
+    : ctx_(ctx),
+      spin_limit_(spin_limit ? *spin_limit : spin_limit_from_environment()),
+      texel_buffers_(vk::texel_buffers_wanted(ctx)) {
   if (ctx.is_cpu_device()) spin_limit_ = std::min(spin_limit_, kCpuDriverMaxSpin);
   const uint32_t sg = ctx.limits().subgroup_size;
   workgroup_size_ = std::max<uint32_t>(kMinWorkgroupSize, sg);
@@ -75,7 +77,17 @@ OnesweepSort::OnesweepSort(vk::Context& ctx, std::optional<uint32_t> spin_limit)
                                            {{0, workgroup_size_}, {1, partition_keys_}, {2, wide}});
     pass_[wide] = vk::ComputePipeline(ctx, "onesweep_pass", sizeof(PassPush),
                                       {{0, workgroup_size_}, {1, subgroups}, {2, keys_per_lane}, {3, wide}});
+    if (texel_buffers_) {
+      histogram_texel_[wide] = vk::ComputePipeline(ctx, "onesweep_histogram_texel", sizeof(HistogramPush),
+                                                   {{0, workgroup_size_}, {1, partition_keys_}, {2, wide}},
+                                                   KeyBuffers::texel_bindings());
+      pass_texel_[wide] =
+          vk::ComputePipeline(ctx, "onesweep_pass_texel", sizeof(PassPush),
+                              {{0, workgroup_size_}, {1, subgroups}, {2, keys_per_lane}, {3, wide}},
+                              KeyBuffers::texel_bindings());
+    }
   }
+  if (texel_buffers_) unused_keys_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "onesweep unused key view");
   control_ = vk::Buffer(ctx, kControlUints * sizeof(uint32_t), vk::MemoryUse::Device, "onesweep control");
   fallbacks_ = vk::Buffer(ctx, sizeof(uint32_t), vk::MemoryUse::Readback, "onesweep fallbacks");
   std::memset(fallbacks_.mapped(), 0, sizeof(uint32_t));
@@ -119,8 +131,16 @@ bool OnesweepSort::record(vk::CommandStream& stream, SortInput& input) {
 
   const uint32_t wide = kb.wide_keys ? 1 : 0;
   const uint32_t passes = (std::min<uint32_t>(input.key_bits, 64) + kDigitBits - 1) / kDigitBits;
-  histogram_[wide].bind(cmd, HistogramPush{kb.keys.address(), control_.address(), status[0], state, passes, 0});
-  histogram_[wide].dispatch_indirect(cmd, input.state.handle(), args_offset);
+  // Texel views per direction (none where a buffer has more texels than the device allows: the address
+  // variants run); the histogram reads the first pass's keys.
+  const std::vector<VkBufferView> views[2] = {
+      texel_buffers_ ? kb.texel_views(false, unused_keys_) : std::vector<VkBufferView>{},
+      texel_buffers_ ? kb.texel_views(true, unused_keys_) : std::vector<VkBufferView>{}};
+  const bool texel = !views[0].empty() && !views[1].empty();
+  const vk::ComputePipeline& histogram = texel ? histogram_texel_[wide] : histogram_[wide];
+  histogram.bind(cmd, HistogramPush{kb.keys.address(), control_.address(), status[0], state, passes, 0});
+  if (texel) histogram.push_texel_views(cmd, views[0]);
+  histogram.dispatch_indirect(cmd, input.state.handle(), args_offset);
   vk::barrier(cmd);
 
   bool in_alt = false;
@@ -131,8 +151,10 @@ bool OnesweepSort::record(vk::CommandStream& stream, SortInput& input) {
                         status[(p + 1) % 2],  state,              fallbacks_.address(),
                         p * kDigitBits,       p,                  spin_limit_,
                         p + 1 < passes ? 1u : 0u};
-    pass_[wide].bind(cmd, push);
-    pass_[wide].dispatch_indirect(cmd, input.state.handle(), args_offset);
+    const vk::ComputePipeline& pass = texel ? pass_texel_[wide] : pass_[wide];
+    pass.bind(cmd, push);
+    if (texel) pass.push_texel_views(cmd, views[in_alt ? 1 : 0]);
+    pass.dispatch_indirect(cmd, input.state.handle(), args_offset);
     vk::barrier(cmd);
     in_alt = !in_alt;
   }

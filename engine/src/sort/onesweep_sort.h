@@ -63,9 +63,12 @@ class OnesweepSort final : public SortStrategy {
   uint32_t workgroup_size_;
   uint32_t partition_keys_;
   uint32_t spin_limit_;
+  bool texel_buffers_;        // CPU drivers: the _texel variants (compute/sort_key_texels.glsl)
   uint32_t status_rows_ = 0;  // partitions each of the two status halves has room for
   vk::ComputePipeline setup_;
-  vk::ComputePipeline histogram_[2], pass_[2];  // [wide keys]
+  vk::ComputePipeline histogram_[2], pass_[2];              // [wide keys]
+  vk::ComputePipeline histogram_texel_[2], pass_texel_[2];  // [wide keys]
+  vk::Buffer unused_keys_;  // the texel binding of the key width a pass does not write
   vk::Buffer control_;    // digit bases and tickets (onesweep_common.glsl)
   vk::Buffer status_;     // two halves of RADIX words per partition: passes alternate between them
   vk::Buffer fallbacks_;  // host-visible counter

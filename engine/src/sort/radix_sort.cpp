@@ -29,13 +29,6 @@ struct PassPush {
   VkDeviceAddress keys_in, values_in, keys_out, values_out, histogram, digit_totals, state;
   uint32_t shift, pad;
 };
-// The texel variants' bindings (radix_common.glsl): keys and values in; narrow keys, wide keys and
-// values out.
-const std::vector<VkDescriptorType> kTexelBindings = {
-    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
-    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
-    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
-
 struct ScanPush {
   VkDeviceAddress histogram, digit_totals, state;
 };
@@ -63,10 +56,10 @@ RadixSort::RadixSort(vk::Context& ctx)
     histogram_pass_[wide] = vk::ComputePipeline(ctx, "radix_histogram", sizeof(PassPush), spec);
     scatter_pass_[wide] = vk::ComputePipeline(ctx, "radix_scatter", sizeof(PassPush), spec);
     if (texel_buffers_) {
-      histogram_texel_pass_[wide] =
-          vk::ComputePipeline(ctx, "radix_histogram_texel", sizeof(PassPush), spec, kTexelBindings);
-      scatter_texel_pass_[wide] =
-          vk::ComputePipeline(ctx, "radix_scatter_texel", sizeof(PassPush), spec, kTexelBindings);
+      histogram_texel_pass_[wide] = vk::ComputePipeline(ctx, "radix_histogram_texel", sizeof(PassPush), spec,
+                                                        KeyBuffers::texel_bindings());
+      scatter_texel_pass_[wide] = vk::ComputePipeline(ctx, "radix_scatter_texel", sizeof(PassPush), spec,
+                                                      KeyBuffers::texel_bindings());
     }
   }
   if (texel_buffers_) unused_keys_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "radix unused key view");
@@ -102,17 +95,9 @@ bool RadixSort::record(vk::CommandStream& stream, SortInput& input) {
     const auto [keys_in, values_in, keys_out, values_out] = kb.pass(in_alt);
     PassPush push{keys_in.address(),    values_in.address(),     keys_out.address(), values_out.address(),
                   histogram_.address(), digit_totals_.address(), state,              p * kDigitBits, 0};
-    // Texel views in binding order; none where a buffer has more texels than the device allows, and
-    // then the address variants run.
-    std::vector<VkBufferView> views;
-    if (texel_buffers_) {
-      const VkFormat key_format = wide ? VK_FORMAT_R32G32_UINT : VK_FORMAT_R32_UINT;
-      views = {keys_in.texel_view(key_format, kb.key_bytes()), values_in.texel_view(VK_FORMAT_R32_UINT, 4),
-               (wide ? unused_keys_ : keys_out).texel_view(VK_FORMAT_R32_UINT, 4),
-               (wide ? keys_out : unused_keys_).texel_view(VK_FORMAT_R32G32_UINT, 8),
-               values_out.texel_view(VK_FORMAT_R32_UINT, 4)};
-      if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
-    }
+    // Texel views (none where a buffer has more texels than the device allows: the address variants run).
+    const std::vector<VkBufferView> views =
+        texel_buffers_ ? kb.texel_views(in_alt, unused_keys_) : std::vector<VkBufferView>{};
     const vk::ComputePipeline& histogram_pass =
         views.empty() ? histogram_pass_[wide] : histogram_texel_pass_[wide];
     const vk::ComputePipeline& scatter_pass = views.empty() ? scatter_pass_[wide] : scatter_texel_pass_[wide];
