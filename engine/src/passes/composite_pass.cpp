@@ -28,11 +28,6 @@ static_assert(sizeof(CompositePush) <= 128, "Vulkan guarantees 128 bytes of push
 // leave a wide margin.
 constexpr uint32_t kCpuDriverChunkSplats = 8192;
 
-// composite_texel's bindings: splat records and the sorted list in, colour, depth and count out.
-const std::vector<VkDescriptorType> kTexelBindings = {
-    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
-    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
-    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
 }  // namespace
 
 // On CPU drivers every shared-memory read is a scalar load per SIMD lane: there one invocation
@@ -48,6 +43,24 @@ uint32_t composite_pixels_per_invocation(const vk::Context& ctx) {
     return uint32_t(std::stoul(value));
   }
   return ctx.is_cpu_device() ? kTileSize : 1;
+}
+
+const std::vector<VkDescriptorType>& composite_texel_bindings() {
+  static const std::vector<VkDescriptorType> types = {
+      VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+      VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
+      VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
+  return types;
+}
+
+std::vector<VkBufferView> composite_texel_views(const vk::Buffer& splats, const vk::Buffer& list,
+                                                const OutputBuffers& out, bool write_depth, bool write_count,
+                                                const vk::Buffer& unused) {
+  return vk::complete_views({splats.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
+                             list.texel_view(VK_FORMAT_R32_UINT, 4),
+                             out.rgba.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
+                             (write_depth ? out.depth : unused).texel_view(VK_FORMAT_R32_SFLOAT, 4),
+                             (write_count ? out.count : unused).texel_view(VK_FORMAT_R32_UINT, 4)});
 }
 
 uint32_t composite_chunk_splats(const vk::Context& ctx) {
@@ -68,17 +81,10 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                            const Cutoffs& cutoffs, const Chunks& chunks, const HostSurface& host) {
   const bool host_depth = host.view_depth != nullptr, surface_depth = host.surface_depth != nullptr;
   const bool host_depth_sorted = host_depth && host.exact_depth_order;
-  // Texel views in binding order (composite.comp, TS_TEXEL_BUFFERS); none where a buffer has more
-  // texels than the device allows, and then this frame takes the address path.
-  std::vector<VkBufferView> views;
-  if (texel_buffers_) {
-    views = {splats.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
-             sorted_indices.texel_view(VK_FORMAT_R32_UINT, 4),
-             out.rgba.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
-             (write_depth ? out.depth : unused_output_).texel_view(VK_FORMAT_R32_SFLOAT, 4),
-             (write_count ? out.count : unused_output_).texel_view(VK_FORMAT_R32_UINT, 4)};
-    if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
-  }
+  const std::vector<VkBufferView> views =
+      texel_buffers_
+          ? composite_texel_views(splats, sorted_indices, out, write_depth, write_count, unused_output_)
+          : std::vector<VkBufferView>{};
   const bool texel = !views.empty();
   const bool chunked = chunks.count > 1;
   auto key = std::make_tuple(write_depth, write_count, cutoffs, host_depth, surface_depth, host_depth_sorted,
@@ -87,20 +93,20 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
   if (it == pipelines_.end()) {
     const float alpha_inv = coverage_alpha_inv(cutoffs.alpha);
     it = pipelines_
-             .emplace(key, vk::ComputePipeline(ctx_, texel ? "composite_texel" : "composite",
-                                               sizeof(CompositePush),
-                                               {{0, write_depth ? 1u : 0u},
-                                                {1, write_count ? 1u : 0u},
-                                                {2, pixels_per_invocation_},
-                                                {3, kTileSize / pixels_per_invocation_},
-                                                {4, std::bit_cast<uint32_t>(cutoffs.alpha)},
-                                                {5, std::bit_cast<uint32_t>(alpha_inv)},
-                                                {6, std::bit_cast<uint32_t>(cutoffs.transmittance)},
-                                                {7, host_depth ? 1u : 0u},
-                                                {8, surface_depth ? 1u : 0u},
-                                                {9, host_depth_sorted ? 1u : 0u},
-                                                {10, chunked ? 1u : 0u}},
-                                               texel ? kTexelBindings : std::vector<VkDescriptorType>{}))
+             .emplace(key, vk::ComputePipeline(
+                               ctx_, texel ? "composite_texel" : "composite", sizeof(CompositePush),
+                               {{0, write_depth ? 1u : 0u},
+                                {1, write_count ? 1u : 0u},
+                                {2, pixels_per_invocation_},
+                                {3, kTileSize / pixels_per_invocation_},
+                                {4, std::bit_cast<uint32_t>(cutoffs.alpha)},
+                                {5, std::bit_cast<uint32_t>(alpha_inv)},
+                                {6, std::bit_cast<uint32_t>(cutoffs.transmittance)},
+                                {7, host_depth ? 1u : 0u},
+                                {8, surface_depth ? 1u : 0u},
+                                {9, host_depth_sorted ? 1u : 0u},
+                                {10, chunked ? 1u : 0u}},
+                               texel ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);

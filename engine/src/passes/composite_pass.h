@@ -5,6 +5,7 @@
 #include <compare>
 #include <map>
 #include <tuple>
+#include <vector>
 
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
@@ -23,6 +24,14 @@ struct OutputBuffers {
 // TILESPLAT_COMPOSITE_PIXELS), and how many splats of a tile's list one dispatch may take (llvmpipe's
 // loop limit; unlimited on GPUs).
 uint32_t composite_pixels_per_invocation(const vk::Context& ctx);
+// The CPU-driver variants of both composites (composite.comp, composite_stochastic.comp with
+// TS_TEXEL_BUFFERS) bind the splat records and the tiles' list in and colour, depth and count out:
+// these descriptor types, and those views (`unused` stands in for an output that is off; empty where
+// a buffer has more texels than the device allows).
+const std::vector<VkDescriptorType>& composite_texel_bindings();
+std::vector<VkBufferView> composite_texel_views(const vk::Buffer& splats, const vk::Buffer& list,
+                                                const OutputBuffers& out, bool write_depth, bool write_count,
+                                                const vk::Buffer& unused);
 uint32_t composite_chunk_splats(const vk::Context& ctx);
 // Dispatches of chunk_splats each that a tile list of this length needs (at least 1).
 uint32_t composite_chunks_needed(uint64_t longest_tile_list, uint32_t chunk_splats);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "vulkan/buffer.h"
+#include "vulkan/compute_pipeline.h"
 #include "vulkan/context.h"
 
 namespace tilesplat {
@@ -52,14 +53,11 @@ struct KeyBuffers {
   std::vector<VkBufferView> texel_views(bool from_alt, const vk::Buffer& unused) const {
     const Pass p = pass(from_alt);
     const VkFormat key_format = wide_keys ? VK_FORMAT_R32G32_UINT : VK_FORMAT_R32_UINT;
-    std::vector<VkBufferView> views = {p.keys_in.texel_view(key_format, key_bytes()),
-                                       p.values_in.texel_view(VK_FORMAT_R32_UINT, 4),
-                                       (wide_keys ? unused : p.keys_out).texel_view(VK_FORMAT_R32_UINT, 4),
-                                       (wide_keys ? p.keys_out : unused).texel_view(VK_FORMAT_R32G32_UINT, 8),
-                                       p.values_out.texel_view(VK_FORMAT_R32_UINT, 4)};
-    for (VkBufferView view : views)
-      if (view == VK_NULL_HANDLE) return {};
-    return views;
+    return vk::complete_views({p.keys_in.texel_view(key_format, key_bytes()),
+                               p.values_in.texel_view(VK_FORMAT_R32_UINT, 4),
+                               (wide_keys ? unused : p.keys_out).texel_view(VK_FORMAT_R32_UINT, 4),
+                               (wide_keys ? p.keys_out : unused).texel_view(VK_FORMAT_R32G32_UINT, 8),
+                               p.values_out.texel_view(VK_FORMAT_R32_UINT, 4)});
   }
   // The descriptor types of those views, in binding order.
   static const std::vector<VkDescriptorType>& texel_bindings() {

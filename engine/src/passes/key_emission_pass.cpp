@@ -1,6 +1,5 @@
 #include "passes/key_emission_pass.h"
 
-#include <algorithm>
 #include <bit>
 #include <utility>
 #include <vector>
@@ -58,7 +57,7 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
       views = {depth_order->texel_view(VK_FORMAT_R32_UINT, 4),
                projected.depth_offsets.texel_view(VK_FORMAT_R32_UINT, 4),
                projected.offsets.texel_view(VK_FORMAT_R32_UINT, 4)};
-      if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
+      views = vk::complete_views(std::move(views));
     }
     const vk::ComputePipeline& scatter = views.empty() ? scatter_offsets_ : scatter_offsets_texel_;
     scatter.bind(cmd, ScatterPush{depth_order->address(), projected.depth_offsets.address(),
@@ -79,7 +78,7 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
              (wide ? unused_keys_ : keys.keys).texel_view(VK_FORMAT_R32_UINT, 4),
              (wide ? keys.keys : unused_keys_).texel_view(VK_FORMAT_R32G32_UINT, 8),
              keys.values.texel_view(VK_FORMAT_R32_UINT, 4)};
-    if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
+    views = vk::complete_views(std::move(views));
   }
   const bool texel = !views.empty();
   const auto variant = std::make_tuple(keys.wide_keys, square_tiles, alpha_inv, texel);

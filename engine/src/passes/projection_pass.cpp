@@ -209,7 +209,7 @@ void ProjectionPass::record(VkCommandBuffer cmd, const SceneBuffers& scene, Proj
              out.depth_order.keys.texel_view(VK_FORMAT_R32_UINT, 4),
              out.depth_order.values.texel_view(VK_FORMAT_R32_UINT, 4),
              camera_params_.texel_view(VK_FORMAT_R32G32_UINT, 8)};
-    if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
+    views = vk::complete_views(std::move(views));
   }
   const auto& pipeline = pipeline_for(variant, !views.empty());
   pipeline.bind(cmd, push);

@@ -1,6 +1,5 @@
 #include "passes/stochastic_composite_pass.h"
 
-#include <algorithm>
 #include <bit>
 #include <stdexcept>
 
@@ -18,11 +17,6 @@ struct StochasticPush {
 };
 static_assert(sizeof(StochasticPush) == 120);
 
-// composite_stochastic_texel's bindings: splat records and the binned list in, colour, depth and count out.
-const std::vector<VkDescriptorType> kTexelBindings = {
-    VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
-    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
-    VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
 }  // namespace
 
 StochasticCompositePass::StochasticCompositePass(vk::Context& ctx)
@@ -43,32 +37,25 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer
   const bool with_state = needs_state(samples.count, chunks.count);
   if (with_state && chunks.state.size() < state_bytes(out.width, out.height))
     throw std::logic_error("stochastic composite: the state buffer is smaller than the image");
-  // Texel views in binding order (composite_stochastic.comp, TS_TEXEL_BUFFERS); none where a buffer has
-  // more texels than the device allows, and then this frame takes the address path.
-  std::vector<VkBufferView> views;
-  if (texel_buffers_) {
-    views = {splats.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
-             binned_indices.texel_view(VK_FORMAT_R32_UINT, 4),
-             out.rgba.texel_view(VK_FORMAT_R32G32B32A32_SFLOAT, 16),
-             (write_depth ? out.depth : unused_output_).texel_view(VK_FORMAT_R32_SFLOAT, 4),
-             (write_count ? out.count : unused_output_).texel_view(VK_FORMAT_R32_UINT, 4)};
-    if (std::find(views.begin(), views.end(), VK_NULL_HANDLE) != views.end()) views.clear();
-  }
+  const std::vector<VkBufferView> views =
+      texel_buffers_
+          ? composite_texel_views(splats, binned_indices, out, write_depth, write_count, unused_output_)
+          : std::vector<VkBufferView>{};
   const bool texel = !views.empty();
   auto key = std::make_tuple(write_depth, write_count, alpha_cutoff, texel);
   auto it = pipelines_.find(key);
   if (it == pipelines_.end()) {
     it = pipelines_
-             .emplace(key,
-                      vk::ComputePipeline(ctx_, texel ? "composite_stochastic_texel" : "composite_stochastic",
-                                          sizeof(StochasticPush),
-                                          {{0, write_depth ? 1u : 0u},
-                                           {1, write_count ? 1u : 0u},
-                                           {2, pixels_per_invocation_},
-                                           {3, kTileSize / pixels_per_invocation_},
-                                           {4, std::bit_cast<uint32_t>(alpha_cutoff)},
-                                           {5, std::bit_cast<uint32_t>(coverage_alpha_inv(alpha_cutoff))}},
-                                          texel ? kTexelBindings : std::vector<VkDescriptorType>{}))
+             .emplace(key, vk::ComputePipeline(
+                               ctx_, texel ? "composite_stochastic_texel" : "composite_stochastic",
+                               sizeof(StochasticPush),
+                               {{0, write_depth ? 1u : 0u},
+                                {1, write_count ? 1u : 0u},
+                                {2, pixels_per_invocation_},
+                                {3, kTileSize / pixels_per_invocation_},
+                                {4, std::bit_cast<uint32_t>(alpha_cutoff)},
+                                {5, std::bit_cast<uint32_t>(coverage_alpha_inv(alpha_cutoff))}},
+                               texel ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);

@@ -28,10 +28,9 @@ void TileRangesPass::record(VkCommandBuffer cmd, const vk::Buffer& sorted_keys, 
   // Texel views; none where a buffer has more texels than the device allows (then the address path).
   std::vector<VkBufferView> views;
   if (texel_buffers_) {
-    views = {
-        sorted_keys.texel_view(wide_keys ? VK_FORMAT_R32G32_UINT : VK_FORMAT_R32_UINT, wide_keys ? 8 : 4),
-        counters.texel_view(VK_FORMAT_R32_UINT, 4)};
-    if (!views[0] || !views[1]) views.clear();
+    views = vk::complete_views(
+        {sorted_keys.texel_view(wide_keys ? VK_FORMAT_R32G32_UINT : VK_FORMAT_R32_UINT, wide_keys ? 8 : 4),
+         counters.texel_view(VK_FORMAT_R32_UINT, 4)});
   }
   const vk::ComputePipeline& pipeline = (views.empty() ? pipeline_ : texel_pipeline_)[wide_keys ? 1 : 0];
   pipeline.bind(cmd, RangesPush{sorted_keys.address(), ranges.address(), counters.address(), tiles, 0});

@@ -136,6 +136,12 @@ void ComputePipeline::push_texel_views(VkCommandBuffer cmd, const std::vector<Vk
                                   writes.data());
 }
 
+std::vector<VkBufferView> complete_views(std::vector<VkBufferView> views) {
+  for (VkBufferView view : views)
+    if (view == VK_NULL_HANDLE) return {};
+  return views;
+}
+
 bool texel_buffers_wanted(const Context& ctx) {
   if (!ctx.features().push_descriptor) return false;
   if (const char* env = std::getenv("TILESPLAT_TEXEL_BUFFERS"); env && *env) {

@@ -66,6 +66,10 @@ void barrier(VkCommandBuffer cmd);
 // so that the tests hold both layouts to the same images.
 bool texel_buffers_wanted(const Context& ctx);
 
+// A pass's texel views, all of them or none: empty when any is VK_NULL_HANDLE (a buffer with more texels
+// than the device allows, Buffer::texel_view), and the pass then takes its address variant.
+std::vector<VkBufferView> complete_views(std::vector<VkBufferView> views);
+
 inline uint32_t div_ceil(uint64_t a, uint64_t b) { return uint32_t((a + b - 1) / b); }
 
 }  // namespace tilesplat::vk
