@@ -67,6 +67,7 @@ class HostApplication : public ::testing::Test {
     vkGetPhysicalDeviceFeatures2(physical, &has);
     VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
     f12.bufferDeviceAddress = VK_TRUE;
+    f12.timelineSemaphore = VK_TRUE;  // the host's own choice; render_to_image takes timeline semaphores too
     VkPhysicalDeviceFeatures2 f{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
     f.pNext = &f12;
     f.features.shaderInt64 = VK_TRUE;
@@ -150,14 +151,17 @@ class HostApplication : public ::testing::Test {
     ASSERT_EQ(vkMapMemory(device, staging_memory, 0, bytes, 0, &staging_data), VK_SUCCESS);
   }
   // Records, submits and waits for one command buffer.
-  void submit(const std::function<void(VkCommandBuffer)>& record) {
+  VkCommandPool pool() {
     if (!command_pool) {
       VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
       pci.queueFamilyIndex = family;
-      ASSERT_EQ(vkCreateCommandPool(device, &pci, nullptr, &command_pool), VK_SUCCESS);
+      EXPECT_EQ(vkCreateCommandPool(device, &pci, nullptr, &command_pool), VK_SUCCESS);
     }
+    return command_pool;
+  }
+  void submit(const std::function<void(VkCommandBuffer)>& record) {
     VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    cai.commandPool = command_pool;
+    cai.commandPool = pool();
     cai.commandBufferCount = 1;
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     ASSERT_EQ(vkAllocateCommandBuffers(device, &cai, &cmd), VK_SUCCESS);
@@ -171,6 +175,49 @@ class HostApplication : public ::testing::Test {
     ASSERT_EQ(vkQueueSubmit(queue, 1, &info, VK_NULL_HANDLE), VK_SUCCESS);
     ASSERT_EQ(vkQueueWaitIdle(queue), VK_SUCCESS);
     vkFreeCommandBuffers(device, command_pool, 1, &cmd);
+    free_pending_command_buffers();  // the queue is idle
+  }
+  void free_pending_command_buffers() {
+    if (!pending_command_buffers.empty())
+      vkFreeCommandBuffers(device, command_pool, uint32_t(pending_command_buffers.size()),
+                           pending_command_buffers.data());
+    pending_command_buffers.clear();
+  }
+  // A binary semaphore, or a timeline one starting at 0; destroyed with the host's other objects.
+  VkSemaphore make_semaphore(bool timeline = false) {
+    VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
+    type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
+    VkSemaphoreCreateInfo sci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    if (timeline) sci.pNext = &type;
+    VkSemaphore semaphore = VK_NULL_HANDLE;
+    EXPECT_EQ(vkCreateSemaphore(device, &sci, nullptr, &semaphore), VK_SUCCESS);
+    semaphores.push_back(semaphore);
+    return semaphore;
+  }
+  // Records and submits one command buffer that waits for and signals binary semaphores, without
+  // waiting for it (the queue is drained by the next submit() or release_host_objects()).
+  void submit_async(const std::function<void(VkCommandBuffer)>& record, VkSemaphore wait,
+                    VkSemaphore signal) {
+    VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cai.commandPool = pool();
+    cai.commandBufferCount = 1;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    ASSERT_EQ(vkAllocateCommandBuffers(device, &cai, &cmd), VK_SUCCESS);
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    ASSERT_EQ(vkBeginCommandBuffer(cmd, &begin), VK_SUCCESS);
+    record(cmd);
+    ASSERT_EQ(vkEndCommandBuffer(cmd), VK_SUCCESS);
+    const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+    VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    info.commandBufferCount = 1;
+    info.pCommandBuffers = &cmd;
+    info.waitSemaphoreCount = wait ? 1 : 0;
+    info.pWaitSemaphores = &wait;
+    info.pWaitDstStageMask = &stage;
+    info.signalSemaphoreCount = signal ? 1 : 0;
+    info.pSignalSemaphores = &signal;
+    ASSERT_EQ(vkQueueSubmit(queue, 1, &info, VK_NULL_HANDLE), VK_SUCCESS);
+    pending_command_buffers.push_back(cmd);
   }
   static void layout_barrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect,
                              VkImageLayout from, VkImageLayout to) {
@@ -188,15 +235,28 @@ class HostApplication : public ::testing::Test {
   // Copies an image (left in TRANSFER_SRC_OPTIMAL) into the staging buffer.
   void read_image(VkImage image, VkImageAspectFlags aspect, VkImageLayout layout, uint32_t width,
                   uint32_t height) {
-    submit([&](VkCommandBuffer cmd) {
-      layout_barrier(cmd, image, aspect, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-      VkBufferImageCopy region{};
-      region.imageSubresource = {aspect, 0, 0, 1};
-      region.imageExtent = {width, height, 1};
-      vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging, 1, &region);
-    });
+    submit([&](VkCommandBuffer cmd) { record_read(cmd, image, aspect, layout, width, height, 0); });
+  }
+  // Records the copy of an image (left in TRANSFER_SRC_OPTIMAL) into the staging buffer at `offset`.
+  void record_read(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout layout,
+                   uint32_t width, uint32_t height, VkDeviceSize offset) {
+    layout_barrier(cmd, image, aspect, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    VkBufferImageCopy region{};
+    region.bufferOffset = offset;
+    region.imageSubresource = {aspect, 0, 0, 1};
+    region.imageExtent = {width, height, 1};
+    vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging, 1, &region);
+    VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                         nullptr, 0, nullptr);
   }
   void release_host_objects() {
+    vkQueueWaitIdle(queue);
+    free_pending_command_buffers();
+    for (VkSemaphore semaphore : semaphores) vkDestroySemaphore(device, semaphore, nullptr);
+    semaphores.clear();
     if (staging_data) vkUnmapMemory(device, staging_memory);
     if (command_pool) vkDestroyCommandPool(device, command_pool, nullptr);
     if (staging) vkDestroyBuffer(device, staging, nullptr);
@@ -216,6 +276,8 @@ class HostApplication : public ::testing::Test {
   void* staging_data = nullptr;
   VkCommandPool command_pool = VK_NULL_HANDLE;
   std::vector<Image> images;
+  std::vector<VkSemaphore> semaphores;
+  std::vector<VkCommandBuffer> pending_command_buffers;
 
   VkInstance instance = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
@@ -462,6 +524,152 @@ TEST_F(HostApplication, RendersIntoHalfAndEightBitColourImages) {
       render_to_image(*renderer, camera, {},
                       {images[0].image, kWidth, kHeight, VK_FORMAT_B8G8R8A8_UNORM, VK_IMAGE_LAYOUT_GENERAL}),
       std::invalid_argument);
+  renderer.reset();
+  release_host_objects();
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
+// The splats inside the host's frame without a CPU stall: the host's submission that draws its depth
+// signals `drawn`, the renderer's frame waits for it and signals `rendered`, and the host's read-back
+// waits for that. Nothing waits on the CPU in between; the images equal the blocking path's to the bit.
+TEST_F(HostApplication, FrameInsideTheHostsFrameWaitsForAndSignalsItsSemaphores) {
+  constexpr uint32_t kWidth = 160, kHeight = 90;
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const Camera camera =
+      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
+  const DepthConvention convention = effects::bench_depth_convention();
+  const std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+  const size_t pixels = size_t(kWidth) * kHeight;
+  const VkDeviceSize colour_bytes = pixels * 16;
+
+  const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
+  const Image depth =
+      make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, kWidth, kHeight);
+  make_staging(colour_bytes + pixels * sizeof(float));
+  std::memcpy(staging_data, wall.data(), pixels * sizeof(float));
+  const VkSemaphore drawn = make_semaphore(), rendered = make_semaphore();
+  submit_async(
+      [&](VkCommandBuffer cmd) {
+        layout_barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+        region.imageExtent = {kWidth, kHeight, 1};
+        vkCmdCopyBufferToImage(cmd, staging, depth.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        layout_barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                       VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+      },
+      VK_NULL_HANDLE, drawn);
+
+  RenderSettings settings;
+  settings.host = HostDepth{convention, {}, true, 0.5f};
+  auto renderer = create_renderer(external());
+  renderer->set_scene(scene);
+  const ExternalImage target{colour.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT,
+                             VK_IMAGE_LAYOUT_UNDEFINED};
+  const ExternalDepthImage host_depth{depth.image, kWidth, kHeight, VK_FORMAT_D32_SFLOAT,
+                                      VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+  const VkSemaphore waits[] = {drawn};
+  const VkPipelineStageFlags wait_stages[] = {VK_PIPELINE_STAGE_TRANSFER_BIT};
+  const VkSemaphore signals[] = {rendered};
+  render_to_image(*renderer, camera, settings, target, &host_depth,
+                  HostFrameSync{waits, wait_stages, {}, signals, {}});
+  submit_async(
+      [&](VkCommandBuffer cmd) {
+        record_read(cmd, colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight,
+                    0);
+        record_read(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT,
+                    VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, kWidth, kHeight, colour_bytes);
+      },
+      rendered, VK_NULL_HANDLE);
+  HOST_CHECK(vkQueueWaitIdle(queue));
+  std::vector<float> rgba(pixels * 4), depth_after(pixels);
+  std::memcpy(rgba.data(), staging_data, colour_bytes);
+  std::memcpy(depth_after.data(), static_cast<const std::byte*>(staging_data) + colour_bytes,
+              pixels * sizeof(float));
+
+  wait_for_frame(*renderer);  // the frame's statistics
+  const FrameStats& stats = renderer->last_frame_stats();
+  EXPECT_TRUE(stats.complete);
+  EXPECT_GT(stats.intersections, 0u);
+  EXPECT_TRUE(std::any_of(stats.passes.begin(), stats.passes.end(),
+                          [](const PassTiming& p) { return p.name == "host_depth_in"; }));
+
+  RenderSettings in_memory = settings;
+  in_memory.host->depth = wall;
+  const RenderImage expected = renderer->render(camera, in_memory);
+  EXPECT_EQ(rgba, expected.rgba);
+  EXPECT_EQ(depth_after, expected.host_depth);
+  EXPECT_NE(depth_after, wall) << "the splats wrote no depth";
+
+  // A timeline semaphore, waited for on the CPU; no depth image. render() after it waits for the frame
+  // by itself.
+  const VkSemaphore timeline = make_semaphore(/*timeline=*/true);
+  const uint64_t done_value = 1;
+  render_to_image(*renderer, camera, {}, target, nullptr,
+                  HostFrameSync{{}, {}, {}, {&timeline, 1}, {&done_value, 1}});
+  VkSemaphoreWaitInfo wait_info{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+  wait_info.semaphoreCount = 1;
+  wait_info.pSemaphores = &timeline;
+  wait_info.pValues = &done_value;
+  HOST_CHECK(vkWaitSemaphores(device, &wait_info, UINT64_MAX));
+  read_image(colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
+  std::memcpy(rgba.data(), staging_data, colour_bytes);
+  EXPECT_EQ(rgba, renderer->render(camera).rgba);
+
+  // Mistakes: a stage or value count that is not one per semaphore, depth out without a depth image.
+  const VkPipelineStageFlags two_stages[] = {VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT};
+  EXPECT_THROW(
+      render_to_image(*renderer, camera, {}, target, nullptr, HostFrameSync{waits, two_stages, {}, {}, {}}),
+      std::invalid_argument);
+  const uint64_t two_values[] = {1, 2};
+  EXPECT_THROW(
+      render_to_image(*renderer, camera, {}, target, nullptr, HostFrameSync{{}, {}, {}, signals, two_values}),
+      std::invalid_argument);
+  EXPECT_THROW(render_to_image(*renderer, camera, settings, target, nullptr, HostFrameSync{}),
+               std::invalid_argument);
+  renderer.reset();
+  release_host_objects();
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
+// A submitted frame cannot re-render: one that wants more (tile, Gaussian) pairs than the key buffers
+// hold is drawn with those that fit and says so, and the next frame, with grown buffers, is whole.
+TEST_F(HostApplication, SubmittedFrameThatOutgrowsTheBuffersSaysSoAndTheNextIsWhole) {
+  constexpr uint32_t kWidth = 640, kHeight = 480;
+  GaussianScene big;  // 120 splats over all 1,200 tiles: 144,000 pairs, the key buffers start at 131,072
+  big.sh_degree = 0;
+  for (int i = 0; i < 120; ++i) {
+    big.positions.insert(big.positions.end(), {0.01f * float(i % 40), 0.0f, 2.0f + 0.01f * float(i)});
+    big.log_scales.insert(big.log_scales.end(), {1.0f, 1.0f, 1.0f});
+    big.rotations.insert(big.rotations.end(), {1, 0, 0, 0});
+    big.opacity_logits.push_back(-4.0f);
+    big.sh.insert(big.sh.end(), {0.5f, 0.2f, -0.3f});
+  }
+  const Camera camera = look_at_camera({0, 0, 0}, {0, 0, 1}, {0, -1, 0}, kWidth, kHeight, 60);
+  const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
+  make_staging(VkDeviceSize(kWidth) * kHeight * 16);
+  auto renderer = create_renderer(external());
+  renderer->set_scene(big);
+  // UNDEFINED: the read-back leaves the image in TRANSFER_SRC_OPTIMAL, and the frame overwrites it all.
+  const ExternalImage target{colour.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT,
+                             VK_IMAGE_LAYOUT_UNDEFINED};
+  std::vector<float> frames[2];
+  bool complete[2] = {};
+  for (int i = 0; i < 2; ++i) {
+    render_to_image(*renderer, camera, {}, target, nullptr, HostFrameSync{});
+    wait_for_frame(*renderer);
+    complete[i] = renderer->last_frame_stats().complete;
+    read_image(colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
+    frames[i].resize(size_t(kWidth) * kHeight * 4);
+    std::memcpy(frames[i].data(), staging_data, frames[i].size() * sizeof(float));
+  }
+  const RenderImage whole = renderer->render(camera);
+  EXPECT_EQ(renderer->last_frame_stats().retries, 0) << "the submitted frames grew the buffers already";
+  EXPECT_FALSE(complete[0]);
+  EXPECT_NE(frames[0], whole.rgba);
+  EXPECT_TRUE(complete[1]);
+  EXPECT_EQ(frames[1], whole.rgba);
   renderer.reset();
   release_host_objects();
   EXPECT_EQ(messages, 0) << "validation messages on the host's instance";

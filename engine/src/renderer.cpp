@@ -26,10 +26,12 @@
 #include <string>
 
 #include "host_depth.h"
+#include "host_images.h"
 #include "passes/composite_pass.h"
 #include "passes/composite_resort_pass.h"
 #include "passes/depth_quantize_pass.h"
 #include "passes/frame_counters.h"
+#include "passes/host_depth_pass.h"
 #include "passes/key_emission_pass.h"
 #include "passes/pack_colour_pass.h"
 #include "passes/prefix_sum_pass.h"
@@ -40,6 +42,7 @@
 #include "sort/sort_strategy.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/vulkan_interop.h"
+#include "vulkan/command_stream.h"
 #include "vulkan/context.h"
 #include "vulkan/gpu_timer.h"
 #include "vulkan/vk_check.h"
@@ -100,10 +103,6 @@ void validate_compositor(const RenderSettings& settings) {
          std::to_string(settings.stochastic.frames));
 }
 
-// Copies a buffer into an image of the host's, from and back to its layout (defined with render_to_image).
-void copy_buffer_to_image(VkCommandBuffer cmd, const vk::Buffer& buffer, VkImage image,
-                          VkImageAspectFlags aspect, VkImageLayout layout, uint32_t width, uint32_t height);
-
 template <typename T>
 vk::Buffer make_buffer(vk::Context& ctx, size_t count, const char* name) {
   return vk::Buffer(ctx, VkDeviceSize(count) * sizeof(T), vk::MemoryUse::Device, name);
@@ -125,9 +124,11 @@ struct Renderer::Impl {
         tile_ranges(ctx),
         composite(ctx),
         pack_colour(ctx),
+        host_depth(ctx),
         composite_resort(ctx),
         stochastic_composite(ctx),
-        counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "frame counters") {}
+        counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "frame counters"),
+        in_flight(ctx) {}
 
   SortStrategy& sort(const std::string& name) {
     auto it = sorts.find(name);
@@ -185,6 +186,7 @@ struct Renderer::Impl {
                                 &outputs.depth,
                                 &outputs.count,
                                 &host_view_depth,
+                                &host_window_depth,
                                 &host_surface_depth,
                                 &packed_colour,
                                 &counters})
@@ -220,8 +222,24 @@ struct Renderer::Impl {
   // reused_sorted_lists). Returns the counters the GPU wrote: a composite-only frame rewrites only
   // max_tile_pairs, so the others still describe the lists it read.
   FrameCounters run_frame(const Camera& camera, const RenderSettings& settings, SortStrategy& sorter,
-                          bool build_lists) {
-    const uint32_t width = uint32_t(camera.width), height = uint32_t(camera.height);
+                          bool build_lists, const ExternalDepthImage* depth_image) {
+    prepare_frame(settings, sorter, build_lists, uint32_t(camera.width), uint32_t(camera.height));
+    vk::CommandStream stream(ctx);
+    record_frame(stream, camera, settings, sorter, build_lists, depth_image);
+    stream.finish();
+    stats.submissions = stream.submissions();
+    return frame_counters();
+  }
+
+  FrameCounters frame_counters() const {
+    FrameCounters result;
+    std::memcpy(&result, counters.mapped(), sizeof(result));
+    return result;
+  }
+
+  // Sizes the buffers a frame's passes will use.
+  void prepare_frame(const RenderSettings& settings, SortStrategy& sorter, bool build_lists, uint32_t width,
+                     uint32_t height) {
     const bool stochastic = settings.compositor == Compositor::kStochastic;
     const ProjectionVariant variant = projection_variant(settings);
     const bool needs_state = stochastic
@@ -247,9 +265,17 @@ struct Renderer::Impl {
       ensure_key_capacity(keys.capacity, wide);
       sorter.reserve(std::max(scene.count, keys.capacity));
     }
+  }
 
-    vk::CommandStream stream(ctx);
+  // Records a frame's passes into the stream: the host's depth image in (when given), the lists
+  // (build_lists) and the composite.
+  void record_frame(vk::CommandStream& stream, const Camera& camera, const RenderSettings& settings,
+                    SortStrategy& sorter, bool build_lists, const ExternalDepthImage* depth_image) {
     timer.begin_frame(stream.cmd());
+    if (depth_image) {
+      record_host_depth_in(stream.cmd(), *depth_image, settings.host->convention);
+      timer.mark(stream.cmd(), "host_depth_in");
+    }
     if (build_lists) {
       lists_in_alt = record_lists(stream, camera, settings, sorter);
     } else {
@@ -260,7 +286,7 @@ struct Renderer::Impl {
 
     const vk::Buffer& tile_lists = lists_in_alt ? keys.values_alt : keys.values;
     const AccuracyModes& modes = settings.accuracy;
-    if (stochastic) {
+    if (settings.compositor == Compositor::kStochastic) {
       stochastic_composite.record(stream, projected.splats, tile_lists, ranges, outputs, settings.background,
                                   settings.depth, settings.splat_count, modes.alpha_cutoff,
                                   {settings.stochastic.frames, settings.stochastic.seed},
@@ -268,7 +294,7 @@ struct Renderer::Impl {
       timer.mark(stream.cmd(), "stochastic_composite");
     } else {
       const CompositePass::Cutoffs cutoffs{modes.alpha_cutoff, modes.transmittance_cutoff};
-      if (variant.ray_depth)
+      if (modes.resort_window > 0)
         composite_resort.record(stream.cmd(), projected.splats, projected.ray_depth, tile_lists, ranges, outputs,
                                 camera, settings.background, settings.depth, settings.splat_count, cutoffs,
                                 uint32_t(modes.resort_window), counters.address());
@@ -278,12 +304,6 @@ struct Renderer::Impl {
                          {composite_chunks, composite_state, counters.address()}, host_surface(settings));
       timer.mark(stream.cmd(), "composite");
     }
-    stream.finish();
-
-    FrameCounters result;
-    std::memcpy(&result, counters.mapped(), sizeof(result));
-    stats.submissions = stream.submissions();
-    return result;
   }
 
   // Records the passes that build each tile's list into the stream, from the projection to the tile
@@ -404,23 +424,49 @@ struct Renderer::Impl {
     bool operator==(const ListKey&) const = default;
   };
 
-  // The host's depth image as view depths (+inf where it drew nothing) in host_view_depth, and room
-  // for the surface depth the composite writes; both released when a frame has no host depth.
-  void upload_host_depth(const RenderSettings& settings, size_t pixels) {
+  // RenderSettings::host's buffers: the host's surfaces as view depths (+inf where it drew nothing) in
+  // host_view_depth, uploaded from HostDepth::depth or converted on the device from a depth image
+  // (host_window_depth holds its window depths, and the depth out before it is copied back); room
+  // for the surface depth the composite writes. Each released when a frame does without it.
+  void prepare_host_depth(const RenderSettings& settings, size_t pixels, bool depth_image) {
     const HostDepth* host = settings.host ? &*settings.host : nullptr;
-    if (!host || host->depth.empty()) {
-      host_view_depth.reset();
-    } else {
+    const VkDeviceSize bytes = pixels * sizeof(float);
+    auto ensure = [&](vk::Buffer& buffer, bool wanted, const char* name) {
+      if (!wanted)
+        buffer.reset();
+      else if (buffer.size() != bytes)
+        buffer = vk::Buffer(ctx, bytes, vk::MemoryUse::Device, name);
+    };
+    const bool from_memory = host && !host->depth.empty();
+    ensure(host_view_depth, from_memory || depth_image, "host view depth");
+    ensure(host_window_depth, depth_image, "host window depth (depth image)");
+    ensure(host_surface_depth, host && host->write_depth, "host surface depth");
+    if (from_memory) {
       const std::vector<float> view_depth = host_view_depths(*host);
-      if (host_view_depth.size() != pixels * sizeof(float))
-        host_view_depth = vk::Buffer(ctx, pixels * sizeof(float), vk::MemoryUse::Device, "host view depth");
-      vk::upload(ctx, host_view_depth, view_depth.data(), pixels * sizeof(float));
+      vk::upload(ctx, host_view_depth, view_depth.data(), bytes);
     }
-    if (!host || !host->write_depth)
-      host_surface_depth.reset();
-    else if (host_surface_depth.size() != pixels * sizeof(float))
-      host_surface_depth =
-          vk::Buffer(ctx, pixels * sizeof(float), vk::MemoryUse::Device, "host surface depth");
+  }
+
+  // The host's depth image into host_window_depth and, as view depths, into host_view_depth.
+  void record_host_depth_in(VkCommandBuffer cmd, const ExternalDepthImage& image,
+                            const DepthConvention& convention) {
+    copy_image_to_buffer(cmd, image.image, depth_aspect(image), image.layout, host_window_depth, image.width,
+                         image.height);
+    vk::barrier(cmd);
+    host_depth.record_view_depths(cmd, convention, host_window_depth, host_view_depth, image.width,
+                                  image.height);
+    vk::barrier(cmd);
+  }
+
+  // The splats' depth where they reached the threshold, and the host's own elsewhere, into the host's
+  // depth image (after the frame that wrote host_surface_depth).
+  void record_host_depth_out(VkCommandBuffer cmd, const ExternalDepthImage& image,
+                             const DepthConvention& convention) {
+    host_depth.record_window_depths(cmd, convention, host_surface_depth, host_window_depth, image.width,
+                                    image.height);
+    vk::barrier(cmd);
+    copy_buffer_to_image(cmd, host_window_depth, image.image, depth_aspect(image), image.layout, image.width,
+                         image.height);
   }
 
   CompositePass::HostSurface host_surface(const RenderSettings& settings) const {
@@ -457,90 +503,202 @@ struct Renderer::Impl {
     for (size_t i = 0; i < pixels; ++i) out[i] = host_depth_out(host, out[i], i);
   }
 
-  // Renders into the output buffers, growing the key buffers and re-rendering on overflow, and
-  // fills the frame statistics (all but cpu_ms).
-  void render_frame(const Camera& camera, const RenderSettings& settings) {
+  // What a frame was built for and started from, for its statistics once it completed.
+  struct FrameStart {
+    ListKey key;
+    bool reuse = false;  // the frame runs the composite alone, on the lists in the buffers
+    SortStrategy* sorter = nullptr;
+    uint64_t fallbacks_before = 0;
+    std::chrono::steady_clock::time_point time;
+  };
+
+  // Checks a frame's camera and settings, sizes the outputs and uploads what the frame reads from
+  // the host (the host's depth values, the camera and lights unless the lists are reused). Waits for
+  // a frame in flight first: its buffers are the same.
+  FrameStart begin_frame(const Camera& camera, const RenderSettings& settings, bool depth_image) {
+    FrameStart start;
+    start.time = std::chrono::steady_clock::now();
+    wait_for_submitted_frame();
     check_camera(camera, ctx.limits(), ctx.is_cpu_device());
     validate(settings.accuracy);
     validate_compositor(settings);
     validate_host_depth(settings, camera);
-    upload_host_depth(settings, size_t(camera.width) * size_t(camera.height));
-    SortStrategy& sorter = sort(settings.sort);
+    prepare_host_depth(settings, size_t(camera.width) * size_t(camera.height), depth_image);
+    start.sorter = &sort(settings.sort);
     ensure_outputs(uint32_t(camera.width), uint32_t(camera.height), settings.depth, settings.splat_count);
-
     stats = {};
-    const ListKey key{scene_generation, camera,   settings.sort,      settings.accuracy,
-                      settings.antialiasing, settings.lighting, settings.compositor};
-    const bool reuse = settings.reuse_lists && lists && *lists == key;
+    start.key = {scene_generation,      camera,
+                 settings.sort,         settings.accuracy,
+                 settings.antialiasing, settings.lighting,
+                 settings.compositor};
+    start.reuse = settings.reuse_lists && lists && *lists == start.key;
     lists.reset();  // valid again once this frame's lists are complete (not if it throws)
     // Reused lists were built with an equal camera and equal (validated) lights, which are in their
     // buffers still: nothing to upload.
-    if (!reuse) {
+    if (!start.reuse) {
       projection.set_lighting(settings.lighting, scene);  // validates the lights; uploads normals on first use
       projection.set_camera(camera);
     }
-    const bool stochastic = settings.compositor == Compositor::kStochastic;
-    uint32_t& chunks = stochastic ? stochastic_chunks : composite_chunks;
-    auto chunks_for = [&](uint64_t longest) {
-      return stochastic ? stochastic_composite.chunks_for(longest) : composite.chunks_for(longest);
-    };
-    const uint64_t fallbacks_before = sorter.stall_fallbacks();
-    // The GPU time of every attempt, summed per pass: a re-rendered frame cost all of them.
-    std::vector<PassTiming> passes;
-    auto add_timings = [&] {
-      double ms = 0;
-      for (const auto& section : timer.read(&ms)) {
-        auto it = std::find_if(passes.begin(), passes.end(), [&](const PassTiming& p) { return p.name == section.name; });
-        if (it == passes.end()) passes.push_back({section.name, section.ms});
-        else it->gpu_ms += section.ms;
-      }
-      stats.gpu_ms += ms;
-    };
-    // A frame re-renders when it wanted more (tile, Gaussian) pairs than the key buffers hold, which
-    // grow, or re-runs its composite when a tile's list needs more composite chunks than it had (CPU
-    // drivers only; the lists are complete then). A frame on reused lists cannot overflow.
-    FrameCounters frame = run_frame(camera, settings, sorter, !reuse);
-    for (int retry = 1;; ++retry) {
-      add_timings();
-      if (frame.overflow) {
-        if (frame.wanted_intersections() > kMaxKeyCapacity || retry > kMaxRetries)
-          throw std::runtime_error(too_many_intersections(frame, camera) + ", more than the renderer's limit of " +
-                                   std::to_string(kMaxKeyCapacity) + " (2^31)");
-        try {  // larger key and sort buffers, which the device may not have room for
-          ensure_key_capacity(grow_capacity(frame.wanted_intersections()), keys.wide_keys);
-          frame = run_frame(camera, settings, sorter, true);
-        } catch (const std::runtime_error& e) {
-          throw std::runtime_error(too_many_intersections(frame, camera) + ": " + e.what());
-        }
-      } else if (!stochastic && settings.accuracy.resort_window > 0 && frame.max_tile_pairs > 0) {
-        throw std::runtime_error("per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
-                                 "): a tile lists " + std::to_string(frame.max_tile_pairs) +
-                                 " splats, more than this device's limit of " +
-                                 std::to_string(composite_resort.max_tile_splats()) +
-                                 " for that mode (render without resortN)");
-      } else if (chunks_for(frame.max_tile_pairs) > chunks) {
-        if (retry > kMaxRetries) throw std::logic_error("composite chunks did not converge");  // one retry suffices
-        chunks = chunks_for(frame.max_tile_pairs);
-        frame = run_frame(camera, settings, sorter, /*build_lists=*/false);
-      } else {
-        // The next frame starts with as many chunks as this one's longest list needed (views change
-        // little from frame to frame), no more: one crowded frame must not leave every later frame
-        // paying for its chunks and their per-pixel state.
-        chunks = chunks_for(frame.max_tile_pairs);
-        break;
-      }
-      stats.retries = retry;
+    start.fallbacks_before = start.sorter->stall_fallbacks();
+    return start;
+  }
+
+  // The GPU time of the frame's passes, added to `passes` (summed per pass over a frame's attempts).
+  void add_timings(std::vector<PassTiming>& passes) {
+    double ms = 0;
+    for (const auto& section : timer.read(&ms)) {
+      auto it = std::find_if(passes.begin(), passes.end(),
+                             [&](const PassTiming& p) { return p.name == section.name; });
+      if (it == passes.end())
+        passes.push_back({section.name, section.ms});
+      else
+        it->gpu_ms += section.ms;
     }
-    lists = key;
+    stats.gpu_ms += ms;
+  }
+
+  uint32_t& composite_chunks_of(const RenderSettings& settings) {
+    return settings.compositor == Compositor::kStochastic ? stochastic_chunks : composite_chunks;
+  }
+  uint32_t chunks_for(const RenderSettings& settings, uint64_t longest) const {
+    return settings.compositor == Compositor::kStochastic ? stochastic_composite.chunks_for(longest)
+                                                          : composite.chunks_for(longest);
+  }
+
+  // A frame that wanted more pairs than the key buffers hold: they grow, within the renderer's limit.
+  std::runtime_error beyond_key_limit(const FrameCounters& frame, const Camera& camera) const {
+    return std::runtime_error(too_many_intersections(frame, camera) + ", more than the renderer's limit of " +
+                              std::to_string(kMaxKeyCapacity) + " (2^31)");
+  }
+  void grow_keys_for(const FrameCounters& frame, const Camera& camera) {
+    if (frame.wanted_intersections() > kMaxKeyCapacity) throw beyond_key_limit(frame, camera);
+    try {  // larger key and sort buffers, which the device may not have room for
+      ensure_key_capacity(grow_capacity(frame.wanted_intersections()), keys.wide_keys);
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(too_many_intersections(frame, camera) + ": " + e.what());
+    }
+  }
+
+  // Per-pixel re-sorting holds a tile's list in shared memory: a longer one is an error.
+  void check_resort_lists(const RenderSettings& settings, const FrameCounters& frame) const {
+    if (settings.compositor != Compositor::kStochastic && settings.accuracy.resort_window > 0 &&
+        frame.max_tile_pairs > 0)
+      throw std::runtime_error(
+          "per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
+          "): a tile lists " + std::to_string(frame.max_tile_pairs) +
+          " splats, more than this device's limit of " + std::to_string(composite_resort.max_tile_splats()) +
+          " for that mode (render without resortN)");
+  }
+
+  // The statistics of a completed frame; its lists become reusable when they are whole.
+  void end_frame(const FrameStart& start, const FrameCounters& frame, std::vector<PassTiming> passes,
+                 bool lists_whole) {
+    if (lists_whole) lists = start.key;
     stats.passes = std::move(passes);
-    stats.reused_sorted_lists = reuse;
+    stats.reused_sorted_lists = start.reuse;
     stats.gaussians = scene.count;
     stats.visible = frame.visible;
     stats.intersections = frame.tile_sort.count;
-    stats.sort_fallbacks = sorter.stall_fallbacks() - fallbacks_before;
+    stats.sort_fallbacks = start.sorter->stall_fallbacks() - start.fallbacks_before;
     stats.device_bytes = device_bytes();
     stats.uploaded_bytes = ctx.uploaded_bytes() - uploaded_bytes_reported;
     uploaded_bytes_reported = ctx.uploaded_bytes();
+  }
+
+  // Renders into the output buffers, growing the key buffers and re-rendering on overflow, and
+  // fills the frame statistics (all but cpu_ms). With a depth image, each attempt converts it first.
+  void render_frame(const Camera& camera, const RenderSettings& settings,
+                    const ExternalDepthImage* depth_image = nullptr) {
+    const FrameStart start = begin_frame(camera, settings, depth_image != nullptr);
+    SortStrategy& sorter = *start.sorter;
+    uint32_t& chunks = composite_chunks_of(settings);
+    std::vector<PassTiming> passes;  // the GPU time of every attempt: a re-rendered frame cost all of them
+    // A frame re-renders when it wanted more (tile, Gaussian) pairs than the key buffers hold, which
+    // grow, or re-runs its composite when a tile's list needs more composite chunks than it had (CPU
+    // drivers only; the lists are complete then). A frame on reused lists cannot overflow.
+    FrameCounters frame = run_frame(camera, settings, sorter, !start.reuse, depth_image);
+    for (int retry = 1;; ++retry) {
+      add_timings(passes);
+      if (frame.overflow) {
+        if (retry > kMaxRetries) throw beyond_key_limit(frame, camera);
+        grow_keys_for(frame, camera);
+        frame = run_frame(camera, settings, sorter, true, depth_image);
+        stats.retries = retry;
+        continue;
+      }
+      check_resort_lists(settings, frame);
+      if (chunks_for(settings, frame.max_tile_pairs) <= chunks) {
+        // The next frame starts with as many chunks as this one's longest list needed (views change
+        // little from frame to frame), no more: one crowded frame must not leave every later frame
+        // paying for its chunks and their per-pixel state.
+        chunks = chunks_for(settings, frame.max_tile_pairs);
+        break;
+      }
+      if (retry > kMaxRetries)
+        throw std::logic_error("composite chunks did not converge");  // one retry suffices
+      chunks = chunks_for(settings, frame.max_tile_pairs);
+      frame = run_frame(camera, settings, sorter, /*build_lists=*/false, depth_image);
+      stats.retries = retry;
+    }
+    end_frame(start, frame, std::move(passes), true);
+  }
+
+  // A frame render_to_image submitted without waiting (HostFrameSync): what its completion needs.
+  struct SubmittedFrame {
+    FrameStart start;
+    Camera camera;
+    RenderSettings settings;  // without HostDepth::depth, which a depth image stands in for
+    int submissions = 0;
+    double cpu_ms = 0;
+  };
+
+  // Records a whole frame, its copies into the host's images included, and submits it without
+  // waiting (render_to_image with HostFrameSync).
+  void submit_frame(const Camera& camera, const RenderSettings& settings, const ExternalImage& target,
+                    const ExternalDepthImage* depth_image, const vk::SubmitSync& sync) {
+    const FrameStart start = begin_frame(camera, settings, depth_image != nullptr);
+    prepare_frame(settings, *start.sorter, !start.reuse, uint32_t(camera.width), uint32_t(camera.height));
+    vk::CommandStream stream(ctx);
+    stream.wait_first(sync);
+    record_frame(stream, camera, settings, *start.sorter, !start.reuse, depth_image);
+    copy_colour_to_image(stream.cmd(), target);
+    if (depth_image && settings.host->write_depth)
+      record_host_depth_out(stream.cmd(), *depth_image, settings.host->convention);
+    stream.submit_in_flight(in_flight, sync);
+    RenderSettings kept = settings;
+    kept.host
+        .reset();  // only the compositor and modes are looked at again, and HostDepth::depth is not owned
+    submitted = SubmittedFrame{
+        start, camera, std::move(kept), stream.submissions(),
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start.time).count()};
+  }
+
+  // Waits for the frame in flight, if any, and makes its statistics the last frame's. It cannot
+  // re-render: a frame that overflowed the key buffers or had too few composite chunks was drawn
+  // without what did not fit (FrameStats::complete false), and the next frame has what it needs.
+  void wait_for_submitted_frame() {
+    if (!submitted) return;
+    const SubmittedFrame frame_info = std::move(*submitted);
+    submitted.reset();
+    in_flight.wait();
+    const FrameCounters frame = frame_counters();
+    stats = {};
+    std::vector<PassTiming> passes;
+    add_timings(passes);
+    stats.submissions = frame_info.submissions;
+    stats.cpu_ms = frame_info.cpu_ms;
+    const RenderSettings& settings = frame_info.settings;
+    uint32_t& chunks = composite_chunks_of(settings);
+    bool lists_whole = !frame.overflow;
+    if (frame.overflow) {
+      stats.complete = false;
+      grow_keys_for(frame, frame_info.camera);
+    } else {
+      check_resort_lists(settings, frame);
+      stats.complete = chunks_for(settings, frame.max_tile_pairs) <= chunks;
+      chunks = chunks_for(settings, frame.max_tile_pairs);
+    }
+    end_frame(frame_info.start, frame, std::move(passes), lists_whole);
   }
 
   template <typename T>
@@ -569,6 +727,7 @@ struct Renderer::Impl {
   TileRangesPass tile_ranges;
   CompositePass composite;
   PackColourPass pack_colour;  // render_to_image into a colour image of another format than RGBA32F
+  HostDepthPass host_depth;    // render_to_image with a depth image
   CompositeResortPass composite_resort;
   StochasticCompositePass stochastic_composite;
   std::map<std::string, std::unique_ptr<SortStrategy>> sorts;
@@ -585,6 +744,7 @@ struct Renderer::Impl {
   vk::Buffer composite_state;  // per-pixel state between a composite's dispatches (chunks, samples)
   vk::Buffer packed_colour;    // render_to_image: the frame in the host image's texel format
   vk::Buffer host_view_depth;  // RenderSettings::host: the host's surfaces as view depth, per pixel
+  vk::Buffer host_window_depth;   // a depth image's window depths, and the depth out before it is copied back
   vk::Buffer host_surface_depth;  // and the view depth at which the splats' alpha reached its threshold
   FrameStats stats;
   // The tile lists in the buffers: what they were built for (none after set_scene or a frame that
@@ -593,6 +753,10 @@ struct Renderer::Impl {
   bool lists_in_alt = false;
   uint64_t scene_generation = 0;  // counts set_scene calls
   uint64_t uploaded_bytes_reported = 0;  // vk::Context::uploaded_bytes() at the last frame's statistics
+  std::optional<SubmittedFrame> submitted;  // the frame render_to_image submitted without waiting
+  // Its fence and command buffer: declared last, so that it is destroyed first and waits for the
+  // frame before any buffer the frame uses goes.
+  vk::InFlightSubmission in_flight;
 };
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -604,6 +768,7 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
 
 void Renderer::set_scene(const GaussianScene& scene) {
   Impl& r = *impl_;
+  r.wait_for_submitted_frame();  // it reads the scene's buffers
   ++r.scene_generation;  // the tile lists in the buffers are the previous scene's
   const size_t n = scene.size();
   if (n > (1u << 30)) throw std::runtime_error("scene has " + std::to_string(n) + " Gaussians; the limit is 2^30");
@@ -671,58 +836,10 @@ std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device, co
   return std::unique_ptr<Renderer>(new Renderer(std::make_unique<Renderer::Impl>(options, device)));
 }
 
-namespace {
-
-void image_barrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout from,
-                   VkImageLayout to, VkAccessFlags src_access, VkAccessFlags dst_access) {
-  VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-  b.oldLayout = from;
-  b.newLayout = to;
-  b.srcAccessMask = src_access;
-  b.dstAccessMask = dst_access;
-  b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.image = image;
-  b.subresourceRange = {aspect, 0, 1, 0, 1};
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
-                       nullptr, 0, nullptr, 1, &b);
-}
-
-constexpr VkAccessFlags kAnyAccess = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
-
-void check_target(const ExternalImage& target, const Camera& camera) {
-  if (target.image == VK_NULL_HANDLE) throw std::invalid_argument("render_to_image: no image");
-  if (target.width != uint32_t(camera.width) || target.height != uint32_t(camera.height))
-    throw std::invalid_argument("render_to_image: image is " + std::to_string(target.width) + "x" +
-                                std::to_string(target.height) + " but the camera renders " +
-                                std::to_string(camera.width) + "x" + std::to_string(camera.height));
-  if (target.format != VK_FORMAT_R32G32B32A32_SFLOAT && PackColourPass::texel_bytes(target.format) == 0)
-    throw std::invalid_argument(
-        "render_to_image: the colour image must be VK_FORMAT_R32G32B32A32_SFLOAT, R16G16B16A16_SFLOAT, "
-        "R8G8B8A8_UNORM or R8G8B8A8_SRGB");
-}
-
-// Copies `buffer` into mip 0, layer 0 of `image` (aspect), leaving the image in `layout` (GENERAL
-// for an image handed over UNDEFINED, which cannot be a destination layout).
-void copy_buffer_to_image(VkCommandBuffer cmd, const vk::Buffer& buffer, VkImage image,
-                          VkImageAspectFlags aspect, VkImageLayout layout, uint32_t width, uint32_t height) {
-  image_barrier(cmd, image, aspect, layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_MEMORY_WRITE_BIT,
-                VK_ACCESS_TRANSFER_WRITE_BIT);
-  VkBufferImageCopy region{};
-  region.imageSubresource = {aspect, 0, 0, 1};
-  region.imageExtent = {width, height, 1};
-  vkCmdCopyBufferToImage(cmd, buffer.handle(), image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-  const VkImageLayout final_layout = layout == VK_IMAGE_LAYOUT_UNDEFINED ? VK_IMAGE_LAYOUT_GENERAL : layout;
-  image_barrier(cmd, image, aspect, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout,
-                VK_ACCESS_TRANSFER_WRITE_BIT, kAnyAccess);
-}
-
-}  // namespace
-
 void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                      const ExternalImage& target) {
   Renderer::Impl& r = *renderer.impl_;
-  check_target(target, camera);
+  check_colour_target(target, camera);
   if (settings.host && settings.host->write_depth)
     throw std::invalid_argument(
         "render_to_image: HostDepth::write_depth needs the host's depth image to write into: pass an "
@@ -737,58 +854,44 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
 void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                      const ExternalImage& target, const ExternalDepthImage& depth) {
   Renderer::Impl& r = *renderer.impl_;
-  check_target(target, camera);
-  auto fail = [](const std::string& why) {
-    throw std::invalid_argument("render_to_image: depth image: " + why);
-  };
-  if (depth.image == VK_NULL_HANDLE) fail("no image");
-  if (depth.width != target.width || depth.height != target.height)
-    fail(std::to_string(depth.width) + "x" + std::to_string(depth.height) + " but the colour image is " +
-         std::to_string(target.width) + "x" + std::to_string(target.height));
-  if (depth.format != VK_FORMAT_D32_SFLOAT && depth.format != VK_FORMAT_R32_SFLOAT)
-    fail("only VK_FORMAT_D32_SFLOAT and VK_FORMAT_R32_SFLOAT are supported");
-  if (depth.layout == VK_IMAGE_LAYOUT_UNDEFINED)
-    fail("its layout is UNDEFINED, so it holds no depth to test against");
-  if (!settings.host) fail("RenderSettings::host must say the image's depth convention");
-  if (!settings.host->depth.empty())
-    fail("RenderSettings::host already has depth values; the image replaces them");
-  const VkImageAspectFlags aspect =
-      depth.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+  check_colour_target(target, camera);
+  check_depth_image(depth, target, settings);
   const auto start = std::chrono::steady_clock::now();
-
-  // The host's depth, through host memory, into the same path as HostDepth::depth.
-  const size_t pixels = size_t(depth.width) * depth.height;
-  vk::Buffer readback(r.ctx, pixels * sizeof(float), vk::MemoryUse::Readback, "host depth image (readback)");
-  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    image_barrier(cmd, depth.image, aspect, depth.layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, kAnyAccess,
-                  VK_ACCESS_TRANSFER_READ_BIT);
-    VkBufferImageCopy region{};
-    region.imageSubresource = {aspect, 0, 0, 1};
-    region.imageExtent = {depth.width, depth.height, 1};
-    vkCmdCopyImageToBuffer(cmd, depth.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.handle(), 1,
-                           &region);
-    image_barrier(cmd, depth.image, aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, depth.layout,
-                  VK_ACCESS_TRANSFER_READ_BIT, kAnyAccess);
-  });
-  std::vector<float> window_depth(pixels);
-  std::memcpy(window_depth.data(), readback.mapped(), pixels * sizeof(float));
-  RenderSettings with_depth = settings;
-  with_depth.host->depth = window_depth;
-  r.render_frame(camera, with_depth);
-
-  vk::Buffer depth_out;
-  if (settings.host->write_depth) {
-    std::vector<float> out;
-    r.read_host_depth(*with_depth.host, out, pixels);
-    depth_out = vk::Buffer(r.ctx, pixels * sizeof(float), vk::MemoryUse::Upload, "host depth image (upload)");
-    std::memcpy(depth_out.mapped(), out.data(), pixels * sizeof(float));
-  }
+  r.render_frame(camera, settings, &depth);
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     r.copy_colour_to_image(cmd, target);
-    if (depth_out)
-      copy_buffer_to_image(cmd, depth_out, depth.image, aspect, depth.layout, depth.width, depth.height);
+    if (settings.host->write_depth) r.record_host_depth_out(cmd, depth, settings.host->convention);
   });
   r.stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                     const ExternalImage& target, const ExternalDepthImage* depth,
+                     const HostFrameSync& sync) {
+  Renderer::Impl& r = *renderer.impl_;
+  check_colour_target(target, camera);
+  if (depth) {
+    check_depth_image(*depth, target, settings);
+  } else if (settings.host && settings.host->write_depth) {
+    throw std::invalid_argument(
+        "render_to_image: HostDepth::write_depth needs the host's depth image to write into: pass an "
+        "ExternalDepthImage");
+  }
+  auto check_count = [](size_t count, size_t semaphores, const char* what) {
+    if (count != 0 && count != semaphores)
+      throw std::invalid_argument(std::string("render_to_image: HostFrameSync has ") + std::to_string(count) +
+                                  " " + what + " for " + std::to_string(semaphores) +
+                                  " semaphores (give one each, or none)");
+  };
+  check_count(sync.wait_stages.size(), sync.wait.size(), "wait_stages");
+  check_count(sync.wait_values.size(), sync.wait.size(), "wait_values");
+  check_count(sync.signal_values.size(), sync.signal.size(), "signal_values");
+  r.submit_frame(camera, settings, target, depth,
+                 {sync.wait, sync.wait_stages, sync.wait_values, sync.signal, sync.signal_values});
+}
+
+void wait_for_frame(Renderer& renderer) {
+  renderer.impl_->wait_for_submitted_frame();
 }
 
 const FrameStats& Renderer::last_frame_stats() const { return impl_->stats; }
@@ -799,6 +902,7 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
     throw std::invalid_argument("sort_keys: key_bits must be 1 to 64, not " + std::to_string(key_bits));
   if (keys.size() > (1u << 31))
     throw std::invalid_argument("sort_keys: " + std::to_string(keys.size()) + " keys, more than 2^31");
+  impl_->wait_for_submitted_frame();  // the sorts' buffers are the frames'
   const uint64_t allowed = key_bits == 64 ? ~0ull : (1ull << key_bits) - 1;
   for (size_t i = 0; i < keys.size(); ++i)
     if (keys[i] & ~allowed)

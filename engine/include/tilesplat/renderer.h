@@ -223,6 +223,10 @@ struct FrameStats {
   /// normals on a scene's first lit frame, and everything a set_scene() since the previous frame
   /// uploaded. A host sort strategy (cpu-radix) moves the pairs through host memory besides.
   uint64_t uploaded_bytes = 0;
+  /// False for a frame that render_to_image submitted without waiting (HostFrameSync) and that needed
+  /// more (tile, Gaussian) pairs or composite chunks than the buffers held: it was drawn without those
+  /// that did not fit, and the buffers grew for the next frame. Frames that wait re-render instead.
+  bool complete = true;
 };
 
 /// The Vulkan device a renderer runs on, and the limits that shape its passes.
@@ -239,6 +243,7 @@ struct DeviceInfo {
 struct ExternalVulkanDevice;  // tilesplat/vulkan_interop.h
 struct ExternalImage;
 struct ExternalDepthImage;
+struct HostFrameSync;
 
 /// Names of the available sort strategies, default first.
 TILESPLAT_API std::vector<std::string> sort_strategies();
@@ -279,7 +284,8 @@ class TILESPLAT_API Renderer {
   RenderImage render(const Camera& camera, const RenderSettings& settings = {});
 
   /// What the last render() (or render_to_image()) did and cost. The reference is valid until the
-  /// next frame.
+  /// next frame. A frame render_to_image submitted without waiting (HostFrameSync) is described once
+  /// it has been waited for: by wait_for_frame(), or by the next call on the renderer.
   const FrameStats& last_frame_stats() const;
 
   /// Sorts key/value pairs with a sort strategy outside any frame, the values being the input
@@ -312,6 +318,9 @@ class TILESPLAT_API Renderer {
   friend void render_to_image(Renderer&, const Camera&, const RenderSettings&, const ExternalImage&);
   friend void render_to_image(Renderer&, const Camera&, const RenderSettings&, const ExternalImage&,
                               const ExternalDepthImage&);
+  friend void render_to_image(Renderer&, const Camera&, const RenderSettings&, const ExternalImage&,
+                              const ExternalDepthImage*, const HostFrameSync&);
+  friend void wait_for_frame(Renderer&);
 };
 
 }  // namespace tilesplat

@@ -6,6 +6,7 @@
 #include <vulkan/vulkan.h>
 
 #include <memory>
+#include <span>
 
 #include "tilesplat/export.h"
 #include "tilesplat/renderer.h"
@@ -74,10 +75,46 @@ TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, con
 /// write_depth, alpha_threshold) without depth values of its own, as the image provides them. The
 /// splats blend only in front of the image's surfaces; with write_depth, the image then holds the
 /// splats' depth where their alpha reached the threshold and keeps the host's elsewhere, so that
-/// geometry drawn afterwards is hidden behind dense splats. The depth goes through host memory (the
-/// call blocks, as the one above). Throws std::invalid_argument for a missing or mismatched image, an
-/// unsupported format or layout, or settings.host unset or with depth values.
+/// geometry drawn afterwards is hidden behind dense splats. The depth stays on the device (a compute
+/// pass converts it, in float64 where the device has it); a NaN in the image means no surface at that
+/// pixel. Blocks, as the call above. Throws std::invalid_argument for a missing or mismatched image,
+/// an unsupported format or layout, or settings.host unset or with depth values.
 TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                                    const ExternalImage& target, const ExternalDepthImage& depth);
+
+/// The host's semaphores around a frame that render_to_image submits without waiting for it. Binary
+/// semaphores, or timeline ones with their values (VkTimelineSemaphoreSubmitInfo, Vulkan 1.2).
+struct HostFrameSync {
+  /// Waited for before the frame's first command (the host's work that wrote the depth image, say).
+  /// Each must be signalled, or have its signal submitted, before the call.
+  std::span<const VkSemaphore> wait;
+  /// The stage each wait blocks, one per semaphore; empty: VK_PIPELINE_STAGE_ALL_COMMANDS_BIT.
+  std::span<const VkPipelineStageFlags> wait_stages;
+  std::span<const uint64_t> wait_values;  ///< one per wait semaphore for timeline ones; empty for binary
+  /// Signalled once the frame's writes to the colour and depth images are complete and available.
+  std::span<const VkSemaphore> signal;
+  std::span<const uint64_t> signal_values;  ///< one per signal semaphore for timeline ones; empty for binary
+};
+
+/// Renders a frame into the host's images without waiting for it: the frame is submitted to
+/// ExternalVulkanDevice::queue, waiting for `sync.wait` and signalling `sync.signal`, and the call
+/// returns while it runs, so the host records and submits its own work meanwhile. `depth` may be null
+/// (then settings.host must not ask for write_depth); otherwise as the blocking overload above.
+///
+/// One frame is in flight at a time: the next call of any kind on the renderer (or
+/// wait_for_frame(), or its destruction) first waits for this one. The images must stay valid, and
+/// must not be used by the host, until `sync.signal` is signalled; they are left in their layouts.
+/// last_frame_stats() describes a frame once it has been waited for. The frame cannot re-render on
+/// the host's time: one that needs more (tile, Gaussian) pairs or composite chunks than the buffers
+/// hold is drawn with those that fit (FrameStats::complete is false), and the buffers grow for the
+/// next frame. Errors found only when the frame is waited for (a frame beyond the renderer's limits)
+/// are thrown by that wait.
+TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                                   const ExternalImage& target, const ExternalDepthImage* depth,
+                                   const HostFrameSync& sync);
+
+/// Waits for the frame render_to_image(..., HostFrameSync) submitted last, if it is still running, and
+/// makes its statistics last_frame_stats(). Nothing to do after a blocking call.
+TILESPLAT_API void wait_for_frame(Renderer& renderer);
 
 }  // namespace tilesplat

@@ -426,19 +426,41 @@ VkCommandBuffer Context::begin_one_time() {
   return cmd;
 }
 
-void Context::end_submit_wait(VkCommandBuffer cmd) {
+void Context::end_submit_wait(VkCommandBuffer cmd, const SubmitSync& sync) {
   struct FreeOnExit {
     Context* ctx;
     VkCommandBuffer cmd;
-    ~FreeOnExit() { vkFreeCommandBuffers(ctx->device_, ctx->command_pool_, 1, &cmd); }
+    ~FreeOnExit() { ctx->free_command_buffer(cmd); }
   } free_on_exit{this, cmd};
+  TS_VK_CHECK(vkResetFences(device_, 1, &fence_));
+  end_submit(cmd, sync, fence_);
+  TS_VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
+}
+
+void Context::end_submit(VkCommandBuffer cmd, const SubmitSync& sync, VkFence fence) {
   TS_VK_CHECK(vkEndCommandBuffer(cmd));
+  const std::vector<VkPipelineStageFlags> all_commands(sync.wait.size(), VK_PIPELINE_STAGE_ALL_COMMANDS_BIT);
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &cmd;
-  TS_VK_CHECK(vkResetFences(device_, 1, &fence_));
-  TS_VK_CHECK(vkQueueSubmit(queue_, 1, &submit, fence_));
-  TS_VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
+  submit.waitSemaphoreCount = uint32_t(sync.wait.size());
+  submit.pWaitSemaphores = sync.wait.data();
+  submit.pWaitDstStageMask = sync.wait_stages.empty() ? all_commands.data() : sync.wait_stages.data();
+  submit.signalSemaphoreCount = uint32_t(sync.signal.size());
+  submit.pSignalSemaphores = sync.signal.data();
+  VkTimelineSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
+  if (!sync.wait_values.empty() || !sync.signal_values.empty()) {
+    timeline.waitSemaphoreValueCount = uint32_t(sync.wait_values.size());
+    timeline.pWaitSemaphoreValues = sync.wait_values.data();
+    timeline.signalSemaphoreValueCount = uint32_t(sync.signal_values.size());
+    timeline.pSignalSemaphoreValues = sync.signal_values.data();
+    submit.pNext = &timeline;
+  }
+  TS_VK_CHECK(vkQueueSubmit(queue_, 1, &submit, fence));
+}
+
+void Context::free_command_buffer(VkCommandBuffer cmd) {
+  vkFreeCommandBuffers(device_, command_pool_, 1, &cmd);
 }
 
 void Context::discard(VkCommandBuffer cmd) {

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,16 @@ struct DeviceLimits {
 struct DeviceFeatures {
   bool shader_float64 = false;  // exact float64 depth keys (else float32: rare order swaps)
   bool push_descriptor = false;  // VK_KHR_push_descriptor: texel-buffer layouts of the CPU-driver passes
+};
+
+// Semaphores a submission waits for and signals besides its fence: a host's, around a frame that
+// render_to_image submits without waiting (HostFrameSync). Values are for timeline semaphores.
+struct SubmitSync {
+  std::span<const VkSemaphore> wait;
+  std::span<const VkPipelineStageFlags> wait_stages;  // one per wait semaphore, or empty: all commands
+  std::span<const uint64_t> wait_values;              // one per wait semaphore, or empty: binary ones
+  std::span<const VkSemaphore> signal;
+  std::span<const uint64_t> signal_values;  // one per signal semaphore, or empty: binary ones
 };
 
 // Owns (or, for a host application, borrows) a VkInstance and VkDevice with one compute queue.
@@ -75,7 +86,12 @@ class Context {
     end_submit_wait(cmd);
   }
   VkCommandBuffer begin_one_time();
-  void end_submit_wait(VkCommandBuffer cmd);
+  // Ends, submits (waiting for `sync.wait` first) and waits for a command buffer, then frees it.
+  void end_submit_wait(VkCommandBuffer cmd, const SubmitSync& sync = {});
+  // Ends and submits a command buffer without waiting: `fence` (unsignalled) and `sync.signal` are
+  // signalled when it completes. The caller frees it (free_command_buffer()) after the fence.
+  void end_submit(VkCommandBuffer cmd, const SubmitSync& sync, VkFence fence);
+  void free_command_buffer(VkCommandBuffer cmd);
   // Frees a command buffer from begin_one_time without submitting it.
   void discard(VkCommandBuffer cmd);
 

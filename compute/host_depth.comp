@@ -1,0 +1,50 @@
+#version 460
+// Host depth (a host's depth image on the device, render_to_image): between the host's window depths,
+// d = a + b / z (DepthConvention), and the view depths z the composite compares splats with. One
+// invocation per pixel.
+//   DIRECTION 0, in:  view[i] = b / (window[i] - a), or +inf where that is not positive (a depth at or
+//                     beyond infinity, and a NaN: no surface at that pixel)
+//   DIRECTION 1, out: window[i] = a + b / surface[i] where the splats' alpha reached the threshold
+//                     (surface[i] > 0), else left as it is (the host's own depth)
+// In float64, as host_depth.cpp computes it for depths in host memory, so that both give the same
+// floats; in float32 on devices without float64 (TS_FP32_HOST_DEPTH).
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+layout(local_size_x = 16, local_size_y = 16) in;
+layout(constant_id = 0) const uint DIRECTION = 0;
+
+layout(push_constant) uniform Push {
+  FloatArray window;  // the host's window depths, one float a pixel
+  FloatArray view;    // view depths, written (DIRECTION 0) or the splats' surface depths, read (1)
+  uvec2 a_bits;       // the convention's a and b as float64 bits
+  uvec2 b_bits;
+  float a32;          // and as float32
+  float b32;
+  uint width;
+  uint height;
+}
+pc;
+
+#ifdef TS_FP32_HOST_DEPTH
+#define real float
+real convention_a() { return pc.a32; }
+real convention_b() { return pc.b32; }
+#else
+#define real double
+real convention_a() { return packDouble2x32(pc.a_bits); }
+real convention_b() { return packDouble2x32(pc.b_bits); }
+#endif
+
+void main() {
+  uvec2 pixel = gl_GlobalInvocationID.xy;
+  if (pixel.x >= pc.width || pixel.y >= pc.height) return;
+  uint i = pixel.y * pc.width + pixel.x;
+  if (DIRECTION == 0) {
+    real z = convention_b() / (real(pc.window.v[i]) - convention_a());
+    pc.view.v[i] = z > 0 ? float(z) : uintBitsToFloat(0x7f800000u);
+  } else {
+    float surface = pc.view.v[i];
+    if (surface > 0) pc.window.v[i] = float(convention_a() + convention_b() / real(surface));
+  }
+}

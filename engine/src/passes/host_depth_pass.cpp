@@ -1,0 +1,52 @@
+#include "passes/host_depth_pass.h"
+
+#include <bit>
+
+namespace tilesplat {
+
+namespace {
+struct HostDepthPush {
+  VkDeviceAddress window, view;
+  uint32_t a_bits[2], b_bits[2];
+  float a32, b32;
+  uint32_t width, height;
+};
+
+void split_bits(double value, uint32_t (&bits)[2]) {
+  const uint64_t all = std::bit_cast<uint64_t>(value);
+  bits[0] = uint32_t(all);  // packDouble2x32 takes the low word first
+  bits[1] = uint32_t(all >> 32);
+}
+}  // namespace
+
+void HostDepthPass::record_view_depths(VkCommandBuffer cmd, const DepthConvention& convention,
+                                       const vk::Buffer& window, const vk::Buffer& view, uint32_t width,
+                                       uint32_t height) {
+  record(cmd, 0, convention, window, view, width, height);
+}
+
+void HostDepthPass::record_window_depths(VkCommandBuffer cmd, const DepthConvention& convention,
+                                         const vk::Buffer& surface, const vk::Buffer& window, uint32_t width,
+                                         uint32_t height) {
+  record(cmd, 1, convention, window, surface, width, height);
+}
+
+void HostDepthPass::record(VkCommandBuffer cmd, uint32_t direction, const DepthConvention& convention,
+                           const vk::Buffer& window, const vk::Buffer& view, uint32_t width,
+                           uint32_t height) {
+  auto it = pipelines_.find(direction);
+  if (it == pipelines_.end()) {
+    const char* shader = ctx_.features().shader_float64 ? "host_depth" : "host_depth_fp32";
+    it = pipelines_
+             .emplace(direction, vk::ComputePipeline(ctx_, shader, sizeof(HostDepthPush), {{0, direction}}))
+             .first;
+  }
+  HostDepthPush push{window.address(),    view.address(),      {},    {},
+                     float(convention.a), float(convention.b), width, height};
+  split_bits(convention.a, push.a_bits);
+  split_bits(convention.b, push.b_bits);
+  it->second.bind(cmd, push);
+  it->second.dispatch(cmd, vk::div_ceil(width, 16), vk::div_ceil(height, 16));
+}
+
+}  // namespace tilesplat
