@@ -1,7 +1,9 @@
-// tilesplat-viewer: a window onto a scene. The engine renders into a float image this app owns
-// (tilesplat/vulkan_interop.h, on the window's own Vulkan device) and each frame is blitted to the
-// window's swapchain. Nothing is rendered while nothing changes: the loop then sleeps in
-// glfwWaitEvents, so an idle viewer costs nothing.
+// tilesplat-viewer: a window onto a scene. The engine renders on the window's own Vulkan device
+// (tilesplat/vulkan_interop.h), submitting each frame without waiting for it, into an image this app
+// owns: with the mesh (viewer/mesh_layer.h), between a box it draws first, whose depth cuts the splats,
+// and a ground grid it draws after, hidden behind the splats' depth; without it (--no-mesh), into a
+// float image alone. Each frame is then blitted to the window's swapchain. Nothing is rendered while
+// nothing changes: the loop then sleeps in glfwWaitEvents, so an idle viewer costs nothing.
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
@@ -21,6 +23,8 @@
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
+#include "viewer/image_readback.h"
+#include "viewer/mesh_layer.h"
 #include "viewer/orbit_controller.h"
 #include "viewer/swapchain.h"
 #include "viewer/window_device.h"
@@ -30,6 +34,7 @@ namespace {
 namespace cli = tilesplat::cli;
 namespace fs = std::filesystem;
 using tilesplat::viewer::FloatImage;
+using tilesplat::viewer::MeshLayer;
 using tilesplat::viewer::OrbitController;
 using tilesplat::viewer::Swapchain;
 using tilesplat::viewer::WindowDevice;
@@ -44,6 +49,8 @@ struct ViewerOptions {
   cli::CommonOptions common;
   int frames = 0;  // 0: until the window is closed
   std::string screenshot;
+  bool no_mesh = false;       // the splats alone, straight into the float image
+  bool no_depth_out = false;  // the splats write no depth: the grid is drawn over them
 };
 
 bool validation_from_environment() {
@@ -78,13 +85,17 @@ using WindowHandle = std::unique_ptr<GLFWwindow, decltype(&glfwDestroyWindow)>;
 // The interactive state (camera, view, accuracy mode, sort) and the loop that redraws when it changes.
 class Viewer {
  public:
-  Viewer(GLFWwindow* window, const WindowDevice& device, tilesplat::Renderer& renderer, const ViewerOptions& options,
-         const cli::LoadedScene& loaded, std::vector<tilesplat::CameraView> views)
+  Viewer(GLFWwindow* window, const WindowDevice& device, tilesplat::Renderer& renderer,
+         const ViewerOptions& options, const cli::LoadedScene& loaded,
+         std::vector<tilesplat::CameraView> views)
       : window_(window),
         device_(device),
         renderer_(renderer),
         swapchain_(device),
-        controller_(loaded.camera, tilesplat::compute_bounds(loaded.scene)),
+        bounds_(tilesplat::compute_bounds(loaded.scene)),
+        controller_(loaded.camera, bounds_),
+        mesh_(!options.no_mesh),
+        depth_out_(!options.no_depth_out),
         scene_name_(loaded.path.filename().string()),
         views_(std::move(views)),
         view_(options.common.view),
@@ -105,6 +116,14 @@ class Viewer {
     glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) { self(w).needs_present_ = true; });
   }
 
+  // The renderer's last frame may still run, into this viewer's images.
+  ~Viewer() {
+    try {
+      tilesplat::wait_for_frame(renderer_);
+    } catch (const std::exception&) {  // an error of that frame's: nothing more to do with it
+    }
+  }
+
   // Runs until the window closes (Esc, Q, the close button), or for `frame_limit` frames when it is
   // positive, each of which is rendered even if nothing changed.
   void run(int frame_limit) {
@@ -119,9 +138,12 @@ class Viewer {
       const auto start = std::chrono::steady_clock::now();
       const bool rendering = needs_render_;
       if (rendering) render();
-      if (needs_present_) needs_present_ = !swapchain_.present(*image_);
+      if (needs_present_) needs_present_ = !present();
       if (rendering) {
-        show_title(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        const double frame_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        if (frames_ > 1) frame_ms_total_ += frame_ms;  // the first frame builds pipelines
+        show_title(frame_ms);
         if (frame_limit > 0 && frames_ >= frame_limit) break;
       }
     }
@@ -140,6 +162,23 @@ class Viewer {
     return settings;
   }
   int frames() const { return frames_; }
+  // The mean wall time of a frame (render and present) after the first; 0 before the second.
+  double mean_frame_ms() const { return frames_ > 1 ? frame_ms_total_ / (frames_ - 1) : 0.0; }
+
+  // What the window shows now (the last frame), as float RGBA.
+  tilesplat::RenderImage picture() {
+    tilesplat::wait_for_frame(renderer_);
+    tilesplat::RenderImage image;
+    const VkExtent2D extent = swapchain_.extent();
+    image.width = int(extent.width);
+    image.height = int(extent.height);
+    image.rgba =
+        mesh_layer_ ? tilesplat::viewer::read_rgba(device_, mesh_layer_->picture(), MeshLayer::kPictureFormat,
+                                                   MeshLayer::kPictureLayout, extent.width, extent.height)
+                    : tilesplat::viewer::read_rgba(device_, image_->image(), VK_FORMAT_R32G32B32A32_SFLOAT,
+                                                   FloatImage::kLayout, extent.width, extent.height);
+    return image;
+  }
 
  private:
   static Viewer& self(GLFWwindow* window) { return *static_cast<Viewer*>(glfwGetWindowUserPointer(window)); }
@@ -167,6 +206,9 @@ class Viewer {
       case GLFW_KEY_LEFT: viewer.step_view(-1); return;
       case GLFW_KEY_M: viewer.mode_ = (viewer.mode_ + 1) % viewer.modes_.size(); break;
       case GLFW_KEY_S: viewer.sort_ = (viewer.sort_ + 1) % viewer.sorts_.size(); break;
+      case GLFW_KEY_D:
+        viewer.depth_out_ = !viewer.depth_out_;
+        break;
       default: return;
     }
     viewer.needs_render_ = true;
@@ -222,9 +264,15 @@ class Viewer {
     swapchain_.recreate(uint32_t(std::max(width, 0)), uint32_t(std::max(height, 0)));
     const VkExtent2D extent = swapchain_.extent();
     minimized_ = extent.width == 0 || extent.height == 0;
-    if (minimized_ || (image_ && image_->width() == extent.width && image_->height() == extent.height)) return;
+    if (minimized_ || (shown_extent_.width == extent.width && shown_extent_.height == extent.height)) return;
+    tilesplat::wait_for_frame(renderer_);  // it may still write into the images
     image_.reset();
-    image_ = std::make_unique<FloatImage>(device_, extent.width, extent.height);
+    mesh_layer_.reset();
+    if (mesh_)
+      mesh_layer_ = std::make_unique<MeshLayer>(device_, bounds_, extent.width, extent.height);
+    else
+      image_ = std::make_unique<FloatImage>(device_, extent.width, extent.height);
+    shown_extent_ = extent;
     controller_.resize(int(extent.width), int(extent.height));
     needs_render_ = true;
   }
@@ -232,12 +280,23 @@ class Viewer {
   void render() {
     tilesplat::RenderSettings frame = settings();
     frame.depth = frame.splat_count = false;  // the window shows colour alone
-    tilesplat::render_to_image(renderer_, controller_.camera(), frame, image_->target());
+    // Submitted without waiting (HostFrameSync): the presentation's blit is queued behind it.
+    if (mesh_layer_)
+      mesh_layer_->draw(renderer_, controller_.camera(), frame, depth_out_);
+    else
+      tilesplat::render_to_image(renderer_, controller_.camera(), frame, image_->target(), nullptr, {});
     needs_render_ = false;
     needs_present_ = true;
     ++frames_;
   }
 
+  bool present() {
+    if (mesh_layer_)
+      return swapchain_.present(mesh_layer_->picture(), MeshLayer::kPictureLayout, shown_extent_);
+    return swapchain_.present(image_->image(), FloatImage::kLayout, shown_extent_);
+  }
+
+  // The GPU time is the previous frame's: a frame's statistics come once it has been waited for.
   void show_title(double frame_ms) {
     std::string title = scene_name_;
     if (!views_.empty()) {
@@ -245,17 +304,24 @@ class Viewer {
       title += " | view " + std::to_string(view_) + (view.name.empty() ? "" : " (" + view.name + ")");
     }
     title += " | " + tilesplat::to_string(modes_[mode_]) + " | " + sorts_[sort_] + " | GPU " +
-             cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | " +
-             cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps";
+             cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
+             cli::format_fixed(frame_ms, 1) + " ms (" +
+             cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps)";
+    if (mesh_layer_ && !depth_out_) title += " | no depth out";
     glfwSetWindowTitle(window_, title.c_str());
   }
 
   GLFWwindow* window_;
   const WindowDevice& device_;
   tilesplat::Renderer& renderer_;
-  std::unique_ptr<FloatImage> image_;  // the swapchain's size
-  Swapchain swapchain_;                // destroyed first: it waits for the device to be idle
+  std::unique_ptr<FloatImage> image_;      // --no-mesh: the splats alone, the swapchain's size
+  std::unique_ptr<MeshLayer> mesh_layer_;  // else the box, the splats and the grid
+  VkExtent2D shown_extent_{0, 0};          // the size of the images above
+  Swapchain swapchain_;                    // destroyed first: it waits for the device to be idle
+  tilesplat::Bounds bounds_;
   OrbitController controller_;
+  bool mesh_;       // draw the box and the grid (not --no-mesh)
+  bool depth_out_;  // the splats write their depth for the grid (D toggles)
   std::string scene_name_;
   std::vector<tilesplat::CameraView> views_;  // of --cameras or the scene file; N and P step through them
   int view_ = 0;
@@ -272,22 +338,19 @@ class Viewer {
   bool resized_ = true;
   bool minimized_ = false;
   int frames_ = 0;
+  double frame_ms_total_ = 0;  // over the frames after the first
 };
 
-void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, const Viewer& viewer,
+// A PNG is the window's picture as shown (the mesh included; sRGB, no exposure or tone curve, as the
+// swapchain shows it). An EXR is the last frame's data: its camera and settings rendered once more
+// (only the composite runs: the lists are reused), with the outputs the EXR carries, exactly as
+// tilesplat-render writes them.
+void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewer& viewer,
                       const cli::LoadedScene& loaded) {
-  // The last frame is in the window's float image; rendering its camera and settings once more
-  // returns it as a RenderImage (only the composite runs: the lists are reused) with the outputs
-  // the EXR carries, exactly as tilesplat-render writes them.
-  const tilesplat::RenderImage image = renderer.render(viewer.camera(), viewer.settings());
   if (cli::has_extension(path, ".png")) {
-    tilesplat::PreviewOptions preview;
-    if (loaded.description) {
-      preview.exposure_stops = loaded.description->effects.exposure_stops;
-      preview.tone_map = loaded.description->effects.tone_map;
-    }
-    tilesplat::write_png_preview(path, image, preview);
+    tilesplat::write_png_preview(path, viewer.picture());
   } else {
+    const tilesplat::RenderImage image = renderer.render(viewer.camera(), viewer.settings());
     tilesplat::ExrWriteOptions exr;
     exr.alpha = !loaded.description || loaded.description->outputs.alpha;
     exr.camera = viewer.camera();
@@ -298,19 +361,32 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, const
 int run(int argc, char** argv) {
   cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
   ViewerOptions options;
-  cli::ArgParser parser(
-      kProgram, "tilesplat-viewer SCENE.ply|SCENE.json [options]",
-      "Shows a 3D Gaussian Splatting scene in a window. Left-drag orbits around the scene's centre, right- or "
-      "middle-drag pans, the wheel zooms; N and P (or the arrow keys) step through the views of --cameras or the "
-      "scene file, M cycles accuracy modes, S cycles sort strategies, Esc or Q quits. The window starts at "
-      "--width x --height (default 960 wide, the view's aspect) and the image follows its size.");
+  cli::ArgParser parser(kProgram, "tilesplat-viewer SCENE.ply|SCENE.json [options]",
+                        "Shows a 3D Gaussian Splatting scene in a window. Left-drag orbits around the "
+                        "scene's centre, right- or "
+                        "middle-drag pans, the wheel zooms; N and P (or the arrow keys) step through the "
+                        "views of --cameras or the "
+                        "scene file, M cycles accuracy modes, S cycles sort strategies, D turns the splats' "
+                        "depth out off and on, "
+                        "Esc or Q quits. The window starts at --width x --height (default 960 wide, the "
+                        "view's aspect) and the image "
+                        "follows its size. A box at the scene's centre is drawn before the splats (it hides "
+                        "what is behind it) and a "
+                        "ground grid after (the splats hide it where they are dense), as a host "
+                        "application's meshes would be.");
   cli::add_common_options(parser, options.common, cli::SortChoice::kOne);
   parser.section("scripting");
   parser.add_int("--frames", "N", "render N frames, then exit (default: run until the window is closed)",
                  &options.frames, 1, 1000000);
-  parser.add_string("--screenshot", "FILE",
-                    "on exit, write the last frame: an .exr as tilesplat-render writes it, or a .png preview",
-                    &options.screenshot);
+  parser.add_string(
+      "--screenshot", "FILE",
+      "on exit, write the last frame: an .exr of the splats as tilesplat-render writes it, or a .png "
+      "of the window as shown",
+      &options.screenshot);
+  parser.section("mesh");
+  parser.add_switch("--no-mesh", "show the splats alone, without the box and the grid", &options.no_mesh);
+  parser.add_switch("--no-depth-out", "the splats write no depth, so the grid is drawn over them (key D)",
+                    &options.no_depth_out);
   if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
   cli::check_common_options(parser, options.common);
   if (!options.screenshot.empty()) {
@@ -340,6 +416,7 @@ int run(int argc, char** argv) {
 
   Viewer viewer(window.get(), device, *renderer, options, loaded, std::move(views));
   viewer.run(options.frames);
+  tilesplat::wait_for_frame(*renderer);                            // the last frame's statistics
   const double last_gpu_ms = renderer->last_frame_stats().gpu_ms;  // before a screenshot renders again
   if (!options.screenshot.empty()) {
     if (viewer.frames() == 0)
@@ -354,6 +431,8 @@ int run(int argc, char** argv) {
                         (viewer.frames() == 1 ? " frame on " : " frames on ") +
                         device.name() + ", the last " + cli::format_size(camera.width, camera.height) + " in " +
                         cli::format_fixed(last_gpu_ms, 2) + " GPU ms";
+  if (viewer.frames() > 1)
+    summary += ", " + cli::format_fixed(viewer.mean_frame_ms(), 1) + " ms a frame after the first";
   if (device.validation()) summary += ", validation: " + std::to_string(device.validation_messages()) + " messages";
   if (!options.screenshot.empty()) summary += " -> " + options.screenshot;
   std::fputs((summary + "\n").c_str(), stderr);

@@ -44,6 +44,8 @@ namespace tilesplat {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::DecodedPng;
+using testing::read_png_rgb;
 
 // ---------------------------------------------------------------------------------------------
 // Helpers
@@ -234,29 +236,6 @@ void write_hand_made_exr(const fs::path& path, int x_min, int y_min, int width, 
       for (int x = 0; x < width; ++x) put(channel.values[static_cast<size_t>(row * width + x)]);
   }
   write_bytes(path, out);
-}
-
-// PNG read back through libpng's simplified API.
-struct DecodedPng {
-  uint32_t width = 0, height = 0;
-  std::vector<uint8_t> rgb;
-};
-
-DecodedPng read_png_rgb(const fs::path& path) {
-  png_image png{};
-  png.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&png, path.c_str())) throw std::runtime_error(png.message);
-  png.format = PNG_FORMAT_RGB;
-  DecodedPng decoded;
-  decoded.width = png.width;
-  decoded.height = png.height;
-  decoded.rgb.resize(PNG_IMAGE_SIZE(png));
-  if (!png_image_finish_read(&png, nullptr, decoded.rgb.data(), 0, nullptr)) {
-    const std::string message = png.message;
-    png_image_free(&png);
-    throw std::runtime_error(message);
-  }
-  return decoded;
 }
 
 uint8_t expected_srgb_byte(double linear) {

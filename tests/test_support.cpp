@@ -1,8 +1,10 @@
 #include "test_support.h"
 
 #include <gtest/gtest.h>
+#include <png.h>
 
 #include <cstdlib>
+#include <stdexcept>
 #include <vector>
 
 namespace tilesplat::testing {
@@ -76,6 +78,23 @@ void expect_composite_layouts_identical(const GaussianScene& scene, const Camera
     EXPECT_EQ(images[k].depth, images[0].depth) << "layout " << k;
     EXPECT_EQ(images[k].splat_count, images[0].splat_count) << "layout " << k;
   }
+}
+
+DecodedPng read_png_rgb(const std::filesystem::path& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&png, path.c_str())) throw std::runtime_error(png.message);
+  png.format = PNG_FORMAT_RGB;
+  DecodedPng decoded;
+  decoded.width = png.width;
+  decoded.height = png.height;
+  decoded.rgb.resize(PNG_IMAGE_SIZE(png));
+  if (!png_image_finish_read(&png, nullptr, decoded.rgb.data(), 0, nullptr)) {
+    const std::string message = png.message;
+    png_image_free(&png);
+    throw std::runtime_error(message);
+  }
+  return decoded;
 }
 
 }  // namespace tilesplat::testing

@@ -1,10 +1,12 @@
 // Helpers shared by the tests: where scenes live, and a renderer with validation that fails on messages.
 #pragma once
 
+#include <cstdint>
 #include <exception>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "tilesplat/camera.h"
 #include "tilesplat/renderer.h"
@@ -36,6 +38,13 @@ Renderer& validated_renderer();
 // expects them to agree bit for bit (rgba, depth, splat counts) and the validation layer to stay silent.
 void expect_composite_layouts_identical(const GaussianScene& scene, const Camera& camera,
                                         const RenderSettings& settings = {});
+
+// An 8-bit PNG read back as RGB through libpng's simplified API (throws std::runtime_error).
+struct DecodedPng {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+};
+DecodedPng read_png_rgb(const std::filesystem::path& path);
 
 // The message of the exception of type E (or derived) that `action` throws, for tests of error
 // messages; "(no exception)" when it throws none. An exception of another type escapes to the test.

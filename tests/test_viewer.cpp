@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -24,6 +26,7 @@ using tilesplat::testing::bundled_playbot;
 using tilesplat::testing::bundled_playbot_cameras;
 using tilesplat::testing::bundled_sh3;
 using tilesplat::testing::bundled_sh3_cameras;
+using tilesplat::testing::DecodedPng;
 using tilesplat::testing::fresh_output_dir;
 using tilesplat::testing::line_count;
 using tilesplat::testing::ProcessResult;
@@ -111,6 +114,76 @@ TEST(Viewer, ValidationLayerStaysSilent) {
   std::string signature(8, '\0');
   png.read(signature.data(), 8);
   EXPECT_EQ(signature, "\x89PNG\r\n\x1a\n");
+}
+
+// The viewer's own mesh, drawn as a host application's would be: the box drawn before the splats hides
+// what lies behind it, and the ground grid drawn after is hidden behind the splats' depth where they are
+// dense (drawn over them with --no-depth-out). Counted on the pixels of PNG screenshots of the window,
+// where the box's faces and the grid have colours of their own.
+TEST(Viewer, BoxHidesSplatsAndSplatsHideTheGrid) {
+  REQUIRE_VIEWER();
+  const std::optional<std::string> prefix = display_prefix();
+  if (!prefix) GTEST_SKIP() << kNoDisplay;
+  const fs::path out = fresh_output_dir();
+  auto screenshot = [&](const std::string& name, const std::vector<std::string>& flags) {
+    std::vector<std::string> args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
+    args.insert(args.end(), flags.begin(), flags.end());
+    args.insert(args.end(), {"--validation", "--frames", "2", "--screenshot", (out / name).string()});
+    const ProcessResult result = run_process(*prefix, kViewerExe, args);
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    EXPECT_NE(result.err.find("validation: 0 messages"), std::string::npos) << result.err;
+    return tilesplat::testing::read_png_rgb(out / name);
+  };
+  const DecodedPng mesh = screenshot("mesh.png", {});
+  const DecodedPng no_depth_out = screenshot("no_depth_out.png", {"--no-depth-out"});
+  const DecodedPng splats_only = screenshot("splats_only.png", {"--no-mesh"});
+  ASSERT_EQ(mesh.width, 320u);
+  ASSERT_EQ(mesh.height, 180u);
+
+  // The colours viewer/mesh_layer.cpp draws with (linear), as the sRGB PNG holds them (+-1 for the
+  // half-float picture's rounding).
+  auto srgb_byte = [](double c) {
+    const double encoded = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
+    return int(std::lround(255 * encoded));
+  };
+  const double box_faces[6][3] = {{0.80, 0.30, 0.08}, {0.70, 0.25, 0.06}, {0.90, 0.45, 0.10},
+                                  {0.55, 0.20, 0.05}, {0.85, 0.38, 0.09}, {0.62, 0.22, 0.05}};
+  std::vector<std::array<int, 3>> box_colours;
+  for (const auto& face : box_faces)
+    box_colours.push_back({srgb_byte(face[0]), srgb_byte(face[1]), srgb_byte(face[2])});
+  auto is = [](const uint8_t* pixel, const std::array<int, 3>& colour) {
+    for (int c = 0; c < 3; ++c)
+      if (std::abs(int(pixel[c]) - colour[size_t(c)]) > 1) return false;
+    return true;
+  };
+  auto count = [&](const DecodedPng& png, auto&& matches) {
+    size_t n = 0;
+    for (size_t i = 0; i + 2 < png.rgb.size(); i += 3) n += matches(&png.rgb[i]) ? 1u : 0u;
+    return n;
+  };
+  auto box = [&](const uint8_t* p) {
+    return std::any_of(box_colours.begin(), box_colours.end(), [&](const auto& c) { return is(p, c); });
+  };
+  auto grid = [&](const uint8_t* p) { return is(p, {0, 255, 255}); };
+
+  const size_t pixels = size_t(mesh.width) * mesh.height;
+  const size_t box_pixels = count(mesh, box), grid_pixels = count(mesh, grid);
+  const size_t grid_over_splats = count(no_depth_out, grid);
+  std::printf(
+      "box %zu of %zu pixels (splats alone: %zu); grid %zu, drawn over the splats %zu (splats alone: %zu)\n",
+      box_pixels, pixels, count(splats_only, box), grid_pixels, grid_over_splats, count(splats_only, grid));
+  EXPECT_GT(box_pixels, pixels / 20) << "the box should cover a good part of the view";
+  EXPECT_LT(count(splats_only, box), box_pixels / 50) << "the splats alone have the box's colours";
+  EXPECT_GT(grid_pixels, pixels / 200) << "the grid should show where no splat covers it";
+  EXPECT_GT(grid_over_splats, grid_pixels + grid_pixels / 10)
+      << "the splats' depth should hide part of the grid";
+  EXPECT_EQ(count(splats_only, grid), 0u);
+  // Where the box is drawn, the splats behind it left nothing: the same pixels show the box with and
+  // without the splats' depth out.
+  size_t box_differs = 0;
+  for (size_t i = 0; i < mesh.rgb.size(); i += 3)
+    if (box(&mesh.rgb[i]) && !box(&no_depth_out.rgb[i]) && !grid(&no_depth_out.rgb[i])) ++box_differs;
+  EXPECT_EQ(box_differs, 0u);
 }
 
 // These fail before a window opens, so they need no display.

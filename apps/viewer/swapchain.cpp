@@ -240,9 +240,9 @@ void Swapchain::recreate(uint32_t width, uint32_t height) {
   for (VkSemaphore& done : blit_done_) vk_check(vkCreateSemaphore(vk, &semaphore, nullptr, &done), "vkCreateSemaphore");
 }
 
-bool Swapchain::present(const FloatImage& source) {
+bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D source_extent) {
   if (!swapchain_) return false;
-  if (source.width() != extent_.width || source.height() != extent_.height)
+  if (source_extent.width != extent_.width || source_extent.height != extent_.height)
     throw std::logic_error("Swapchain::present: the source image is not the swapchain's size");
   VkDevice vk = device_.device();
   uint32_t index = 0;
@@ -260,8 +260,9 @@ bool Swapchain::present(const FloatImage& source) {
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   vk_check(vkBeginCommandBuffer(commands_, &begin), "vkBeginCommandBuffer");
-  // The previous contents are not needed (UNDEFINED). The source needs no barrier of ours:
-  // render_to_image ends with one whose second scope is every later command, ours included.
+  // The previous contents are not needed (UNDEFINED). The source needs no barrier of ours: both
+  // render_to_image and the mesh layer's last pass end with one whose second scope is every later
+  // command, ours included.
   transition(commands_, images_[index], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
              VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
   VkImageBlit region{};
@@ -270,8 +271,8 @@ bool Swapchain::present(const FloatImage& source) {
   region.dstSubresource = region.srcSubresource;
   region.dstOffsets[1] = region.srcOffsets[1];
   // 1:1, so NEAREST copies each pixel; the blit converts float to the swapchain's format.
-  vkCmdBlitImage(commands_, source.image(), FloatImage::kLayout, images_[index], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                 1, &region, VK_FILTER_NEAREST);
+  vkCmdBlitImage(commands_, source, source_layout, images_[index], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                 &region, VK_FILTER_NEAREST);
   transition(commands_, images_[index], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
              VK_ACCESS_TRANSFER_WRITE_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
   vk_check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");

@@ -53,12 +53,12 @@ class Swapchain {
   VkExtent2D extent() const { return extent_; }
   VkFormat format() const { return format_; }
 
-  // Blits `source` (the swapchain's extent) into the next image and presents it, FIFO (vsync).
-  // Returns when the blit has read the source, so the caller may render into it again. Returns
+  // Blits `source` (the swapchain's extent, in `source_layout`) into the next image and presents it,
+  // FIFO (vsync). Returns when the blit has read the source, so the caller may render into it again. Returns
   // false when nothing was shown (VK_ERROR_OUT_OF_DATE_KHR, or no images): recreate, present again.
   // Either way, stale() says whether the swapchain no longer fits the surface (also after
   // VK_SUBOPTIMAL_KHR, when the frame was shown): recreate it before the next frame.
-  bool present(const FloatImage& source);
+  bool present(VkImage source, VkImageLayout source_layout, VkExtent2D source_extent);
   bool stale() const { return stale_; }
 
  private:

@@ -94,9 +94,9 @@ struct Host {
     throw std::runtime_error("no suitable memory type");
   }
 
-  // Records commands into a one-time command buffer, submits them and waits.
+  // Records commands into a one-time command buffer, submits them (after `wait`, if given) and waits.
   template <typename Record>
-  void run_once(Record&& record) const {
+  void run_once(Record&& record, VkSemaphore wait = VK_NULL_HANDLE) const {
     VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
     pool_info.queueFamilyIndex = family;
     VkCommandPool pool = VK_NULL_HANDLE;
@@ -111,7 +111,11 @@ struct Host {
     check(vkBeginCommandBuffer(commands, &begin), "vkBeginCommandBuffer");
     record(commands);
     check(vkEndCommandBuffer(commands), "vkEndCommandBuffer");
+    const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
     VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    submit.waitSemaphoreCount = wait ? 1 : 0;
+    submit.pWaitSemaphores = &wait;
+    submit.pWaitDstStageMask = &wait_stage;
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &commands;
     check(vkQueueSubmit(queue, 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
@@ -197,6 +201,10 @@ int main(int argc, char** argv) {
     projection[11] = -1;
     projection[14] = kFar * kNear / (kNear - kFar);
 
+    // Signalled by the renderer's frame; the host's next submission waits for it.
+    VkSemaphoreCreateInfo semaphore_info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    VkSemaphore splats_drawn = VK_NULL_HANDLE;
+    check(vkCreateSemaphore(host.device, &semaphore_info, nullptr, &splats_drawn), "vkCreateSemaphore");
     {
       // The renderer borrows the host's handles and never destroys them.
       const auto renderer = tilesplat::create_renderer(
@@ -210,10 +218,16 @@ int main(int argc, char** argv) {
                                            {},
                                            /*write_depth=*/true,
                                            /*alpha_threshold=*/0.5f};
+      // Submitted without waiting: the call returns while the frame runs and signals splats_drawn once
+      // both images are written (the host could record its next work meanwhile). Destroying the renderer
+      // waits for the frame.
+      const tilesplat::ExternalDepthImage depth_image{depth, width, height, VK_FORMAT_D32_SFLOAT,
+                                                      VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+      const VkSemaphore signals[] = {splats_drawn};
       tilesplat::render_to_image(
           *renderer, camera, settings,
-          {image, width, height, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_LAYOUT_UNDEFINED},
-          {depth, width, height, VK_FORMAT_D32_SFLOAT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL});
+          {image, width, height, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_LAYOUT_UNDEFINED}, &depth_image,
+          tilesplat::HostFrameSync{{}, {}, {}, signals, {}});
     }
 
     // The host reads its image back (in an application it would sample or blend it instead).
@@ -230,22 +244,25 @@ int main(int argc, char** argv) {
     VkDeviceMemory readback_memory = VK_NULL_HANDLE;
     check(vkAllocateMemory(host.device, &allocate, nullptr, &readback_memory), "vkAllocateMemory");
     check(vkBindBufferMemory(host.device, readback, readback_memory, 0), "vkBindBufferMemory");
-    host.run_once([&](VkCommandBuffer commands) {
-      VkImageMemoryBarrier to_source{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-      to_source.oldLayout = VK_IMAGE_LAYOUT_GENERAL;
-      to_source.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-      to_source.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
-      to_source.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-      to_source.srcQueueFamilyIndex = to_source.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      to_source.image = image;
-      to_source.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-      vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                           nullptr, 0, nullptr, 1, &to_source);
-      VkBufferImageCopy region{};
-      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-      region.imageExtent = {width, height, 1};
-      vkCmdCopyImageToBuffer(commands, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback, 1, &region);
-    });
+    host.run_once(
+        [&](VkCommandBuffer commands) {
+          VkImageMemoryBarrier to_source{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+          to_source.oldLayout = VK_IMAGE_LAYOUT_GENERAL;
+          to_source.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+          to_source.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
+          to_source.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+          to_source.srcQueueFamilyIndex = to_source.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+          to_source.image = image;
+          to_source.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+          vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                               0, 0, nullptr, 0, nullptr, 1, &to_source);
+          VkBufferImageCopy region{};
+          region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+          region.imageExtent = {width, height, 1};
+          vkCmdCopyImageToBuffer(commands, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback, 1, &region);
+        },
+        splats_drawn);
+    vkDestroySemaphore(host.device, splats_drawn, nullptr);
     tilesplat::RenderImage result;
     result.width = camera.width;
     result.height = camera.height;

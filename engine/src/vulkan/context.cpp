@@ -189,7 +189,8 @@ void Context::destroy() {
   if (device_) {
     // A borrowed device may be busy with the host's own work: wait only for our submissions.
     if (owns_handles_) vkDeviceWaitIdle(device_);
-    else if (fence_) vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX);
+    else if (fence_pending_)
+      vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX);
     if (fence_) vkDestroyFence(device_, fence_, nullptr);
     if (command_pool_) vkDestroyCommandPool(device_, command_pool_, nullptr);
     fence_ = VK_NULL_HANDLE;
@@ -434,7 +435,9 @@ void Context::end_submit_wait(VkCommandBuffer cmd, const SubmitSync& sync) {
   } free_on_exit{this, cmd};
   TS_VK_CHECK(vkResetFences(device_, 1, &fence_));
   end_submit(cmd, sync, fence_);
+  fence_pending_ = true;
   TS_VK_CHECK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
+  fence_pending_ = false;
 }
 
 void Context::end_submit(VkCommandBuffer cmd, const SubmitSync& sync, VkFence fence) {

@@ -128,6 +128,7 @@ class Context {
   uint32_t queue_family_ = 0;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
+  bool fence_pending_ = false;  // submitted and not yet waited for (a wait that threw): destroy() waits
   VkPhysicalDeviceMemoryProperties memory_properties_{};
   DeviceLimits limits_;
   DeviceFeatures features_;

@@ -1,0 +1,6 @@
+#version 460
+// One triangle that covers the viewport (vertices 0, 1, 2 of a draw of three, no vertex buffer).
+void main() {
+  vec2 corner = vec2((gl_VertexIndex << 1) & 2, gl_VertexIndex & 2);
+  gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
+}
