@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -232,6 +233,18 @@ class HostApplication : public ::testing::Test {
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
                          nullptr, 0, nullptr, 1, &b);
   }
+  // The host "draws" its depth: the staging buffer's floats into a D32 image, which ends in the layout a
+  // host keeps a depth buffer in.
+  void record_draw_depth(VkCommandBuffer cmd, VkImage depth, uint32_t width, uint32_t height) {
+    layout_barrier(cmd, depth, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+    region.imageExtent = {width, height, 1};
+    vkCmdCopyBufferToImage(cmd, staging, depth, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    layout_barrier(cmd, depth, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                   VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+  }
   // Copies an image (left in TRANSFER_SRC_OPTIMAL) into the staging buffer.
   void read_image(VkImage image, VkImageAspectFlags aspect, VkImageLayout layout, uint32_t width,
                   uint32_t height) {
@@ -423,16 +436,7 @@ TEST_F(HostApplication, DepthImageCutsTheSplatsAndReceivesTheirDepth) {
   make_staging(VkDeviceSize(kWidth) * kHeight * 16);
   // The host "draws" its wall: the depth image ends in the layout a host keeps a depth buffer in.
   std::memcpy(staging_data, wall.data(), wall.size() * sizeof(float));
-  submit([&](VkCommandBuffer cmd) {
-    layout_barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
-    region.imageExtent = {kWidth, kHeight, 1};
-    vkCmdCopyBufferToImage(cmd, staging, depth.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    layout_barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                   VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
-  });
+  submit([&](VkCommandBuffer cmd) { record_draw_depth(cmd, depth.image, kWidth, kHeight); });
 
   RenderSettings settings;
   settings.host = HostDepth{convention, {}, true, 0.5f};
@@ -474,6 +478,62 @@ TEST_F(HostApplication, DepthImageCutsTheSplatsAndReceivesTheirDepth) {
   }
   EXPECT_GT(nearer, wall.size() / 20) << "the splats wrote their depth at too few pixels to mean anything";
 
+  release_host_objects();
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
+// A depth image cannot be checked for NaNs on the host without reading it back: on the device a NaN
+// means no surface at that pixel (every splat blends, as over a cleared infinite far plane), and the
+// depth out keeps the NaN where the splats do not reach the threshold.
+TEST_F(HostApplication, NanInTheDepthImageMeansNoSurface) {
+  constexpr uint32_t kWidth = 160, kHeight = 90;
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const Camera camera =
+      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
+  const DepthConvention convention = effects::bench_depth_convention();
+  std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+  std::vector<float> no_surface = wall;  // what the NaN rows mean, in host memory
+  for (size_t i = 40 * kWidth; i < 50 * kWidth; ++i) {
+    wall[i] = std::numeric_limits<float>::quiet_NaN();
+    no_surface[i] = std::numeric_limits<float>::infinity();
+  }
+  const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
+  const Image depth =
+      make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, kWidth, kHeight);
+  make_staging(VkDeviceSize(kWidth) * kHeight * 16);
+  std::memcpy(staging_data, wall.data(), wall.size() * sizeof(float));
+  submit([&](VkCommandBuffer cmd) { record_draw_depth(cmd, depth.image, kWidth, kHeight); });
+
+  RenderSettings settings;
+  settings.host = HostDepth{convention, {}, true, 0.5f};
+  auto renderer = create_renderer(external());
+  renderer->set_scene(scene);
+  render_to_image(
+      *renderer, camera, settings,
+      {colour.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_LAYOUT_UNDEFINED},
+      {depth.image, kWidth, kHeight, VK_FORMAT_D32_SFLOAT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL});
+  RenderSettings in_memory = settings;
+  in_memory.host->depth = no_surface;
+  const RenderImage expected = renderer->render(camera, in_memory);
+
+  std::vector<float> rgba(size_t(kWidth) * kHeight * 4), depth_after(size_t(kWidth) * kHeight);
+  read_image(colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
+  std::memcpy(rgba.data(), staging_data, rgba.size() * sizeof(float));
+  read_image(depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, kWidth,
+             kHeight);
+  std::memcpy(depth_after.data(), staging_data, depth_after.size() * sizeof(float));
+  EXPECT_EQ(rgba, expected.rgba);
+  size_t kept_nan = 0;
+  for (size_t i = 0; i < depth_after.size(); ++i) {
+    if (std::isnan(wall[i]) && std::isinf(expected.host_depth[i])) {
+      EXPECT_TRUE(std::isnan(depth_after[i])) << "pixel " << i;
+      ++kept_nan;
+    } else {
+      EXPECT_EQ(depth_after[i], expected.host_depth[i]) << "pixel " << i;
+    }
+  }
+  EXPECT_GT(kept_nan, 0u) << "no NaN pixel without splats: the test shows nothing of that case";
+  renderer.reset();
   release_host_objects();
   EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
 }
@@ -548,18 +608,8 @@ TEST_F(HostApplication, FrameInsideTheHostsFrameWaitsForAndSignalsItsSemaphores)
   make_staging(colour_bytes + pixels * sizeof(float));
   std::memcpy(staging_data, wall.data(), pixels * sizeof(float));
   const VkSemaphore drawn = make_semaphore(), rendered = make_semaphore();
-  submit_async(
-      [&](VkCommandBuffer cmd) {
-        layout_barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
-        region.imageExtent = {kWidth, kHeight, 1};
-        vkCmdCopyBufferToImage(cmd, staging, depth.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-        layout_barrier(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                       VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
-      },
-      VK_NULL_HANDLE, drawn);
+  submit_async([&](VkCommandBuffer cmd) { record_draw_depth(cmd, depth.image, kWidth, kHeight); },
+               VK_NULL_HANDLE, drawn);
 
   RenderSettings settings;
   settings.host = HostDepth{convention, {}, true, 0.5f};
