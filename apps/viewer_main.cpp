@@ -307,7 +307,10 @@ class Viewer {
              cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
              cli::format_fixed(frame_ms, 1) + " ms (" +
              cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps)";
-    if (mesh_layer_ && !depth_out_) title += " | no depth out";
+    if (mesh_layer_ && !MeshLayer::depth_testable(settings()))
+      title += " | mesh off: this mode does not depth-test";
+    else if (mesh_layer_ && !depth_out_)
+      title += " | no depth out";
     glfwSetWindowTitle(window_, title.c_str());
   }
 

@@ -118,7 +118,8 @@ TEST(Viewer, ValidationLayerStaysSilent) {
 
 // The viewer's own mesh, drawn as a host application's would be: the box drawn before the splats hides
 // what lies behind it, and the ground grid drawn after is hidden behind the splats' depth where they are
-// dense (drawn over them with --no-depth-out). Counted on the pixels of PNG screenshots of the window,
+// dense (drawn over them with --no-depth-out); in a mode that cannot depth-test, the splats show alone.
+// Counted on the pixels of PNG screenshots of the window,
 // where the box's faces and the grid have colours of their own.
 TEST(Viewer, BoxHidesSplatsAndSplatsHideTheGrid) {
   REQUIRE_VIEWER();
@@ -137,6 +138,8 @@ TEST(Viewer, BoxHidesSplatsAndSplatsHideTheGrid) {
   const DecodedPng mesh = screenshot("mesh.png", {});
   const DecodedPng no_depth_out = screenshot("no_depth_out.png", {"--no-depth-out"});
   const DecodedPng splats_only = screenshot("splats_only.png", {"--no-mesh"});
+  // Per-pixel re-sorting cannot depth-test against a host's surfaces: the viewer shows the splats alone.
+  const DecodedPng resorted = screenshot("resorted.png", {"--mode", "resort8"});
   ASSERT_EQ(mesh.width, 320u);
   ASSERT_EQ(mesh.height, 180u);
 
@@ -178,6 +181,8 @@ TEST(Viewer, BoxHidesSplatsAndSplatsHideTheGrid) {
   EXPECT_GT(grid_over_splats, grid_pixels + grid_pixels / 10)
       << "the splats' depth should hide part of the grid";
   EXPECT_EQ(count(splats_only, grid), 0u);
+  EXPECT_LT(count(resorted, box), box_pixels / 50);
+  EXPECT_EQ(count(resorted, grid), 0u);
   // Where the box is drawn, the splats behind it left nothing: the same pixels show the box with and
   // without the splats' depth out.
   size_t box_differs = 0;

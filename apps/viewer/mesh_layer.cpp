@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace tilesplat::viewer {
 
@@ -101,10 +102,8 @@ MeshLayer::~MeshLayer() {
 }
 
 void MeshLayer::destroy() {
-  if (submitted_) {
-    const VkFence fences[] = {box_fence_, grid_fence_};
-    vkWaitForFences(vk_, 2, fences, VK_TRUE, std::numeric_limits<uint64_t>::max());
-  }
+  for (auto [fence, pending] : {std::pair{box_fence_, box_pending_}, std::pair{grid_fence_, grid_pending_}})
+    if (pending) vkWaitForFences(vk_, 1, &fence, VK_TRUE, std::numeric_limits<uint64_t>::max());
   for (VkPipeline p : {box_pipeline_, grid_pipeline_, over_pipeline_})
     if (p) vkDestroyPipeline(vk_, p, nullptr);
   for (VkPipelineLayout l : {mesh_layout_, over_layout_})
@@ -455,8 +454,15 @@ void MeshLayer::begin(VkCommandBuffer cmd) {
   vk_check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
 }
 
+void MeshLayer::wait_for(VkFence fence, bool& pending) {
+  if (!pending) return;
+  vk_check(vkWaitForFences(vk_, 1, &fence, VK_TRUE, std::numeric_limits<uint64_t>::max()), "vkWaitForFences");
+  pending = false;
+}
+
 void MeshLayer::submit(VkCommandBuffer cmd, VkSemaphore wait, VkSemaphore signal, VkFence fence) {
   vk_check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  if (fence) vk_check(vkResetFences(vk_, 1, &fence), "vkResetFences");
   const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
   VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   info.waitSemaphoreCount = wait ? 1 : 0;
@@ -469,17 +475,20 @@ void MeshLayer::submit(VkCommandBuffer cmd, VkSemaphore wait, VkSemaphore signal
   vk_check(vkQueueSubmit(device_.queue(), 1, &info, fence), "vkQueueSubmit (mesh)");
 }
 
+bool MeshLayer::depth_testable(const RenderSettings& settings) {
+  return settings.compositor == Compositor::kSorted && settings.accuracy.resort_window == 0;
+}
+
 void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                      bool depth_out) {
   if (uint32_t(camera.width) != width_ || uint32_t(camera.height) != height_)
     throw std::logic_error("MeshLayer::draw: the camera is not the layer's size");
+  // Per-pixel re-sorting and the stochastic compositor cannot depth-test against a host's surfaces: in
+  // those modes the splats are drawn over the background alone, without the mesh.
+  const bool mesh = depth_testable(settings);
   // The previous frame's command buffers are free again (the renderer waits for its own frame).
-  const VkFence fences[] = {box_fence_, grid_fence_};
-  if (submitted_) {
-    vk_check(vkWaitForFences(vk_, 2, fences, VK_TRUE, std::numeric_limits<uint64_t>::max()),
-             "vkWaitForFences");
-    vk_check(vkResetFences(vk_, 2, fences), "vkResetFences");
-  }
+  wait_for(box_fence_, box_pending_);
+  wait_for(grid_fence_, grid_pending_);
   const std::array<double, 16> projection_matrix = projection(camera);
   const std::array<double, 16> view = view_matrix(camera);
   float clip_from_world[16];
@@ -507,23 +516,36 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
   vkCmdPushConstants(box_commands_, mesh_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(clip_from_world),
                      clip_from_world);
   vkCmdBindVertexBuffers(box_commands_, 0, 1, &vertices_, &offset);
-  vkCmdDraw(box_commands_, box_vertices_, 1, 0, 0);
+  if (mesh) vkCmdDraw(box_commands_, box_vertices_, 1, 0, 0);
   vkCmdEndRenderPass(box_commands_);
   submit(box_commands_, VK_NULL_HANDLE, box_drawn_, box_fence_);
-  submitted_ = true;
+  box_pending_ = true;
 
   // 2. The splats, cut by the box's depth and writing theirs where they reach alpha 0.5, over black
   // (the background is the picture's), submitted between the box and the grid without waiting.
   RenderSettings splat_settings = settings;
   splat_settings.background = {0, 0, 0};
-  splat_settings.host = HostDepth{DepthConvention::from_projection(projection_matrix), {}, depth_out, 0.5f};
+  if (mesh)
+    splat_settings.host = HostDepth{DepthConvention::from_projection(projection_matrix), {}, depth_out, 0.5f};
   const ExternalImage target{splats_.image, width_, height_, kSplatFormat, VK_IMAGE_LAYOUT_UNDEFINED};
   const ExternalDepthImage depth{depth_.image, width_, height_, kDepthFormat,
                                  VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
   const VkSemaphore waits[] = {box_drawn_};
   const VkSemaphore signals[] = {splats_drawn_};
-  render_to_image(renderer, camera, splat_settings, target, &depth,
-                  HostFrameSync{waits, {}, {}, signals, {}});
+  try {
+    render_to_image(renderer, camera, splat_settings, target, mesh ? &depth : nullptr,
+                    HostFrameSync{waits, {}, {}, signals, {}});
+  } catch (...) {
+    // Nothing will wait for the box's semaphore now: an empty batch does, so that the next frame may
+    // signal it again.
+    const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+    VkSubmitInfo consume{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    consume.waitSemaphoreCount = 1;
+    consume.pWaitSemaphores = &box_drawn_;
+    consume.pWaitDstStageMask = &stage;
+    vkQueueSubmit(device_.queue(), 1, &consume, VK_NULL_HANDLE);
+    throw;
+  }
 
   // 3. The splats over the box (premultiplied), then the grid, depth-tested against the splats' depth.
   begin(grid_commands_);
@@ -550,9 +572,10 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
   vkCmdPushConstants(grid_commands_, mesh_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(clip_from_world),
                      clip_from_world);
   vkCmdBindVertexBuffers(grid_commands_, 0, 1, &vertices_, &offset);
-  vkCmdDraw(grid_commands_, grid_vertices_, 1, box_vertices_, 0);
+  if (mesh) vkCmdDraw(grid_commands_, grid_vertices_, 1, box_vertices_, 0);
   vkCmdEndRenderPass(grid_commands_);
   submit(grid_commands_, splats_drawn_, VK_NULL_HANDLE, grid_fence_);
+  grid_pending_ = true;
 }
 
 }  // namespace tilesplat::viewer

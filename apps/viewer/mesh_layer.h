@@ -31,6 +31,9 @@ class MeshLayer {
   // grid's), the grid. `settings` are the frame's; the background becomes the clear colour. Without
   // `depth_out` the splats leave the depth buffer as the box left it, and the grid is drawn over them.
   void draw(Renderer& renderer, const Camera& camera, const RenderSettings& settings, bool depth_out);
+  // Whether the frame's modes depth-test against a host's surfaces (not per-pixel re-sorting, not the
+  // stochastic compositor); draw() shows the splats alone over the background in the others.
+  static bool depth_testable(const RenderSettings& settings);
 
   // The composed picture, R16G16B16A16_SFLOAT in TRANSFER_SRC_OPTIMAL after draw(), for the blit.
   VkImage picture() const { return picture_.image; }
@@ -63,7 +66,9 @@ class MeshLayer {
   VkPipeline make_pipeline(VkShaderModule vertex, VkShaderModule fragment, VkPrimitiveTopology topology,
                            bool mesh, VkRenderPass pass);
   void begin(VkCommandBuffer cmd);
+  // Resets `fence` (when given) and submits `cmd`, after `wait` and signalling `signal` (either may be null).
   void submit(VkCommandBuffer cmd, VkSemaphore wait, VkSemaphore signal, VkFence fence);
+  void wait_for(VkFence fence, bool& pending);
   void destroy();
 
   const WindowDevice& device_;
@@ -89,7 +94,7 @@ class MeshLayer {
   VkCommandBuffer box_commands_ = VK_NULL_HANDLE, grid_commands_ = VK_NULL_HANDLE;
   VkSemaphore box_drawn_ = VK_NULL_HANDLE, splats_drawn_ = VK_NULL_HANDLE;
   VkFence box_fence_ = VK_NULL_HANDLE, grid_fence_ = VK_NULL_HANDLE;
-  bool submitted_ = false;  // the fences have a submission to wait for
+  bool box_pending_ = false, grid_pending_ = false;  // the fences have a submission to wait for
 };
 
 }  // namespace tilesplat::viewer
