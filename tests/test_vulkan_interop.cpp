@@ -538,6 +538,60 @@ TEST_F(HostApplication, NanInTheDepthImageMeansNoSurface) {
   EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
 }
 
+// A device without float64 (here: the host says it did not enable it) converts the depth image in
+// float32 (host_depth_fp32): within float rounding of the float64 conversion in host memory.
+TEST_F(HostApplication, DepthImageConvertsInFloat32WithoutFloat64) {
+  constexpr uint32_t kWidth = 160, kHeight = 90;
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const Camera camera =
+      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
+  const DepthConvention convention = effects::bench_depth_convention();
+  const std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+  const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
+  const Image depth =
+      make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, kWidth, kHeight);
+  make_staging(VkDeviceSize(kWidth) * kHeight * 16);
+  std::memcpy(staging_data, wall.data(), wall.size() * sizeof(float));
+  submit([&](VkCommandBuffer cmd) { record_draw_depth(cmd, depth.image, kWidth, kHeight); });
+
+  ExternalVulkanDevice without_float64 = external();
+  without_float64.shader_float64_enabled = false;
+  auto renderer = create_renderer(without_float64);
+  renderer->set_scene(scene);
+  RenderSettings settings;
+  settings.host = HostDepth{convention, {}, true, 0.5f};
+  render_to_image(
+      *renderer, camera, settings,
+      {colour.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_LAYOUT_UNDEFINED},
+      {depth.image, kWidth, kHeight, VK_FORMAT_D32_SFLOAT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL});
+  RenderSettings in_memory = settings;
+  in_memory.host->depth = wall;
+  const RenderImage expected = renderer->render(camera, in_memory);
+
+  std::vector<float> rgba(size_t(kWidth) * kHeight * 4), depth_after(size_t(kWidth) * kHeight);
+  read_image(colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
+  std::memcpy(rgba.data(), staging_data, rgba.size() * sizeof(float));
+  read_image(depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, kWidth,
+             kHeight);
+  std::memcpy(depth_after.data(), staging_data, depth_after.size() * sizeof(float));
+  // A splat whose depth lies within a float's rounding of the wall's may fall on the other side of it:
+  // a few pixels may differ, by at most that splat's contribution.
+  size_t differing = 0;
+  for (size_t i = 0; i < rgba.size(); ++i) differing += rgba[i] != expected.rgba[i] ? 1u : 0u;
+  EXPECT_LE(differing, rgba.size() / 100);
+  std::printf("float32 conversion: %zu of %zu values differ\n", differing, rgba.size());
+  size_t reached = 0;
+  for (size_t i = 0; i < depth_after.size(); ++i) {
+    EXPECT_NEAR(depth_after[i], expected.host_depth[i], 2e-6f * std::abs(expected.host_depth[i]) + 1e-7f)
+        << "pixel " << i;
+    reached += expected.host_depth[i] != wall[i] ? 1u : 0u;
+  }
+  EXPECT_GT(reached, depth_after.size() / 20);
+  renderer.reset();
+  release_host_objects();
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
 // Half-float and 8-bit colour images (UNORM and sRGB) hold the frame's RGBA rounded to their texels.
 TEST_F(HostApplication, RendersIntoHalfAndEightBitColourImages) {
   constexpr uint32_t kWidth = 96, kHeight = 64;
