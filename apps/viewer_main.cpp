@@ -284,7 +284,8 @@ class Viewer {
     if (mesh_layer_)
       mesh_layer_->draw(renderer_, controller_.camera(), frame, depth_out_);
     else
-      tilesplat::render_to_image(renderer_, controller_.camera(), frame, image_->target(), nullptr, {});
+      tilesplat::render_to_image(renderer_, controller_.camera(), frame, image_->target(), nullptr,
+                                 tilesplat::HostFrameSync{});
     needs_render_ = false;
     needs_present_ = true;
     ++frames_;

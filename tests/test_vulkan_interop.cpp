@@ -737,6 +737,112 @@ TEST_F(HostApplication, FrameInsideTheHostsFrameWaitsForAndSignalsItsSemaphores)
   EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
 }
 
+// The frame recorded into the host's own command buffer, between the host's commands: the host draws
+// its depth before it and reads both images back after it, in one submission that signals the host's
+// timeline semaphore. The images equal the blocking path's to the bit.
+TEST_F(HostApplication, FrameRecordedIntoTheHostsCommandBuffer) {
+  constexpr uint32_t kWidth = 160, kHeight = 90;
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const Camera camera =
+      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
+  const DepthConvention convention = effects::bench_depth_convention();
+  const std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+  const size_t pixels = size_t(kWidth) * kHeight;
+  const VkDeviceSize colour_bytes = pixels * 16;
+  const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
+  const Image depth =
+      make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, kWidth, kHeight);
+  make_staging(colour_bytes + pixels * sizeof(float));
+  std::memcpy(staging_data, wall.data(), pixels * sizeof(float));
+  const VkSemaphore timeline = make_semaphore(/*timeline=*/true);
+  auto begin_commands = [&] {
+    VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cai.commandPool = pool();
+    cai.commandBufferCount = 1;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    EXPECT_EQ(vkAllocateCommandBuffers(device, &cai, &cmd), VK_SUCCESS);
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    EXPECT_EQ(vkBeginCommandBuffer(cmd, &begin), VK_SUCCESS);
+    pending_command_buffers.push_back(cmd);
+    return cmd;
+  };
+  auto submit_signalling = [&](VkCommandBuffer cmd, uint64_t value) {
+    ASSERT_EQ(vkEndCommandBuffer(cmd), VK_SUCCESS);
+    VkTimelineSemaphoreSubmitInfo values{VK_STRUCTURE_TYPE_TIMELINE_SEMAPHORE_SUBMIT_INFO};
+    values.signalSemaphoreValueCount = 1;
+    values.pSignalSemaphoreValues = &value;
+    VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    info.pNext = &values;
+    info.commandBufferCount = 1;
+    info.pCommandBuffers = &cmd;
+    info.signalSemaphoreCount = 1;
+    info.pSignalSemaphores = &timeline;
+    ASSERT_EQ(vkQueueSubmit(queue, 1, &info, VK_NULL_HANDLE), VK_SUCCESS);
+  };
+
+  RenderSettings settings;
+  settings.host = HostDepth{convention, {}, true, 0.5f};
+  auto renderer = create_renderer(external());
+  renderer->set_scene(scene);
+  const ExternalImage target{colour.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT,
+                             VK_IMAGE_LAYOUT_UNDEFINED};
+  const ExternalDepthImage host_depth{depth.image, kWidth, kHeight, VK_FORMAT_D32_SFLOAT,
+                                      VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+  VkCommandBuffer cmd = begin_commands();
+  record_draw_depth(cmd, depth.image, kWidth, kHeight);
+  render_to_image(*renderer, camera, settings, target, &host_depth, HostCommandBuffer{cmd, timeline, 1});
+  record_read(cmd, colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight, 0);
+  record_read(cmd, depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+              kWidth, kHeight, colour_bytes);
+  submit_signalling(cmd, 1);
+  wait_for_frame(*renderer);  // waits for the timeline to reach 1
+  std::vector<float> rgba(pixels * 4), depth_after(pixels);
+  std::memcpy(rgba.data(), staging_data, colour_bytes);
+  std::memcpy(depth_after.data(), static_cast<const std::byte*>(staging_data) + colour_bytes,
+              pixels * sizeof(float));
+  EXPECT_TRUE(renderer->last_frame_stats().complete);
+  EXPECT_GT(renderer->last_frame_stats().intersections, 0u);
+
+  RenderSettings in_memory = settings;
+  in_memory.host->depth = wall;
+  const RenderImage expected = renderer->render(camera, in_memory);
+  EXPECT_EQ(rgba, expected.rgba);
+  EXPECT_EQ(depth_after, expected.host_depth);
+
+  // The stochastic compositor's 100 samples, which its own submissions split in two, fit one command
+  // buffer of the host's.
+  RenderSettings stochastic;
+  stochastic.compositor = Compositor::kStochastic;
+  stochastic.stochastic.frames = 100;
+  cmd = begin_commands();
+  const ExternalImage again{colour.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT,
+                            VK_IMAGE_LAYOUT_UNDEFINED};
+  render_to_image(*renderer, camera, stochastic, again, nullptr, HostCommandBuffer{cmd, timeline, 2});
+  record_read(cmd, colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight, 0);
+  submit_signalling(cmd, 2);
+  wait_for_frame(*renderer);
+  std::memcpy(rgba.data(), staging_data, colour_bytes);
+  EXPECT_EQ(rgba, renderer->render(camera, stochastic).rgba);
+
+  // Refused before anything is recorded: a host sort strategy, a null command buffer or semaphore.
+  cmd = begin_commands();
+  RenderSettings host_sort;
+  host_sort.sort = "cpu-radix";
+  EXPECT_THROW(
+      render_to_image(*renderer, camera, host_sort, again, nullptr, HostCommandBuffer{cmd, timeline, 3}),
+      std::invalid_argument);
+  EXPECT_THROW(
+      render_to_image(*renderer, camera, {}, again, nullptr, HostCommandBuffer{VK_NULL_HANDLE, timeline, 3}),
+      std::invalid_argument);
+  EXPECT_THROW(
+      render_to_image(*renderer, camera, {}, again, nullptr, HostCommandBuffer{cmd, VK_NULL_HANDLE, 3}),
+      std::invalid_argument);
+  EXPECT_EQ(vkEndCommandBuffer(cmd), VK_SUCCESS);  // empty
+  renderer.reset();
+  release_host_objects();
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
 // A submitted frame cannot re-render: one that wants more (tile, Gaussian) pairs than the key buffers
 // hold is drawn with those that fit and says so, and the next frame, with grown buffers, is whole.
 TEST_F(HostApplication, SubmittedFrameThatOutgrowsTheBuffersSaysSoAndTheNextIsWhole) {

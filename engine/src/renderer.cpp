@@ -643,13 +643,17 @@ struct Renderer::Impl {
     end_frame(start, frame, std::move(passes), true);
   }
 
-  // A frame render_to_image submitted without waiting (HostFrameSync): what its completion needs.
+  // A frame render_to_image did not wait for (HostFrameSync, HostCommandBuffer): what its completion needs.
   struct SubmittedFrame {
     FrameStart start;
     Camera camera;
     RenderSettings settings;  // without HostDepth::depth, which a depth image stands in for
     int submissions = 0;
     double cpu_ms = 0;
+    // Recorded into a host's command buffer: complete once this timeline semaphore reaches `value`
+    // (else the renderer's own submission, in_flight).
+    VkSemaphore timeline = VK_NULL_HANDLE;
+    uint64_t value = 0;
   };
 
   // Records a whole frame, its copies into the host's images included, and submits it without
@@ -665,12 +669,40 @@ struct Renderer::Impl {
     if (depth_image && settings.host->write_depth)
       record_host_depth_out(stream.cmd(), *depth_image, settings.host->convention);
     stream.submit_in_flight(in_flight, sync);
+    keep_submitted(start, camera, settings, stream.submissions());
+  }
+
+  // Records a whole frame, its copies into the host's images included, into the host's command buffer
+  // (render_to_image with HostCommandBuffer), which the host submits and reports complete through its
+  // timeline semaphore.
+  void record_frame_into(const HostCommandBuffer& host, const Camera& camera, const RenderSettings& settings,
+                         const ExternalImage& target, const ExternalDepthImage* depth_image) {
+    if (sort(settings.sort).sorts_on_host())
+      throw std::invalid_argument(
+          "render_to_image: the sort strategy '" + settings.sort +
+          "' sorts on the host in the middle of the frame, which a command buffer of the "
+          "host's cannot hold: use a GPU strategy, or HostFrameSync");
+    const FrameStart start = begin_frame(camera, settings, depth_image != nullptr);
+    prepare_frame(settings, *start.sorter, !start.reuse, uint32_t(camera.width), uint32_t(camera.height));
+    vk::CommandStream stream(ctx, host.command_buffer);
+    record_frame(stream, camera, settings, *start.sorter, !start.reuse, depth_image);
+    copy_colour_to_image(stream.cmd(), target);
+    if (depth_image && settings.host->write_depth)
+      record_host_depth_out(stream.cmd(), *depth_image, settings.host->convention);
+    stream.end_borrowed();
+    keep_submitted(start, camera, settings, 0);
+    submitted->timeline = host.timeline;
+    submitted->value = host.value;
+  }
+
+  void keep_submitted(const FrameStart& start, const Camera& camera, const RenderSettings& settings,
+                      int submissions) {
     RenderSettings kept = settings;
     kept.host
         .reset();  // only the compositor and modes are looked at again, and HostDepth::depth is not owned
-    submitted = SubmittedFrame{
-        start, camera, std::move(kept), stream.submissions(),
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start.time).count()};
+    const double cpu_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start.time).count();
+    submitted = SubmittedFrame{start, camera, std::move(kept), submissions, cpu_ms};
   }
 
   // Waits for the frame in flight, if any, and makes its statistics the last frame's. It cannot
@@ -680,7 +712,15 @@ struct Renderer::Impl {
     if (!submitted) return;
     const SubmittedFrame frame_info = std::move(*submitted);
     submitted.reset();
-    in_flight.wait();
+    if (frame_info.timeline != VK_NULL_HANDLE) {
+      VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+      wait.semaphoreCount = 1;
+      wait.pSemaphores = &frame_info.timeline;
+      wait.pValues = &frame_info.value;
+      TS_VK_CHECK(vkWaitSemaphores(ctx.device(), &wait, UINT64_MAX));
+    } else {
+      in_flight.wait();
+    }
     const FrameCounters frame = frame_counters();
     stats = {};
     std::vector<PassTiming> passes;
@@ -888,6 +928,26 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   check_count(sync.signal_values.size(), sync.signal.size(), "signal_values");
   r.submit_frame(camera, settings, target, depth,
                  {sync.wait, sync.wait_stages, sync.wait_values, sync.signal, sync.signal_values});
+}
+
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                     const ExternalImage& target, const ExternalDepthImage* depth,
+                     const HostCommandBuffer& commands) {
+  Renderer::Impl& r = *renderer.impl_;
+  check_colour_target(target, camera);
+  if (depth) {
+    check_depth_image(*depth, target, settings);
+  } else if (settings.host && settings.host->write_depth) {
+    throw std::invalid_argument(
+        "render_to_image: HostDepth::write_depth needs the host's depth image to write into: pass an "
+        "ExternalDepthImage");
+  }
+  if (commands.command_buffer == VK_NULL_HANDLE)
+    throw std::invalid_argument("render_to_image: HostCommandBuffer has no command buffer");
+  if (commands.timeline == VK_NULL_HANDLE)
+    throw std::invalid_argument(
+        "render_to_image: HostCommandBuffer has no timeline semaphore to say when the frame has completed");
+  r.record_frame_into(commands, camera, settings, target, depth);
 }
 
 void wait_for_frame(Renderer& renderer) {

@@ -244,6 +244,7 @@ struct ExternalVulkanDevice;  // tilesplat/vulkan_interop.h
 struct ExternalImage;
 struct ExternalDepthImage;
 struct HostFrameSync;
+struct HostCommandBuffer;
 
 /// Names of the available sort strategies, default first.
 TILESPLAT_API std::vector<std::string> sort_strategies();
@@ -320,6 +321,8 @@ class TILESPLAT_API Renderer {
                               const ExternalDepthImage&);
   friend void render_to_image(Renderer&, const Camera&, const RenderSettings&, const ExternalImage&,
                               const ExternalDepthImage*, const HostFrameSync&);
+  friend void render_to_image(Renderer&, const Camera&, const RenderSettings&, const ExternalImage&,
+                              const ExternalDepthImage*, const HostCommandBuffer&);
   friend void wait_for_frame(Renderer&);
 };
 

@@ -113,8 +113,33 @@ TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, con
                                    const ExternalImage& target, const ExternalDepthImage* depth,
                                    const HostFrameSync& sync);
 
-/// Waits for the frame render_to_image(..., HostFrameSync) submitted last, if it is still running, and
-/// makes its statistics last_frame_stats(). Nothing to do after a blocking call.
+/// A command buffer of the host's that render_to_image records a frame into, and how the renderer
+/// learns that the host's submission of it has completed.
+struct HostCommandBuffer {
+  /// In the recording state, from a pool of ExternalVulkanDevice::queue_family; the host submits it
+  /// (to a queue of that family) before its next call on the renderer.
+  VkCommandBuffer command_buffer = VK_NULL_HANDLE;
+  /// A timeline semaphore (Vulkan 1.2) that the host's submission of the command buffer signals...
+  VkSemaphore timeline = VK_NULL_HANDLE;
+  uint64_t value = 0;  ///< ...to this value, or a later one, once the command buffer has completed
+};
+
+/// Records a frame into the host's command buffer instead of submitting it: the frame runs inside the
+/// host's own submission, wherever the host puts it among its commands. Every image access is fenced
+/// by barriers against all commands before and after it (docs/embedding.md), and the images are left
+/// in their layouts. The renderer's own buffers are uploaded as the call records, so one frame is in
+/// flight at a time: the next call on the renderer (or wait_for_frame(), or its destruction) first
+/// waits for `commands.timeline` to reach `commands.value`, and the host must have submitted the
+/// command buffer by then. As with HostFrameSync, a frame that outgrows the buffers is drawn with what
+/// fits (FrameStats::complete). Throws std::invalid_argument as the calls above, for a null command
+/// buffer or semaphore, and for a sort strategy that sorts on the host mid-frame (cpu-radix), before
+/// recording anything.
+TILESPLAT_API void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                                   const ExternalImage& target, const ExternalDepthImage* depth,
+                                   const HostCommandBuffer& commands);
+
+/// Waits for the frame render_to_image(..., HostFrameSync or HostCommandBuffer) left running, if it
+/// has not completed, and makes its statistics last_frame_stats(). Nothing to do after a blocking call.
 TILESPLAT_API void wait_for_frame(Renderer& renderer);
 
 }  // namespace tilesplat

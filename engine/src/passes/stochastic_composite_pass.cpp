@@ -61,7 +61,7 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
   for (uint32_t sample = 0; sample < samples.count; ++sample) {
-    if (sample > 0 && sample % kSamplesPerSubmission == 0) stream.flush();
+    if (sample > 0 && sample % kSamplesPerSubmission == 0) stream.may_split();
     for (uint32_t chunk = 0; chunk < chunks.count; ++chunk) {
       // Each dispatch reads what the previous one left in the state buffer.
       if (sample > 0 || chunk > 0) vk::barrier(stream.cmd());

@@ -42,6 +42,7 @@ class CpuRadixSort final : public SortStrategy {
   void reserve(uint32_t max_keys) override;
   bool record(vk::CommandStream& stream, SortInput& input) override;
   bool exact() const override { return keys_ == Keys::kExact; }
+  bool sorts_on_host() const override { return true; }
   uint64_t device_bytes() const override { return staging_.size(); }
 
   // Whether the last record() copied through the staging buffer (false: it sorted in place).

@@ -55,6 +55,9 @@ class SortStrategy {
   // path (onesweep's look-back), over its life. 0 for a strategy that never waits. Read it once the
   // recorded sorts have finished.
   virtual uint64_t stall_fallbacks() const { return 0; }
+  // True for a strategy that sorts on the host in the middle of the frame (CommandStream::flush): its
+  // frame cannot be recorded into a host application's command buffer.
+  virtual bool sorts_on_host() const { return false; }
 };
 
 // Every strategy by name: the built-in ones, then those added at run time. Thread-safe.

@@ -29,7 +29,7 @@ void InFlightSubmission::wait() {
 }
 
 CommandStream::~CommandStream() {
-  if (cmd_ != VK_NULL_HANDLE) ctx_.discard(cmd_);
+  if (cmd_ != VK_NULL_HANDLE && !borrowed_) ctx_.discard(cmd_);
 }
 
 void CommandStream::make_writes_host_visible() {
@@ -54,7 +54,14 @@ void CommandStream::submit() {
   ++submissions_;
 }
 
+void CommandStream::end_borrowed() {
+  make_writes_host_visible();
+  cmd_ = VK_NULL_HANDLE;
+}
+
 void CommandStream::flush() {
+  if (borrowed_)
+    throw std::logic_error("CommandStream::flush: a host's command buffer cannot be submitted here");
   submit();
   cmd_ = ctx_.begin_one_time();
 }

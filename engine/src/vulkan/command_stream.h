@@ -33,6 +33,9 @@ class InFlightSubmission {
 class CommandStream {
  public:
   explicit CommandStream(Context& ctx) : ctx_(ctx), cmd_(ctx.begin_one_time()) {}
+  // Records into a host application's command buffer (in the recording state), which the host submits:
+  // flush() is an error there, may_split() does nothing, and end_borrowed() ends the stream.
+  CommandStream(Context& ctx, VkCommandBuffer borrowed) : ctx_(ctx), cmd_(borrowed), borrowed_(true) {}
   // A stream left unfinished (an exception while recording) is discarded without being submitted.
   ~CommandStream();
   CommandStream(const CommandStream&) = delete;
@@ -45,8 +48,17 @@ class CommandStream {
   void wait_first(const SubmitSync& waits) { first_waits_ = waits; }
 
   // Submits what is recorded, waits for it with its shader and transfer writes visible to the host
-  // (mapped memory may be read right after), and begins a new command buffer.
+  // (mapped memory may be read right after), and begins a new command buffer. Throws std::logic_error
+  // on a host's command buffer.
   void flush();
+  // Where a long stream (the stochastic composite's samples) may be cut into submissions: flush() on
+  // the stream's own command buffers, nothing on a host's.
+  void may_split() {
+    if (!borrowed_) flush();
+  }
+  // Ends a stream on a host's command buffer, with its writes made visible to the host once the host's
+  // submission of it has completed.
+  void end_borrowed();
   // Submits what is recorded and waits for it, with the same host visibility; the stream ends.
   void finish();
   // Submits what is recorded without waiting, signalling `signal` (its wait half unused) and
@@ -64,6 +76,7 @@ class CommandStream {
   Context& ctx_;
   VkCommandBuffer cmd_;
   SubmitSync first_waits_;
+  bool borrowed_ = false;
   int submissions_ = 0;
 };
 
