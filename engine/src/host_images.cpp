@@ -65,6 +65,17 @@ void check_depth_image(const ExternalDepthImage& depth, const ExternalImage& tar
     fail("RenderSettings::host already has depth values; the image replaces them");
 }
 
+void check_images(const ExternalImage& target, const ExternalDepthImage* depth, const Camera& camera,
+                  const RenderSettings& settings) {
+  check_colour_target(target, camera);
+  if (depth)
+    check_depth_image(*depth, target, settings);
+  else if (settings.host && settings.host->write_depth)
+    throw std::invalid_argument(
+        "render_to_image: HostDepth::write_depth needs the host's depth image to write into: pass an "
+        "ExternalDepthImage");
+}
+
 VkImageAspectFlags depth_aspect(const ExternalDepthImage& depth) {
   return depth.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
 }

@@ -15,6 +15,9 @@ namespace tilesplat {
 void check_colour_target(const ExternalImage& target, const Camera& camera);
 void check_depth_image(const ExternalDepthImage& depth, const ExternalImage& target,
                        const RenderSettings& settings);
+// Both: the depth image when given, else that settings.host asks for no depth out (it has nowhere to go).
+void check_images(const ExternalImage& target, const ExternalDepthImage* depth, const Camera& camera,
+                  const RenderSettings& settings);
 
 // The aspect a depth image's depths are in (DEPTH for D32_SFLOAT, COLOR for R32_SFLOAT).
 VkImageAspectFlags depth_aspect(const ExternalDepthImage& depth);

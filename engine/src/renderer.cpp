@@ -879,11 +879,7 @@ std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device, co
 void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                      const ExternalImage& target) {
   Renderer::Impl& r = *renderer.impl_;
-  check_colour_target(target, camera);
-  if (settings.host && settings.host->write_depth)
-    throw std::invalid_argument(
-        "render_to_image: HostDepth::write_depth needs the host's depth image to write into: pass an "
-        "ExternalDepthImage");
+  check_images(target, nullptr, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings);
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) { r.copy_colour_to_image(cmd, target); });
@@ -894,8 +890,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
 void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                      const ExternalImage& target, const ExternalDepthImage& depth) {
   Renderer::Impl& r = *renderer.impl_;
-  check_colour_target(target, camera);
-  check_depth_image(depth, target, settings);
+  check_images(target, &depth, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings, &depth);
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
@@ -909,14 +904,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
                      const ExternalImage& target, const ExternalDepthImage* depth,
                      const HostFrameSync& sync) {
   Renderer::Impl& r = *renderer.impl_;
-  check_colour_target(target, camera);
-  if (depth) {
-    check_depth_image(*depth, target, settings);
-  } else if (settings.host && settings.host->write_depth) {
-    throw std::invalid_argument(
-        "render_to_image: HostDepth::write_depth needs the host's depth image to write into: pass an "
-        "ExternalDepthImage");
-  }
+  check_images(target, depth, camera, settings);
   auto check_count = [](size_t count, size_t semaphores, const char* what) {
     if (count != 0 && count != semaphores)
       throw std::invalid_argument(std::string("render_to_image: HostFrameSync has ") + std::to_string(count) +
@@ -934,14 +922,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
                      const ExternalImage& target, const ExternalDepthImage* depth,
                      const HostCommandBuffer& commands) {
   Renderer::Impl& r = *renderer.impl_;
-  check_colour_target(target, camera);
-  if (depth) {
-    check_depth_image(*depth, target, settings);
-  } else if (settings.host && settings.host->write_depth) {
-    throw std::invalid_argument(
-        "render_to_image: HostDepth::write_depth needs the host's depth image to write into: pass an "
-        "ExternalDepthImage");
-  }
+  check_images(target, depth, camera, settings);
   if (commands.command_buffer == VK_NULL_HANDLE)
     throw std::invalid_argument("render_to_image: HostCommandBuffer has no command buffer");
   if (commands.timeline == VK_NULL_HANDLE)
