@@ -103,6 +103,15 @@ void validate_compositor(const RenderSettings& settings) {
          std::to_string(settings.stochastic.frames));
 }
 
+// Waits for a timeline semaphore (a host's, HostCommandBuffer) to reach `value`.
+VkResult wait_for_value(VkDevice device, VkSemaphore timeline, uint64_t value) {
+  VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+  wait.semaphoreCount = 1;
+  wait.pSemaphores = &timeline;
+  wait.pValues = &value;
+  return vkWaitSemaphores(device, &wait, UINT64_MAX);
+}
+
 template <typename T>
 vk::Buffer make_buffer(vk::Context& ctx, size_t count, const char* name) {
   return vk::Buffer(ctx, VkDeviceSize(count) * sizeof(T), vk::MemoryUse::Device, name);
@@ -129,6 +138,12 @@ struct Renderer::Impl {
         stochastic_composite(ctx),
         counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "frame counters"),
         in_flight(ctx) {}
+  // A frame recorded into a host's command buffer may still run on the buffers about to go (a frame
+  // the renderer submitted itself is waited for by in_flight's destructor).
+  ~Impl() {
+    if (submitted && submitted->timeline != VK_NULL_HANDLE)
+      wait_for_value(ctx.device(), submitted->timeline, submitted->value);  // no throwing from a destructor
+  }
 
   SortStrategy& sort(const std::string& name) {
     auto it = sorts.find(name);
@@ -712,15 +727,10 @@ struct Renderer::Impl {
     if (!submitted) return;
     const SubmittedFrame frame_info = std::move(*submitted);
     submitted.reset();
-    if (frame_info.timeline != VK_NULL_HANDLE) {
-      VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
-      wait.semaphoreCount = 1;
-      wait.pSemaphores = &frame_info.timeline;
-      wait.pValues = &frame_info.value;
-      TS_VK_CHECK(vkWaitSemaphores(ctx.device(), &wait, UINT64_MAX));
-    } else {
+    if (frame_info.timeline != VK_NULL_HANDLE)
+      TS_VK_CHECK(wait_for_value(ctx.device(), frame_info.timeline, frame_info.value));
+    else
       in_flight.wait();
-    }
     const FrameCounters frame = frame_counters();
     stats = {};
     std::vector<PassTiming> passes;
