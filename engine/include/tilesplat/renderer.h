@@ -208,7 +208,9 @@ struct FrameStats {
   uint64_t intersections = 0;      ///< (Gaussian, tile) pairs sorted
   uint32_t sort_bits = 0;  ///< key bits sorted: 32 depth bits (per Gaussian) + the tile bits (per pair)
   int retries = 0;         ///< re-renders after growing the intersection buffers
-  int submissions = 0;     ///< command buffers the frame took: 1, more for a strategy that sorts on the host
+  /// Command buffers the frame took: 1, more for a strategy that sorts on the host; 0 when recorded
+  /// into a host's (HostCommandBuffer).
+  int submissions = 0;
   uint64_t sort_fallbacks = 0;  ///< onesweep look-backs that gave up waiting and counted keys themselves
   uint64_t device_bytes = 0;    ///< device memory held by the renderer's buffers
   /// True when the frame ran only its composite, on the tile lists the previous frame left in the
