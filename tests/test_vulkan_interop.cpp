@@ -696,6 +696,7 @@ TEST_F(HostApplication, FrameInsideTheHostsFrameWaitsForAndSignalsItsSemaphores)
   const FrameStats& stats = renderer->last_frame_stats();
   EXPECT_TRUE(stats.complete);
   EXPECT_GT(stats.intersections, 0u);
+  EXPECT_EQ(stats.submissions, 1);
   EXPECT_TRUE(std::any_of(stats.passes.begin(), stats.passes.end(),
                           [](const PassTiming& p) { return p.name == "host_depth_in"; }));
 
@@ -802,6 +803,7 @@ TEST_F(HostApplication, FrameRecordedIntoTheHostsCommandBuffer) {
               pixels * sizeof(float));
   EXPECT_TRUE(renderer->last_frame_stats().complete);
   EXPECT_GT(renderer->last_frame_stats().intersections, 0u);
+  EXPECT_EQ(renderer->last_frame_stats().submissions, 0);  // the host's
 
   RenderSettings in_memory = settings;
   in_memory.host->depth = wall;
