@@ -676,13 +676,9 @@ struct Renderer::Impl {
   void submit_frame(const Camera& camera, const RenderSettings& settings, const ExternalImage& target,
                     const ExternalDepthImage* depth_image, const vk::SubmitSync& sync) {
     const FrameStart start = begin_frame(camera, settings, depth_image != nullptr);
-    prepare_frame(settings, *start.sorter, !start.reuse, uint32_t(camera.width), uint32_t(camera.height));
     vk::CommandStream stream(ctx);
     stream.wait_first(sync);
-    record_frame(stream, camera, settings, *start.sorter, !start.reuse, depth_image);
-    copy_colour_to_image(stream.cmd(), target);
-    if (depth_image && settings.host->write_depth)
-      record_host_depth_out(stream.cmd(), *depth_image, settings.host->convention);
+    record_frame_to_images(stream, start, camera, settings, target, depth_image);
     stream.submit_in_flight(in_flight, sync);
     keep_submitted(start, camera, settings, stream.submissions());
   }
@@ -698,26 +694,38 @@ struct Renderer::Impl {
           "' sorts on the host in the middle of the frame, which a command buffer of the "
           "host's cannot hold: use a GPU strategy, or HostFrameSync");
     const FrameStart start = begin_frame(camera, settings, depth_image != nullptr);
-    prepare_frame(settings, *start.sorter, !start.reuse, uint32_t(camera.width), uint32_t(camera.height));
     vk::CommandStream stream(ctx, host.command_buffer);
-    record_frame(stream, camera, settings, *start.sorter, !start.reuse, depth_image);
-    copy_colour_to_image(stream.cmd(), target);
-    if (depth_image && settings.host->write_depth)
-      record_host_depth_out(stream.cmd(), *depth_image, settings.host->convention);
+    record_frame_to_images(stream, start, camera, settings, target, depth_image);
     stream.end_borrowed();
-    keep_submitted(start, camera, settings, 0);
-    submitted->timeline = host.timeline;
-    submitted->value = host.value;
+    keep_submitted(start, camera, settings, 0, host.timeline, host.value);
+  }
+
+  // A frame that goes on without the renderer waiting for it (submit_frame, record_frame_into): its
+  // whole recording, from the buffers' sizes to the copies into the host's images.
+  void record_frame_to_images(vk::CommandStream& stream, const FrameStart& start, const Camera& camera,
+                              const RenderSettings& settings, const ExternalImage& target,
+                              const ExternalDepthImage* depth_image) {
+    prepare_frame(settings, *start.sorter, !start.reuse, uint32_t(camera.width), uint32_t(camera.height));
+    record_frame(stream, camera, settings, *start.sorter, !start.reuse, depth_image);
+    record_copies_to_images(stream.cmd(), settings, target, depth_image);
+  }
+
+  // What the host sees of a frame: its colour, and with a depth image and write_depth, the splats' depth.
+  void record_copies_to_images(VkCommandBuffer cmd, const RenderSettings& settings,
+                               const ExternalImage& target, const ExternalDepthImage* depth_image) {
+    copy_colour_to_image(cmd, target);
+    if (depth_image && settings.host->write_depth)
+      record_host_depth_out(cmd, *depth_image, settings.host->convention);
   }
 
   void keep_submitted(const FrameStart& start, const Camera& camera, const RenderSettings& settings,
-                      int submissions) {
+                      int submissions, VkSemaphore timeline = VK_NULL_HANDLE, uint64_t value = 0) {
     RenderSettings kept = settings;
     kept.host
         .reset();  // only the compositor and modes are looked at again, and HostDepth::depth is not owned
     const double cpu_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start.time).count();
-    submitted = SubmittedFrame{start, camera, std::move(kept), submissions, cpu_ms};
+    submitted = SubmittedFrame{start, camera, std::move(kept), submissions, cpu_ms, timeline, value};
   }
 
   // Waits for the frame in flight, if any, and makes its statistics the last frame's. It cannot
@@ -892,7 +900,8 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   check_images(target, nullptr, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings);
-  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) { r.copy_colour_to_image(cmd, target); });
+  r.ctx.submit_and_wait(
+      [&](VkCommandBuffer cmd) { r.record_copies_to_images(cmd, settings, target, nullptr); });
   r.stats.cpu_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -903,10 +912,8 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   check_images(target, &depth, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings, &depth);
-  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    r.copy_colour_to_image(cmd, target);
-    if (settings.host->write_depth) r.record_host_depth_out(cmd, depth, settings.host->convention);
-  });
+  r.ctx.submit_and_wait(
+      [&](VkCommandBuffer cmd) { r.record_copies_to_images(cmd, settings, target, &depth); });
   r.stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
