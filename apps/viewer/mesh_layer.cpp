@@ -126,14 +126,6 @@ void MeshLayer::destroy() {
   destroy_image(splats_);
 }
 
-uint32_t MeshLayer::memory_type(uint32_t bits, VkMemoryPropertyFlags flags) const {
-  VkPhysicalDeviceMemoryProperties memory;
-  vkGetPhysicalDeviceMemoryProperties(device_.physical_device(), &memory);
-  for (uint32_t i = 0; i < memory.memoryTypeCount; ++i)
-    if ((bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & flags) == flags) return i;
-  throw std::runtime_error(device_.name() + ": no memory type for the viewer's mesh");
-}
-
 MeshLayer::Image MeshLayer::make_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect) {
   Image made;
   VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
@@ -150,7 +142,7 @@ MeshLayer::Image MeshLayer::make_image(VkFormat format, VkImageUsageFlags usage,
   vkGetImageMemoryRequirements(vk_, made.image, &requirements);
   VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   allocate.allocationSize = requirements.size;
-  allocate.memoryTypeIndex = memory_type(requirements.memoryTypeBits, 0);
+  allocate.memoryTypeIndex = device_.memory_type(requirements.memoryTypeBits, 0, 0, "the viewer's mesh");
   const VkResult allocated = vkAllocateMemory(vk_, &allocate, nullptr, &made.memory);
   if (allocated != VK_SUCCESS) destroy_image(made);
   vk_check(allocated, "vkAllocateMemory (mesh layer)");
@@ -214,9 +206,9 @@ void MeshLayer::build_geometry(const Bounds& bounds) {
   vkGetBufferMemoryRequirements(vk_, vertices_, &requirements);
   VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   allocate.allocationSize = requirements.size;
-  allocate.memoryTypeIndex =
-      memory_type(requirements.memoryTypeBits,
-                  VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+  allocate.memoryTypeIndex = device_.memory_type(
+      requirements.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+      0, "the viewer's mesh");
   vk_check(vkAllocateMemory(vk_, &allocate, nullptr, &vertex_memory_), "vkAllocateMemory (mesh)");
   vk_check(vkBindBufferMemory(vk_, vertices_, vertex_memory_, 0), "vkBindBufferMemory");
   void* mapped = nullptr;

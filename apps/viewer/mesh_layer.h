@@ -59,7 +59,6 @@ class MeshLayer {
   };
   Image make_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect);
   void destroy_image(Image& image);
-  uint32_t memory_type(uint32_t bits, VkMemoryPropertyFlags flags) const;
   void build_geometry(const Bounds& bounds);
   void create_render_passes();
   void create_pipelines();

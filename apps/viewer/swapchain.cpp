@@ -74,19 +74,11 @@ FloatImage::FloatImage(const WindowDevice& device, uint32_t width, uint32_t heig
 
   VkMemoryRequirements requirements;
   vkGetImageMemoryRequirements(device_, image_, &requirements);
-  VkPhysicalDeviceMemoryProperties memory;
-  vkGetPhysicalDeviceMemoryProperties(device.physical_device(), &memory);
-  // Device-local where the device has it (every GPU); any allowed type otherwise.
-  uint32_t type = std::numeric_limits<uint32_t>::max();
-  for (uint32_t i = 0; i < memory.memoryTypeCount; ++i) {
-    if (!(requirements.memoryTypeBits & (1u << i))) continue;
-    const bool local = memory.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-    if (type == std::numeric_limits<uint32_t>::max() || local) type = i;
-    if (local) break;
-  }
   VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   allocate.allocationSize = requirements.size;
-  allocate.memoryTypeIndex = type;
+  // Device-local where the device has it (every GPU); any allowed type otherwise.
+  allocate.memoryTypeIndex = device.memory_type(requirements.memoryTypeBits, 0,
+                                                VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "the float image");
   try {
     vk_check(vkAllocateMemory(device_, &allocate, nullptr, &memory_), "vkAllocateMemory (the float image)");
     vk_check(vkBindImageMemory(device_, image_, memory_, 0), "vkBindImageMemory (the float image)");
@@ -99,32 +91,10 @@ FloatImage::FloatImage(const WindowDevice& device, uint32_t width, uint32_t heig
 
 // Once, so that every frame's blit reads the image in the layout made for it.
 void FloatImage::enter_blit_layout(const WindowDevice& device) {
-  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
-  pool_info.queueFamilyIndex = device.queue_family();
-  VkCommandPool pool = VK_NULL_HANDLE;
-  vk_check(vkCreateCommandPool(device_, &pool_info, nullptr, &pool), "vkCreateCommandPool");
-  VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  allocate.commandPool = pool;
-  allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  allocate.commandBufferCount = 1;
-  VkCommandBuffer commands = VK_NULL_HANDLE;
-  VkResult result = vkAllocateCommandBuffers(device_, &allocate, &commands);
-  if (result == VK_SUCCESS) {
-    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    vkBeginCommandBuffer(commands, &begin);
+  device.submit_and_wait([&](VkCommandBuffer commands) {
     transition(commands, image_, VK_IMAGE_LAYOUT_UNDEFINED, kLayout, 0, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
                VK_PIPELINE_STAGE_TRANSFER_BIT);
-    vkEndCommandBuffer(commands);
-    VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &commands;
-    result = vkQueueSubmit(device.queue(), 1, &submit, VK_NULL_HANDLE);
-    if (result == VK_SUCCESS) result = vkQueueWaitIdle(device.queue());
-  }
-  vkDestroyCommandPool(device_, pool, nullptr);
-  vk_check(result, "moving the float image to its layout");
+  });
 }
 
 FloatImage::~FloatImage() { destroy(); }

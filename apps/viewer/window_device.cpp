@@ -127,6 +127,51 @@ ExternalVulkanDevice WindowDevice::external() const {
 
 std::string WindowDevice::name() const { return device_name(physical_device_); }
 
+uint32_t WindowDevice::memory_type(uint32_t allowed, VkMemoryPropertyFlags required,
+                                   VkMemoryPropertyFlags preferred, const char* what) const {
+  VkPhysicalDeviceMemoryProperties memory;
+  vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory);
+  uint32_t found = memory.memoryTypeCount;
+  for (uint32_t i = 0; i < memory.memoryTypeCount; ++i) {
+    const VkMemoryPropertyFlags flags = memory.memoryTypes[i].propertyFlags;
+    if (!(allowed & (1u << i)) || (flags & required) != required) continue;
+    if ((flags & preferred) == preferred) return i;
+    if (found == memory.memoryTypeCount) found = i;
+  }
+  if (found == memory.memoryTypeCount) throw std::runtime_error(name() + ": no memory type for " + what);
+  return found;
+}
+
+void WindowDevice::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) const {
+  struct Pool {  // destroyed, with its command buffer, on every way out
+    VkDevice device;
+    VkCommandPool pool = VK_NULL_HANDLE;
+    ~Pool() {
+      if (pool) vkDestroyCommandPool(device, pool, nullptr);
+    }
+  } pool{device_};
+  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+  pool_info.queueFamilyIndex = queue_family_;
+  vk_check(vkCreateCommandPool(device_, &pool_info, nullptr, &pool.pool), "vkCreateCommandPool");
+  VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  allocate.commandPool = pool.pool;
+  allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  allocate.commandBufferCount = 1;
+  VkCommandBuffer commands = VK_NULL_HANDLE;
+  vk_check(vkAllocateCommandBuffers(device_, &allocate, &commands), "vkAllocateCommandBuffers");
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  vk_check(vkBeginCommandBuffer(commands, &begin), "vkBeginCommandBuffer");
+  record(commands);
+  vk_check(vkEndCommandBuffer(commands), "vkEndCommandBuffer");
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &commands;
+  vk_check(vkQueueSubmit(queue_, 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
+  vk_check(vkQueueWaitIdle(queue_), "vkQueueWaitIdle");
+}
+
 void WindowDevice::create_instance(bool validation) {
   uint32_t glfw_count = 0;
   const char** glfw_extensions = glfwGetRequiredInstanceExtensions(&glfw_count);

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "tilesplat/vulkan_interop.h"
@@ -37,6 +38,14 @@ class WindowDevice {
   uint32_t queue_family() const { return queue_family_; }
   VkSurfaceKHR surface() const { return surface_; }
   std::string name() const;
+
+  // A memory type among `allowed` (VkMemoryRequirements::memoryTypeBits) with every `required` flag,
+  // one that also has the `preferred` ones where there is one. Throws std::runtime_error naming `what`
+  // when none has the required flags.
+  uint32_t memory_type(uint32_t allowed, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred,
+                       const char* what) const;
+  // Records `record` into a one-time command buffer, submits it and waits for the queue to be idle.
+  void submit_and_wait(const std::function<void(VkCommandBuffer)>& record) const;
   bool validation() const { return messenger_ != VK_NULL_HANDLE; }
   uint64_t validation_messages() const { return validation_messages_.load(); }
 
