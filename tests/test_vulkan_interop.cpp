@@ -233,6 +233,23 @@ class HostApplication : public ::testing::Test {
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
                          nullptr, 0, nullptr, 1, &b);
   }
+  // The depth tests' host: the bundled playbot from view 0 at width x height, and the wall it drew into
+  // its depth buffer (the effects bench's plane, tilted through the scene) in the bench's convention.
+  struct WallScene {
+    GaussianScene scene;
+    Camera camera;
+    DepthConvention convention;
+    std::vector<float> wall;
+  };
+  static WallScene wall_through_scene(uint32_t width, uint32_t height) {
+    WallScene made;
+    made.scene = load_scene(testing::bundled_playbot());
+    made.camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera,
+                                int(width), int(height));
+    made.convention = effects::bench_depth_convention();
+    made.wall = effects::plane_through_scene(made.scene, made.camera, made.convention);
+    return made;
+  }
   // The host "draws" its depth: the staging buffer's floats into a D32 image, which ends in the layout a
   // host keeps a depth buffer in.
   void record_draw_depth(VkCommandBuffer cmd, VkImage depth, uint32_t width, uint32_t height) {
@@ -424,11 +441,7 @@ TEST_F(HostApplication, RendersOnTheHostDeviceIntoTheHostImage) {
 // written into the same buffer for what the host draws next.
 TEST_F(HostApplication, DepthImageCutsTheSplatsAndReceivesTheirDepth) {
   constexpr uint32_t kWidth = 160, kHeight = 90;
-  const GaussianScene scene = load_scene(testing::bundled_playbot());
-  const Camera camera =
-      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
-  const DepthConvention convention = effects::bench_depth_convention();
-  const std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+  const auto [scene, camera, convention, wall] = wall_through_scene(kWidth, kHeight);
 
   const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
   const Image depth =
@@ -487,11 +500,7 @@ TEST_F(HostApplication, DepthImageCutsTheSplatsAndReceivesTheirDepth) {
 // depth out keeps the NaN where the splats do not reach the threshold.
 TEST_F(HostApplication, NanInTheDepthImageMeansNoSurface) {
   constexpr uint32_t kWidth = 160, kHeight = 90;
-  const GaussianScene scene = load_scene(testing::bundled_playbot());
-  const Camera camera =
-      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
-  const DepthConvention convention = effects::bench_depth_convention();
-  std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+  auto [scene, camera, convention, wall] = wall_through_scene(kWidth, kHeight);
   std::vector<float> no_surface = wall;  // what the NaN rows mean, in host memory
   for (size_t i = 40 * kWidth; i < 50 * kWidth; ++i) {
     wall[i] = std::numeric_limits<float>::quiet_NaN();
@@ -542,11 +551,7 @@ TEST_F(HostApplication, NanInTheDepthImageMeansNoSurface) {
 // float32 (host_depth_fp32): within float rounding of the float64 conversion in host memory.
 TEST_F(HostApplication, DepthImageConvertsInFloat32WithoutFloat64) {
   constexpr uint32_t kWidth = 160, kHeight = 90;
-  const GaussianScene scene = load_scene(testing::bundled_playbot());
-  const Camera camera =
-      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
-  const DepthConvention convention = effects::bench_depth_convention();
-  const std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+  const auto [scene, camera, convention, wall] = wall_through_scene(kWidth, kHeight);
   const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
   const Image depth =
       make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, kWidth, kHeight);
@@ -648,11 +653,7 @@ TEST_F(HostApplication, RendersIntoHalfAndEightBitColourImages) {
 // waits for that. Nothing waits on the CPU in between; the images equal the blocking path's to the bit.
 TEST_F(HostApplication, FrameInsideTheHostsFrameWaitsForAndSignalsItsSemaphores) {
   constexpr uint32_t kWidth = 160, kHeight = 90;
-  const GaussianScene scene = load_scene(testing::bundled_playbot());
-  const Camera camera =
-      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
-  const DepthConvention convention = effects::bench_depth_convention();
-  const std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+  const auto [scene, camera, convention, wall] = wall_through_scene(kWidth, kHeight);
   const size_t pixels = size_t(kWidth) * kHeight;
   const VkDeviceSize colour_bytes = pixels * 16;
 
@@ -743,11 +744,7 @@ TEST_F(HostApplication, FrameInsideTheHostsFrameWaitsForAndSignalsItsSemaphores)
 // timeline semaphore. The images equal the blocking path's to the bit.
 TEST_F(HostApplication, FrameRecordedIntoTheHostsCommandBuffer) {
   constexpr uint32_t kWidth = 160, kHeight = 90;
-  const GaussianScene scene = load_scene(testing::bundled_playbot());
-  const Camera camera =
-      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, kWidth, kHeight);
-  const DepthConvention convention = effects::bench_depth_convention();
-  const std::vector<float> wall = effects::plane_through_scene(scene, camera, convention);
+  const auto [scene, camera, convention, wall] = wall_through_scene(kWidth, kHeight);
   const size_t pixels = size_t(kWidth) * kHeight;
   const VkDeviceSize colour_bytes = pixels * 16;
   const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
