@@ -233,6 +233,22 @@ class HostApplication : public ::testing::Test {
     vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
                          nullptr, 0, nullptr, 1, &b);
   }
+  // Both images of a depth test as the host reads them back: the colour image (left GENERAL by a frame
+  // that was handed it UNDEFINED) and the depth image (kept in DEPTH_STENCIL_ATTACHMENT_OPTIMAL).
+  struct ColourAndDepth {
+    std::vector<float> rgba, depth;
+  };
+  ColourAndDepth read_colour_and_depth(const Image& colour, const Image& depth, uint32_t width,
+                                       uint32_t height) {
+    ColourAndDepth read{std::vector<float>(size_t(width) * height * 4),
+                        std::vector<float>(size_t(width) * height)};
+    read_image(colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, width, height);
+    std::memcpy(read.rgba.data(), staging_data, read.rgba.size() * sizeof(float));
+    read_image(depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+               width, height);
+    std::memcpy(read.depth.data(), staging_data, read.depth.size() * sizeof(float));
+    return read;
+  }
   // The depth tests' host: the bundled playbot from view 0 at width x height, and the wall it drew into
   // its depth buffer (the effects bench's plane, tilted through the scene) in the bench's convention.
   struct WallScene {
@@ -476,12 +492,7 @@ TEST_F(HostApplication, DepthImageCutsTheSplatsAndReceivesTheirDepth) {
   }
 
   // Read both images back as the host would.
-  std::vector<float> rgba(size_t(kWidth) * kHeight * 4), depth_after(size_t(kWidth) * kHeight);
-  read_image(colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
-  std::memcpy(rgba.data(), staging_data, rgba.size() * sizeof(float));
-  read_image(depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, kWidth,
-             kHeight);
-  std::memcpy(depth_after.data(), staging_data, depth_after.size() * sizeof(float));
+  const auto [rgba, depth_after] = read_colour_and_depth(colour, depth, kWidth, kHeight);
   EXPECT_EQ(rgba, expected.rgba);
   EXPECT_EQ(depth_after, expected.host_depth);
   size_t nearer = 0;
@@ -525,12 +536,7 @@ TEST_F(HostApplication, NanInTheDepthImageMeansNoSurface) {
   in_memory.host->depth = no_surface;
   const RenderImage expected = renderer->render(camera, in_memory);
 
-  std::vector<float> rgba(size_t(kWidth) * kHeight * 4), depth_after(size_t(kWidth) * kHeight);
-  read_image(colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
-  std::memcpy(rgba.data(), staging_data, rgba.size() * sizeof(float));
-  read_image(depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, kWidth,
-             kHeight);
-  std::memcpy(depth_after.data(), staging_data, depth_after.size() * sizeof(float));
+  const auto [rgba, depth_after] = read_colour_and_depth(colour, depth, kWidth, kHeight);
   EXPECT_EQ(rgba, expected.rgba);
   size_t kept_nan = 0;
   for (size_t i = 0; i < depth_after.size(); ++i) {
@@ -573,12 +579,7 @@ TEST_F(HostApplication, DepthImageConvertsInFloat32WithoutFloat64) {
   in_memory.host->depth = wall;
   const RenderImage expected = renderer->render(camera, in_memory);
 
-  std::vector<float> rgba(size_t(kWidth) * kHeight * 4), depth_after(size_t(kWidth) * kHeight);
-  read_image(colour.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
-  std::memcpy(rgba.data(), staging_data, rgba.size() * sizeof(float));
-  read_image(depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, kWidth,
-             kHeight);
-  std::memcpy(depth_after.data(), staging_data, depth_after.size() * sizeof(float));
+  const auto [rgba, depth_after] = read_colour_and_depth(colour, depth, kWidth, kHeight);
   // A splat whose depth lies within a float's rounding of the wall's may fall on the other side of it:
   // a few pixels may differ, by at most that splat's contribution.
   size_t differing = 0;
