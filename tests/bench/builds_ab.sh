@@ -17,25 +17,9 @@ rounds="${5:-3}"
 require_files builds_ab "$before" "$after" "$scene" "$cameras"
 echo "builds_ab: $(basename "$scene"), $rounds rounds; before $("$before" --version), after $("$after" --version)" >&2
 
-# The median column of a metric row of the frame table.
-metric() { awk -v name="$1" '$0 ~ "^  " name " " { print $(NF - 2); exit }'; }
-# "median ms (ratio)" of a row of the sort table: bits, sorter.
-sort_row() { awk -v bits="$1" -v who="$2" '$1 == bits && $3 == who { print $5 " (" $7 ")"; exit }'; }
-
-echo "| round | build | projection | depth_sort | key_emission | tile_sort | composite | GPU frame | radix 32-bit (vs std::sort) | radix 64-bit (vs std::sort) |"
-echo "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+source tests/bench/ab_rows.sh  # bench_paths.sh made the repository root the working directory
+ab_header build
 for ((round = 1; round <= rounds; round++)); do
-  for build in before after; do
-    bench="${!build}"
-    frame=$("$bench" "$scene" --cameras "$cameras" --view 0 --width 1920 --height 1080 --sort radix --warmup 1 \
-      --repeat 5 2> /dev/null)
-    sorts=$("$bench" --sort-bench --sort radix --sort-sizes 22 --key-bits 32,64 --warmup 1 --repeat 3 2> /dev/null)
-    row="| $round | $build |"
-    for pass in projection depth_sort key_emission tile_sort composite "gpu frame"; do
-      row="$row $(echo "$frame" | metric "$pass") |"
-    done
-    row="$row $(echo "$sorts" | sort_row 32 radix) ms |"
-    row="$row $(echo "$sorts" | sort_row 64 radix) ms |"
-    echo "$row"
-  done
+  ab_row "$round" before "$before"
+  ab_row "$round" after "$after"
 done
