@@ -2,14 +2,44 @@
 // Radix sort, step 3 of a pass (scatter): each subgroup walks its block in order and writes every key
 // to digit_base[digit] + (its block's offset for that digit) + (its rank among equal digits so far).
 // The rank among the subgroup's lanes comes from 8 ballots (a "multi-split"), so the pass is stable.
+// CPU drivers walk the block differently (scatter_lane_runs), with the same result.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #include "common.glsl"
 #include "radix_common.glsl"
 
 shared uint s_digit_base[RADIX];
 shared uint s_offsets[SUBGROUPS_PER_WORKGROUP * RADIX];
+
+#ifdef TS_TEXEL_BUFFERS
+// The CPU-driver variant: each lane owns a contiguous run of the block (block_keys() / subgroup size
+// keys) and walks it in order with its own 256 offsets in a private array, starting where the runs of
+// the lanes before it end (the block's offset + an exclusive subgroup sum of the lanes' digit counts,
+// which it counts first). The pass stays stable without the ballots, the shared-memory offsets and
+// their per-lane loads and stores, which llvmpipe runs one SIMD lane at a time (2^22 32-bit keys:
+// about 10% faster; docs/benchmarks.md).
+void scatter_lane_runs(uint block, uint blocks, uint n) {
+  uint start = block * block_keys();
+  uint end = min(start + block_keys(), n);
+  uint per_lane = block_keys() / gl_SubgroupSize;
+  uint run_start = min(start + gl_SubgroupInvocationID * per_lane, end);
+  uint run_end = min(run_start + per_lane, end);
+  uint offsets[RADIX];
+  for (uint d = 0; d < RADIX; ++d) offsets[d] = 0u;
+  for (uint k = run_start; k < run_end; ++k) ++offsets[digit_of(radix_load_key(k))];
+  for (uint d = 0; d < RADIX; ++d)
+    offsets[d] = s_digit_base[d] + pc.histogram.v[d * blocks + block] + subgroupExclusiveAdd(offsets[d]);
+  for (uint k = run_start; k < run_end; ++k) {
+    uint64_t key = radix_load_key(k);
+    uint digit = digit_of(key);
+    uint dst = offsets[digit];
+    offsets[digit] = dst + 1u;
+    radix_store(dst, key, radix_load_value(k));
+  }
+}
+#endif
 
 void main() {
   uint n = pc.state.v[SORT_COUNT];
@@ -25,6 +55,10 @@ void main() {
 
   uint block = gl_WorkGroupID.x * SUBGROUPS_PER_WORKGROUP + gl_SubgroupID;
   if (block >= blocks) return;
+#ifdef TS_TEXEL_BUFFERS
+  scatter_lane_runs(block, blocks, n);
+  return;
+#endif
   uint my = gl_SubgroupID * RADIX;
   for (uint d = gl_SubgroupInvocationID; d < RADIX; d += gl_SubgroupSize)
     s_offsets[my + d] = s_digit_base[d] + pc.histogram.v[d * blocks + block];
