@@ -249,6 +249,21 @@ class HostApplication : public ::testing::Test {
     std::memcpy(read.depth.data(), staging_data, read.depth.size() * sizeof(float));
     return read;
   }
+  // The depth tests' host images: a colour image, and a D32 depth buffer into which the host "draws"
+  // `wall` (ending in the layout a host keeps a depth buffer in); the staging buffer is left for reading
+  // them back.
+  struct ColourAndDepthImages {
+    Image colour, depth;
+  };
+  ColourAndDepthImages draw_wall(const std::vector<float>& wall, uint32_t width, uint32_t height) {
+    const ColourAndDepthImages made{
+        make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, width, height),
+        make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, width, height)};
+    make_staging(VkDeviceSize(width) * height * 16);
+    std::memcpy(staging_data, wall.data(), wall.size() * sizeof(float));
+    submit([&](VkCommandBuffer cmd) { record_draw_depth(cmd, made.depth.image, width, height); });
+    return made;
+  }
   // The depth tests' host: the bundled playbot from view 0 at width x height, and the wall it drew into
   // its depth buffer (the effects bench's plane, tilted through the scene) in the bench's convention.
   struct WallScene {
@@ -459,13 +474,7 @@ TEST_F(HostApplication, DepthImageCutsTheSplatsAndReceivesTheirDepth) {
   constexpr uint32_t kWidth = 160, kHeight = 90;
   const auto [scene, camera, convention, wall] = wall_through_scene(kWidth, kHeight);
 
-  const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
-  const Image depth =
-      make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, kWidth, kHeight);
-  make_staging(VkDeviceSize(kWidth) * kHeight * 16);
-  // The host "draws" its wall: the depth image ends in the layout a host keeps a depth buffer in.
-  std::memcpy(staging_data, wall.data(), wall.size() * sizeof(float));
-  submit([&](VkCommandBuffer cmd) { record_draw_depth(cmd, depth.image, kWidth, kHeight); });
+  const auto [colour, depth] = draw_wall(wall, kWidth, kHeight);
 
   RenderSettings settings;
   settings.host = HostDepth{convention, {}, true, 0.5f};
@@ -517,12 +526,7 @@ TEST_F(HostApplication, NanInTheDepthImageMeansNoSurface) {
     wall[i] = std::numeric_limits<float>::quiet_NaN();
     no_surface[i] = std::numeric_limits<float>::infinity();
   }
-  const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
-  const Image depth =
-      make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, kWidth, kHeight);
-  make_staging(VkDeviceSize(kWidth) * kHeight * 16);
-  std::memcpy(staging_data, wall.data(), wall.size() * sizeof(float));
-  submit([&](VkCommandBuffer cmd) { record_draw_depth(cmd, depth.image, kWidth, kHeight); });
+  const auto [colour, depth] = draw_wall(wall, kWidth, kHeight);
 
   RenderSettings settings;
   settings.host = HostDepth{convention, {}, true, 0.5f};
@@ -558,12 +562,7 @@ TEST_F(HostApplication, NanInTheDepthImageMeansNoSurface) {
 TEST_F(HostApplication, DepthImageConvertsInFloat32WithoutFloat64) {
   constexpr uint32_t kWidth = 160, kHeight = 90;
   const auto [scene, camera, convention, wall] = wall_through_scene(kWidth, kHeight);
-  const Image colour = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
-  const Image depth =
-      make_image(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, kWidth, kHeight);
-  make_staging(VkDeviceSize(kWidth) * kHeight * 16);
-  std::memcpy(staging_data, wall.data(), wall.size() * sizeof(float));
-  submit([&](VkCommandBuffer cmd) { record_draw_depth(cmd, depth.image, kWidth, kHeight); });
+  const auto [colour, depth] = draw_wall(wall, kWidth, kHeight);
 
   ExternalVulkanDevice without_float64 = external();
   without_float64.shader_float64_enabled = false;
