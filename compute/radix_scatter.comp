@@ -11,7 +11,6 @@
 #include "radix_common.glsl"
 
 shared uint s_digit_base[RADIX];
-shared uint s_offsets[SUBGROUPS_PER_WORKGROUP * RADIX];
 
 #ifdef TS_TEXEL_BUFFERS
 // The CPU-driver variant: each lane owns a contiguous run of the block (block_keys() / subgroup size
@@ -39,26 +38,11 @@ void scatter_lane_runs(uint block, uint blocks, uint n) {
     radix_store(dst, key, radix_load_value(k));
   }
 }
-#endif
-
-void main() {
-  uint n = pc.state.v[SORT_COUNT];
-  uint blocks = pc.state.v[SORT_BLOCKS];
-  if (gl_LocalInvocationIndex == 0) {
-    uint running = 0;
-    for (uint d = 0; d < RADIX; ++d) {
-      s_digit_base[d] = running;
-      running += pc.digit_totals.v[d];
-    }
-  }
-  barrier();
-
-  uint block = gl_WorkGroupID.x * SUBGROUPS_PER_WORKGROUP + gl_SubgroupID;
-  if (block >= blocks) return;
-#ifdef TS_TEXEL_BUFFERS
-  scatter_lane_runs(block, blocks, n);
-  return;
-#endif
+#else
+// GPUs: the subgroup walks the block 8 keys a step, ranking each step's equal digits with 8 ballots;
+// its running offsets per digit are in shared memory.
+shared uint s_offsets[SUBGROUPS_PER_WORKGROUP * RADIX];
+void scatter_multisplit(uint block, uint blocks, uint n) {
   uint my = gl_SubgroupID * RADIX;
   for (uint d = gl_SubgroupInvocationID; d < RADIX; d += gl_SubgroupSize)
     s_offsets[my + d] = s_digit_base[d] + pc.histogram.v[d * blocks + block];
@@ -90,4 +74,26 @@ void main() {
     subgroupMemoryBarrierShared();
     subgroupBarrier();
   }
+}
+#endif
+
+void main() {
+  uint n = pc.state.v[SORT_COUNT];
+  uint blocks = pc.state.v[SORT_BLOCKS];
+  if (gl_LocalInvocationIndex == 0) {
+    uint running = 0;
+    for (uint d = 0; d < RADIX; ++d) {
+      s_digit_base[d] = running;
+      running += pc.digit_totals.v[d];
+    }
+  }
+  barrier();
+
+  uint block = gl_WorkGroupID.x * SUBGROUPS_PER_WORKGROUP + gl_SubgroupID;
+  if (block >= blocks) return;
+#ifdef TS_TEXEL_BUFFERS
+  scatter_lane_runs(block, blocks, n);
+#else
+  scatter_multisplit(block, blocks, n);
+#endif
 }
