@@ -42,6 +42,7 @@ struct RenderOptions {
   tilesplat::PreviewOptions preview;
   bool half = false;
   tilesplat::ExrCompression compression = tilesplat::ExrCompression::kZip;
+  tilesplat::ColourEncoding exr_colour = tilesplat::ColourEncoding::kSceneLinear;
   bool no_depth = false;
   bool no_count = false;
   bool reference = false;
@@ -130,10 +131,13 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                     "the EXR to write (required): R G B A, plus Z (expected depth) and 'splats' (blended "
                     "splats per pixel) unless turned off; for a scene file, the channels its \"outputs\" list",
                     &options.output, "-o");
-  parser.add_string("--png", "FILE.png", "also write an 8-bit sRGB preview of the colours", &options.png);
+  parser.add_string("--png", "FILE.png",
+                    "also write an 8-bit sRGB preview: the trained colours, round(255 c), as other viewers show "
+                    "them",
+                    &options.png);
   parser.add_value("--exposure", "STOPS",
-                   "brighten (or darken, if negative) the --png preview by 2^STOPS, -20 to 20 (default: the "
-                   "scene file's, else 0)",
+                   "brighten (or darken, if negative) the --png preview by 2^STOPS of linear light, -20 to 20 "
+                   "(default: the scene file's, else 0)",
                    [&options](const std::string& text) {
                      const double stops = cli::parse_double("--exposure", text);
                      if (!(std::abs(stops) <= 20))
@@ -141,8 +145,8 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                      options.preview.exposure_stops = stops;
                    });
   parser.add_value("--tone-map", "CURVE",
-                   "the --png preview's tone curve: none (clip at 1), aces (filmic) or reinhard (x / (1 + x)) "
-                   "(default: the scene file's, else none)",
+                   "the --png preview's tone curve, on linear light: none (clip at 1), aces (filmic) or reinhard "
+                   "(x / (1 + x)) (default: the scene file's, else none)",
                    [&options](const std::string& text) {
                      if (text == "none") options.preview.tone_map = tilesplat::ToneMap::kNone;
                      else if (text == "aces") options.preview.tone_map = tilesplat::ToneMap::kAces;
@@ -165,11 +169,22 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
           }
         throw cli::UsageError("--exr-compression must be zip, piz, dwaa or none, got " + single_quoted(text));
       });
+  parser.add_value("--exr-colour", "ENCODING",
+                   "what the EXR's R G B hold: linear (default: scene-linear Rec.709, the sRGB decoding of the "
+                   "trained colours, as compositing tools expect) or display (the trained colours as rendered, "
+                   "bit for bit); the header's colorInteropID says which (docs/colour.md)",
+                   [&options](const std::string& text) {
+                     if (text == "linear") options.exr_colour = tilesplat::ColourEncoding::kSceneLinear;
+                     else if (text == "display") options.exr_colour = tilesplat::ColourEncoding::kSrgbDisplay;
+                     else
+                       throw cli::UsageError("--exr-colour must be linear or display, got " + single_quoted(text));
+                   });
   parser.add_switch("--no-depth", "do not compute or store the depth channel (Z)", &options.no_depth);
   parser.add_switch("--no-count", "do not compute or store the per-pixel splat count", &options.no_count);
 
   parser.section("rendering");
-  parser.add_value("--background", "R,G,B", "linear background colour (default: the scene file's, else 0,0,0)",
+  parser.add_value("--background", "R,G,B", "background colour, in the trained colours' display values (default: the scene file's, else "
+                   "0,0,0)",
                    [&options](const std::string& text) {
                      options.background = cli::parse_rgb("--background", text);
                    });
@@ -627,6 +642,7 @@ int run(int argc, char** argv) {
   writer.exr.alpha = !loaded.description || loaded.description->outputs.alpha;
   writer.exr.attributes["commandLine"] = cli::command_line(kProgram, argc, argv);
   writer.exr.compression = options.compression;
+  writer.exr.colour = options.exr_colour;
   // Empty pixels far away, for depth compositing; with a background, an opaque frame (docs: README).
   writer.exr.empty_depth = tilesplat::kFarDepth;
   writer.exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
@@ -637,7 +653,8 @@ int run(int argc, char** argv) {
   if (sequence) {
     // Everything besides the camera that makes two runs' files differ, for the manifest.
     std::string settings_line = settings_text(settings) + " exr=" + (options.half ? "half" : "float") + "," +
-                                tilesplat::to_string(options.compression) + (writer.exr.alpha ? ",A" : "") +
+                                tilesplat::to_string(options.compression) + "," +
+                                tilesplat::to_string(options.exr_colour) + (writer.exr.alpha ? ",A" : "") +
                                 (settings.depth ? ",Z" : "") + (settings.splat_count ? ",splats" : "");
     if (!options.png.empty()) settings_line += " png=" + png_settings_text(writer.preview);
     return render_sequence(options, frames, shard, loaded, settings, writer, settings_line);

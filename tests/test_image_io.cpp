@@ -245,6 +245,18 @@ uint8_t expected_srgb_byte(double linear) {
   return static_cast<uint8_t>(std::floor(encoded * 255.0 + 0.5));
 }
 
+// IEC 61966-2-1's decoding, written out here so that the library's is checked against it; negatives
+// mirror the curve (as extended sRGB does).
+double decode_srgb(double v) {
+  const double m = std::fabs(v);
+  return std::copysign(m <= 0.04045 ? m / 12.92 : std::pow((m + 0.055) / 1.055, 2.4), v);
+}
+
+// A trained (display) colour as the PNG holds it without grading.
+uint8_t expected_display_byte(double colour) {
+  return static_cast<uint8_t>(std::floor(std::clamp(colour, 0.0, 1.0) * 255.0 + 0.5));
+}
+
 // ---------------------------------------------------------------------------------------------
 // EXR
 
@@ -263,8 +275,10 @@ TEST(ExrIo, FloatRoundTripIsBitExact) {
   // 2^24, far above any real count (a pixel stops blending after at most ~2,350 splats of alpha >= 1/255).
   image.splat_count[0] = 1u << 24;
 
+  // The display encoding stores the rendered values as they are (scene-linear converts them: below).
   const fs::path path = fresh_dir() / "float.exr";
-  write_exr(path, image);
+  write_exr(path, image, ExrWriteOptions{.colour = ColourEncoding::kSrgbDisplay});
+  EXPECT_EQ(read_exr_string_attributes(path).at("colorInteropID"), "srgb_rec709_display");
   const RenderImage back = read_exr(path);
   EXPECT_EQ(back.width, 13);
   EXPECT_EQ(back.height, 7);
@@ -273,11 +287,108 @@ TEST(ExrIo, FloatRoundTripIsBitExact) {
   EXPECT_EQ(back.splat_count, image.splat_count);
 }
 
+TEST(Colour, SrgbTransferFunctionFollowsIec61966AndInvertsItself) {
+  for (const double v : {0.0, 0.001, 0.04045, 0.05, 0.18, 0.5, 0.75, 1.0, 2.0, 8.0}) {
+    EXPECT_NEAR(srgb_to_linear(v), decode_srgb(v), 1e-15 * std::max(1.0, decode_srgb(v))) << v;
+    // The standard's two thresholds (0.04045 and 0.0031308) miss each other by 5e-9 in linear light, so
+    // at 0.04045 the round trip is exact only to 3e-8; elsewhere to double rounding.
+    EXPECT_NEAR(linear_to_srgb(srgb_to_linear(v)), v, (v == 0.04045 ? 1e-7 : 1e-12) * std::max(1.0, v)) << v;
+    EXPECT_EQ(srgb_to_linear(-v), -srgb_to_linear(v)) << "negatives mirror the curve";
+  }
+  EXPECT_NEAR(srgb_to_linear(0.5), 0.21404114048223255, 1e-15);  // literal: mid-grey is 21% of the light
+  EXPECT_NEAR(linear_to_srgb(0.18), 0.46135612950044164, 1e-15);
+  EXPECT_TRUE(std::isnan(srgb_to_linear(std::nan(""))));
+  EXPECT_EQ(to_string(ColourEncoding::kSceneLinear), "lin_rec709_scene");
+  EXPECT_EQ(to_string(ColourEncoding::kSrgbDisplay), "srgb_rec709_display");
+}
+
+TEST(Colour, ConversionDecodesTheColourNotThePremultipliedValue) {
+  // (colour 0.5 at coverage 0.4, premultiplied 0.2), an opaque pixel, and one without coverage.
+  const std::vector<float> rgba = {0.2f, 0.4f, 0.0f, 0.4f, 0.5f, 1.0f, 0.25f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+  const std::vector<float> linear = convert_colours(rgba, ColourEncoding::kSrgbDisplay, ColourEncoding::kSceneLinear);
+  EXPECT_NEAR(linear[0], 0.4 * decode_srgb(0.5), 1e-7);
+  EXPECT_NEAR(linear[1], 0.4 * decode_srgb(1.0), 1e-7);
+  EXPECT_EQ(linear[3], 0.4f) << "alpha is kept";
+  EXPECT_NEAR(linear[4], decode_srgb(0.5), 1e-7);
+  EXPECT_NEAR(linear[6], decode_srgb(0.25), 1e-7);
+  EXPECT_EQ(linear[8], 0.0f);
+  const std::vector<float> back = convert_colours(linear, ColourEncoding::kSceneLinear, ColourEncoding::kSrgbDisplay);
+  for (size_t i = 0; i < rgba.size(); ++i) EXPECT_NEAR(back[i], rgba[i], 1e-7) << i;
+  // Taken as opaque (a file without alpha), the premultiplied value itself is decoded.
+  const std::vector<float> opaque =
+      convert_colours(rgba, ColourEncoding::kSrgbDisplay, ColourEncoding::kSceneLinear, /*opaque=*/true);
+  EXPECT_NEAR(opaque[0], decode_srgb(0.2), 1e-7);
+  EXPECT_EQ(convert_colours(rgba, ColourEncoding::kSceneLinear, ColourEncoding::kSceneLinear), rgba);
+}
+
+// What a compositing tool reads: scene-linear values, A * decode(C / A), said so by the header; read_exr()
+// gives the rendered colours back.
+TEST(ExrIo, WritesSceneLinearColoursByDefaultAndReadsThemBack) {
+  RenderImage image = make_image(13, 7, true, true);
+  const fs::path path = fresh_dir() / "linear.exr";
+  write_exr(path, image);
+  const auto attributes = read_exr_string_attributes(path);
+  EXPECT_EQ(attributes.at("colorInteropID"), "lin_rec709_scene");
+  const StoredExr stored = read_exr_as_stored(path);
+  EXPECT_EQ(stored.encoding, ColourEncoding::kSceneLinear);
+  const RenderImage back = read_exr(path);
+  size_t partly_covered = 0;
+  for (size_t pixel = 0; pixel < image.pixels(); ++pixel) {
+    const double alpha = image.rgba[4 * pixel + 3];
+    ASSERT_EQ(stored.image.rgba[4 * pixel + 3], image.rgba[4 * pixel + 3]);
+    partly_covered += alpha > 0 && alpha < 1;
+    for (size_t c = 0; c < 3; ++c) {
+      const double colour = image.rgba[4 * pixel + c];
+      const double want = alpha > 0 && alpha < 1 ? alpha * decode_srgb(colour / alpha) : decode_srgb(colour);
+      EXPECT_NEAR(stored.image.rgba[4 * pixel + c], want, 1e-6 * std::max(1.0, want)) << pixel << " " << c;
+      EXPECT_NEAR(back.rgba[4 * pixel + c], colour, 1e-6 * std::max(1.0, colour)) << pixel << " " << c;
+    }
+  }
+  EXPECT_GT(partly_covered, 0u) << "the test image should have pixels of partial coverage";
+  EXPECT_TRUE(same_bits(back.depth, image.depth));
+  EXPECT_EQ(back.splat_count, image.splat_count);
+
+  // Without alpha (or with A = 1), the file is opaque and its colours convert as they are.
+  const fs::path opaque = fresh_dir() / "opaque.exr";
+  write_exr(opaque, image, ExrWriteOptions{.alpha = false});
+  const StoredExr stored_opaque = read_exr_as_stored(opaque);
+  EXPECT_NEAR(stored_opaque.image.rgba[0], decode_srgb(image.rgba[0]), 1e-6);
+  EXPECT_NEAR(read_exr(opaque).rgba[0], image.rgba[0], 1e-6);
+}
+
+#if TILESPLAT_TEST_HAS_OPENEXR
+TEST(ExrIo, UnknownColourEncodingIsAnErrorNamingIt) {
+  const fs::path path = fresh_dir() / "acescg.exr";
+  {
+    Imf::Header header(2, 2);
+    header.channels().insert("R", Imf::Channel(Imf::FLOAT));
+    header.channels().insert("G", Imf::Channel(Imf::FLOAT));
+    header.channels().insert("B", Imf::Channel(Imf::FLOAT));
+    header.insert("colorInteropID", Imf::StringAttribute("lin_ap1_scene"));
+    std::vector<float> zeros(4, 0.0f);
+    Imf::FrameBuffer frame;
+    for (const char* name : {"R", "G", "B"})
+      frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(zeros.data()), sizeof(float),
+                                    2 * sizeof(float)));
+    Imf::OutputFile file(path.c_str(), header);
+    file.setFrameBuffer(frame);
+    file.writePixels(2);
+  }
+  try {
+    read_exr(path);
+    FAIL() << "read_exr accepted colours it cannot convert";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("colorInteropID 'lin_ap1_scene'"), std::string::npos) << error.what();
+  }
+}
+#endif
+
 TEST(ExrIo, HalfRoundTripKeepsHalfPrecisionAndExactDepth) {
   RenderImage image = make_image(11, 6, true, true);
   image.rgba[0] = 1e-6f;  // a half subnormal
   const fs::path path = fresh_dir() / "half.exr";
-  write_exr(path, image, ExrWriteOptions{.half = true});
+  write_exr(path, image, ExrWriteOptions{.half = true, .colour = ColourEncoding::kSrgbDisplay});
   const RenderImage back = read_exr(path);
   ASSERT_EQ(back.width, image.width);
   ASSERT_EQ(back.height, image.height);
@@ -512,6 +623,7 @@ TEST(ExrIo, EveryCompressionMethodWritesAReadableFile) {
       ExrWriteOptions options;
       options.compression = method;
       options.half = half;
+      options.colour = ColourEncoding::kSrgbDisplay;  // the values as they are, so that lossless is exact
       write_exr(path, image, options);
       EXPECT_EQ(parse_exr_header(path).compression, code) << path;
       const RenderImage back = read_exr(path);
@@ -725,15 +837,16 @@ TEST(AtomicWrite, PathWithoutDirectoryWritesToCurrentDirectory) {
 // ---------------------------------------------------------------------------------------------
 // PNG previews
 
-TEST(PngPreview, WritesSrgbEncodedPixels) {
-  const std::vector<float> linear = {0.0f, 1.0f,  0.5f, 0.0031308f, 0.2f, 0.0001f, 2.0f, -1.0f,
-                                     std::numeric_limits<float>::quiet_NaN(), 0.04f, 0.75f, 0.01f};
+TEST(PngPreview, WritesTheTrainedColoursAsTheyAre) {
+  // Rendered colours are display values already: the preview is round(255 * clamp(c)), no encoding.
+  const std::vector<float> colours = {0.0f, 1.0f,  0.5f, 0.0031308f, 0.2f, 0.0001f, 2.0f, -1.0f,
+                                      std::numeric_limits<float>::quiet_NaN(), 0.04f, 0.75f, 0.01f};
   RenderImage image;
   image.width = 2;
   image.height = 2;
   image.rgba.resize(16);
   for (size_t pixel = 0; pixel < 4; ++pixel) {
-    for (size_t c = 0; c < 3; ++c) image.rgba[4 * pixel + c] = linear[3 * pixel + c];
+    for (size_t c = 0; c < 3; ++c) image.rgba[4 * pixel + c] = colours[3 * pixel + c];
     image.rgba[4 * pixel + 3] = 0.25f;  // alpha is dropped, not applied
   }
   const fs::path path = fresh_dir() / "preview.png";
@@ -753,26 +866,30 @@ TEST(PngPreview, WritesSrgbEncodedPixels) {
   EXPECT_EQ(big_endian_at(20), 2u);  // height
   EXPECT_EQ(static_cast<unsigned char>(bytes[24]), 8u);  // bit depth
   EXPECT_EQ(static_cast<unsigned char>(bytes[25]), 2u);  // colour type: RGB
+  // The bytes are sRGB-encoded values, and the file says so (an sRGB chunk), as training photographs are.
+  EXPECT_NE(std::string(bytes.begin(), bytes.end()).find("sRGB"), std::string::npos);
 
   const DecodedPng decoded = read_png_rgb(path);
   ASSERT_EQ(decoded.width, 2u);
   ASSERT_EQ(decoded.height, 2u);
   ASSERT_EQ(decoded.rgb.size(), 12u);
-  for (size_t i = 0; i < linear.size(); ++i) {
-    const double value = std::isnan(linear[i]) ? 0.0 : double{linear[i]};
-    EXPECT_EQ(decoded.rgb[i], expected_srgb_byte(value)) << "linear " << linear[i];
+  for (size_t i = 0; i < colours.size(); ++i) {
+    const double value = std::isnan(colours[i]) ? 0.0 : double{colours[i]};
+    EXPECT_EQ(decoded.rgb[i], expected_display_byte(value)) << "colour " << colours[i];
   }
-  // The anchors of the sRGB curve, as literal values.
+  // As literal values: a second sRGB encoding would make 0.5 188 and 0.0031308 10.
   EXPECT_EQ(decoded.rgb[0], 0);
   EXPECT_EQ(decoded.rgb[1], 255);
-  EXPECT_EQ(decoded.rgb[2], 188);
-  EXPECT_EQ(decoded.rgb[3], 10);
+  EXPECT_EQ(decoded.rgb[2], 128);
+  EXPECT_EQ(decoded.rgb[3], 1);
+  EXPECT_EQ(decoded.rgb[4], 51);
   EXPECT_EQ(decoded.rgb[6], 255) << "over-range values clamp to white";
   EXPECT_EQ(decoded.rgb[7], 0) << "negative values clamp to black";
   EXPECT_EQ(decoded.rgb[8], 0) << "NaN becomes black";
 }
 
-TEST(PngPreview, ExposureScalesLinearColour) {
+TEST(PngPreview, ExposureScalesLinearLight) {
+  // A stop doubles the light: the colour is decoded, scaled and encoded again.
   RenderImage image;
   image.width = 1;
   image.height = 1;
@@ -781,13 +898,14 @@ TEST(PngPreview, ExposureScalesLinearColour) {
   write_png_preview(path, image, {.exposure_stops = 1.0});  // times 2
   const DecodedPng decoded = read_png_rgb(path);
   ASSERT_EQ(decoded.rgb.size(), 3u);
-  EXPECT_EQ(decoded.rgb[0], expected_srgb_byte(0.5));
-  EXPECT_EQ(decoded.rgb[1], expected_srgb_byte(0.25));
+  EXPECT_EQ(decoded.rgb[0], expected_srgb_byte(2 * decode_srgb(0.25)));
+  EXPECT_EQ(decoded.rgb[1], expected_srgb_byte(2 * decode_srgb(0.125)));
   EXPECT_EQ(decoded.rgb[2], 255);
+  EXPECT_EQ(decoded.rgb[0], 90);  // 0.25 -> 0.0508 linear -> 0.1016 -> 0.3518: not 0.5 (127)
 
   write_png_preview(path, image, {.exposure_stops = -2.0});  // times 1/4
   const DecodedPng darker = read_png_rgb(path);
-  EXPECT_EQ(darker.rgb[0], expected_srgb_byte(0.0625));
+  EXPECT_EQ(darker.rgb[0], expected_srgb_byte(decode_srgb(0.25) / 4));
   EXPECT_EQ(darker.rgb[2], expected_srgb_byte(0.25));
 }
 
@@ -829,17 +947,19 @@ TEST(PngPreview, ToneMapCompressesHighlightsInsteadOfClipping) {
   EXPECT_EQ(clipped.rgb[3], 255);  // 2.0 and 8.0 both clip to white
   EXPECT_EQ(clipped.rgb[6], 255);
 
+  // The curves act on linear light: the decoded colour.
   write_png_preview(path, image, {.tone_map = ToneMap::kReinhard});
   const DecodedPng reinhard = read_png_rgb(path);
-  EXPECT_EQ(reinhard.rgb[0], expected_srgb_byte(0.18 / 1.18));
-  EXPECT_EQ(reinhard.rgb[3], expected_srgb_byte(2.0 / 3.0));
-  EXPECT_EQ(reinhard.rgb[6], expected_srgb_byte(8.0 / 9.0));
+  auto reinhard_of = [](double c) { return decode_srgb(c) / (1 + decode_srgb(c)); };
+  EXPECT_EQ(reinhard.rgb[0], expected_srgb_byte(reinhard_of(0.18)));
+  EXPECT_EQ(reinhard.rgb[3], expected_srgb_byte(reinhard_of(2.0)));
+  EXPECT_EQ(reinhard.rgb[6], expected_srgb_byte(reinhard_of(8.0)));
   EXPECT_LT(reinhard.rgb[3], reinhard.rgb[6]);  // highlights stay distinct
 
-  write_png_preview(path, image, {.exposure_stops = 1.0, .tone_map = ToneMap::kAces});
+  write_png_preview(path, image, {.exposure_stops = -1.0, .tone_map = ToneMap::kAces});
   const DecodedPng aces = read_png_rgb(path);
-  EXPECT_EQ(aces.rgb[0], expected_srgb_byte(apply_tone_map(ToneMap::kAces, 0.36)));
-  EXPECT_EQ(aces.rgb[3], expected_srgb_byte(apply_tone_map(ToneMap::kAces, 4.0)));
+  EXPECT_EQ(aces.rgb[0], expected_srgb_byte(apply_tone_map(ToneMap::kAces, decode_srgb(0.18) / 2)));
+  EXPECT_EQ(aces.rgb[3], expected_srgb_byte(apply_tone_map(ToneMap::kAces, decode_srgb(2.0) / 2)));
   EXPECT_LT(aces.rgb[3], 255);
 }
 

@@ -30,6 +30,35 @@ struct RenderImage {
   size_t pixels() const { return size_t(width) * size_t(height); }
 };
 
+/// What a render's colours are, and what the files hold (docs/colour.md). A 3DGS model is trained so that its
+/// blended colour reproduces the photographs' 8-bit sRGB values: RenderImage::rgba holds those display values
+/// (sRGB-encoded, Rec.709 primaries, D65), as every viewer shows them. Linear light is their sRGB decoding.
+enum class ColourEncoding {
+  /// Scene-linear Rec.709: the sRGB decoding of the colour, alpha kept premultiplied (A * decode(C / A)).
+  /// OpenEXR's convention, what compositing tools assume; colorInteropID "lin_rec709_scene".
+  kSceneLinear,
+  /// The trained display values as rendered (sRGB-encoded, premultiplied as blended): what the float64
+  /// reference and the PSNRs use; colorInteropID "srgb_rec709_display".
+  kSrgbDisplay,
+};
+/// The Color Interop Forum's identifier of an encoding: "lin_rec709_scene", "srgb_rec709_display". It is the
+/// value of the `colorInteropID` attribute of every EXR that write_exr() writes.
+TILESPLAT_API std::string to_string(ColourEncoding encoding);
+
+/// The sRGB transfer function (IEC 61966-2-1), exact and piecewise: display value to linear light.
+/// Extended to all reals as an odd function (negatives mirror the positive curve), so that it is
+/// invertible everywhere; NaN stays NaN.
+TILESPLAT_API double srgb_to_linear(double encoded);
+/// The inverse of srgb_to_linear(): linear light to the sRGB-encoded display value.
+TILESPLAT_API double linear_to_srgb(double linear);
+
+/// An image's R G B A (premultiplied) converted between encodings, each pixel on its own: to scene-linear
+/// A * decode(C / A), back A * encode(L / A); a pixel with A <= 0 (or A not finite) is taken as opaque (its
+/// colour converted as it is). `opaque` takes every pixel as opaque, for a file written without alpha or with
+/// A = 1. Depth, counts and alpha are untouched. Converting to the same encoding copies.
+TILESPLAT_API std::vector<float> convert_colours(const std::vector<float>& rgba, ColourEncoding from,
+                                                 ColourEncoding to, bool opaque = false);
+
 /// OpenEXR's compression methods that write_exr() offers.
 enum class ExrCompression {
   kZip,   ///< lossless, 16 scanlines per block: the default, good on rendered images
@@ -61,6 +90,10 @@ struct ExrWriteOptions {
   /// hold the background: the file is then a valid premultiplied image of an opaque frame
   /// (tilesplat-render does so whenever the background is not black).
   bool opaque_alpha = false;
+  /// What the R G B channels hold. Scene-linear by default, as OpenEXR's `chromaticities` (written always)
+  /// and every compositing tool assume; kSrgbDisplay keeps the rendered values bit for bit. Either way the
+  /// string attribute `colorInteropID` names it, and read_exr() converts back.
+  ColourEncoding colour = ColourEncoding::kSceneLinear;
 };
 
 /// Blender's Z for pixels that show no surface: finite, so that filters and resampling stay finite,
@@ -69,8 +102,9 @@ inline constexpr float kFarDepth = 1e10f;
 
 /// Writes channels R G B A (A unless options.alpha is false), Z when depth is present, and "splats"
 /// (FLOAT, so that compositing tools read counts as numbers; exact up to 2^24) when counts are present.
-/// Every file carries `chromaticities` (linear Rec.709 primaries, D65 white: the renderer's RGB) and
-/// records which engine wrote it, as string attributes:
+/// Every file carries `chromaticities` (Rec.709 primaries, D65 white) and `colorInteropID` (the encoding of
+/// R G B, options.colour: scene-linear unless asked otherwise) and records which engine wrote it, as string
+/// attributes:
 /// "tilesplatVersion" (build_info().version), "tilesplatCommit" (when built from a checkout) and
 /// "tilesplatBuildType" (when set); then options.attributes.
 /// Atomic: the image goes to a temporary file beside `path` that is renamed over it only once
@@ -79,7 +113,18 @@ TILESPLAT_API void write_exr(const std::filesystem::path& path, const RenderImag
                              const ExrWriteOptions& options = {});
 
 /// Reads an EXR's R G B A (A = 1 when absent), Z and "splats" (each when present), any pixel type
-/// converted, any data window origin. Throws std::runtime_error naming the file.
+/// converted, any data window origin. The colours come back as a render holds them (display values): a file
+/// whose `colorInteropID` is "lin_rec709_scene" is sRGB-encoded back (convert_colours), one that says
+/// "srgb_rec709_display" or has no such attribute (tilesplat's files before it wrote one, and the float64
+/// references in shared/scenes) is taken as it is. Throws std::runtime_error naming the file, also for any
+/// other colorInteropID.
+/// The file's R G B A exactly as stored, with the encoding its header names (kSrgbDisplay when it names none).
+struct StoredExr {
+  RenderImage image;        ///< as read_exr(), but the colours not converted
+  ColourEncoding encoding;  ///< what its `colorInteropID` says
+};
+/// read_exr() without the colour conversion. Throws as read_exr().
+TILESPLAT_API StoredExr read_exr_as_stored(const std::filesystem::path& path);
 TILESPLAT_API RenderImage read_exr(const std::filesystem::path& path);
 
 /// The camera write_exr() recorded in an EXR (ExrWriteOptions::camera), rebuilt exactly from its
@@ -101,9 +146,9 @@ TILESPLAT_API std::optional<Camera> read_exr_camera(const std::filesystem::path&
 TILESPLAT_API std::map<std::string, std::string> read_exr_string_attributes(
     const std::filesystem::path& path);
 
-/// How a PNG preview maps linear radiance to display values: colour times 2^exposure_stops, then the
-/// tone curve per channel, then a clamp to [0, 1] and the sRGB encoding. The EXR keeps the linear
-/// values; only previews are tone mapped.
+/// How a PNG preview grades a render, in linear light: the colour sRGB-decoded, times 2^exposure_stops, the
+/// tone curve per channel, a clamp to [0, 1] and the sRGB encoding. Without exposure and curve the preview is
+/// the trained colour itself, round(255 * clamp(C, 0, 1)). The EXR is never graded.
 enum class ToneMap {
   kNone,      ///< clamp: values above 1 clip
   kAces,      ///< Narkowicz's fit of the ACES filmic curve: x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)
@@ -113,13 +158,14 @@ TILESPLAT_API std::string to_string(ToneMap tone_map);  ///< "none", "aces", "re
 /// The tone curve of one linear channel value (exposure already applied); NaN and negatives map to 0.
 TILESPLAT_API double apply_tone_map(ToneMap tone_map, double linear);
 
-/// How write_png_preview() maps linear colour to the 8-bit preview (see ToneMap).
+/// How write_png_preview() grades the colours (see ToneMap); the defaults leave them as trained.
 struct PreviewOptions {
   double exposure_stops = 0;          ///< colour times 2^exposure_stops before the curve; -20 to 20
   ToneMap tone_map = ToneMap::kNone;  ///< the tone curve
 };
 
-/// An 8-bit sRGB PNG preview of the colour channels (alpha dropped). Atomic like write_exr. Throws
+/// An 8-bit sRGB PNG preview of the colour channels (alpha dropped): byte = round(255 * clamp(C, 0, 1)) of
+/// the rendered display value C unless options grade it (ToneMap). Atomic like write_exr. Throws
 /// std::runtime_error naming the file for an empty image or an exposure out of range.
 TILESPLAT_API void write_png_preview(const std::filesystem::path& path, const RenderImage& image,
                                      const PreviewOptions& options = {});

@@ -22,6 +22,7 @@
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "image/atomic_file.h"
@@ -34,6 +35,18 @@ namespace {
 constexpr std::array<const char*, 4> kColourChannels = {"R", "G", "B", "A"};
 constexpr const char* kDepthChannel = "Z";
 constexpr const char* kSplatCountChannel = "splats";
+constexpr const char* kColourInteropAttribute = "colorInteropID";
+
+// The encoding a header names for its R G B; a file without the attribute holds display values (those
+// tilesplat wrote before it recorded one, and the float64 references).
+ColourEncoding stored_encoding(const Imf::Header& header) {
+  const auto* id = header.findTypedAttribute<Imf::StringAttribute>(kColourInteropAttribute);
+  if (!id) return ColourEncoding::kSrgbDisplay;
+  for (const ColourEncoding encoding : {ColourEncoding::kSceneLinear, ColourEncoding::kSrgbDisplay})
+    if (id->value() == to_string(encoding)) return encoding;
+  throw std::runtime_error(std::string(kColourInteropAttribute) + " '" + id->value() +
+                           "' is not an encoding tilesplat reads (lin_rec709_scene, srgb_rec709_display)");
+}
 
 void check_writable_image(const std::filesystem::path& path, const RenderImage& image) {
   const std::string prefix = "cannot write " + path.string() + ": ";
@@ -58,10 +71,10 @@ void check_writable_image(const std::filesystem::path& path, const RenderImage& 
 // The attributes write_exr sets itself, which options.attributes may not replace: OpenEXR would
 // overwrite them with strings and write a file no reader opens.
 bool is_written_by_the_writer(const std::string& name) {
-  static const std::array<const char*, 14> kOwn = {
+  static const std::array<const char*, 15> kOwn = {
       "channels",         "compression",        "dataWindow",        "displayWindow", "lineOrder",
       "pixelAspectRatio", "screenWindowCenter", "screenWindowWidth", "tiles",         "type",
-      "version",          "chromaticities",     "worldToCamera",     "worldToNDC"};
+      "version",          "chromaticities",     "worldToCamera",     "worldToNDC", "colorInteropID"};
   for (const char* own : kOwn)
     if (name == own) return true;
   return name.rfind("tilesplat", 0) == 0;
@@ -147,9 +160,10 @@ std::string channel_names(const Imf::ChannelList& channels) {
 
 // Throws plain std::runtime_errors (and OpenEXR's exceptions); read_exr adds the file name.
 // The caller (with_exr_file_named_in_errors) has checked that the file is OpenEXR.
-RenderImage read_exr_file(const std::filesystem::path& path) {
+StoredExr read_exr_file(const std::filesystem::path& path) {
   Imf::InputFile file(path.c_str());
   const Imf::Header& header = file.header();
+  const ColourEncoding encoding = stored_encoding(header);
   const Imath::Box2i data_window = header.dataWindow();
   const std::int64_t width = std::int64_t{data_window.max.x} - data_window.min.x + 1;
   const std::int64_t height = std::int64_t{data_window.max.y} - data_window.min.y + 1;
@@ -201,7 +215,7 @@ RenderImage read_exr_file(const std::filesystem::path& path) {
   if (!file.isComplete()) throw std::runtime_error("the file is incomplete (truncated?)");
   file.setFrameBuffer(frame);
   file.readPixels(data_window.min.y, data_window.max.y);
-  return image;
+  return {std::move(image), encoding};
 }
 
 // Runs read(), a reader of the EXR file `path`, once the file exists and is OpenEXR, with the file
@@ -229,14 +243,17 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
   check_writable_image(path, image);
   check_attributes(path, options);
 
-  // What the file holds where the options change the image: A = 1 for an opaque frame, and the
-  // far value in Z where nothing was blended.
+  // What the file holds where the options change the image: the colours in the encoding asked for
+  // (a file without A, or with A = 1, is opaque, so its colours convert as they are), A = 1 for an
+  // opaque frame, and the far value in Z where nothing was blended.
+  const bool opaque = options.opaque_alpha || !options.alpha;
   const std::vector<float>* rgba = &image.rgba;
-  std::vector<float> opaque_rgba;
-  if (options.opaque_alpha) {
-    opaque_rgba = image.rgba;
-    for (size_t i = 3; i < opaque_rgba.size(); i += 4) opaque_rgba[i] = 1.0f;
-    rgba = &opaque_rgba;
+  std::vector<float> stored_rgba;
+  if (opaque || options.colour != ColourEncoding::kSrgbDisplay) {
+    stored_rgba = convert_colours(image.rgba, ColourEncoding::kSrgbDisplay, options.colour, opaque);
+    if (options.opaque_alpha)
+      for (size_t i = 3; i < stored_rgba.size(); i += 4) stored_rgba[i] = 1.0f;
+    rgba = &stored_rgba;
   }
   const std::vector<float>* depth = &image.depth;
   std::vector<float> depth_with_empty;
@@ -262,6 +279,8 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
     header.compression() = openexr_compression(options.compression);
     add_string_attributes(header, options);
     Imf::addChromaticities(header, Imf::Chromaticities());  // Rec. 709 primaries, D65 white
+    // The transfer function beside the primaries, by the Color Interop Forum's identifier.
+    header.insert(kColourInteropAttribute, Imf::StringAttribute(to_string(options.colour)));
     if (options.camera) add_camera_attributes(header, *options.camera);
     const Imath::Box2i data_window = header.dataWindow();
 
@@ -295,8 +314,14 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
   });
 }
 
-RenderImage read_exr(const std::filesystem::path& path) {
+StoredExr read_exr_as_stored(const std::filesystem::path& path) {
   return with_exr_file_named_in_errors(path, [&] { return read_exr_file(path); });
+}
+
+RenderImage read_exr(const std::filesystem::path& path) {
+  StoredExr stored = read_exr_as_stored(path);
+  stored.image.rgba = convert_colours(stored.image.rgba, stored.encoding, ColourEncoding::kSrgbDisplay);
+  return std::move(stored.image);
 }
 
 std::string to_string(ExrCompression compression) {

@@ -1,4 +1,5 @@
-// 8-bit sRGB PNG previews of RenderImages, written with libpng's simplified API.
+// 8-bit sRGB PNG previews of RenderImages (the trained display values, graded on request), written with
+// libpng's simplified API.
 #include <png.h>
 
 #include <algorithm>
@@ -15,17 +16,15 @@
 namespace tilesplat {
 namespace {
 
-// The exact piecewise sRGB encoding (IEC 61966-2-1), not a 2.2 gamma approximation, so previews
-// match what image viewers expect for 8-bit sRGB data.
-double linear_to_srgb(double linear) {
-  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
-}
-
-// Exposure and tone curve, then the clamp and encoding; NaN, which fails every comparison, maps to black.
+// The trained colour as it is, unless graded: grading happens in linear light (decode, exposure, tone
+// curve, encode), so that a stop of exposure doubles the light as a camera's would. NaN, which fails
+// every comparison, maps to black.
 std::uint8_t preview_byte(float colour, double scale, ToneMap tone_map) {
-  double mapped = apply_tone_map(tone_map, double{colour} * scale);
-  if (mapped > 1.0) mapped = 1.0;
-  return static_cast<std::uint8_t>(std::lround(linear_to_srgb(mapped) * 255.0));
+  double display = colour;
+  if (scale != 1.0 || tone_map != ToneMap::kNone)
+    display = linear_to_srgb(std::min(1.0, apply_tone_map(tone_map, srgb_to_linear(colour) * scale)));
+  if (!(display > 0.0)) return 0;
+  return static_cast<std::uint8_t>(std::lround(std::min(display, 1.0) * 255.0));
 }
 
 }  // namespace
