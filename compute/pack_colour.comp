@@ -2,9 +2,9 @@
 // Pack colour: the frame's float RGBA (premultiplied) into the texel layout of a host's colour image
 // that is not R32G32B32A32_SFLOAT, for render_to_image to copy. One invocation per pixel.
 //   FORMAT 0: R16G16B16A16_SFLOAT (round to nearest half; 8 bytes a texel)
-//   FORMAT 1: R8G8B8A8_UNORM (clamped to [0, 1], round(255 c); 4 bytes)
-//   FORMAT 2: R8G8B8A8_SRGB (R G B through the sRGB transfer function, A linear, then as UNORM): a
-//             host sampling or blending the image reads the premultiplied linear colour back.
+//   FORMAT 1: R8G8B8A8_UNORM and R8G8B8A8_SRGB (clamped to [0, 1], round(255 c); 4 bytes). The frame's
+//             colours are already sRGB-encoded display values (docs/colour.md), so an _SRGB image gets the
+//             same bytes: a host sampling it reads linear light, and a second encoding would wash it out.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
@@ -19,11 +19,6 @@ layout(push_constant) uniform Push {
 }
 pc;
 
-vec3 srgb_encode(vec3 linear) {
-  vec3 c = clamp(linear, 0.0, 1.0);
-  return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
-}
-
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;
   if (pixel.x >= pc.width || pixel.y >= pc.height) return;
@@ -33,7 +28,6 @@ void main() {
     pc.packed.v[2 * i] = packHalf2x16(c.rg);
     pc.packed.v[2 * i + 1] = packHalf2x16(c.ba);
   } else {
-    if (FORMAT == 2) c.rgb = srgb_encode(c.rgb);
     pc.packed.v[i] = packUnorm4x8(c);
   }
 }

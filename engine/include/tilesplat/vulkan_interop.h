@@ -38,9 +38,10 @@ struct ExternalImage {
   VkImage image = VK_NULL_HANDLE;  ///< the host's 2D image; mip level 0, array layer 0 is written
   uint32_t width = 0;              ///< must equal the camera's width
   uint32_t height = 0;             ///< must equal the camera's height
-  /// R32G32B32A32_SFLOAT (the frame as it is), R16G16B16A16_SFLOAT (rounded to half), R8G8B8A8_UNORM
-  /// (clamped to [0, 1], round(255 c)) or R8G8B8A8_SRGB (R G B through the sRGB transfer function, A
-  /// linear: sampling or blending the image gives the premultiplied linear colour back).
+  /// R32G32B32A32_SFLOAT (the frame as it is: display values, as Renderer::render returns them),
+  /// R16G16B16A16_SFLOAT (rounded to half), R8G8B8A8_UNORM (clamped to [0, 1], round(255 c)) or
+  /// R8G8B8A8_SRGB (the same bytes as UNORM, since the colours are sRGB-encoded already: sampling the image
+  /// decodes them to linear light, per premultiplied channel; docs/colour.md).
   VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;
   /// The layout the image is in when render_to_image is called; it is left in the same layout
   /// (an image handed over in VK_IMAGE_LAYOUT_UNDEFINED is left in VK_IMAGE_LAYOUT_GENERAL).

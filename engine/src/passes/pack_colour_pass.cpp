@@ -16,9 +16,8 @@ uint32_t shader_format(VkFormat format) {
     case VK_FORMAT_R16G16B16A16_SFLOAT:
       return 0;
     case VK_FORMAT_R8G8B8A8_UNORM:
+    case VK_FORMAT_R8G8B8A8_SRGB:  // the same bytes: the colours are sRGB-encoded already
       return 1;
-    case VK_FORMAT_R8G8B8A8_SRGB:
-      return 2;
     default:
       throw std::logic_error("pack_colour: unsupported format");
   }
