@@ -162,22 +162,20 @@ class Viewer {
     return settings;
   }
   int frames() const { return frames_; }
+  VkFormat window_format() const { return swapchain_.format(); }
   // The mean wall time of a frame (render and present) after the first; 0 before the second.
   double mean_frame_ms() const { return frames_ > 1 ? frame_ms_total_ / (frames_ - 1) : 0.0; }
 
-  // What the window shows now (the last frame), as float RGBA.
-  tilesplat::RenderImage picture() {
+  // What the window shows now: the last frame presented once more, its bytes read back from the
+  // window's image.
+  tilesplat::viewer::WindowPixels window_pixels() {
     tilesplat::wait_for_frame(renderer_);
-    tilesplat::RenderImage image;
-    const VkExtent2D extent = swapchain_.extent();
-    image.width = int(extent.width);
-    image.height = int(extent.height);
-    image.rgba =
-        mesh_layer_ ? tilesplat::viewer::read_rgba(device_, mesh_layer_->picture(), MeshLayer::kPictureFormat,
-                                                   MeshLayer::kPictureLayout, extent.width, extent.height)
-                    : tilesplat::viewer::read_rgba(device_, image_->image(), VK_FORMAT_R32G32B32A32_SFLOAT,
-                                                   FloatImage::kLayout, extent.width, extent.height);
-    return image;
+    tilesplat::viewer::WindowPixels shown;
+    const VkImage source = mesh_layer_ ? mesh_layer_->picture() : image_->image();
+    const VkImageLayout layout = mesh_layer_ ? MeshLayer::kPictureLayout : FloatImage::kLayout;
+    if (!swapchain_.present(source, layout, shown_extent_, &shown))
+      throw std::runtime_error("the window could not show the last frame again for the screenshot");
+    return shown;
   }
 
  private:
@@ -345,14 +343,22 @@ class Viewer {
   double frame_ms_total_ = 0;  // over the frames after the first
 };
 
-// A PNG is the window's picture as shown (the mesh included; sRGB, no exposure or tone curve, as the
-// swapchain shows it). An EXR is the last frame's data: its camera and settings rendered once more
+// A PNG is the window's pixels as shown (the mesh included; the bytes of the window's image, which
+// are the trained colours as a PNG preview without exposure or tone curve holds them). An EXR is the last frame's data: its camera and settings rendered once more
 // (only the composite runs: the lists are reused), with the outputs the EXR carries, exactly as
 // tilesplat-render writes them.
 void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewer& viewer,
                       const cli::LoadedScene& loaded) {
   if (cli::has_extension(path, ".png")) {
-    tilesplat::write_png_preview(path, viewer.picture());
+    const tilesplat::viewer::WindowPixels shown = viewer.window_pixels();
+    // The bytes through write_png_preview unchanged: round(255 * (b / 255)) is b.
+    tilesplat::RenderImage image;
+    image.width = int(shown.width);
+    image.height = int(shown.height);
+    image.rgba.assign(4 * image.pixels(), 1.0f);
+    for (size_t pixel = 0; pixel < image.pixels(); ++pixel)
+      for (size_t c = 0; c < 3; ++c) image.rgba[4 * pixel + c] = float(shown.rgb[3 * pixel + c]) / 255.0f;
+    tilesplat::write_png_preview(path, image);
   } else {
     const tilesplat::RenderImage image = renderer.render(viewer.camera(), viewer.settings());
     tilesplat::ExrWriteOptions exr;
@@ -433,7 +439,8 @@ int run(int argc, char** argv) {
   std::string summary = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
                         cli::describe_scene(loaded.scene) + ", " + std::to_string(viewer.frames()) +
                         (viewer.frames() == 1 ? " frame on " : " frames on ") +
-                        device.name() + ", the last " + cli::format_size(camera.width, camera.height) + " in " +
+                        device.name() + " (window " + tilesplat::viewer::format_name(viewer.window_format()) +
+                        "), the last " + cli::format_size(camera.width, camera.height) + " in " +
                         cli::format_fixed(last_gpu_ms, 2) + " GPU ms";
   if (viewer.frames() > 1)
     summary += ", " + cli::format_fixed(viewer.mean_frame_ms(), 1) + " ms a frame after the first";

@@ -95,6 +95,50 @@ TEST(Viewer, ScreenshotIsTheRenderOfTheSameView) {
   EXPECT_EQ(shown.splat_count, rendered.splat_count);
 }
 
+// The window shows the trained colours as a PNG preview holds them (docs/colour.md): the bytes of the
+// window's image equal tilesplat-render's --png of the same view within one level (the blit's float to
+// 8-bit rounding against the preview's). Both kinds of window format: a _UNORM one, which the viewer
+// prefers, and an _SRGB one (TILESPLAT_VIEWER_SWAPCHAIN=srgb), which would encode the colours a second
+// time if the viewer blitted into it directly.
+TEST(Viewer, WindowPixelsAreThePngPreviewOfTheSameView) {
+  REQUIRE_VIEWER();
+  const std::optional<std::string> prefix = display_prefix();
+  if (!prefix) GTEST_SKIP() << kNoDisplay;
+  const fs::path out = fresh_output_dir();
+  std::vector<std::string> render_args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
+  render_args.insert(render_args.end(), {"-o", (out / "render.exr").string(), "--png", (out / "render.png").string()});
+  const ProcessResult render = run_process("", kRenderExe, render_args);
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  const DecodedPng preview = tilesplat::testing::read_png_rgb(out / "render.png");
+
+  for (const std::string kind : {"unorm", "srgb"}) {
+    std::vector<std::string> viewer_args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
+    const fs::path shot = out / ("window_" + kind + ".png");
+    viewer_args.insert(viewer_args.end(), {"--no-mesh", "--validation", "--frames", "2", "--screenshot", shot.string()});
+    const ProcessResult viewer =
+        run_process("env TILESPLAT_VIEWER_SWAPCHAIN=" + kind + " " + *prefix, kViewerExe, viewer_args);
+    ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
+    EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
+    EXPECT_NE(viewer.err.find(kind == "srgb" ? "_SRGB)" : "_UNORM)"), std::string::npos) << viewer.err;
+    const DecodedPng window = tilesplat::testing::read_png_rgb(shot);
+    ASSERT_EQ(window.width, preview.width);
+    ASSERT_EQ(window.height, preview.height);
+    ASSERT_EQ(window.rgb.size(), preview.rgb.size());
+    size_t differ = 0, lit = 0;
+    int worst = 0;
+    for (size_t i = 0; i < window.rgb.size(); ++i) {
+      const int difference = std::abs(int(window.rgb[i]) - int(preview.rgb[i]));
+      worst = std::max(worst, difference);
+      differ += difference > 0;
+      lit += preview.rgb[i] > 32;
+    }
+    std::printf("[ measure  ] %s window: %zu of %zu values differ from the preview, by at most %d\n", kind.c_str(),
+                differ, window.rgb.size(), worst);
+    EXPECT_LE(worst, 1) << kind;
+    EXPECT_GT(lit, window.rgb.size() / 10) << "the view should show the scene";
+  }
+}
+
 // Every mode and sort path the keys reach goes through the same frame code; this one takes a
 // non-default one of each and a PNG screenshot.
 TEST(Viewer, ValidationLayerStaysSilent) {
@@ -143,8 +187,8 @@ TEST(Viewer, BoxHidesSplatsAndSplatsHideTheGrid) {
   ASSERT_EQ(mesh.width, 320u);
   ASSERT_EQ(mesh.height, 180u);
 
-  // The colours viewer/mesh_layer.cpp draws with (linear), as the sRGB PNG holds them (+-1 for the
-  // half-float picture's rounding).
+  // The colours viewer/mesh_layer.cpp draws with (linear light), sRGB-encoded by its fragment shader, as
+  // the window and so the PNG hold them (+-1 for the half-float picture's rounding).
   auto srgb_byte = [](double c) {
     const double encoded = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
     return int(std::lround(255 * encoded));

@@ -1,4 +1,5 @@
-// The window's picture back in host memory, for a screenshot of what the viewer shows.
+// Device data back in host memory: a buffer that a copy writes and the host reads, for a screenshot of
+// what the window shows.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -10,9 +11,24 @@
 
 namespace tilesplat::viewer {
 
-// Waits for the queue to be idle and copies an R32G32B32A32_SFLOAT or R16G16B16A16_SFLOAT image (in
-// `layout`, left there) into float RGBA, row 0 at the top.
-std::vector<float> read_rgba(const WindowDevice& device, VkImage image, VkFormat format, VkImageLayout layout,
-                             uint32_t width, uint32_t height);
+// A host-visible, coherent buffer that transfers write into, mapped for its lifetime.
+class HostBuffer {
+ public:
+  HostBuffer(const WindowDevice& device, VkDeviceSize bytes);
+  ~HostBuffer();
+  HostBuffer(const HostBuffer&) = delete;
+  HostBuffer& operator=(const HostBuffer&) = delete;
+
+  VkBuffer buffer() const { return buffer_; }
+  const void* map() const { return mapped_; }
+
+ private:
+  void destroy();
+
+  VkDevice device_;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  void* mapped_ = nullptr;
+};
 
 }  // namespace tilesplat::viewer

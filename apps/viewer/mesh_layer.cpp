@@ -20,7 +20,8 @@ namespace {
 
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkFormat kSplatFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
-// Unlit colours, linear: each box face its own, and the grid one the splats hardly ever produce.
+// Unlit colours, linear light (flat_colour.frag encodes them): each box face its own, and the grid one the
+// splats hardly ever produce.
 constexpr float kBoxColours[6][3] = {{0.80f, 0.30f, 0.08f}, {0.70f, 0.25f, 0.06f}, {0.90f, 0.45f, 0.10f},
                                      {0.55f, 0.20f, 0.05f}, {0.85f, 0.38f, 0.09f}, {0.62f, 0.22f, 0.05f}};
 constexpr float kGridColour[3] = {0.0f, 1.0f, 1.0f};

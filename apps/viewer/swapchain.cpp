@@ -1,6 +1,10 @@
 #include "viewer/swapchain.h"
 
+#include "viewer/image_readback.h"
+
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -17,9 +21,19 @@ bool supports(VkPhysicalDevice device, VkFormat format, VkFormatFeatureFlags fea
   return (properties.optimalTilingFeatures & features) == features;
 }
 
-// The renderer writes linear radiance. An _SRGB swapchain makes the blit encode it, so the window
-// shows what a PNG preview without exposure or tone curve shows; a _UNORM one shows the linear
-// values (darker mid-tones).
+bool is_srgb(VkFormat format) { return format == VK_FORMAT_B8G8R8A8_SRGB || format == VK_FORMAT_R8G8B8A8_SRGB; }
+
+// The _UNORM format with an _SRGB one's layout (and so its bytes).
+VkFormat unencoded_twin(VkFormat format) {
+  return format == VK_FORMAT_B8G8R8A8_SRGB ? VK_FORMAT_B8G8R8A8_UNORM
+         : format == VK_FORMAT_R8G8B8A8_SRGB ? VK_FORMAT_R8G8B8A8_UNORM
+                                             : format;
+}
+
+// The renderer's colours are display values already (docs/colour.md): a _UNORM swapchain shows them
+// as they are. An _SRGB one is taken only where the surface offers no _UNORM format, or where
+// TILESPLAT_VIEWER_SWAPCHAIN=srgb asks for it (so that tests cover that path too); it receives the
+// same bytes through a copy (Swapchain::present).
 VkSurfaceFormatKHR choose_format(const WindowDevice& device) {
   uint32_t count = 0;
   vk_check(vkGetPhysicalDeviceSurfaceFormatsKHR(device.physical_device(), device.surface(), &count, nullptr),
@@ -27,12 +41,21 @@ VkSurfaceFormatKHR choose_format(const WindowDevice& device) {
   std::vector<VkSurfaceFormatKHR> formats(count);
   vk_check(vkGetPhysicalDeviceSurfaceFormatsKHR(device.physical_device(), device.surface(), &count, formats.data()),
            "vkGetPhysicalDeviceSurfaceFormatsKHR");
-  const VkFormat preferred[] = {VK_FORMAT_B8G8R8A8_SRGB, VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_UNORM,
-                                VK_FORMAT_R8G8B8A8_UNORM};
+  const char* wanted_kind = std::getenv("TILESPLAT_VIEWER_SWAPCHAIN");
+  const bool srgb_first = wanted_kind && std::string(wanted_kind) == "srgb";
+  std::vector<VkFormat> preferred = {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_B8G8R8A8_SRGB,
+                                     VK_FORMAT_R8G8B8A8_SRGB};
+  if (srgb_first) std::rotate(preferred.begin(), preferred.begin() + 2, preferred.end());
   for (VkFormat wanted : preferred)
-    for (const VkSurfaceFormatKHR& format : formats)
-      if (format.format == wanted && supports(device.physical_device(), wanted, VK_FORMAT_FEATURE_BLIT_DST_BIT))
-        return format;
+    for (const VkSurfaceFormatKHR& format : formats) {
+      if (format.format != wanted) continue;
+      // An _SRGB image is written by a copy from its twin, which the blit writes.
+      const bool usable = is_srgb(wanted)
+                              ? supports(device.physical_device(), unencoded_twin(wanted),
+                                         VK_FORMAT_FEATURE_BLIT_DST_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT)
+                              : supports(device.physical_device(), wanted, VK_FORMAT_FEATURE_BLIT_DST_BIT);
+      if (usable) return format;
+    }
   throw std::runtime_error(device.name() + ": the window offers no 8-bit RGBA format that a blit can write");
 }
 
@@ -53,16 +76,28 @@ void transition(VkCommandBuffer commands, VkImage image, VkImageLayout from, VkI
 
 }  // namespace
 
-// ---------------------------------------------------------------------------------------------
-// FloatImage
+std::string format_name(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_B8G8R8A8_UNORM: return "B8G8R8A8_UNORM";
+    case VK_FORMAT_R8G8B8A8_UNORM: return "R8G8B8A8_UNORM";
+    case VK_FORMAT_B8G8R8A8_SRGB: return "B8G8R8A8_SRGB";
+    case VK_FORMAT_R8G8B8A8_SRGB: return "R8G8B8A8_SRGB";
+    default: return "format " + std::to_string(int(format));
+  }
+}
 
-FloatImage::FloatImage(const WindowDevice& device, uint32_t width, uint32_t height)
-    : device_(device.device()), width_(width), height_(height) {
-  if (!supports(device.physical_device(), kFloatFormat, VK_FORMAT_FEATURE_BLIT_SRC_BIT))
-    throw std::runtime_error(device.name() + ": R32G32B32A32_SFLOAT images cannot be blitted from");
+// ---------------------------------------------------------------------------------------------
+// TransferImage, FloatImage
+
+TransferImage::TransferImage(const WindowDevice& device, VkFormat format, VkFormatFeatureFlags features,
+                             VkImageLayout layout, uint32_t width, uint32_t height)
+    : device_(device.device()), format_(format), layout_(layout), width_(width), height_(height) {
+  if (!supports(device.physical_device(), format, features))
+    throw std::runtime_error(device.name() + ": images of " + format_name(format) +
+                             " cannot be blitted or copied as the viewer needs");
   VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   info.imageType = VK_IMAGE_TYPE_2D;
-  info.format = kFloatFormat;
+  info.format = format;
   info.extent = {width, height, 1};
   info.mipLevels = 1;
   info.arrayLayers = 1;
@@ -70,7 +105,7 @@ FloatImage::FloatImage(const WindowDevice& device, uint32_t width, uint32_t heig
   info.tiling = VK_IMAGE_TILING_OPTIMAL;
   info.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
   info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  vk_check(vkCreateImage(device_, &info, nullptr, &image_), "vkCreateImage (the float image)");
+  vk_check(vkCreateImage(device_, &info, nullptr, &image_), "vkCreateImage (a viewer image)");
 
   VkMemoryRequirements requirements;
   vkGetImageMemoryRequirements(device_, image_, &requirements);
@@ -78,33 +113,32 @@ FloatImage::FloatImage(const WindowDevice& device, uint32_t width, uint32_t heig
   allocate.allocationSize = requirements.size;
   // Device-local where the device has it (every GPU); any allowed type otherwise.
   allocate.memoryTypeIndex = device.memory_type(requirements.memoryTypeBits, 0,
-                                                VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "the float image");
+                                                VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "a viewer image");
   try {
-    vk_check(vkAllocateMemory(device_, &allocate, nullptr, &memory_), "vkAllocateMemory (the float image)");
-    vk_check(vkBindImageMemory(device_, image_, memory_, 0), "vkBindImageMemory (the float image)");
-    enter_blit_layout(device);
+    vk_check(vkAllocateMemory(device_, &allocate, nullptr, &memory_), "vkAllocateMemory (a viewer image)");
+    vk_check(vkBindImageMemory(device_, image_, memory_, 0), "vkBindImageMemory (a viewer image)");
+    // Once, so that every use finds the image in the layout made for it.
+    device.submit_and_wait([&](VkCommandBuffer commands) {
+      transition(commands, image_, VK_IMAGE_LAYOUT_UNDEFINED, layout_, 0, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                 VK_PIPELINE_STAGE_TRANSFER_BIT);
+    });
   } catch (...) {
     destroy();  // a throwing constructor runs no destructor
     throw;
   }
 }
 
-// Once, so that every frame's blit reads the image in the layout made for it.
-void FloatImage::enter_blit_layout(const WindowDevice& device) {
-  device.submit_and_wait([&](VkCommandBuffer commands) {
-    transition(commands, image_, VK_IMAGE_LAYOUT_UNDEFINED, kLayout, 0, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
-               VK_PIPELINE_STAGE_TRANSFER_BIT);
-  });
-}
+TransferImage::~TransferImage() { destroy(); }
 
-FloatImage::~FloatImage() { destroy(); }
-
-void FloatImage::destroy() {
+void TransferImage::destroy() {
   if (image_) vkDestroyImage(device_, image_, nullptr);
   if (memory_) vkFreeMemory(device_, memory_, nullptr);
   image_ = VK_NULL_HANDLE;
   memory_ = VK_NULL_HANDLE;
 }
+
+FloatImage::FloatImage(const WindowDevice& device, uint32_t width, uint32_t height)
+    : image_(device, kFloatFormat, VK_FORMAT_FEATURE_BLIT_SRC_BIT, kLayout, width, height) {}
 
 // ---------------------------------------------------------------------------------------------
 // Swapchain
@@ -153,6 +187,7 @@ void Swapchain::destroy_images() {
   for (VkSemaphore semaphore : blit_done_) vkDestroySemaphore(device_.device(), semaphore, nullptr);
   blit_done_.clear();
   images_.clear();  // owned by the swapchain
+  unencoded_.reset();
 }
 
 void Swapchain::recreate(uint32_t width, uint32_t height) {
@@ -187,7 +222,9 @@ void Swapchain::recreate(uint32_t width, uint32_t height) {
   info.imageColorSpace = VK_COLOR_SPACE_SRGB_NONLINEAR_KHR;
   info.imageExtent = extent_;
   info.imageArrayLayers = 1;
-  info.imageUsage = VK_IMAGE_USAGE_TRANSFER_DST_BIT;  // written by the blit only, never rendered to
+  // Written by the blit or copy only, never rendered to; read back for a screenshot where it can be.
+  can_read_back_ = (caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT) != 0;
+  info.imageUsage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | (can_read_back_ ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0);
   info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
   info.preTransform = caps.currentTransform;
   info.compositeAlpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
@@ -208,10 +245,29 @@ void Swapchain::recreate(uint32_t width, uint32_t height) {
   VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
   blit_done_.assign(count, VK_NULL_HANDLE);
   for (VkSemaphore& done : blit_done_) vk_check(vkCreateSemaphore(vk, &semaphore, nullptr, &done), "vkCreateSemaphore");
+  if (is_srgb(format_))
+    unencoded_ = std::make_unique<TransferImage>(
+        device_, unencoded_twin(format_), VK_FORMAT_FEATURE_BLIT_DST_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT,
+        VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, extent_.width, extent_.height);
 }
 
-bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D source_extent) {
+// A 1:1 blit, so NEAREST copies each pixel; it converts float to the target's 8-bit format. The
+// target is in TRANSFER_DST_OPTIMAL.
+void Swapchain::record_blit(VkImage source, VkImageLayout source_layout, VkImage target) {
+  VkImageBlit region{};
+  region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.srcOffsets[1] = {int32_t(extent_.width), int32_t(extent_.height), 1};
+  region.dstSubresource = region.srcSubresource;
+  region.dstOffsets[1] = region.srcOffsets[1];
+  vkCmdBlitImage(commands_, source, source_layout, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region,
+                 VK_FILTER_NEAREST);
+}
+
+bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D source_extent,
+                        WindowPixels* shown) {
   if (!swapchain_) return false;
+  if (shown && !can_read_back_)
+    throw std::runtime_error(device_.name() + ": the window's images cannot be read back (no TRANSFER_SRC usage)");
   if (source_extent.width != extent_.width || source_extent.height != extent_.height)
     throw std::logic_error("Swapchain::present: the source image is not the swapchain's size");
   VkDevice vk = device_.device();
@@ -235,16 +291,47 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
   // command, ours included.
   transition(commands_, images_[index], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
              VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
-  VkImageBlit region{};
-  region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-  region.srcOffsets[1] = {int32_t(extent_.width), int32_t(extent_.height), 1};
-  region.dstSubresource = region.srcSubresource;
-  region.dstOffsets[1] = region.srcOffsets[1];
-  // 1:1, so NEAREST copies each pixel; the blit converts float to the swapchain's format.
-  vkCmdBlitImage(commands_, source, source_layout, images_[index], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
-                 &region, VK_FILTER_NEAREST);
-  transition(commands_, images_[index], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-             VK_ACCESS_TRANSFER_WRITE_BIT, 0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+  VkImage window_image = images_[index];
+  if (!unencoded_) {
+    record_blit(source, source_layout, window_image);
+  } else {
+    // The blit writes the _UNORM twin (no encoding); its bytes go to the _SRGB image unchanged.
+    VkImage twin = unencoded_->image();
+    record_blit(source, source_layout, twin);
+    transition(commands_, twin, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+               VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+               VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkImageCopy copy{};
+    copy.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    copy.dstSubresource = copy.srcSubresource;
+    copy.extent = {extent_.width, extent_.height, 1};
+    vkCmdCopyImage(commands_, twin, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, window_image,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+    // Back to the layout the next frame's blit expects, once the copy has read it.
+    transition(commands_, twin, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+               VK_ACCESS_TRANSFER_READ_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+               VK_PIPELINE_STAGE_TRANSFER_BIT);
+  }
+  std::unique_ptr<HostBuffer> readback;
+  VkImageLayout window_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  if (shown) {
+    readback = std::make_unique<HostBuffer>(device_, VkDeviceSize(extent_.width) * extent_.height * 4);
+    transition(commands_, window_image, window_layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+               VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+               VK_PIPELINE_STAGE_TRANSFER_BIT);
+    window_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {extent_.width, extent_.height, 1};
+    vkCmdCopyImageToBuffer(commands_, window_image, window_layout, readback->buffer(), 1, &region);
+    VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                         nullptr, 0, nullptr);
+  }
+  transition(commands_, window_image, window_layout, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+             shown ? VkAccessFlags{0} : VkAccessFlags{VK_ACCESS_TRANSFER_WRITE_BIT}, 0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
   vk_check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
 
   // The blit waits for the acquired image at the transfer stage, where the first barrier starts.
@@ -270,6 +357,16 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
   // source for the next render; the renderer waits for its own work anyway, so little is lost.
   vk_check(vkWaitForFences(vk, 1, &blit_fence_, VK_TRUE, std::numeric_limits<uint64_t>::max()), "vkWaitForFences");
   vk_check(vkResetFences(vk, 1, &blit_fence_), "vkResetFences");
+  if (shown) {
+    // The window's bytes in its format's channel order; the screenshot is R G B.
+    const bool bgr = format_ == VK_FORMAT_B8G8R8A8_UNORM || format_ == VK_FORMAT_B8G8R8A8_SRGB;
+    const auto* bytes = static_cast<const uint8_t*>(readback->map());
+    shown->width = extent_.width;
+    shown->height = extent_.height;
+    shown->rgb.resize(size_t(extent_.width) * extent_.height * 3);
+    for (size_t pixel = 0; pixel < size_t(extent_.width) * extent_.height; ++pixel)
+      for (size_t c = 0; c < 3; ++c) shown->rgb[3 * pixel + c] = bytes[4 * pixel + (bgr ? 2 - c : c)];
+  }
   if (presented == VK_ERROR_OUT_OF_DATE_KHR) {
     stale_ = true;
     return false;

@@ -1,10 +1,17 @@
 // What the viewer shows and how: the float image the renderer writes, and the window's swapchain,
 // into which each frame is blitted (float to 8-bit, the format conversion done by the blit).
+//
+// Colours (docs/colour.md): the renderer's values are the trained display values, already sRGB-encoded,
+// so the window must receive them as they are, byte = round(255 * c). A _UNORM swapchain does that
+// through the blit. An _SRGB one would encode them a second time (washed out); where the surface offers
+// only those, the blit writes a _UNORM image of the same layout whose bytes are then copied unchanged.
 #pragma once
 
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "tilesplat/vulkan_interop.h"
@@ -12,31 +19,59 @@
 
 namespace tilesplat::viewer {
 
+// A 2D image in device memory that transfers read and write (TRANSFER_SRC and _DST), kept in one
+// layout between uses.
+class TransferImage {
+ public:
+  // Throws std::runtime_error when the format lacks any of `features` (optimal tiling).
+  TransferImage(const WindowDevice& device, VkFormat format, VkFormatFeatureFlags features, VkImageLayout layout,
+                uint32_t width, uint32_t height);
+  ~TransferImage();
+  TransferImage(const TransferImage&) = delete;
+  TransferImage& operator=(const TransferImage&) = delete;
+
+  VkImage image() const { return image_; }
+  VkFormat format() const { return format_; }
+  VkImageLayout layout() const { return layout_; }
+  uint32_t width() const { return width_; }
+  uint32_t height() const { return height_; }
+
+ private:
+  void destroy();
+
+  VkDevice device_;
+  VkFormat format_;
+  VkImageLayout layout_;
+  VkImage image_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  uint32_t width_, height_;
+};
+
 // An R32G32B32A32_SFLOAT image the renderer writes with render_to_image (TRANSFER_DST) and the
 // swapchain blits from (TRANSFER_SRC), in device memory. It lives in TRANSFER_SRC_OPTIMAL, the
 // layout of the blit; render_to_image leaves it in the layout it found it in.
 class FloatImage {
  public:
   FloatImage(const WindowDevice& device, uint32_t width, uint32_t height);
-  ~FloatImage();
-  FloatImage(const FloatImage&) = delete;
-  FloatImage& operator=(const FloatImage&) = delete;
 
   static constexpr VkImageLayout kLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
 
-  ExternalImage target() const { return {image_, width_, height_, VK_FORMAT_R32G32B32A32_SFLOAT, kLayout}; }
-  VkImage image() const { return image_; }
-  uint32_t width() const { return width_; }
-  uint32_t height() const { return height_; }
+  ExternalImage target() const {
+    return {image_.image(), image_.width(), image_.height(), VK_FORMAT_R32G32B32A32_SFLOAT, kLayout};
+  }
+  VkImage image() const { return image_.image(); }
 
  private:
-  void enter_blit_layout(const WindowDevice& device);
-  void destroy();
+  TransferImage image_;
+};
 
-  VkDevice device_;
-  VkImage image_ = VK_NULL_HANDLE;
-  VkDeviceMemory memory_ = VK_NULL_HANDLE;
-  uint32_t width_, height_;
+// "B8G8R8A8_UNORM" and so on, for the formats a swapchain may be given.
+std::string format_name(VkFormat format);
+
+// The window's pixels as presented: RGB bytes, row 0 at the top, as the swapchain image held them.
+struct WindowPixels {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgb;
 };
 
 class Swapchain {
@@ -58,12 +93,16 @@ class Swapchain {
   // false when nothing was shown (VK_ERROR_OUT_OF_DATE_KHR, or no images): recreate, present again.
   // Either way, stale() says whether the swapchain no longer fits the surface (also after
   // VK_SUBOPTIMAL_KHR, when the frame was shown): recreate it before the next frame.
-  bool present(VkImage source, VkImageLayout source_layout, VkExtent2D source_extent);
+  // With `shown`, the presented image's bytes are also copied back into it (needs TRANSFER_SRC on the
+  // window's images; std::runtime_error where the surface does not offer it).
+  bool present(VkImage source, VkImageLayout source_layout, VkExtent2D source_extent,
+               WindowPixels* shown = nullptr);
   bool stale() const { return stale_; }
 
  private:
   void destroy_images();
   void destroy();
+  void record_blit(VkImage source, VkImageLayout source_layout, VkImage target);
 
   const WindowDevice& device_;
   VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
@@ -78,6 +117,10 @@ class Swapchain {
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer commands_ = VK_NULL_HANDLE;
   bool stale_ = true;  // no images yet
+  bool can_read_back_ = false;  // the window's images were created with TRANSFER_SRC
+  // An _SRGB swapchain's _UNORM twin, which the blit writes and whose bytes are copied into the
+  // window's image unchanged; null for a _UNORM swapchain.
+  std::unique_ptr<TransferImage> unencoded_;
 };
 
 }  // namespace tilesplat::viewer
