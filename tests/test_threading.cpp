@@ -106,7 +106,8 @@ TEST(Threading, ReadersWritersAndTheReferenceRunConcurrently) {
           const RenderImage image = tilesplat::render_reference(sh3_scene, camera);
           if (image.rgba != reference.rgba) throw std::runtime_error("a concurrent reference render differs");
           const fs::path file = out / ("thread" + std::to_string(t) + ".exr");
-          tilesplat::write_exr(file, image);
+          // The display encoding stores the values as they are, so that the read back is bit-exact.
+          tilesplat::write_exr(file, image, {.colour = tilesplat::ColourEncoding::kSrgbDisplay});
           if (tilesplat::read_exr(file).rgba != image.rgba)
             throw std::runtime_error("an EXR read back differs");
         }

@@ -118,6 +118,7 @@ TILESPLAT_API void write_exr(const std::filesystem::path& path, const RenderImag
 /// "srgb_rec709_display" or has no such attribute (tilesplat's files before it wrote one, and the float64
 /// references in shared/scenes) is taken as it is. Throws std::runtime_error naming the file, also for any
 /// other colorInteropID.
+TILESPLAT_API RenderImage read_exr(const std::filesystem::path& path);
 /// The file's R G B A exactly as stored, with the encoding its header names (kSrgbDisplay when it names none).
 struct StoredExr {
   RenderImage image;        ///< as read_exr(), but the colours not converted
@@ -125,7 +126,6 @@ struct StoredExr {
 };
 /// read_exr() without the colour conversion. Throws as read_exr().
 TILESPLAT_API StoredExr read_exr_as_stored(const std::filesystem::path& path);
-TILESPLAT_API RenderImage read_exr(const std::filesystem::path& path);
 
 /// The camera write_exr() recorded in an EXR (ExrWriteOptions::camera), rebuilt exactly from its
 /// double-precision attributes (`tilesplatRotation` M33d = Camera::rotation, `tilesplatPosition` V3d,
