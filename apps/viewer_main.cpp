@@ -439,8 +439,8 @@ int run(int argc, char** argv) {
   std::string summary = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
                         cli::describe_scene(loaded.scene) + ", " + std::to_string(viewer.frames()) +
                         (viewer.frames() == 1 ? " frame on " : " frames on ") +
-                        device.name() + " (window " + tilesplat::viewer::format_name(viewer.window_format()) +
-                        "), the last " + cli::format_size(camera.width, camera.height) + " in " +
+                        device.name() + " in a " + tilesplat::viewer::format_name(viewer.window_format()) +
+                        " window, the last " + cli::format_size(camera.width, camera.height) + " in " +
                         cli::format_fixed(last_gpu_ms, 2) + " GPU ms";
   if (viewer.frames() > 1)
     summary += ", " + cli::format_fixed(viewer.mean_frame_ms(), 1) + " ms a frame after the first";

@@ -7,7 +7,9 @@
 // its colour; no kept splat gives the background. The chance that splat i wins is
 // alpha_i * prod over the splats j before it of (1 - alpha_j): exactly its weight in the sorted
 // front-to-back blend without the transmittance early-out, so the mean over samples converges to the
-// sorted image (the early-out's T < 1e-4 leaves a difference below 1e-4 of a colour).
+// sorted image (the early-out's T < 1e-4 leaves a difference below 1e-4 of a colour). The mean is over
+// the display values the blend is defined on, not over linear light: it estimates the sorted frame, and
+// a mean of decoded samples would converge to a brighter image (docs/colour.md, "Averages").
 //
 // One dispatch per sample: the host runs the samples back to back and this shader keeps the running
 // sums per pixel in `state`; the last sample writes the means. Alpha is the fraction of samples that

@@ -119,7 +119,7 @@ TEST(Viewer, WindowPixelsAreThePngPreviewOfTheSameView) {
         run_process("env TILESPLAT_VIEWER_SWAPCHAIN=" + kind + " " + *prefix, kViewerExe, viewer_args);
     ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
     EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
-    EXPECT_NE(viewer.err.find(kind == "srgb" ? "_SRGB)" : "_UNORM)"), std::string::npos) << viewer.err;
+    EXPECT_NE(viewer.err.find(kind == "srgb" ? "_SRGB window" : "_UNORM window"), std::string::npos) << viewer.err;
     const DecodedPng window = tilesplat::testing::read_png_rgb(shot);
     ASSERT_EQ(window.width, preview.width);
     ASSERT_EQ(window.height, preview.height);
