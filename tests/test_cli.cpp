@@ -793,7 +793,7 @@ TEST(CliRender, SceneFileExposureAndToneMapShapeThePngOnly) {
       run_exe(kRenderExe, {plain.string(), "-o", (out / "flags.exr").string(), "--png", (out / "flags.png").string(),
                            "--exposure", "2", "--tone-map", "aces"});
   ASSERT_EQ(flags_result.exit_code, 0) << flags_result.err;
-  // The EXR stays linear; only the preview is graded.
+  // The EXR is never graded; only the preview is.
   EXPECT_EQ(tilesplat::read_exr(out / "plain.exr").rgba, tilesplat::read_exr(out / "graded.exr").rgba);
   EXPECT_NE(read_file(out / "plain.png"), read_file(out / "graded.png"));
   EXPECT_EQ(read_file(out / "graded.png"), read_file(out / "flags.png"));

@@ -2,8 +2,8 @@
 //
 //   render_exr SCENE CAMERAS.json VIEW WIDTH HEIGHT OUT.exr
 //
-// SCENE is any format tilesplat reads (.ply, .spz, .sog, ...). The image is linear premultiplied
-// RGBA over black, as tilesplat-render writes it.
+// SCENE is any format tilesplat reads (.ply, .spz, .sog, ...). The image is premultiplied RGBA over
+// black, scene-linear (the sRGB decoding of the trained colours), as tilesplat-render writes it.
 #include <tilesplat/camera.h>
 #include <tilesplat/image.h>
 #include <tilesplat/renderer.h>

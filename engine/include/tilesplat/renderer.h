@@ -110,7 +110,7 @@ struct Light {
   Type type = Type::kDirectional;              ///< which of the two
   std::array<float, 3> direction = {0, 1, 0};  ///< directional: where the light travels (any non-zero length)
   std::array<float, 3> position = {0, 0, 0};   ///< point: world position
-  std::array<float, 3> color = {1, 1, 1};      ///< linear RGB, >= 0
+  std::array<float, 3> color = {1, 1, 1};      ///< RGB factor on the trained colour (docs/colour.md), >= 0
   float intensity = 1;                         ///< >= 0
   /// Member-wise equality.
   bool operator==(const Light&) const = default;
@@ -174,7 +174,7 @@ struct HostDepth {
 
 /// Everything that changes how one frame is rendered.
 struct RenderSettings {
-  std::array<float, 3> background = {0, 0, 0};         ///< linear RGB behind the splats: C + T * background
+  std::array<float, 3> background = {0, 0, 0};         ///< RGB behind the splats, in the splats' display values (docs/colour.md): C + T * background
   std::string sort = "radix";                          ///< the key sort strategy (see sort_strategies())
   bool depth = true;                                   ///< produce the expected-depth channel
   bool splat_count = true;                             ///< produce the per-pixel blended-splat count

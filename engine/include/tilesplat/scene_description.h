@@ -102,7 +102,7 @@ struct SceneLight {
   Type type = Type::kDirectional;               ///< which of the two
   std::array<double, 3> direction = {0, 1, 0};  ///< directional: where the light travels (unit length)
   std::array<double, 3> position = {0, 0, 0};   ///< point
-  std::array<double, 3> color = {1, 1, 1};      ///< linear RGB
+  std::array<double, 3> color = {1, 1, 1};      ///< RGB factor on the trained colour (docs/colour.md)
   double intensity = 1;                         ///< >= 0
 };
 
@@ -113,7 +113,7 @@ struct SceneEffects {
   std::optional<int> sh_degree;
   Antialiasing antialiasing = Antialiasing::kClassic;  ///< the footprint filter the assets were trained with
   std::vector<SceneLight> lights;             ///< relighting (tilesplat::Lighting has the model); none: unlit
-  std::array<double, 3> ambient = {0, 0, 0};  ///< relighting's ambient light, linear RGB (only with lights)
+  std::array<double, 3> ambient = {0, 0, 0};  ///< relighting's ambient factor, RGB (only with lights)
   double exposure_stops = 0;                  ///< PNG previews: colours times 2^exposure (PreviewOptions)
   ToneMap tone_map = ToneMap::kNone;          ///< PNG previews (PreviewOptions)
 };
@@ -132,7 +132,7 @@ struct SceneDescription {
   std::vector<SceneModel> models;      ///< the splat files, in order (load_described_scene() merges them)
   std::vector<CameraView> cameras;     ///< empty when the file has none
   std::filesystem::path cameras_file;  ///< resolved cameras.json when "cameras" names one, else empty
-  std::array<float, 3> background = {0, 0, 0};  ///< linear RGB behind the splats
+  std::array<float, 3> background = {0, 0, 0};  ///< RGB behind the splats, display values like theirs
   SceneEffects effects;                         ///< what to simulate; each off unless the file asks
   SceneOutputs outputs;                         ///< which images to write
 };
