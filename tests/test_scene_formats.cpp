@@ -123,7 +123,7 @@ TEST_P(SceneFormats, GaussiansAndImagesMatchThePlyBesideIt) {
   TILESPLAT_REQUIRE_SHARED_SCENES();
   const FormatCase& c = GetParam();
   const fs::path native_path = testing::shared_scenes() / c.native;
-  if (!fs::exists(native_path)) GTEST_SKIP() << native_path << " not found";
+  if (!fs::exists(native_path)) TILESPLAT_SKIP_OR_FAIL(native_path << " not found");
   LoadReport report;
   const GaussianScene native = load_scene(native_path, {}, &report);
   const GaussianScene decoded = load_scene(testing::shared_scenes() / c.decoded);
@@ -282,7 +282,7 @@ class FormatErrors : public ::testing::Test {
   void SetUp() override {
     TILESPLAT_REQUIRE_SHARED_SCENES();
     formats_ = testing::shared_scenes() / "formats";
-    if (!fs::exists(formats_)) GTEST_SKIP() << formats_ << " not found";
+    if (!fs::exists(formats_)) TILESPLAT_SKIP_OR_FAIL(formats_ << " not found");
   }
   std::string original(const std::string& file) const { return read_file(formats_ / file); }
   fs::path formats_;

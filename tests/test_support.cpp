@@ -34,6 +34,11 @@ std::filesystem::path shared_scenes() {
   return {};
 }
 
+bool skips_forbidden() {
+  const char* value = std::getenv("TILESPLAT_NO_SKIPS");
+  return value && *value && std::string(value) != "0";
+}
+
 std::filesystem::path temp_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "tilesplat";

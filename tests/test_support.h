@@ -21,8 +21,13 @@ std::filesystem::path bundled_playbot_cameras();
 std::filesystem::path bundled_sh3();  // scenes/playcanvas_test/playcanvas_test_64_sh3.ply
 std::filesystem::path bundled_sh3_cameras();
 
-// ../shared/scenes, or $TILESPLAT_SHARED_SCENES. Empty path when absent: callers GTEST_SKIP().
+// ../shared/scenes, or $TILESPLAT_SHARED_SCENES. Empty path when absent: callers skip
+// (TILESPLAT_SKIP_OR_FAIL).
 std::filesystem::path shared_scenes();
+
+// Whether a test whose inputs or tools are missing must fail rather than skip: TILESPLAT_NO_SKIPS is
+// set (to anything but "" or "0"), as .ci/run sets it, so that nothing CI must run can pass by skipping.
+bool skips_forbidden();
 
 // A directory unique to the running test for temporary files (removed by the OS, not by tests).
 std::filesystem::path temp_dir();
@@ -60,9 +65,19 @@ std::string error_of(Action&& action) {
 
 }  // namespace tilesplat::testing
 
-// Skips the test, visibly, when ../shared/scenes is not available.
-#define TILESPLAT_REQUIRE_SHARED_SCENES()                                                                  \
-  do {                                                                                                     \
-    if (::tilesplat::testing::shared_scenes().empty())                                                     \
-      GTEST_SKIP() << "shared scenes not found: set TILESPLAT_SHARED_SCENES or -DTILESPLAT_SHARED_SCENES"; \
+// Skips the test, saying why (`message` may stream: a << " b"), or fails it where skips are forbidden
+// (skips_forbidden(): CI). Like GTEST_SKIP, it returns from the test body.
+#define TILESPLAT_SKIP_OR_FAIL(message)                                                          \
+  do {                                                                                           \
+    if (::tilesplat::testing::skips_forbidden())                                                 \
+      GTEST_FAIL() << message << " (TILESPLAT_NO_SKIPS is set: this test must run, not skip)"; \
+    else                                                                                         \
+      GTEST_SKIP() << message;                                                                   \
+  } while (0)
+
+// Skips the test, visibly, when ../shared/scenes is not available (fails where skips are forbidden).
+#define TILESPLAT_REQUIRE_SHARED_SCENES()                                                                      \
+  do {                                                                                                         \
+    if (::tilesplat::testing::shared_scenes().empty())                                                         \
+      TILESPLAT_SKIP_OR_FAIL("shared scenes not found: set TILESPLAT_SHARED_SCENES or -DTILESPLAT_SHARED_SCENES"); \
   } while (0)

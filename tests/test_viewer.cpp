@@ -38,7 +38,7 @@ constexpr const char* kViewerExe = TILESPLAT_VIEWER_EXE;
 #define REQUIRE_VIEWER() (void)0
 #else
 constexpr const char* kViewerExe = "";
-#define REQUIRE_VIEWER() GTEST_SKIP() << "tilesplat-viewer is not built (configure with -DTILESPLAT_BUILD_VIEWER=ON)"
+#define REQUIRE_VIEWER() TILESPLAT_SKIP_OR_FAIL("tilesplat-viewer is not built (configure with -DTILESPLAT_BUILD_VIEWER=ON)")
 #endif
 constexpr const char* kRenderExe = TILESPLAT_RENDER_EXE;
 
@@ -71,7 +71,7 @@ void expect_one_error_line(const ProcessResult& result) {
 TEST(Viewer, ScreenshotIsTheRenderOfTheSameView) {
   REQUIRE_VIEWER();
   const std::optional<std::string> prefix = display_prefix();
-  if (!prefix) GTEST_SKIP() << kNoDisplay;
+  if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
   const fs::path out = fresh_output_dir();
   std::vector<std::string> viewer_args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
   std::vector<std::string> render_args = viewer_args;
@@ -103,7 +103,7 @@ TEST(Viewer, ScreenshotIsTheRenderOfTheSameView) {
 TEST(Viewer, WindowPixelsAreThePngPreviewOfTheSameView) {
   REQUIRE_VIEWER();
   const std::optional<std::string> prefix = display_prefix();
-  if (!prefix) GTEST_SKIP() << kNoDisplay;
+  if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
   const fs::path out = fresh_output_dir();
   std::vector<std::string> render_args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
   render_args.insert(render_args.end(), {"-o", (out / "render.exr").string(), "--png", (out / "render.png").string()});
@@ -144,7 +144,7 @@ TEST(Viewer, WindowPixelsAreThePngPreviewOfTheSameView) {
 TEST(Viewer, ValidationLayerStaysSilent) {
   REQUIRE_VIEWER();
   const std::optional<std::string> prefix = display_prefix();
-  if (!prefix) GTEST_SKIP() << kNoDisplay;
+  if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
   const fs::path out = fresh_output_dir();
   std::vector<std::string> args = view_args(bundled_sh3(), bundled_sh3_cameras(), 1);
   args.insert(args.end(), {"--validation", "--mode", "depth16", "--sort", "onesweep", "--frames", "2", "--screenshot",
@@ -168,7 +168,7 @@ TEST(Viewer, ValidationLayerStaysSilent) {
 TEST(Viewer, BoxHidesSplatsAndSplatsHideTheGrid) {
   REQUIRE_VIEWER();
   const std::optional<std::string> prefix = display_prefix();
-  if (!prefix) GTEST_SKIP() << kNoDisplay;
+  if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
   const fs::path out = fresh_output_dir();
   auto screenshot = [&](const std::string& name, const std::vector<std::string>& flags) {
     std::vector<std::string> args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);

@@ -136,9 +136,15 @@ step "merge refuses: ${merge#*error: }"
 
 submit "$work/second.out" || fail "the resubmitted array failed: $(cat "$work/second.out")"
 second=$(head -n 1 "$work/second.out" | cut -d';' -f1)
-grep -q "$done_at_cancel already done" "$work/log/task-${second}_1.log" ||
-  fail "task 1 did not resume: $(cat "$work/log/task-${second}_1.log")"
-grep -q "16 already done" "$work/log/task-${second}_0.log" || fail "task 0 rendered again what it had done"
+# Whole lines, so that "2 already done" cannot pass for "12 already done": each task's log must have
+# tilesplat-render's resume line with its own shard and count.
+expect_resume_line() {  # expect_resume_line TASK DONE
+  local log="$work/log/task-${second}_$1.log"
+  grep -q -x -E "tilesplat-render: shard $1/$tasks \([^)]*\): 16 of 64 frames, $2 already done \(manifest and checksums match\), skipped" "$log" ||
+    fail "task $1 of job $second should have skipped $2 frames: $(cat "$log")"
+}
+expect_resume_line 1 "$done_at_cancel"
+for task in 0 2 3; do expect_resume_line "$task" 16; done
 step "job $second: task 1 skipped its $done_at_cancel frames and rendered the rest; tasks 0, 2, 3 skipped all 16"
 
 "$render" --merge-manifests "$work/out" >"$work/merge.log" 2>&1 || fail "the merge failed: $(cat "$work/merge.log")"

@@ -113,6 +113,14 @@ fi
 
 echo "== public headers include no OpenEXR, glm or JSON, and Vulkan only in vulkan_interop.h =="
 # (sort_strategy.h, the extension point for GPU sorts, reaches Vulkan through vulkan_interop.h.)
+# Every public header of the source tree must have been installed: a glob that matched nothing would
+# let the grep below pass.
+installed_headers=$(find "$work/shared/include/tilesplat" -name '*.h' | wc -l)
+source_headers=$(find "$root/engine/include/tilesplat" -name '*.h' | wc -l)
+if [ "$installed_headers" -lt "$source_headers" ] || [ "$source_headers" -eq 0 ]; then
+  echo "installed $installed_headers public headers, the source tree has $source_headers"
+  exit 1
+fi
 if grep -n -E '#include <(Imf|Iex|OpenEXR|glm|nlohmann|vulkan)' "$work"/shared/include/tilesplat/*.h |
   grep -v 'vulkan_interop.h:.*<vulkan/vulkan.h>'; then
   echo "a public header includes a dependency's header"
