@@ -328,3 +328,87 @@ TEST(CameraPaths, KeyframeFileMistakesNameTheKey) {
 }
 
 }  // namespace
+
+namespace {
+
+// Files written in the layouts COLMAP and nerfstudio document, not by this project's writer
+// (tests/data/camera_models/make_camera_models.py): views 2 and 5 of the bundled playbot's cameras.json.
+const fs::path kCameraModels = fs::path(TILESPLAT_SOURCE_DIR) / "tests" / "data" / "camera_models";
+
+std::vector<CameraView> bundled_views() {
+  return tilesplat::load_cameras_json(tilesplat::testing::bundled_playbot_cameras());
+}
+
+TEST(DatasetCameras, ColmapTextModelWithSimplePinholeReadsAsTheTrainersCameras) {
+  const auto views = tilesplat::load_camera_set(kCameraModels / "colmap" / "sparse" / "0");
+  const auto expected = bundled_views();
+  ASSERT_EQ(views.size(), 2u);
+  EXPECT_EQ(views[0].name, "frame_00001.jpg");
+  EXPECT_EQ(views[1].name, "frame_00002.jpg");
+  // Camera 1 is SIMPLE_PINHOLE (f cx cy): one focal length for both axes.
+  EXPECT_EQ(views[0].camera.fx, 1662.7687752661222);
+  EXPECT_EQ(views[0].camera.fy, 1662.7687752661222);
+  EXPECT_EQ(views[0].camera.cx, 960.0);
+  EXPECT_EQ(views[0].camera.cy, 540.0);
+  expect_near_camera(views[0].camera, expected[2].camera, 1e-12);
+  expect_near_camera(views[1].camera, expected[5].camera, 1e-12);
+
+  // Rendered: the same images as the trainer's cameras (rotations equal to rounding).
+  auto& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(tilesplat::load_scene(tilesplat::testing::bundled_playbot()));
+  for (const auto& [colmap, trainer] : {std::pair{0, 2}, std::pair{1, 5}}) {
+    const auto a = renderer.render(tilesplat::resize_camera(views[size_t(colmap)].camera, 160, 90));
+    const auto b = renderer.render(tilesplat::resize_camera(expected[size_t(trainer)].camera, 160, 90));
+    EXPECT_LT(tilesplat::compare_images(a, b).max_abs, 1e-4) << "COLMAP image " << colmap;
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(DatasetCameras, NerfstudioTransformsJsonReadsAndItsOffCentreFrameRendersShifted) {
+  const auto views = tilesplat::load_camera_set(kCameraModels / "nerfstudio" / "transforms.json");
+  const auto expected = bundled_views();
+  ASSERT_EQ(views.size(), 2u);
+  EXPECT_EQ(views[0].name, "images/frame_00001.png");
+  expect_near_camera(views[0].camera, expected[2].camera, 1e-12);
+  // Frame 1 gives its own principal point, (+64, +128) pixels off the centre: the frame's fields win
+  // over the file's.
+  EXPECT_EQ(views[1].camera.cx, 1024.0);
+  EXPECT_EQ(views[1].camera.cy, 668.0);
+
+  // At a quarter of the size the principal point moves by (16, 32) pixels, one tile and two: the
+  // image moves with it, right and down, and the tiles see the same splats, so the overlap agrees to
+  // float rounding.
+  auto& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(tilesplat::load_scene(tilesplat::testing::bundled_playbot()));
+  const auto centred = renderer.render(tilesplat::resize_camera(views[0].camera, 480, 270));
+  const auto shifted = renderer.render(tilesplat::resize_camera(views[1].camera, 480, 270));
+  double worst = 0, changed = 0;
+  for (int y = 32; y < 270; ++y)
+    for (int x = 16; x < 480; ++x)
+      for (size_t c = 0; c < 4; ++c) {
+        const size_t at = 4 * (size_t(y) * 480 + size_t(x)) + c;
+        const size_t from = 4 * (size_t(y - 32) * 480 + size_t(x - 16)) + c;
+        worst = std::max(worst, double(std::abs(shifted.rgba[at] - centred.rgba[from])));
+        changed = std::max(changed, double(std::abs(shifted.rgba[at] - centred.rgba[at])));
+      }
+  EXPECT_LT(worst, 1e-4) << "the off-centre frame is not the centred one moved by (16, 32)";
+  EXPECT_GT(changed, 0.1) << "the principal point did not move the image";
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// The app takes the model folder and the transforms.json as --cameras, as a user would.
+TEST(DatasetCameras, RenderAppTakesBothFiles) {
+  const fs::path out = fresh_output_dir();
+  for (const fs::path& cameras : {kCameraModels / "colmap" / "sparse" / "0", kCameraModels / "nerfstudio" / "transforms.json"}) {
+    const auto result = tilesplat::testing::run_process(
+        "", TILESPLAT_RENDER_EXE,
+        {tilesplat::testing::bundled_playbot().string(), "--cameras", cameras.string(), "--views", "all", "--width",
+         "96", "-o", (out / (cameras.filename().string() + "_%02d.exr")).string(), "--validation"});
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    EXPECT_EQ(result.err.find("validation messages"), std::string::npos) << result.err;
+    EXPECT_TRUE(fs::exists(out / (cameras.filename().string() + "_00.exr")));
+    EXPECT_TRUE(fs::exists(out / (cameras.filename().string() + "_01.exr")));
+  }
+}
+
+}  // namespace
