@@ -58,6 +58,11 @@ ProcessResult run_process(const std::string& prefix, const std::string& exe, con
   const int status = ::pclose(pipe);
   if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
   result.err = read_file(err_path);
+  // The apps run with the validation layer on in the tests (TILESPLAT_VALIDATION=1), warn about its
+  // messages and still exit 0: every run of an app is checked here, so that no test can miss them.
+  for (const char* sign : {"vulkan validation", "Vulkan validation messages"})
+    if (result.err.find(sign) != std::string::npos)
+      ADD_FAILURE() << "the validation layer reported messages while running " << command << ":\n" << result.err;
   return result;
 }
 

@@ -16,7 +16,8 @@ struct ProcessResult {
 
 // Runs `prefix exe args...` through the shell (prefix: e.g. "env -u DISPLAY " or "xvfb-run -a ";
 // empty for none) with stdout captured and stderr in a file beside the test's temporaries.
-// VK_LOADER_DEBUG is emptied so that loader chatter cannot pollute stderr.
+// VK_LOADER_DEBUG is emptied so that loader chatter cannot pollute stderr. A validation-layer message
+// in stderr (the apps print them and still exit 0) fails the calling test.
 ProcessResult run_process(const std::string& prefix, const std::string& exe, const std::vector<std::string>& args);
 
 std::string read_file(const std::filesystem::path& path);
