@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -35,6 +36,7 @@ ManifestEntry entry_of(const json& line) {
   entry.frames = line.at("frames").get<int>();
   entry.number = line.at("number").get<int>();
   entry.camera = line.at("camera").get<std::string>();
+  entry.pose = line.value("pose", "");
   entry.width = line.at("width").get<int>();
   entry.height = line.at("height").get<int>();
   entry.file = line.at("file").get<std::string>();
@@ -63,11 +65,26 @@ bool file_matches(const fs::path& path, uint64_t bytes, const std::string& sha25
 
 }  // namespace
 
+std::string camera_pose_text(const Camera& camera) {
+  std::string text;
+  auto add = [&text](double value) {
+    char buffer[32];
+    const auto end = std::to_chars(buffer, buffer + sizeof buffer, value).ptr;  // shortest round trip
+    if (!text.empty()) text += ' ';
+    text.append(buffer, end);
+  };
+  for (const double value : {camera.fx, camera.fy, camera.cx, camera.cy}) add(value);
+  for (const double value : camera.rotation) add(value);
+  for (const double value : camera.position) add(value);
+  return text;
+}
+
 std::string to_json_line(const ManifestEntry& entry) {
   nlohmann::ordered_json line = {{"frame", entry.frame},
                                  {"frames", entry.frames},
                                  {"number", entry.number},
                                  {"camera", entry.camera},
+                                 {"pose", entry.pose},
                                  {"width", entry.width},
                                  {"height", entry.height},
                                  {"file", entry.file},
@@ -133,9 +150,24 @@ bool files_match(const fs::path& folder, const ManifestEntry& entry) {
 }
 
 ManifestAppender::ManifestAppender(fs::path path) : path_(std::move(path)) {
-  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (fd_ < 0)
     throw std::runtime_error("cannot open " + in_quotes(path_) + " for appending: " + std::strerror(errno));
+  drop_torn_last_line();
+}
+
+// A run killed while it wrote a line leaves that line without its newline. Readers ignore it (its frame
+// was still in flight), but a line appended after it would join it into one malformed line: cut it off.
+void ManifestAppender::drop_torn_last_line() {
+  const off_t size = ::lseek(fd_, 0, SEEK_END);
+  if (size <= 0) return;
+  std::string text(static_cast<size_t>(size), '\0');
+  if (::pread(fd_, text.data(), text.size(), 0) != size)
+    throw std::runtime_error("cannot read " + in_quotes(path_) + ": " + std::strerror(errno));
+  const size_t last_newline = text.rfind('\n');
+  const off_t keep = last_newline == std::string::npos ? 0 : static_cast<off_t>(last_newline + 1);
+  if (keep != size && ::ftruncate(fd_, keep) != 0)
+    throw std::runtime_error("cannot cut the torn last line of " + in_quotes(path_) + ": " + std::strerror(errno));
 }
 
 ManifestAppender::~ManifestAppender() {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "frame_sequence.h"
+#include "tilesplat/camera.h"
 
 namespace tilesplat::cli {
 
@@ -19,6 +20,9 @@ struct ManifestEntry {
   int frames = 0;      // how many frames the whole run (all shards) has
   int number = 0;      // the number in its file name: the view index, or the frame of a path
   std::string camera;  // "view 3 of cameras.json (img_0003)", "orbit frame 5 of 100", ...
+  // The camera's values, exactly (camera_pose_text): the description stays the same when an orbit's
+  // elevation or a cameras.json changes, the values do not. "" in manifests written before it.
+  std::string pose;
   int width = 0, height = 0;
   std::string file;  // the EXR, relative to the manifest's folder
   uint64_t bytes = 0;
@@ -31,6 +35,9 @@ struct ManifestEntry {
 };
 
 std::string to_json_line(const ManifestEntry& entry);  // one line, no newline
+
+// fx fy cx cy, the rotation's 9 and the position's 3 values, each as its shortest exact decimal.
+std::string camera_pose_text(const Camera& camera);
 
 // "manifest.jsonl" for a run in one shard, "manifest.shard-I-of-N.jsonl" for a shard.
 std::string manifest_file_name(const Shard& shard);
@@ -50,7 +57,7 @@ bool files_match(const std::filesystem::path& folder, const ManifestEntry& entry
 
 // Appends lines to one manifest. Each line goes out in one write() with O_APPEND and is synced to
 // the disk before append() returns, so a line is either complete or (when killed mid-write) a
-// torn last line that read_manifests ignores.
+// torn last line that read_manifests ignores, and that the next appender cuts off before it appends.
 class ManifestAppender {
  public:
   explicit ManifestAppender(std::filesystem::path path);
@@ -61,6 +68,8 @@ class ManifestAppender {
   const std::filesystem::path& path() const { return path_; }
 
  private:
+  void drop_torn_last_line();
+
   std::filesystem::path path_;
   int fd_ = -1;
 };

@@ -355,6 +355,7 @@ cli::ManifestEntry manifest_entry(const Frame& frame, int frame_count, const fs:
   entry.frames = frame_count;
   entry.number = frame.number;
   entry.camera = frame.description;
+  entry.pose = cli::camera_pose_text(frame.camera);
   entry.width = frame.camera.width;
   entry.height = frame.camera.height;
   entry.file = frame.exr.lexically_relative(folder).string();
@@ -363,7 +364,8 @@ cli::ManifestEntry manifest_entry(const Frame& frame, int frame_count, const fs:
   return entry;
 }
 
-// The frames whose manifest line matches this run's frame (same file, camera, size and settings)
+// The frames whose manifest line matches this run's frame (same file, camera and its values, size and
+// settings)
 // and whose files are intact. A later line of the same frame overrides an earlier one.
 std::map<int, cli::ManifestEntry> finished_frames(const std::vector<Frame>& frames, const fs::path& folder,
                                                   const std::string& settings, const cli::Shard& shard) {
@@ -376,7 +378,7 @@ std::map<int, cli::ManifestEntry> finished_frames(const std::vector<Frame>& fram
     const cli::ManifestEntry wanted =
         manifest_entry(frames[size_t(entry.frame)], static_cast<int>(frames.size()), folder, settings);
     if (entry.file == wanted.file && entry.png == wanted.png && entry.camera == wanted.camera &&
-        entry.width == wanted.width && entry.height == wanted.height && entry.settings == wanted.settings &&
+        entry.pose == wanted.pose && entry.width == wanted.width && entry.height == wanted.height && entry.settings == wanted.settings &&
         entry.number == wanted.number)
       latest[entry.frame] = entry;
   }

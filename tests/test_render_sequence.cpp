@@ -465,4 +465,117 @@ TEST(RenderSequence, MistakesFailBeforeAnyFrameIsRendered) {
   EXPECT_EQ(left, (std::vector<std::string>{"a_file", "one_key.json"}));
 }
 
+// A resume skips only frames whose manifest line matches what the run would write now: a changed
+// size, camera, setting or EXR encoding renders every frame again (render_main.cpp's comparison of
+// file, camera, size and settings), and the same arguments once more skip them all.
+TEST(RenderSequence, ResumeRendersAgainWhatChangedAndSkipsWhatDidNot) {
+  const fs::path out = fresh_output_dir();
+  const std::string scene = tilesplat::testing::bundled_playbot().string();
+  const std::string pattern = (out / "o_%02d.exr").string();
+  auto run = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {scene, "--orbit", "4", "--width", "64", "--height", "36", "-o", pattern};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto result = render(args);
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    return result.err;
+  };
+  auto expect_rendered_all = [&](const std::string& err, const std::string& what) {
+    EXPECT_TRUE(contains(err, "4 frames rendered")) << what << ": " << err;
+    EXPECT_FALSE(contains(err, "already done")) << what << ": " << err;
+  };
+  expect_rendered_all(run({}), "the first run");
+  const std::string again = run({});
+  EXPECT_TRUE(contains(again, "4 already done")) << again;
+  EXPECT_TRUE(contains(again, "0 frames rendered")) << again;
+  expect_rendered_all(run({"--width", "96", "--height", "54"}), "another size");
+  EXPECT_EQ(tilesplat::read_exr(out / "o_02.exr").width, 96);
+  expect_rendered_all(run({"--width", "96", "--height", "54", "--elevation", "35"}), "other cameras");
+  expect_rendered_all(run({"--width", "96", "--height", "54", "--elevation", "35", "--mode", "depth16"}),
+                      "another accuracy mode");
+  expect_rendered_all(
+      run({"--width", "96", "--height", "54", "--elevation", "35", "--mode", "depth16", "--exr-colour", "display"}),
+      "another EXR encoding");
+  EXPECT_EQ(tilesplat::read_exr_string_attributes(out / "o_03.exr").at("colorInteropID"), "srgb_rec709_display");
+  const std::string last = run({"--width", "96", "--height", "54", "--elevation", "35", "--mode", "depth16",
+                                "--exr-colour", "display"});
+  EXPECT_TRUE(contains(last, "4 already done")) << last;
+  // Each frame's newest line describes the files now in the folder.
+  std::map<int, cli::ManifestEntry> newest;
+  for (const cli::ManifestEntry& entry : manifest_entries(out)) newest[entry.frame] = entry;
+  ASSERT_EQ(newest.size(), 4u);
+  for (const auto& [frame, entry] : newest) {
+    EXPECT_EQ(entry.width, 96) << frame;
+    EXPECT_TRUE(cli::files_match(out, entry)) << frame;
+  }
+}
+
+// A run killed while writing leaves a torn last line: the next run ignores it, cuts it off before it
+// appends, and leaves a manifest whose every line parses. A complete line that is not an entry is an
+// error naming the manifest and the line, before anything is rendered.
+TEST(RenderSequence, TornManifestLineIsCutOffAndMalformedLineIsNamed) {
+  const fs::path out = fresh_output_dir();
+  const std::vector<std::string> args = {tilesplat::testing::bundled_playbot().string(), "--orbit", "3", "--width",
+                                         "64", "--height", "36", "-o", (out / "t_%d.exr").string()};
+  ASSERT_EQ(render(args).exit_code, 0);
+  const fs::path manifest = out / "manifest.jsonl";
+  const std::string complete = read_file(manifest);
+  ASSERT_EQ(std::count(complete.begin(), complete.end(), '\n'), 3);
+  // Frame 1's file is lost and the manifest ends in half a line, as a kill mid-write leaves it.
+  fs::remove(out / "t_1.exr");
+  std::ofstream(manifest, std::ios::app) << R"({"frame":1,"frames":3,"number":1,"camera":"orb)";
+  const auto resumed = render(args);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_TRUE(contains(resumed.err, "2 already done")) << resumed.err;
+  EXPECT_TRUE(contains(resumed.err, "1 frames rendered")) << resumed.err;
+  const std::string repaired = read_file(manifest);
+  EXPECT_EQ(repaired.substr(0, complete.size()), complete) << "the complete lines must stay as they were";
+  EXPECT_EQ(repaired.back(), '\n');
+  EXPECT_EQ(std::count(repaired.begin(), repaired.end(), '\n'), 4);
+  EXPECT_EQ(manifest_entries(out).size(), 4u);  // every line parses
+  EXPECT_TRUE(fs::exists(out / "t_1.exr"));
+
+  std::ofstream(manifest, std::ios::app) << "{\"frame\": \"one\"}\n";
+  const auto malformed = render(args);
+  EXPECT_EQ(malformed.exit_code, 1) << malformed.err;
+  expect_one_error_line(malformed, "tilesplat-render");
+  EXPECT_TRUE(contains(malformed.err, "manifest.jsonl' line 5 is not a manifest entry")) << malformed.err;
+}
+
+// The merge refuses shards that do not fit together: a frame claimed by two shards, and shards that
+// disagree on how many frames the run has.
+TEST(RenderSequence, MergeRefusesAFrameInTwoShardsAndShardsOfDifferentRuns) {
+  const fs::path root = fresh_output_dir();
+  const std::string scene = tilesplat::testing::bundled_playbot().string();
+  auto shard = [&](const fs::path& folder, int frames, int index) {
+    fs::create_directories(folder);
+    const auto result = render({scene, "--orbit", std::to_string(frames), "--width", "48", "--height", "27",
+                                "--shard", std::to_string(index) + "/2", "-o", (folder / "m_%02d.exr").string()});
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+  };
+  const fs::path twice = root / "twice";
+  shard(twice, 4, 0);
+  shard(twice, 4, 1);
+  ASSERT_EQ(render({"--merge-manifests", twice.string()}).exit_code, 0);
+  // Shard 0's manifest also claims frame 1 of shard 1 (its line copied over).
+  const std::string shard1 = read_file(twice / "manifest.shard-1-of-2.jsonl");
+  std::ofstream(twice / "manifest.shard-0-of-2.jsonl", std::ios::app) << shard1.substr(0, shard1.find('\n') + 1);
+  const auto both = render({"--merge-manifests", twice.string()});
+  EXPECT_EQ(both.exit_code, 1) << both.err;
+  expect_one_error_line(both, "tilesplat-render");
+  EXPECT_TRUE(contains(both.err, "frame 1 is in both 'manifest.shard-0-of-2.jsonl' and "
+                                 "'manifest.shard-1-of-2.jsonl': each frame must belong to exactly one shard"))
+      << both.err;
+
+  const fs::path mixed = root / "mixed";
+  shard(mixed, 4, 0);
+  shard(mixed, 6, 1);
+  const auto disagree = render({"--merge-manifests", mixed.string()});
+  EXPECT_EQ(disagree.exit_code, 1) << disagree.err;
+  expect_one_error_line(disagree, "tilesplat-render");
+  EXPECT_TRUE(contains(disagree.err, "the manifests disagree on the number of frames: "
+                                     "'manifest.shard-0-of-2.jsonl' has 4, 'manifest.shard-1-of-2.jsonl' 6"))
+      << disagree.err;
+  EXPECT_FALSE(fs::exists(mixed / "manifest.jsonl"));
+}
+
 }  // namespace
