@@ -57,30 +57,35 @@ TEST(AccuracyModes, BadNamesAndValuesAreClearErrors) {
   EXPECT_THROW(renderer.render(orbit_camera(scene, 32, 32), settings), std::invalid_argument);
 }
 
+// What a mode must visibly change against the reference mode's GPU frame, so that a mode that silently
+// did nothing cannot pass its bound: the image, the (tile, Gaussian) pairs, or the depth key's bits.
+enum class Changes { kNothing, kImage, kPairs, kSortBits };
+
 struct Bound {
   const char* modes;
   double min_psnr_db;  // against the float64 reference, each view (docs/accuracy.md)
+  Changes changes;
 };
 
 // Measured on lavapipe with `tilesplat-bench --accuracy` at 320x180, views 0 and 3; each bound
 // sits a few dB under the lowest measured PSNR so that another driver's rounding passes.
 constexpr Bound kPlaybotBounds[] = {
-    {"reference", 60.0},  // the spine's bound for the reference mode
-    {"depth24", 55.0},
-    {"depth16", 55.0},
-    {"square-tiles", 60.0},
-    {"opacity-extent", 75.0},
-    {"opacity-extent+square-tiles", 75.0},
-    {"sh0", 25.0},
-    {"sh1", 30.0},
-    {"fp16-sh", 80.0},
-    {"fp16-cov", 70.0},
-    {"t-cutoff=1e-3", 52.0},
-    {"t-cutoff=1e-2", 35.0},
-    {"alpha-cutoff=1/128", 48.0},
-    {"alpha-cutoff=1/64", 40.0},
-    {"resort4", 30.0},
-    {"depth16+opacity-extent+fp16-sh+fp16-cov", 55.0},
+    {"reference", 60.0, Changes::kNothing},  // the spine's bound for the reference mode
+    {"depth24", 55.0, Changes::kSortBits},
+    {"depth16", 55.0, Changes::kSortBits},
+    {"square-tiles", 60.0, Changes::kPairs},  // more pairs, the same pixels (tested below)
+    {"opacity-extent", 75.0, Changes::kPairs},
+    {"opacity-extent+square-tiles", 75.0, Changes::kPairs},
+    {"sh0", 25.0, Changes::kImage},
+    {"sh1", 30.0, Changes::kImage},
+    {"fp16-sh", 80.0, Changes::kImage},
+    {"fp16-cov", 70.0, Changes::kImage},
+    {"t-cutoff=1e-3", 52.0, Changes::kImage},
+    {"t-cutoff=1e-2", 35.0, Changes::kImage},
+    {"alpha-cutoff=1/128", 48.0, Changes::kImage},
+    {"alpha-cutoff=1/64", 40.0, Changes::kImage},
+    {"resort4", 30.0, Changes::kImage},
+    {"depth16+opacity-extent+fp16-sh+fp16-cov", 55.0, Changes::kImage},
 };
 
 TEST(AccuracyModes, EachModeStaysWithinItsBoundOnARealScene) {
@@ -93,14 +98,36 @@ TEST(AccuracyModes, EachModeStaysWithinItsBoundOnARealScene) {
     RenderSettings settings;
     settings.depth = false;
     settings.splat_count = false;
+    settings.reuse_lists = false;  // every frame sorts, so that its statistics describe its own work
     const RenderImage reference = render_reference(scene, camera, settings);
+    settings.accuracy = {};
+    const RenderImage exact = renderer.render(camera, settings);
+    const FrameStats exact_stats = renderer.last_frame_stats();
     for (const Bound& bound : kPlaybotBounds) {
       settings.accuracy = parse_accuracy_modes(bound.modes);
       const RenderImage image = renderer.render(camera, settings);
+      const FrameStats stats = renderer.last_frame_stats();
       const ImageDifference d = compare_images(image, reference);
-      std::printf("view %d  %-45s PSNR %7.2f dB (bound %5.1f)  max abs %.4f  SSIM %.5f\n", view, bound.modes,
-                  d.psnr_db, bound.min_psnr_db, d.max_abs, ssim(image, reference));
+      const double change = compare_images(image, exact).max_abs;
+      std::printf("view %d  %-45s PSNR %7.2f dB (bound %5.1f)  max abs %.4f  SSIM %.5f  change %.2e, pairs %llu, "
+                  "key bits %u\n",
+                  view, bound.modes, d.psnr_db, bound.min_psnr_db, d.max_abs, ssim(image, reference), change,
+                  static_cast<unsigned long long>(stats.intersections), stats.sort_bits);
       EXPECT_GE(d.psnr_db, bound.min_psnr_db) << bound.modes << " at view " << view;
+      switch (bound.changes) {
+        case Changes::kNothing:
+          EXPECT_EQ(change, 0.0) << bound.modes;
+          break;
+        case Changes::kImage:
+          EXPECT_GT(change, 0.0) << bound.modes << " changed no pixel";
+          break;
+        case Changes::kPairs:
+          EXPECT_NE(stats.intersections, exact_stats.intersections) << bound.modes << " changed no pair";
+          break;
+        case Changes::kSortBits:
+          EXPECT_LT(stats.sort_bits, exact_stats.sort_bits) << bound.modes << " sorted as many bits";
+          break;
+      }
       for (float v : image.rgba) ASSERT_TRUE(std::isfinite(v)) << bound.modes;
     }
   }

@@ -133,6 +133,80 @@ TEST(HostDepth, TiltedPlaneThroughARealSceneMatchesTheReference) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// An OpenGL projection (y up, NDC depth in [-1, 1]) with near and far planes, column-major.
+std::array<double, 16> opengl_projection(double near, double far) {
+  std::array<double, 16> p = vulkan_projection(near, far, false);
+  p[5] = 1;
+  p[10] = -(far + near) / (far - near);
+  p[14] = -2 * far * near / (far - near);
+  return p;
+}
+
+// The same tilted wall given in the depth conventions hosts use besides the standard one: reversed-Z
+// with an infinite far plane (near ones), and OpenGL's [-1, 1] clip space. Each is rendered against
+// the float64 reference with the same depth image, its depth out is the reference's in that convention
+// and lies on the camera's side of the wall (larger depth values are nearer in reversed-Z), and the
+// colours are the standard convention's but where float rounding moves the wall across a splat.
+TEST(HostDepth, ReversedZAndOpenGlWallsMatchTheReference) {
+  const Views& views = playbot_views();
+  auto& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(views.scene);
+  const Camera& camera = views.cameras[0];
+  const DepthConvention standard = DepthConvention::from_projection(vulkan_projection(0.05, 200, false));
+  const std::vector<float> standard_plane = tilted_plane(views, camera, standard);
+  RenderSettings standard_settings;
+  standard_settings.host = HostDepth{standard, standard_plane, true, 0.5f};
+  const tilesplat::RenderImage standard_image = renderer.render(camera, standard_settings);
+  const tilesplat::RenderImage uncut = renderer.render(camera);
+
+  struct Case {
+    const char* name;
+    DepthConvention convention;
+    bool nearer_is_larger;
+  };
+  const Case cases[] = {
+      {"reversed-Z", DepthConvention::from_projection(vulkan_projection(0.05, 0, true)), true},
+      // Other planes than the standard case's: with the same ones, OpenGL's window depth equals Vulkan's.
+      {"OpenGL", DepthConvention::from_projection(opengl_projection(0.1, 100), tilesplat::ClipSpace::opengl()),
+       false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::vector<float> plane = tilted_plane(views, camera, c.convention);
+    ASSERT_NE(plane, standard_plane) << "the convention should change the depth values";
+    RenderSettings settings;
+    settings.host = HostDepth{c.convention, plane, true, 0.5f};
+    const tilesplat::RenderImage gpu = renderer.render(camera, settings);
+    const tilesplat::RenderImage reference = tilesplat::render_reference(views.scene, camera, settings);
+    const tilesplat::ImageDifference difference = tilesplat::compare_images(gpu, reference);
+    EXPECT_GE(difference.psnr_db, 60.0);
+    EXPECT_LE(difference.max_abs, 2e-3) << "at (" << difference.worst_x << ", " << difference.worst_y << ")";
+    EXPECT_GT(tilesplat::compare_images(gpu, uncut).max_abs, 0.1) << "the wall should hide part of the scene";
+
+    size_t colour_moved = 0, reached = 0, differ = 0;
+    for (size_t i = 0; i < gpu.pixels(); ++i) {
+      for (size_t k = 0; k < 4; ++k)
+        if (std::abs(gpu.rgba[4 * i + k] - standard_image.rgba[4 * i + k]) > 1e-3f) {
+          ++colour_moved;
+          break;
+        }
+      reached += gpu.host_depth[i] != plane[i];
+      differ += std::abs(gpu.host_depth[i] - reference.host_depth[i]) > 1e-6f * std::max(1.0f, plane[i]);
+      if (c.nearer_is_larger)
+        EXPECT_GE(gpu.host_depth[i], plane[i]) << "pixel " << i;
+      else
+        EXPECT_LE(gpu.host_depth[i], plane[i]) << "pixel " << i;
+    }
+    std::printf("host depth, %s wall: PSNR %.1f dB, max abs %.2g; %zu of %zu pixels differ from the standard "
+                "convention's by more than 1e-3; depth out reached at %zu\n",
+                c.name, difference.psnr_db, difference.max_abs, colour_moved, gpu.pixels(), reached);
+    EXPECT_LE(colour_moved, gpu.pixels() / 200);
+    EXPECT_GT(reached, gpu.pixels() / 20);
+    EXPECT_EQ(differ, 0u);
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 TEST(HostDepth, SurfaceInFrontOfEverySplatLeavesExactlyNothing) {
   const Views& views = playbot_views();
   auto& renderer = tilesplat::testing::validated_renderer();
