@@ -238,9 +238,29 @@ class GltfReader {
     } else {
       if (!load_buffer_)
         fail("buffer " + std::to_string(i) + " is the external file '" + uri + "': read the .gltf from disk");
-      loaded_[i] = load_buffer_(uri);
+      loaded_[i] = load_buffer_(percent_decoded(uri, i));
     }
     return *loaded_[i];
+  }
+
+  // A relative URI reference names its file with reserved characters percent-encoded (glTF 2.0,
+  // "URIs"): "scene%20data.bin" is the file "scene data.bin".
+  std::string percent_decoded(const std::string& uri, size_t buffer_index) const {
+    std::string name;
+    for (size_t k = 0; k < uri.size(); ++k) {
+      if (uri[k] != '%') {
+        name += uri[k];
+        continue;
+      }
+      const auto hex = [](char c) {
+        return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+      };
+      if (k + 2 >= uri.size() || hex(uri[k + 1]) < 0 || hex(uri[k + 2]) < 0)
+        fail("buffer " + std::to_string(buffer_index) + ": the uri '" + uri + "' has a malformed percent escape");
+      name += static_cast<char>(hex(uri[k + 1]) * 16 + hex(uri[k + 2]));
+      k += 2;
+    }
+    return name;
   }
 
   std::vector<unsigned char> decode_base64(std::string_view text) const {
