@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "process_support.h"
+#include "test_math.h"
 #include "test_support.h"
 #include "tilesplat/scene.h"
 
@@ -38,14 +39,9 @@ uint8_t quantize(double value, double low, double high, int levels = 255) {
   return static_cast<uint8_t>(std::lround(std::clamp(t, 0.0, 1.0) * levels));
 }
 
-using Matrix3 = std::array<double, 9>;
+using tilesplat::testing::math::Matrix3;
 Matrix3 rotation_of(const float* wxyz) {
-  double w = wxyz[0], x = wxyz[1], y = wxyz[2], z = wxyz[3];
-  const double n = std::sqrt(w * w + x * x + y * y + z * z);
-  w /= n, x /= n, y /= n, z /= n;
-  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+  return tilesplat::testing::math::quaternion_matrix(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
 }
 void expect_same_rotation(const float* actual, const float* expected, double tolerance, size_t gaussian) {
   const Matrix3 a = rotation_of(actual), b = rotation_of(expected);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "process_support.h"
+#include "test_math.h"
 #include "test_support.h"
 #include "tilesplat/scene.h"
 
@@ -25,8 +26,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-using Matrix3 = std::array<double, 9>;  // row-major
-using Vector3 = std::array<double, 3>;
+using tilesplat::testing::math::Matrix3;
+using tilesplat::testing::math::multiply;
+using Vector3 = tilesplat::testing::math::Vec3;
+constexpr auto transform = tilesplat::testing::math::times;
+constexpr auto rotation_of = tilesplat::testing::math::quaternion_matrix;
 
 constexpr size_t kCount = 3;
 // The file's values, glTF axes (y up). Rotations as x y z w.
@@ -161,25 +165,6 @@ std::string base64(const std::vector<uint8_t>& bytes) {
   return text;
 }
 
-// Rotation matrix of a unit quaternion (w, x, y, z).
-Matrix3 rotation_of(double w, double x, double y, double z) {
-  const double n = std::sqrt(w * w + x * x + y * y + z * z);
-  w /= n, x /= n, y /= n, z /= n;
-  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-}
-Matrix3 multiply(const Matrix3& a, const Matrix3& b) {
-  Matrix3 c{};
-  for (size_t r = 0; r < 3; ++r)
-    for (size_t col = 0; col < 3; ++col)
-      for (size_t k = 0; k < 3; ++k) c[r * 3 + col] += a[r * 3 + k] * b[k * 3 + col];
-  return c;
-}
-Vector3 transform(const Matrix3& m, const Vector3& v) {
-  return {m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
-          m[6] * v[0] + m[7] * v[1] + m[8] * v[2]};
-}
 // glTF (y up) to the trainer's frame: 180 degrees about z.
 constexpr Matrix3 kFlip = {-1, 0, 0, 0, -1, 0, 0, 0, 1};
 

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "test_math.h"
 #include "test_support.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
@@ -77,18 +78,8 @@ Camera view_of(const fs::path& cameras, size_t index) {
 
 // --- independent small math (not the library's) for the hand-built scenes
 
-Matrix3 multiply(const Matrix3& a, const Matrix3& b) {
-  Matrix3 out{};
-  for (size_t i = 0; i < 3; ++i)
-    for (size_t j = 0; j < 3; ++j)
-      for (size_t k = 0; k < 3; ++k) out[i * 3 + j] += a[i * 3 + k] * b[k * 3 + j];
-  return out;
-}
-
-Vec3 times(const Matrix3& m, const Vec3& v) {
-  return {m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
-          m[6] * v[0] + m[7] * v[1] + m[8] * v[2]};
-}
+using tilesplat::testing::math::multiply;
+using tilesplat::testing::math::times;
 
 Vec3 transposed_times(const Matrix3& m, const Vec3& v) {
   return {m[0] * v[0] + m[3] * v[1] + m[6] * v[2], m[1] * v[0] + m[4] * v[1] + m[7] * v[2],
