@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "tilesplat/renderer.h"
+#include "tilesplat/render_settings.h"
 
 namespace tilesplat {
 

@@ -4,7 +4,8 @@
 #include <vector>
 
 #include "tilesplat/camera.h"
-#include "tilesplat/renderer.h"
+#include "tilesplat/image.h"
+#include "tilesplat/render_settings.h"
 
 namespace tilesplat {
 

@@ -6,7 +6,7 @@
 #include <array>
 #include <vector>
 
-#include "tilesplat/renderer.h"
+#include "tilesplat/render_settings.h"
 
 namespace tilesplat {
 

@@ -817,11 +817,19 @@ struct Renderer::Impl {
   vk::InFlightSubmission in_flight;
 };
 
+// How the functions of vulkan_interop.h, which are not members, reach a renderer's implementation.
+struct RendererAccess {
+  static Renderer::Impl& impl(Renderer& renderer) { return *renderer.impl_; }
+  static std::unique_ptr<Renderer> make(std::unique_ptr<Renderer::Impl> impl) {
+    return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
+  }
+};
+
 Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Renderer::~Renderer() = default;
 
 std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
-  return std::unique_ptr<Renderer>(new Renderer(std::make_unique<Impl>(options)));
+  return RendererAccess::make(std::make_unique<Impl>(options));
 }
 
 void Renderer::set_scene(const GaussianScene& scene) {
@@ -891,12 +899,12 @@ RenderImage Renderer::render(const Camera& camera, const RenderSettings& setting
 }
 
 std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device, const RendererOptions& options) {
-  return std::unique_ptr<Renderer>(new Renderer(std::make_unique<Renderer::Impl>(options, device)));
+  return RendererAccess::make(std::make_unique<Renderer::Impl>(options, device));
 }
 
 void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                      const ExternalImage& target) {
-  Renderer::Impl& r = *renderer.impl_;
+  Renderer::Impl& r = RendererAccess::impl(renderer);
   check_images(target, nullptr, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings);
@@ -908,7 +916,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
 
 void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                      const ExternalImage& target, const ExternalDepthImage& depth) {
-  Renderer::Impl& r = *renderer.impl_;
+  Renderer::Impl& r = RendererAccess::impl(renderer);
   check_images(target, &depth, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings, &depth);
@@ -920,7 +928,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
 void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                      const ExternalImage& target, const ExternalDepthImage* depth,
                      const HostFrameSync& sync) {
-  Renderer::Impl& r = *renderer.impl_;
+  Renderer::Impl& r = RendererAccess::impl(renderer);
   check_images(target, depth, camera, settings);
   auto check_count = [](size_t count, size_t semaphores, const char* what) {
     if (count != 0 && count != semaphores)
@@ -938,7 +946,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
 void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
                      const ExternalImage& target, const ExternalDepthImage* depth,
                      const HostCommandBuffer& commands) {
-  Renderer::Impl& r = *renderer.impl_;
+  Renderer::Impl& r = RendererAccess::impl(renderer);
   check_images(target, depth, camera, settings);
   if (commands.command_buffer == VK_NULL_HANDLE)
     throw std::invalid_argument("render_to_image: HostCommandBuffer has no command buffer");
@@ -949,7 +957,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
 }
 
 void wait_for_frame(Renderer& renderer) {
-  renderer.impl_->wait_for_submitted_frame();
+  RendererAccess::impl(renderer).wait_for_submitted_frame();
 }
 
 const FrameStats& Renderer::last_frame_stats() const { return impl_->stats; }

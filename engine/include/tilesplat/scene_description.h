@@ -13,7 +13,8 @@
 
 #include "tilesplat/camera.h"
 #include "tilesplat/export.h"
-#include "tilesplat/renderer.h"
+#include "tilesplat/image.h"
+#include "tilesplat/render_settings.h"
 #include "tilesplat/scene.h"
 
 namespace tilesplat {
