@@ -649,7 +649,7 @@ TEST(ExrIo, EveryCompressionMethodWritesAReadableFile) {
 
 TEST(ExrIo, AttributesTheWriterOwnsAreRejectedAndNothingIsWritten) {
   const fs::path dir = fresh_dir();
-  for (const std::string name : {"", "channels", "dataWindow", "compression", "chromaticities", "worldToNDC",
+  for (const std::string name : {"", "channels", "dataWindow", "compression", "chromaticities", "colorInteropID", "worldToNDC",
                                  "tilesplatVersion", "tilesplatAnything"}) {
     const fs::path path = dir / "rejected.exr";
     ExrWriteOptions options;
