@@ -166,15 +166,34 @@ TEST(SortPlugin, RegistrationRejectsBadNames) {
             "sort strategy 'no-factory' has no factory");
   EXPECT_THROW(tilesplat::register_sort_strategy("radix", factory), std::invalid_argument);
 
-  // A factory that throws fails the frame that needs it, with its message, and nothing else.
-  tilesplat::register_sort_strategy("throws-on-creation", factory);
-  EXPECT_EQ(tilesplat::sort_strategies().back(), "throws-on-creation");
-  auto& renderer = tilesplat::testing::validated_renderer();
-  EXPECT_EQ(tilesplat::testing::error_of([&] {
-              renderer.sort_keys("throws-on-creation", {3, 1, 2}, 8);
-            }),
-            "never made");
-  EXPECT_EQ(renderer.sort_keys("radix", {3, 1, 2}, 8).order, (std::vector<uint32_t>{1, 2, 0}));
+  // A factory that throws fails the frame that needs it, with its message, and nothing else. Scoped, so
+  // that no later test in the same process finds it among the strategies.
+  {
+    const tilesplat::ScopedSortStrategy throws("throws-on-creation", factory);
+    EXPECT_EQ(tilesplat::sort_strategies().back(), "throws-on-creation");
+    EXPECT_EQ(tilesplat::testing::error_of([&] {
+                tilesplat::ScopedSortStrategy again("throws-on-creation", factory);
+              }),
+              "a sort strategy named 'throws-on-creation' is already registered");
+    auto& renderer = tilesplat::testing::validated_renderer();
+    EXPECT_EQ(tilesplat::testing::error_of([&] {
+                renderer.sort_keys("throws-on-creation", {3, 1, 2}, 8);
+              }),
+              "never made");
+    EXPECT_EQ(renderer.sort_keys("radix", {3, 1, 2}, 8).order, (std::vector<uint32_t>{1, 2, 0}));
+  }
+  // Gone with its handle; the built-in ones stay, and the name may be registered again.
+  const std::vector<std::string> after = tilesplat::sort_strategies();
+  EXPECT_EQ(std::find(after.begin(), after.end(), "throws-on-creation"), after.end());
+  EXPECT_NE(std::find(after.begin(), after.end(), "radix"), after.end());
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              tilesplat::testing::validated_renderer().sort_keys("throws-on-creation", {3, 1, 2}, 8);
+            }).find("unknown sort strategy 'throws-on-creation'"),
+            std::string::npos);
+  tilesplat::ScopedSortStrategy moved_from("throws-on-creation", factory);
+  const tilesplat::ScopedSortStrategy owner = std::move(moved_from);
+  EXPECT_EQ(owner.name(), "throws-on-creation");
+  EXPECT_EQ(moved_from.name(), "");  // NOLINT(bugprone-use-after-move): a moved-from handle owns nothing
 }
 
 }  // namespace

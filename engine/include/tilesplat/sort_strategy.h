@@ -104,6 +104,29 @@ using SortStrategyFactory = std::function<std::unique_ptr<ExternalSortStrategy>(
 /// @throws std::invalid_argument when `name` is empty, contains a comma or whitespace, or is taken.
 TILESPLAT_API void register_sort_strategy(const std::string& name, SortStrategyFactory factory);
 
+/// A sort strategy registered for as long as this object lives, as register_sort_strategy does (and
+/// throwing as it does); destroying it removes the name from sort_strategies(), so that a test or a
+/// short-lived tool leaves nothing behind for the rest of the process. A renderer that already made
+/// the strategy keeps its instance; a frame that names it afterwards fails as for an unknown name.
+class TILESPLAT_API ScopedSortStrategy {
+ public:
+  /// Registers `factory` under `name`.
+  ScopedSortStrategy(std::string name, SortStrategyFactory factory);
+  /// Removes the registration (nothing when moved from).
+  ~ScopedSortStrategy();
+  ScopedSortStrategy(const ScopedSortStrategy&) = delete;             ///< one owner per registration
+  ScopedSortStrategy& operator=(const ScopedSortStrategy&) = delete;  ///< one owner per registration
+  /// Takes over the registration; `other` then owns none.
+  ScopedSortStrategy(ScopedSortStrategy&& other) noexcept;
+  /// Removes this object's registration and takes over `other`'s.
+  ScopedSortStrategy& operator=(ScopedSortStrategy&& other) noexcept;
+  /// The registered name ("" when moved from).
+  const std::string& name() const { return name_; }
+
+ private:
+  std::string name_;
+};
+
 /// What a sort plugin registers its strategies with.
 class SortPluginRegistry {
  public:

@@ -92,6 +92,27 @@ void register_sort_strategy(const std::string& name, SortStrategyFactory factory
   });
 }
 
+ScopedSortStrategy::ScopedSortStrategy(std::string name, SortStrategyFactory factory) : name_(std::move(name)) {
+  register_sort_strategy(name_, std::move(factory));
+}
+
+ScopedSortStrategy::~ScopedSortStrategy() {
+  if (!name_.empty()) remove_sort_strategy(name_);
+}
+
+ScopedSortStrategy::ScopedSortStrategy(ScopedSortStrategy&& other) noexcept : name_(std::move(other.name_)) {
+  other.name_.clear();
+}
+
+ScopedSortStrategy& ScopedSortStrategy::operator=(ScopedSortStrategy&& other) noexcept {
+  if (this != &other) {
+    if (!name_.empty()) remove_sort_strategy(name_);
+    name_ = std::move(other.name_);
+    other.name_.clear();
+  }
+  return *this;
+}
+
 std::vector<std::string> load_sort_plugin(const std::filesystem::path& path) {
   const std::string prefix = "cannot load sort plugin " + path.string() + ": ";
   std::error_code error;

@@ -1,5 +1,6 @@
 #include "sort/sort_strategy.h"
 
+#include <algorithm>
 #include <functional>
 #include <mutex>
 #include <stdexcept>
@@ -41,6 +42,8 @@ std::vector<Registration>& registry() {
   return strategies;
 }
 
+const size_t kBuiltIn = registry().size();  // before anything is registered at run time
+
 // A copy: the registry may grow (and move its entries) once the lock is released.
 Registration find(const std::string& name) {
   const std::lock_guard lock(registry_mutex);
@@ -72,6 +75,15 @@ void add_sort_strategy(const std::string& name, bool exact, SortStrategyMaker ma
     if (r.name == name)
       throw std::invalid_argument("a sort strategy named '" + name + "' is already registered");
   registry().push_back({name, exact, std::move(make)});
+}
+
+void remove_sort_strategy(const std::string& name) {
+  const std::lock_guard lock(registry_mutex);
+  std::vector<Registration>& strategies = registry();
+  // The built-in ones are the first kBuiltIn entries: never removed.
+  const auto first_added = strategies.begin() + std::ptrdiff_t(std::min(kBuiltIn, strategies.size()));
+  strategies.erase(std::remove_if(first_added, strategies.end(), [&](const Registration& r) { return r.name == name; }),
+                   strategies.end());
 }
 
 std::unique_ptr<SortStrategy> make_sort_strategy(const std::string& name, vk::Context& ctx) {

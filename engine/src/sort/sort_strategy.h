@@ -66,6 +66,9 @@ using SortStrategyMaker = std::function<std::unique_ptr<SortStrategy>(vk::Contex
 // Adds a strategy after the built-in ones (tilesplat::register_sort_strategy). Thread-safe. Throws
 // std::invalid_argument for an empty name, one with a comma or whitespace, or one already taken.
 void add_sort_strategy(const std::string& name, bool exact, SortStrategyMaker make);
+// Removes a strategy added at run time (tilesplat::ScopedSortStrategy); the built-in ones stay, and an
+// unknown name is ignored. Thread-safe.
+void remove_sort_strategy(const std::string& name);
 // Throws std::invalid_argument naming the strategy and the valid names.
 std::unique_ptr<SortStrategy> make_sort_strategy(const std::string& name, vk::Context& ctx);
 // SortStrategy::exact() of a strategy, without a device to make it on. Throws like make_sort_strategy.
