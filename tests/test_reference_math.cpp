@@ -25,17 +25,7 @@ namespace {
 constexpr double kC0 = 0.28209479177387814;
 constexpr double kC1 = 0.4886025119029199;
 
-// A pinhole camera at the origin looking down +z with the principal point at the image centre.
-Camera axis_camera(int width, int height, double focal) {
-  Camera camera;
-  camera.width = width;
-  camera.height = height;
-  camera.fx = focal;
-  camera.fy = focal;
-  camera.cx = width / 2.0;
-  camera.cy = height / 2.0;
-  return camera;
-}
+using testing::axis_camera;
 
 struct GaussianSpec {
   std::array<float, 3> position = {0, 0, 1};

@@ -25,16 +25,7 @@ namespace {
 
 constexpr double kShC0 = 0.28209479177387814;
 
-// A camera at the origin looking down +z (world = camera axes).
-Camera axis_camera(int width, int height, double focal) {
-  Camera camera;
-  camera.width = width;
-  camera.height = height;
-  camera.fx = camera.fy = focal;
-  camera.cx = width / 2.0;
-  camera.cy = height / 2.0;
-  return camera;
-}
+using tilesplat::testing::axis_camera;
 
 // One splat at (0, 0, 2): flat along its local z (log scale -9), rotation w x y z, colour from its DC
 // term, which the unlit colour max(C0 dc + 0.5, 0) reproduces.

@@ -170,13 +170,7 @@ double focal_for_fov(int pixels, double fov_deg) {
 // At the origin looking down +z with the identity rotation, so that view z is world z exactly
 // (the near-plane cases rely on it); square pixels, principal point at the centre.
 Camera axis_camera(int width, int height, double vertical_fov_deg = 50) {
-  Camera camera;
-  camera.width = width;
-  camera.height = height;
-  camera.fx = camera.fy = focal_for_fov(height, vertical_fov_deg);
-  camera.cx = width / 2.0;
-  camera.cy = height / 2.0;
-  return camera;
+  return testing::axis_camera(width, height, focal_for_fov(height, vertical_fov_deg));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -39,6 +39,16 @@ bool skips_forbidden() {
   return value && *value && std::string(value) != "0";
 }
 
+Camera axis_camera(int width, int height, double focal) {
+  Camera camera;
+  camera.width = width;
+  camera.height = height;
+  camera.fx = camera.fy = focal;
+  camera.cx = width / 2.0;
+  camera.cy = height / 2.0;
+  return camera;
+}
+
 std::filesystem::path temp_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "tilesplat";

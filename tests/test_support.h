@@ -29,6 +29,10 @@ std::filesystem::path shared_scenes();
 // set (to anything but "" or "0"), as .ci/run sets it, so that nothing CI must run can pass by skipping.
 bool skips_forbidden();
 
+// A pinhole camera at the origin looking down +z (camera axes = world axes, identity rotation), square
+// pixels of focal length `focal`, the principal point at the image centre.
+Camera axis_camera(int width, int height, double focal);
+
 // A directory unique to the running test for temporary files (removed by the OS, not by tests).
 std::filesystem::path temp_dir();
 
