@@ -299,24 +299,26 @@ struct Renderer::Impl {
       vk::barrier(stream.cmd());
     }
 
-    const vk::Buffer& tile_lists = lists_in_alt ? keys.values_alt : keys.values;
     const AccuracyModes& modes = settings.accuracy;
+    const CompositeInputs inputs{.splats = projected.splats,
+                                 .tile_lists = lists_in_alt ? keys.values_alt : keys.values,
+                                 .ranges = ranges,
+                                 .out = outputs,
+                                 .background = settings.background,
+                                 .write_depth = settings.depth,
+                                 .write_count = settings.splat_count,
+                                 .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff}};
     if (settings.compositor == Compositor::kStochastic) {
-      stochastic_composite.record(stream, projected.splats, tile_lists, ranges, outputs, settings.background,
-                                  settings.depth, settings.splat_count, modes.alpha_cutoff,
-                                  {settings.stochastic.frames, settings.stochastic.seed},
+      stochastic_composite.record(stream, inputs, {settings.stochastic.frames, settings.stochastic.seed},
                                   {stochastic_chunks, composite_state, counters.address()});
       timer.mark(stream.cmd(), "stochastic_composite");
     } else {
-      const CompositePass::Cutoffs cutoffs{modes.alpha_cutoff, modes.transmittance_cutoff};
       if (modes.resort_window > 0)
-        composite_resort.record(stream.cmd(), projected.splats, projected.ray_depth, tile_lists, ranges, outputs,
-                                camera, settings.background, settings.depth, settings.splat_count, cutoffs,
-                                uint32_t(modes.resort_window), counters.address());
+        composite_resort.record(stream.cmd(), inputs, projected.ray_depth, camera, uint32_t(modes.resort_window),
+                                counters.address());
       else
-        composite.record(stream.cmd(), projected.splats, tile_lists, ranges, outputs, settings.background,
-                         settings.depth, settings.splat_count, cutoffs,
-                         {composite_chunks, composite_state, counters.address()}, host_surface(settings));
+        composite.record(stream.cmd(), inputs, {composite_chunks, composite_state, counters.address()},
+                         host_surface(settings));
       timer.mark(stream.cmd(), "composite");
     }
   }

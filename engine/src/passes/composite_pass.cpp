@@ -75,38 +75,41 @@ CompositePass::CompositePass(vk::Context& ctx)
   if (texel_buffers_) unused_output_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "composite unused output");
 }
 
-void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
-                           const vk::Buffer& ranges, OutputBuffers& out,
-                           const std::array<float, 3>& background, bool write_depth, bool write_count,
-                           const Cutoffs& cutoffs, const Chunks& chunks, const HostSurface& host) {
-  const bool host_depth = host.view_depth != nullptr, surface_depth = host.surface_depth != nullptr;
-  const bool host_depth_sorted = host_depth && host.exact_depth_order;
+void CompositePass::record(VkCommandBuffer cmd, const CompositeInputs& in, const Chunks& chunks,
+                           const HostSurface& host) {
+  OutputBuffers& out = in.out;
   const std::vector<VkBufferView> views =
-      texel_buffers_
-          ? composite_texel_views(splats, sorted_indices, out, write_depth, write_count, unused_output_)
-          : std::vector<VkBufferView>{};
-  const bool texel = !views.empty();
-  const bool chunked = chunks.count > 1;
-  auto key = std::make_tuple(write_depth, write_count, cutoffs, host_depth, surface_depth, host_depth_sorted,
-                             texel, chunked);
-  auto it = pipelines_.find(key);
+      texel_buffers_ ? composite_texel_views(in.splats, in.tile_lists, out, in.write_depth, in.write_count,
+                                             unused_output_)
+                     : std::vector<VkBufferView>{};
+  Variant variant;
+  variant.write_depth = in.write_depth;
+  variant.write_count = in.write_count;
+  variant.cutoffs = in.cutoffs;
+  variant.host_depth_in = host.view_depth != nullptr;
+  variant.surface_depth_out = host.surface_depth != nullptr;
+  variant.exact_depth_order = variant.host_depth_in && host.exact_depth_order;
+  variant.texel_buffers = !views.empty();
+  variant.chunked = chunks.count > 1;
+  auto it = pipelines_.find(variant);
   if (it == pipelines_.end()) {
-    const float alpha_inv = coverage_alpha_inv(cutoffs.alpha);
+    const float alpha_inv = coverage_alpha_inv(variant.cutoffs.alpha);
     it = pipelines_
-             .emplace(key, vk::ComputePipeline(
-                               ctx_, texel ? "composite_texel" : "composite", sizeof(CompositePush),
-                               {{0, write_depth ? 1u : 0u},
-                                {1, write_count ? 1u : 0u},
-                                {2, pixels_per_invocation_},
-                                {3, kTileSize / pixels_per_invocation_},
-                                {4, std::bit_cast<uint32_t>(cutoffs.alpha)},
-                                {5, std::bit_cast<uint32_t>(alpha_inv)},
-                                {6, std::bit_cast<uint32_t>(cutoffs.transmittance)},
-                                {7, host_depth ? 1u : 0u},
-                                {8, surface_depth ? 1u : 0u},
-                                {9, host_depth_sorted ? 1u : 0u},
-                                {10, chunked ? 1u : 0u}},
-                               texel ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
+             .emplace(variant,
+                      vk::ComputePipeline(
+                          ctx_, variant.texel_buffers ? "composite_texel" : "composite", sizeof(CompositePush),
+                          {{0, variant.write_depth ? 1u : 0u},
+                           {1, variant.write_count ? 1u : 0u},
+                           {2, pixels_per_invocation_},
+                           {3, kTileSize / pixels_per_invocation_},
+                           {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
+                           {5, std::bit_cast<uint32_t>(alpha_inv)},
+                           {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
+                           {7, variant.host_depth_in ? 1u : 0u},
+                           {8, variant.surface_depth_out ? 1u : 0u},
+                           {9, variant.exact_depth_order ? 1u : 0u},
+                           {10, variant.chunked ? 1u : 0u}},
+                          variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
@@ -115,17 +118,17 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
     throw std::logic_error("composite: the chunk state buffer is smaller than the image");
   for (uint32_t chunk = 0; chunk < chunks.count; ++chunk) {
     if (chunk > 0) vk::barrier(cmd);
-    CompositePush push{splats.address(),
-                       sorted_indices.address(),
-                       ranges.address(),
+    CompositePush push{in.splats.address(),
+                       in.tile_lists.address(),
+                       in.ranges.address(),
                        out.rgba.address(),
-                       write_depth ? out.depth.address() : 0,
-                       write_count ? out.count.address() : 0,
+                       in.write_depth ? out.depth.address() : 0,
+                       in.write_count ? out.count.address() : 0,
                        chunks.count > 1 ? chunks.state.address() : 0,
                        chunks.counters,
-                       host_depth ? host.view_depth->address() : 0,
-                       surface_depth ? host.surface_depth->address() : 0,
-                       {background[0], background[1], background[2], 0.0f},
+                       variant.host_depth_in ? host.view_depth->address() : 0,
+                       variant.surface_depth_out ? host.surface_depth->address() : 0,
+                       {in.background[0], in.background[1], in.background[2], 0.0f},
                        out.width,
                        out.height,
                        tiles_x,
@@ -134,7 +137,7 @@ void CompositePass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const 
                        chunk + 1 == chunks.count ? 1u : 0u,
                        host.surface_alpha};
     it->second.bind(cmd, push);
-    if (texel) it->second.push_texel_views(cmd, views);
+    if (variant.texel_buffers) it->second.push_texel_views(cmd, views);
     it->second.dispatch(cmd, tiles_x, tiles_y);
   }
 }

@@ -4,7 +4,6 @@
 #include <array>
 #include <compare>
 #include <map>
-#include <tuple>
 #include <vector>
 
 #include "vulkan/buffer.h"
@@ -33,18 +32,34 @@ std::vector<VkBufferView> composite_texel_views(const vk::Buffer& splats, const 
                                                 const OutputBuffers& out, bool write_depth, bool write_count,
                                                 const vk::Buffer& unused);
 uint32_t composite_chunk_splats(const vk::Context& ctx);
+
+// The cut-offs as in AccuracyModes (reference: 1/255 and 1e-4).
+struct CompositeCutoffs {
+  float alpha = 1.0f / 255.0f;
+  float transmittance = 1e-4f;
+  auto operator<=>(const CompositeCutoffs&) const = default;
+};
+
+// What every composite blends and where to: the projected splats, each tile's list of Gaussian
+// indices (front to back for the sorted composites, in any order for the stochastic one) and its
+// [start, end) in `ranges`, the output images, and what the frame asks of them.
+struct CompositeInputs {
+  const vk::Buffer& splats;      // ProjectedBuffers::splats
+  const vk::Buffer& tile_lists;  // Gaussian indices, tile after tile
+  const vk::Buffer& ranges;      // [start, end) of each tile's run in tile_lists
+  OutputBuffers& out;
+  std::array<float, 3> background = {0, 0, 0};
+  bool write_depth = true;
+  bool write_count = true;
+  CompositeCutoffs cutoffs;
+};
 // Dispatches of chunk_splats each that a tile list of this length needs (at least 1).
 uint32_t composite_chunks_needed(uint64_t longest_tile_list, uint32_t chunk_splats);
 
 class CompositePass {
  public:
   explicit CompositePass(vk::Context& ctx);
-  // The cut-offs as in AccuracyModes (reference: 1/255 and 1e-4).
-  struct Cutoffs {
-    float alpha = 1.0f / 255.0f;
-    float transmittance = 1e-4f;
-    auto operator<=>(const Cutoffs&) const = default;
-  };
+  using Cutoffs = CompositeCutoffs;
   // How many dispatches blend each tile's list (see composite.comp): 1, or more on a driver that
   // limits loop iterations, with the pixels' state in `state` (state_bytes) between them. Chunk 0
   // writes the longest list over one chunk to FrameCounters::max_tile_pairs; chunks_for() turns it
@@ -62,10 +77,7 @@ class CompositePass {
     float surface_alpha = 0.5f;
     bool exact_depth_order = false;  // 32-bit depth keys: a pixel is done at its first splat behind the host
   };
-  void record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& sorted_indices,
-              const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
-              bool write_depth, bool write_count, const Cutoffs& cutoffs, const Chunks& chunks,
-              const HostSurface& host);
+  void record(VkCommandBuffer cmd, const CompositeInputs& in, const Chunks& chunks, const HostSurface& host);
   uint32_t chunks_for(uint64_t longest_tile_list) const;
   static VkDeviceSize state_bytes(uint32_t width, uint32_t height) { return VkDeviceSize(width) * height * 32; }
 
@@ -75,9 +87,19 @@ class CompositePass {
   uint32_t chunk_splats_;  // splats per tile and dispatch
   bool texel_buffers_;     // the CPU layout reads and writes through texel buffers (composite_texel)
   vk::Buffer unused_output_;  // the texel binding of an output that is off
-  // By outputs (depth, count), cut-offs, host depth (in, out, in exact depth order), texel buffers and
-  // whether a tile's list takes more than one dispatch.
-  std::map<std::tuple<bool, bool, Cutoffs, bool, bool, bool, bool, bool>, vk::ComputePipeline> pipelines_;
+  // A pipeline of composite.comp: its specialization constants by name.
+  struct Variant {
+    bool write_depth = true;
+    bool write_count = true;
+    Cutoffs cutoffs;
+    bool host_depth_in = false;       // the host's surfaces test each splat (HOST_DEPTH)
+    bool surface_depth_out = false;   // the depth where alpha reaches surface_alpha is written (SURFACE_DEPTH)
+    bool exact_depth_order = false;   // a pixel is done at its first splat behind the host (HOST_DEPTH_SORTED)
+    bool texel_buffers = false;       // the CPU layout (composite_texel)
+    bool chunked = false;             // a tile's list takes more than one dispatch (CHUNKED)
+    auto operator<=>(const Variant&) const = default;
+  };
+  std::map<Variant, vk::ComputePipeline> pipelines_;
 };
 
 }  // namespace tilesplat

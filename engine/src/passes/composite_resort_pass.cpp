@@ -24,36 +24,34 @@ static_assert(offsetof(CompositeResortPush, background) == 64);
 // slower than 1 on playbot_lod3 at 480x270: four windows spill.
 CompositeResortPass::CompositeResortPass(vk::Context& ctx) : ctx_(ctx), pixels_per_invocation_(1) {}
 
-void CompositeResortPass::record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& ray_depth,
-                                 const vk::Buffer& sorted_indices, const vk::Buffer& ranges, OutputBuffers& out,
-                                 const Camera& camera, const std::array<float, 3>& background, bool write_depth,
-                                 bool write_count, const CompositePass::Cutoffs& cutoffs, uint32_t window,
-                                 VkDeviceAddress counters) {
-  auto key = std::make_tuple(write_depth, write_count, cutoffs, window);
-  auto it = pipelines_.find(key);
+void CompositeResortPass::record(VkCommandBuffer cmd, const CompositeInputs& in, const vk::Buffer& ray_depth,
+                                 const Camera& camera, uint32_t window, VkDeviceAddress counters) {
+  OutputBuffers& out = in.out;
+  const Variant variant{in.write_depth, in.write_count, in.cutoffs, window};
+  auto it = pipelines_.find(variant);
   if (it == pipelines_.end())
     it = pipelines_
-             .emplace(key, vk::ComputePipeline(ctx_, "composite_resort", sizeof(CompositeResortPush),
-                                               {{0, write_depth ? 1u : 0u},
-                                                {1, write_count ? 1u : 0u},
-                                                {2, pixels_per_invocation_},
-                                                {3, kTileSize / pixels_per_invocation_},
-                                                {4, std::bit_cast<uint32_t>(cutoffs.alpha)},
-                                                {6, std::bit_cast<uint32_t>(cutoffs.transmittance)},
-                                                {7, window}}))
+             .emplace(variant, vk::ComputePipeline(ctx_, "composite_resort", sizeof(CompositeResortPush),
+                                                   {{0, variant.write_depth ? 1u : 0u},
+                                                    {1, variant.write_count ? 1u : 0u},
+                                                    {2, pixels_per_invocation_},
+                                                    {3, kTileSize / pixels_per_invocation_},
+                                                    {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
+                                                    {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
+                                                    {7, variant.window}}))
              .first;
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
-  CompositeResortPush push{splats.address(),
+  CompositeResortPush push{in.splats.address(),
                            ray_depth.address(),
-                           sorted_indices.address(),
-                           ranges.address(),
+                           in.tile_lists.address(),
+                           in.ranges.address(),
                            out.rgba.address(),
-                           write_depth ? out.depth.address() : 0,
-                           write_count ? out.count.address() : 0,
+                           in.write_depth ? out.depth.address() : 0,
+                           in.write_count ? out.count.address() : 0,
                            out.width,
                            out.height,
-                           {background[0], background[1], background[2], 0.0f},
+                           {in.background[0], in.background[1], in.background[2], 0.0f},
                            {float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy)},
                            tiles_x,
                            max_tile_splats(),

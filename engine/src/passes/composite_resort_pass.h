@@ -3,7 +3,6 @@
 #pragma once
 
 #include <map>
-#include <tuple>
 
 #include "passes/composite_pass.h"
 
@@ -15,10 +14,9 @@ class CompositeResortPass {
  public:
   explicit CompositeResortPass(vk::Context& ctx);
   // ray_depth: the projection's per-Gaussian re-sorting data (ProjectedBuffers::ray_depth).
-  void record(VkCommandBuffer cmd, const vk::Buffer& splats, const vk::Buffer& ray_depth,
-              const vk::Buffer& sorted_indices, const vk::Buffer& ranges, OutputBuffers& out, const Camera& camera,
-              const std::array<float, 3>& background, bool write_depth, bool write_count,
-              const CompositePass::Cutoffs& cutoffs, uint32_t window, VkDeviceAddress counters);
+  // `in.tile_lists` in centre-depth order; `window` splats re-sorted per pixel by ray depth.
+  void record(VkCommandBuffer cmd, const CompositeInputs& in, const vk::Buffer& ray_depth, const Camera& camera,
+              uint32_t window, VkDeviceAddress counters);
   // The longest tile list this pass blends on this device; a longer one is written to
   // FrameCounters::max_tile_pairs (and the frame is refused). Unlimited except on CPU drivers,
   // where llvmpipe cuts a shader short after 65535 loop iterations (~130 per batch of 128 here).
@@ -27,7 +25,15 @@ class CompositeResortPass {
  private:
   vk::Context& ctx_;
   uint32_t pixels_per_invocation_;
-  std::map<std::tuple<bool, bool, CompositePass::Cutoffs, uint32_t>, vk::ComputePipeline> pipelines_;
+  // A pipeline of composite_resort.comp: its specialization constants by name.
+  struct Variant {
+    bool write_depth = true;
+    bool write_count = true;
+    CompositeCutoffs cutoffs;
+    uint32_t window = 0;  // AccuracyModes::resort_window
+    auto operator<=>(const Variant&) const = default;
+  };
+  std::map<Variant, vk::ComputePipeline> pipelines_;
 };
 
 }  // namespace tilesplat

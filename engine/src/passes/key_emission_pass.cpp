@@ -81,7 +81,7 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
     views = vk::complete_views(std::move(views));
   }
   const bool texel = !views.empty();
-  const auto variant = std::make_tuple(keys.wide_keys, square_tiles, alpha_inv, texel);
+  const Variant variant{keys.wide_keys, square_tiles, alpha_inv, texel};
   auto it = emit_keys_.find(variant);
   if (it == emit_keys_.end()) {
     const std::vector<vk::SpecConstant> spec = {

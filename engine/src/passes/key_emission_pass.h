@@ -6,7 +6,6 @@
 #pragma once
 
 #include <map>
-#include <tuple>
 #include <utility>
 
 #include "passes/key_buffers.h"
@@ -31,10 +30,16 @@ class KeyEmissionPass {
   vk::Context& ctx_;
   vk::ComputePipeline frame_setup_;
   vk::ComputePipeline scatter_offsets_;
-  // key_emission (or key_emission_texel) and key_emission_big, by (wide keys, square, alpha_inv,
-  // texel buffers).
-  std::map<std::tuple<bool, bool, float, bool>, std::pair<vk::ComputePipeline, vk::ComputePipeline>>
-      emit_keys_;
+  // The pipelines of key_emission (or key_emission_texel) and key_emission_big: their specialization
+  // constants by name.
+  struct Variant {
+    bool wide_keys = false;      // 64-bit (tile, depth) keys
+    bool square_tiles = false;   // the projection's tile test (ProjectionVariant::square_tiles)
+    float alpha_inv = 255.0f;    // the projection's coverage alpha (ProjectionVariant::alpha_inv)
+    bool texel_buffers = false;  // the CPU layout (key_emission_texel)
+    auto operator<=>(const Variant&) const = default;
+  };
+  std::map<Variant, std::pair<vk::ComputePipeline, vk::ComputePipeline>> emit_keys_;
   bool texel_buffers_;      // CPU drivers: key_emission_texel (vk::texel_buffers_wanted)
   vk::Buffer unused_keys_;  // the texel binding of the key width a frame does not write
   vk::ComputePipeline scatter_offsets_texel_;  // CPU drivers: scatter_offsets through texel buffers

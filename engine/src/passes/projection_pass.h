@@ -2,7 +2,7 @@
 #pragma once
 
 #include <map>
-#include <tuple>
+#include <compare>
 #include <utility>
 #include <vector>
 
@@ -45,11 +45,7 @@ struct ProjectionVariant {
   bool compensate_opacity = false;
   bool lighting = false;      // relighting on (the lights themselves are data: ProjectionPass::set_lighting)
   bool file_normals = false;  // lit, with the scene's normal buffer (else every splat's shortest axis)
-  auto tie() const {
-    return std::tie(sh_degree, stored_sh_degree, sh_half, covariance_half, opacity_extent, square_tiles, alpha_inv,
-                    depth_key_bits, ray_depth, dilation_tenths, compensate_opacity, lighting, file_normals);
-  }
-  bool operator<(const ProjectionVariant& o) const { return tie() < o.tie(); }
+  auto operator<=>(const ProjectionVariant&) const = default;
 };
 
 // Bytes of one projected splat record (SPLAT_VEC4S vec4 in compute/common.glsl).

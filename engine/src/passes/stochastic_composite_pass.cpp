@@ -28,34 +28,32 @@ StochasticCompositePass::StochasticCompositePass(vk::Context& ctx)
     unused_output_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "stochastic composite unused output");
 }
 
-void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer& splats,
-                                     const vk::Buffer& binned_indices, const vk::Buffer& ranges, OutputBuffers& out,
-                                     const std::array<float, 3>& background, bool write_depth, bool write_count,
-                                     float alpha_cutoff, const Samples& samples,
+void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeInputs& in, const Samples& samples,
                                      const CompositePass::Chunks& chunks) {
+  OutputBuffers& out = in.out;
   if (samples.count == 0) throw std::logic_error("stochastic composite: no samples");
   const bool with_state = needs_state(samples.count, chunks.count);
   if (with_state && chunks.state.size() < state_bytes(out.width, out.height))
     throw std::logic_error("stochastic composite: the state buffer is smaller than the image");
   const std::vector<VkBufferView> views =
-      texel_buffers_
-          ? composite_texel_views(splats, binned_indices, out, write_depth, write_count, unused_output_)
-          : std::vector<VkBufferView>{};
-  const bool texel = !views.empty();
-  auto key = std::make_tuple(write_depth, write_count, alpha_cutoff, texel);
-  auto it = pipelines_.find(key);
+      texel_buffers_ ? composite_texel_views(in.splats, in.tile_lists, out, in.write_depth, in.write_count,
+                                             unused_output_)
+                     : std::vector<VkBufferView>{};
+  const Variant variant{in.write_depth, in.write_count, in.cutoffs.alpha, !views.empty()};
+  auto it = pipelines_.find(variant);
   if (it == pipelines_.end()) {
     it = pipelines_
-             .emplace(key, vk::ComputePipeline(
-                               ctx_, texel ? "composite_stochastic_texel" : "composite_stochastic",
-                               sizeof(StochasticPush),
-                               {{0, write_depth ? 1u : 0u},
-                                {1, write_count ? 1u : 0u},
-                                {2, pixels_per_invocation_},
-                                {3, kTileSize / pixels_per_invocation_},
-                                {4, std::bit_cast<uint32_t>(alpha_cutoff)},
-                                {5, std::bit_cast<uint32_t>(coverage_alpha_inv(alpha_cutoff))}},
-                               texel ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
+             .emplace(variant,
+                      vk::ComputePipeline(
+                          ctx_, variant.texel_buffers ? "composite_stochastic_texel" : "composite_stochastic",
+                          sizeof(StochasticPush),
+                          {{0, variant.write_depth ? 1u : 0u},
+                           {1, variant.write_count ? 1u : 0u},
+                           {2, pixels_per_invocation_},
+                           {3, kTileSize / pixels_per_invocation_},
+                           {4, std::bit_cast<uint32_t>(variant.alpha_cutoff)},
+                           {5, std::bit_cast<uint32_t>(coverage_alpha_inv(variant.alpha_cutoff))}},
+                          variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
@@ -65,15 +63,15 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer
     for (uint32_t chunk = 0; chunk < chunks.count; ++chunk) {
       // Each dispatch reads what the previous one left in the state buffer.
       if (sample > 0 || chunk > 0) vk::barrier(stream.cmd());
-      StochasticPush push{splats.address(),
-                          binned_indices.address(),
-                          ranges.address(),
+      StochasticPush push{in.splats.address(),
+                          in.tile_lists.address(),
+                          in.ranges.address(),
                           out.rgba.address(),
-                          write_depth ? out.depth.address() : 0,
-                          write_count ? out.count.address() : 0,
+                          in.write_depth ? out.depth.address() : 0,
+                          in.write_count ? out.count.address() : 0,
                           with_state ? chunks.state.address() : 0,
                           chunks.counters,
-                          {background[0], background[1], background[2], 0.0f},
+                          {in.background[0], in.background[1], in.background[2], 0.0f},
                           out.width,
                           out.height,
                           tiles_x,
@@ -85,7 +83,7 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const vk::Buffer
                           samples.seed,
                           0};
       it->second.bind(stream.cmd(), push);
-      if (texel) it->second.push_texel_views(stream.cmd(), views);
+      if (variant.texel_buffers) it->second.push_texel_views(stream.cmd(), views);
       it->second.dispatch(stream.cmd(), tiles_x, tiles_y);
     }
   }

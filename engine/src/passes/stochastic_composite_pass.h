@@ -5,7 +5,6 @@
 
 #include <array>
 #include <map>
-#include <tuple>
 
 #include "passes/composite_pass.h"
 #include "vulkan/buffer.h"
@@ -26,9 +25,9 @@ class StochasticCompositePass {
   // count a re-render needs). The per-pixel sums and the chunks' carried state live in chunks.state
   // (state_bytes), which only one sample in one chunk does without. Flushes the stream after every
   // kSamplesPerSubmission samples, so that no submission runs long enough for a GPU watchdog.
-  void record(vk::CommandStream& stream, const vk::Buffer& splats, const vk::Buffer& binned_indices,
-              const vk::Buffer& ranges, OutputBuffers& out, const std::array<float, 3>& background,
-              bool write_depth, bool write_count, float alpha_cutoff, const Samples& samples,
+  // `in.tile_lists` binned by tile in any order; of the cut-offs only alpha applies (a sample keeps
+  // one splat, so there is no transmittance to cut).
+  void record(vk::CommandStream& stream, const CompositeInputs& in, const Samples& samples,
               const CompositePass::Chunks& chunks);
   uint32_t chunks_for(uint64_t longest_tile_list) const;
   static bool needs_state(uint32_t samples, uint32_t chunks) { return samples > 1 || chunks > 1; }
@@ -42,8 +41,15 @@ class StochasticCompositePass {
   uint32_t chunk_splats_;  // splats per tile and dispatch
   bool texel_buffers_;  // the CPU layout reads and writes through texel buffers (composite_stochastic_texel)
   vk::Buffer unused_output_;  // the texel binding of an output that is off
-  // By outputs, alpha cut-off and texel buffers.
-  std::map<std::tuple<bool, bool, float, bool>, vk::ComputePipeline> pipelines_;
+  // A pipeline of composite_stochastic.comp: its specialization constants by name.
+  struct Variant {
+    bool write_depth = true;
+    bool write_count = true;
+    float alpha_cutoff = 1.0f / 255.0f;
+    bool texel_buffers = false;  // the CPU layout (composite_stochastic_texel)
+    auto operator<=>(const Variant&) const = default;
+  };
+  std::map<Variant, vk::ComputePipeline> pipelines_;
 };
 
 }  // namespace tilesplat
