@@ -21,9 +21,14 @@ std::filesystem::path directory_of(const std::filesystem::path& target) {
 std::filesystem::path temp_path_beside(const std::filesystem::path& target) {
   static std::atomic<std::uint64_t> counter{0};
   const std::uint64_t serial = counter.fetch_add(1, std::memory_order_relaxed);
-  // A leading dot keeps half-written files out of casual listings and globs like *.exr.
-  const std::string name = "." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                           std::to_string(serial);
+  // A leading dot keeps half-written files out of casual listings and globs like *.exr. Built by
+  // appending: GCC 12 misreports '"." + text + ...' under -Wrestrict.
+  std::string name(1, '.');
+  name += target.filename().string();
+  name += ".tmp-";
+  name += std::to_string(::getpid());
+  name += '-';
+  name += std::to_string(serial);
   return directory_of(target) / name;
 }
 
