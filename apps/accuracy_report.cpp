@@ -300,8 +300,10 @@ std::string text_table(const SceneReport& report) {
 
 std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& device, const std::string& command) {
   std::string md = "Device: " + device.name + " (" + device.driver + "). Command:\n\n```\n" + command + "\n```\n";
-  md += "\nErrors are measured on the trained display values (sRGB-encoded, peak 1), as renders are compared with "
-        "photographs (docs/colour.md).\n";
+  md +=
+      "\nErrors are measured on the trained display values (sRGB-encoded, peak 1), as renders are compared "
+      "with "
+      "photographs (docs/colour.md).\n";
   for (const auto& report : reports) {
     md += "\n### " + report.scene + "\n\n" + report.description + "; " + report.views + ". Popping over a " +
           std::to_string(report.path_frames) + "-frame " + to_string(report.path) + " (step " +

@@ -80,19 +80,12 @@ std::string camera_pose_text(const Camera& camera) {
 }
 
 std::string to_json_line(const ManifestEntry& entry) {
-  nlohmann::ordered_json line = {{"frame", entry.frame},
-                                 {"frames", entry.frames},
-                                 {"number", entry.number},
-                                 {"camera", entry.camera},
-                                 {"pose", entry.pose},
-                                 {"width", entry.width},
-                                 {"height", entry.height},
-                                 {"file", entry.file},
-                                 {"bytes", entry.bytes},
-                                 {"sha256", entry.sha256},
-                                 {"gpu_ms", entry.gpu_ms},
-                                 {"resident_mib", entry.resident_mib},
-                                 {"settings", entry.settings}};
+  nlohmann::ordered_json line = {
+      {"frame", entry.frame},      {"frames", entry.frames}, {"number", entry.number},
+      {"camera", entry.camera},    {"pose", entry.pose},     {"width", entry.width},
+      {"height", entry.height},    {"file", entry.file},     {"bytes", entry.bytes},
+      {"sha256", entry.sha256},    {"gpu_ms", entry.gpu_ms}, {"resident_mib", entry.resident_mib},
+      {"settings", entry.settings}};
   if (!entry.png.empty()) {
     line["png"] = entry.png;
     line["png_sha256"] = entry.png_sha256;
@@ -167,7 +160,8 @@ void ManifestAppender::drop_torn_last_line() {
   const size_t last_newline = text.rfind('\n');
   const off_t keep = last_newline == std::string::npos ? 0 : static_cast<off_t>(last_newline + 1);
   if (keep != size && ::ftruncate(fd_, keep) != 0)
-    throw std::runtime_error("cannot cut the torn last line of " + in_quotes(path_) + ": " + std::strerror(errno));
+    throw std::runtime_error("cannot cut the torn last line of " + in_quotes(path_) + ": " +
+                             std::strerror(errno));
 }
 
 ManifestAppender::~ManifestAppender() {

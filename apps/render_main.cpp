@@ -131,29 +131,35 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                     "the EXR to write (required): R G B A, plus Z (expected depth) and 'splats' (blended "
                     "splats per pixel) unless turned off; for a scene file, the channels its \"outputs\" list",
                     &options.output, "-o");
-  parser.add_string("--png", "FILE.png",
-                    "also write an 8-bit sRGB preview: the trained colours, round(255 c), as other viewers show "
-                    "them",
-                    &options.png);
-  parser.add_value("--exposure", "STOPS",
-                   "brighten (or darken, if negative) the --png preview by 2^STOPS of linear light, -20 to 20 "
-                   "(default: the scene file's, else 0)",
-                   [&options](const std::string& text) {
-                     const double stops = cli::parse_double("--exposure", text);
-                     if (!(std::abs(stops) <= 20))
-                       throw cli::UsageError("--exposure must be from -20 to 20 stops, got " + single_quoted(text));
-                     options.preview.exposure_stops = stops;
-                   });
-  parser.add_value("--tone-map", "CURVE",
-                   "the --png preview's tone curve, on linear light: none (clip at 1), aces (filmic) or reinhard "
-                   "(x / (1 + x)) (default: the scene file's, else none)",
-                   [&options](const std::string& text) {
-                     if (text == "none") options.preview.tone_map = tilesplat::ToneMap::kNone;
-                     else if (text == "aces") options.preview.tone_map = tilesplat::ToneMap::kAces;
-                     else if (text == "reinhard") options.preview.tone_map = tilesplat::ToneMap::kReinhard;
-                     else
-                       throw cli::UsageError("--tone-map must be none, aces or reinhard, got " + single_quoted(text));
-                   });
+  parser.add_string(
+      "--png", "FILE.png",
+      "also write an 8-bit sRGB preview: the trained colours, round(255 c), as other viewers show "
+      "them",
+      &options.png);
+  parser.add_value(
+      "--exposure", "STOPS",
+      "brighten (or darken, if negative) the --png preview by 2^STOPS of linear light, -20 to 20 "
+      "(default: the scene file's, else 0)",
+      [&options](const std::string& text) {
+        const double stops = cli::parse_double("--exposure", text);
+        if (!(std::abs(stops) <= 20))
+          throw cli::UsageError("--exposure must be from -20 to 20 stops, got " + single_quoted(text));
+        options.preview.exposure_stops = stops;
+      });
+  parser.add_value(
+      "--tone-map", "CURVE",
+      "the --png preview's tone curve, on linear light: none (clip at 1), aces (filmic) or reinhard "
+      "(x / (1 + x)) (default: the scene file's, else none)",
+      [&options](const std::string& text) {
+        if (text == "none")
+          options.preview.tone_map = tilesplat::ToneMap::kNone;
+        else if (text == "aces")
+          options.preview.tone_map = tilesplat::ToneMap::kAces;
+        else if (text == "reinhard")
+          options.preview.tone_map = tilesplat::ToneMap::kReinhard;
+        else
+          throw cli::UsageError("--tone-map must be none, aces or reinhard, got " + single_quoted(text));
+      });
   parser.add_switch("--half", "store the EXR channels as 16-bit HALF instead of 32-bit FLOAT", &options.half);
   parser.add_value(
       "--exr-compression", "METHOD",
@@ -169,25 +175,28 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
           }
         throw cli::UsageError("--exr-compression must be zip, piz, dwaa or none, got " + single_quoted(text));
       });
-  parser.add_value("--exr-colour", "ENCODING",
-                   "what the EXR's R G B hold: linear (default: scene-linear Rec.709, the sRGB decoding of the "
-                   "trained colours, as compositing tools expect) or display (the trained colours as rendered, "
-                   "bit for bit); the header's colorInteropID says which (docs/colour.md)",
-                   [&options](const std::string& text) {
-                     if (text == "linear") options.exr_colour = tilesplat::ColourEncoding::kSceneLinear;
-                     else if (text == "display") options.exr_colour = tilesplat::ColourEncoding::kSrgbDisplay;
-                     else
-                       throw cli::UsageError("--exr-colour must be linear or display, got " + single_quoted(text));
-                   });
+  parser.add_value(
+      "--exr-colour", "ENCODING",
+      "what the EXR's R G B hold: linear (default: scene-linear Rec.709, the sRGB decoding of the "
+      "trained colours, as compositing tools expect) or display (the trained colours as rendered, "
+      "bit for bit); the header's colorInteropID says which (docs/colour.md)",
+      [&options](const std::string& text) {
+        if (text == "linear")
+          options.exr_colour = tilesplat::ColourEncoding::kSceneLinear;
+        else if (text == "display")
+          options.exr_colour = tilesplat::ColourEncoding::kSrgbDisplay;
+        else
+          throw cli::UsageError("--exr-colour must be linear or display, got " + single_quoted(text));
+      });
   parser.add_switch("--no-depth", "do not compute or store the depth channel (Z)", &options.no_depth);
   parser.add_switch("--no-count", "do not compute or store the per-pixel splat count", &options.no_count);
 
   parser.section("rendering");
-  parser.add_value("--background", "R,G,B", "background colour, in the trained colours' display values (default: the scene file's, else "
-                   "0,0,0)",
-                   [&options](const std::string& text) {
-                     options.background = cli::parse_rgb("--background", text);
-                   });
+  parser.add_value(
+      "--background", "R,G,B",
+      "background colour, in the trained colours' display values (default: the scene file's, else "
+      "0,0,0)",
+      [&options](const std::string& text) { options.background = cli::parse_rgb("--background", text); });
   parser.add_int("--stochastic", "N",
                  "composite without a depth sort: each splat kept per pixel with probability alpha, nearest kept "
                  "wins, the mean of N such frames (1 to 4096; converges to the sorted image as 1/sqrt(N))",
@@ -378,8 +387,8 @@ std::map<int, cli::ManifestEntry> finished_frames(const std::vector<Frame>& fram
     const cli::ManifestEntry wanted =
         manifest_entry(frames[size_t(entry.frame)], static_cast<int>(frames.size()), folder, settings);
     if (entry.file == wanted.file && entry.png == wanted.png && entry.camera == wanted.camera &&
-        entry.pose == wanted.pose && entry.width == wanted.width && entry.height == wanted.height && entry.settings == wanted.settings &&
-        entry.number == wanted.number)
+        entry.pose == wanted.pose && entry.width == wanted.width && entry.height == wanted.height &&
+        entry.settings == wanted.settings && entry.number == wanted.number)
       latest[entry.frame] = entry;
   }
   std::map<int, cli::ManifestEntry> finished;

@@ -344,9 +344,9 @@ class Viewer {
 };
 
 // A PNG is the window's pixels as shown (the mesh included; the bytes of the window's image, which
-// are the trained colours as a PNG preview without exposure or tone curve holds them). An EXR is the last frame's data: its camera and settings rendered once more
-// (only the composite runs: the lists are reused), with the outputs the EXR carries, exactly as
-// tilesplat-render writes them.
+// are the trained colours as a PNG preview without exposure or tone curve holds them). An EXR is the last
+// frame's data: its camera and settings rendered once more (only the composite runs: the lists are reused),
+// with the outputs the EXR carries, exactly as tilesplat-render writes them.
 void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewer& viewer,
                       const cli::LoadedScene& loaded) {
   if (cli::has_extension(path, ".png")) {
@@ -438,9 +438,9 @@ int run(int argc, char** argv) {
   const tilesplat::Camera& camera = viewer.camera();
   std::string summary = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
                         cli::describe_scene(loaded.scene) + ", " + std::to_string(viewer.frames()) +
-                        (viewer.frames() == 1 ? " frame on " : " frames on ") +
-                        device.name() + " in a " + tilesplat::viewer::format_name(viewer.window_format()) +
-                        " window, the last " + cli::format_size(camera.width, camera.height) + " in " +
+                        (viewer.frames() == 1 ? " frame on " : " frames on ") + device.name() + " in a " +
+                        tilesplat::viewer::format_name(viewer.window_format()) + " window, the last " +
+                        cli::format_size(camera.width, camera.height) + " in " +
                         cli::format_fixed(last_gpu_ms, 2) + " GPU ms";
   if (viewer.frames() > 1)
     summary += ", " + cli::format_fixed(viewer.mean_frame_ms(), 1) + " ms a frame after the first";

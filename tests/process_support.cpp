@@ -62,7 +62,8 @@ ProcessResult run_process(const std::string& prefix, const std::string& exe, con
   // messages and still exit 0: every run of an app is checked here, so that no test can miss them.
   for (const char* sign : {"vulkan validation", "Vulkan validation messages"})
     if (result.err.find(sign) != std::string::npos)
-      ADD_FAILURE() << "the validation layer reported messages while running " << command << ":\n" << result.err;
+      ADD_FAILURE() << "the validation layer reported messages while running " << command << ":\n"
+                    << result.err;
   return result;
 }
 

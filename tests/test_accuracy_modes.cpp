@@ -109,10 +109,11 @@ TEST(AccuracyModes, EachModeStaysWithinItsBoundOnARealScene) {
       const FrameStats stats = renderer.last_frame_stats();
       const ImageDifference d = compare_images(image, reference);
       const double change = compare_images(image, exact).max_abs;
-      std::printf("view %d  %-45s PSNR %7.2f dB (bound %5.1f)  max abs %.4f  SSIM %.5f  change %.2e, pairs %llu, "
-                  "key bits %u\n",
-                  view, bound.modes, d.psnr_db, bound.min_psnr_db, d.max_abs, ssim(image, reference), change,
-                  static_cast<unsigned long long>(stats.intersections), stats.sort_bits);
+      std::printf(
+          "view %d  %-45s PSNR %7.2f dB (bound %5.1f)  max abs %.4f  SSIM %.5f  change %.2e, pairs %llu, "
+          "key bits %u\n",
+          view, bound.modes, d.psnr_db, bound.min_psnr_db, d.max_abs, ssim(image, reference), change,
+          static_cast<unsigned long long>(stats.intersections), stats.sort_bits);
       EXPECT_GE(d.psnr_db, bound.min_psnr_db) << bound.modes << " at view " << view;
       switch (bound.changes) {
         case Changes::kNothing:

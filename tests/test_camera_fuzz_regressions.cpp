@@ -29,7 +29,8 @@ TEST(CameraFuzzRegressions, EveryInputPassesTheFuzzersInvariants) {
   for (const fs::path& input : inputs) {
     SCOPED_TRACE(input.filename().string());
     std::ifstream file(input, std::ios::binary);
-    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)),
+                                     std::istreambuf_iterator<char>());
     ASSERT_FALSE(bytes.empty());
     EXPECT_EQ(LLVMFuzzerTestOneInput(bytes.data(), bytes.size()), 0);
   }

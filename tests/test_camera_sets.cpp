@@ -399,11 +399,13 @@ TEST(DatasetCameras, NerfstudioTransformsJsonReadsAndItsOffCentreFrameRendersShi
 // The app takes the model folder and the transforms.json as --cameras, as a user would.
 TEST(DatasetCameras, RenderAppTakesBothFiles) {
   const fs::path out = fresh_output_dir();
-  for (const fs::path& cameras : {kCameraModels / "colmap" / "sparse" / "0", kCameraModels / "nerfstudio" / "transforms.json"}) {
+  for (const fs::path& cameras :
+       {kCameraModels / "colmap" / "sparse" / "0", kCameraModels / "nerfstudio" / "transforms.json"}) {
     const auto result = tilesplat::testing::run_process(
         "", TILESPLAT_RENDER_EXE,
-        {tilesplat::testing::bundled_playbot().string(), "--cameras", cameras.string(), "--views", "all", "--width",
-         "96", "-o", (out / (cameras.filename().string() + "_%02d.exr")).string(), "--validation"});
+        {tilesplat::testing::bundled_playbot().string(), "--cameras", cameras.string(), "--views", "all",
+         "--width", "96", "-o", (out / (cameras.filename().string() + "_%02d.exr")).string(),
+         "--validation"});
     ASSERT_EQ(result.exit_code, 0) << result.err;
     EXPECT_EQ(result.err.find("validation messages"), std::string::npos) << result.err;
     EXPECT_TRUE(fs::exists(out / (cameras.filename().string() + "_00.exr")));

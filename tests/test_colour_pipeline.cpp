@@ -36,14 +36,22 @@ double encode_srgb(double linear) {
 }
 
 tilesplat::Camera view_camera(int view) {
-  return tilesplat::resize_camera(tilesplat::load_cameras_json(bundled_playbot_cameras()).at(size_t(view)).camera,
-                                  kWidth, kHeight);
+  return tilesplat::resize_camera(
+      tilesplat::load_cameras_json(bundled_playbot_cameras()).at(size_t(view)).camera, kWidth, kHeight);
 }
 
 std::vector<std::string> render_args(int view, const fs::path& exr) {
-  return {bundled_playbot().string(), "--cameras", bundled_playbot_cameras().string(), "--view",
-          std::to_string(view),        "--width",   std::to_string(kWidth),             "--height",
-          std::to_string(kHeight),     "-o",        exr.string()};
+  return {bundled_playbot().string(),
+          "--cameras",
+          bundled_playbot_cameras().string(),
+          "--view",
+          std::to_string(view),
+          "--width",
+          std::to_string(kWidth),
+          "--height",
+          std::to_string(kHeight),
+          "-o",
+          exr.string()};
 }
 
 // The PNG of the GPU render is the float64 reference's colour rounded to bytes. The GPU's colours differ
@@ -84,7 +92,8 @@ TEST(ColourPipeline, PngIsTheReferenceColourRoundedToBytes) {
         ++straddling;
         ASSERT_EQ(std::abs(gpu_byte - want), 1) << "pixel " << pixel << " channel " << c << ": " << scaled;
         const double boundary = double(gpu_byte + want) / 2.0;  // the half between the two bytes
-        ASSERT_LT(std::abs(scaled - boundary), 0.25) << "pixel " << pixel << " channel " << c << ": " << scaled;
+        ASSERT_LT(std::abs(scaled - boundary), 0.25)
+            << "pixel " << pixel << " channel " << c << ": " << scaled;
       }
     // A second sRGB encoding would lift every mid-tone by tens of levels: count the values it would change.
     for (size_t pixel = 0; pixel < reference.pixels(); ++pixel)
@@ -92,9 +101,10 @@ TEST(ColourPipeline, PngIsTheReferenceColourRoundedToBytes) {
         const double value = std::clamp(double(reference.rgba[4 * pixel + c]), 0.0, 1.0);
         mid_grey_to_bright += std::lround(255 * encode_srgb(value)) - std::lround(255 * value) > 10;
       }
-    std::printf("[ measure  ] view %d: %zu values exact, %zu off by one at a rounding boundary; a second "
-                "encoding would brighten %zu by more than 10 levels\n",
-                view, exact, straddling, mid_grey_to_bright);
+    std::printf(
+        "[ measure  ] view %d: %zu values exact, %zu off by one at a rounding boundary; a second "
+        "encoding would brighten %zu by more than 10 levels\n",
+        view, exact, straddling, mid_grey_to_bright);
     EXPECT_LE(straddling, exact / 100);
     EXPECT_GT(mid_grey_to_bright, reference.pixels() / 20) << "the view should have mid-tones";
   }
@@ -110,7 +120,8 @@ TEST(ColourPipeline, ExrHoldsSceneLinearColoursThatEncodeBackToTheRender) {
   renderer.set_scene(tilesplat::load_scene(bundled_playbot()));
   const tilesplat::RenderImage rendered = renderer.render(view_camera(2));
 
-  EXPECT_EQ(tilesplat::read_exr_string_attributes(out / "linear.exr").at("colorInteropID"), "lin_rec709_scene");
+  EXPECT_EQ(tilesplat::read_exr_string_attributes(out / "linear.exr").at("colorInteropID"),
+            "lin_rec709_scene");
   const tilesplat::StoredExr stored = tilesplat::read_exr_as_stored(out / "linear.exr");
   ASSERT_EQ(stored.image.rgba.size(), rendered.rgba.size());
   size_t checked = 0, darker = 0;
@@ -141,14 +152,17 @@ TEST(ColourPipeline, ExrColourDisplayKeepsTheRenderedValues) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   tilesplat::Renderer& renderer = tilesplat::testing::validated_renderer();
   renderer.set_scene(tilesplat::load_scene(bundled_playbot()));
-  EXPECT_EQ(tilesplat::read_exr_string_attributes(out / "display.exr").at("colorInteropID"), "srgb_rec709_display");
-  EXPECT_EQ(tilesplat::read_exr_as_stored(out / "display.exr").image.rgba, renderer.render(view_camera(2)).rgba);
+  EXPECT_EQ(tilesplat::read_exr_string_attributes(out / "display.exr").at("colorInteropID"),
+            "srgb_rec709_display");
+  EXPECT_EQ(tilesplat::read_exr_as_stored(out / "display.exr").image.rgba,
+            renderer.render(view_camera(2)).rgba);
 
   args = render_args(2, out / "bad.exr");
   args.insert(args.end(), {"--exr-colour", "acescg"});
   const auto bad = run_process("", kRenderExe, args);
   EXPECT_EQ(bad.exit_code, 2);
-  EXPECT_NE(bad.err.find("--exr-colour must be linear or display, got 'acescg'"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("--exr-colour must be linear or display, got 'acescg'"), std::string::npos)
+      << bad.err;
   EXPECT_FALSE(fs::exists(out / "bad.exr"));
 }
 

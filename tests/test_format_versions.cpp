@@ -30,9 +30,13 @@ namespace {
 namespace fs = std::filesystem;
 using tilesplat::GaussianScene;
 
-GaussianScene bundled_scene() { return tilesplat::load_scene(tilesplat::testing::bundled_sh3()); }
+GaussianScene bundled_scene() {
+  return tilesplat::load_scene(tilesplat::testing::bundled_sh3());
+}
 
-double sigmoid(double x) { return 1 / (1 + std::exp(-x)); }
+double sigmoid(double x) {
+  return 1 / (1 + std::exp(-x));
+}
 
 uint8_t quantize(double value, double low, double high, int levels = 255) {
   const double t = high > low ? (value - low) / (high - low) : 0;
@@ -45,7 +49,8 @@ Matrix3 rotation_of(const float* wxyz) {
 }
 void expect_same_rotation(const float* actual, const float* expected, double tolerance, size_t gaussian) {
   const Matrix3 a = rotation_of(actual), b = rotation_of(expected);
-  for (size_t k = 0; k < 9; ++k) EXPECT_NEAR(a[k], b[k], tolerance) << "Gaussian " << gaussian << " rotation " << k;
+  for (size_t k = 0; k < 9; ++k)
+    EXPECT_NEAR(a[k], b[k], tolerance) << "Gaussian " << gaussian << " rotation " << k;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -53,10 +58,13 @@ void expect_same_rotation(const float* actual, const float* expected, double tol
 
 // The sign of each SH basis function (k = 1..15, 3DGS order) under y -> -y, z -> -z (SPZ's RUB axes
 // against the trainer's RDF): (-1)^(the function's degree in y plus its degree in z).
-constexpr int kShYzDegree[15] = {1, 1, 0,  // y, z, x
+constexpr int kShYzDegree[15] = {1, 1, 0,        // y, z, x
                                  1, 2, 2, 1, 0,  // xy, yz, 2z^2-x^2-y^2 (even), xz, x^2-y^2 (even)
-                                 1, 2, 1, 1, 2, 1, 0};  // y(3x^2-y^2), xyz, y(4z^2-..), z(..), x(4z^2-..), z(x^2-y^2), x(..)
-double rub_sign(size_t k) { return kShYzDegree[k] % 2 ? -1.0 : 1.0; }
+                                 1, 2, 1, 1, 2,
+                                 1, 0};  // y(3x^2-y^2), xyz, y(4z^2-..), z(..), x(4z^2-..), z(x^2-y^2), x(..)
+double rub_sign(size_t k) {
+  return kShYzDegree[k] % 2 ? -1.0 : 1.0;
+}
 
 std::vector<uint8_t> gzip(const std::vector<uint8_t>& raw) {
   z_stream stream{};
@@ -114,11 +122,13 @@ TEST(FormatVersions, SpzVersion2ReadsWithinItsQuantization) {
   for (size_t i = 0; i < n; ++i)
     for (size_t k = 1; k < 16; ++k)
       for (size_t c = 0; c < 3; ++c)
-        raw.push_back(uint8_t(std::clamp(std::lround(rub_sign(k - 1) * ply.sh[stride * i + 3 * k + c] * 128 + 128), 0L, 255L)));
+        raw.push_back(uint8_t(
+            std::clamp(std::lround(rub_sign(k - 1) * ply.sh[stride * i + 3 * k + c] * 128 + 128), 0L, 255L)));
 
   const fs::path out = tilesplat::testing::fresh_output_dir() / "v2.spz";
   const std::vector<uint8_t> file = gzip(raw);
-  std::ofstream(out, std::ios::binary).write(reinterpret_cast<const char*>(file.data()), std::streamsize(file.size()));
+  std::ofstream(out, std::ios::binary)
+      .write(reinterpret_cast<const char*>(file.data()), std::streamsize(file.size()));
   tilesplat::LoadReport report;
   const GaussianScene spz = tilesplat::load_scene(out, {}, &report);
   EXPECT_EQ(report.format, "spz");
@@ -128,7 +138,8 @@ TEST(FormatVersions, SpzVersion2ReadsWithinItsQuantization) {
   size_t sh_checked = 0;
   for (size_t i = 0; i < n; ++i) {
     for (size_t a = 0; a < 3; ++a) {
-      EXPECT_NEAR(spz.positions[3 * i + a], ply.positions[3 * i + a], 0.5 / (1 << kFractionalBits) + 1e-6) << i;
+      EXPECT_NEAR(spz.positions[3 * i + a], ply.positions[3 * i + a], 0.5 / (1 << kFractionalBits) + 1e-6)
+          << i;
       if (ply.log_scales[3 * i + a] > -10 && ply.log_scales[3 * i + a] < 5.9) {
         EXPECT_NEAR(spz.log_scales[3 * i + a], ply.log_scales[3 * i + a], 0.5 / 16 + 1e-6) << i;
       }
@@ -179,10 +190,13 @@ std::vector<uint8_t> lossless_webp(const std::vector<uint8_t>& rgba, int width, 
 }
 
 void write_bytes(const fs::path& path, const std::vector<uint8_t>& bytes) {
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
 }
 
-double log_transform(double v) { return std::copysign(std::log(std::abs(v) + 1), v); }
+double log_transform(double v) {
+  return std::copysign(std::log(std::abs(v) + 1), v);
+}
 
 TEST(FormatVersions, SogVersion1ReadsWithinItsQuantization) {
   const GaussianScene ply = bundled_scene();
@@ -266,17 +280,36 @@ TEST(FormatVersions, SogVersion1ReadsWithinItsQuantization) {
 
   using nlohmann::json;
   auto shape = [&](std::initializer_list<size_t> dims) { return json(std::vector<size_t>(dims)); };
-  const json meta = {
-      {"means", {{"shape", shape({n, 3})}, {"dtype", "float32"}, {"mins", mean_low}, {"maxs", mean_high},
-                 {"files", {"means_l.webp", "means_u.webp"}}}},
-      {"scales", {{"shape", shape({n, 3})}, {"dtype", "float32"}, {"mins", scale_low}, {"maxs", scale_high},
-                  {"files", {"scales.webp"}}}},
-      {"quats", {{"shape", shape({n, 4})}, {"dtype", "uint8"}, {"encoding", "quaternion_packed"},
-                 {"files", {"quats.webp"}}}},
-      {"sh0", {{"shape", shape({n, 1, 4})}, {"dtype", "float32"}, {"mins", colour_low}, {"maxs", colour_high},
-               {"files", {"sh0.webp"}}}},
-      {"shN", {{"shape", shape({n, 45})}, {"dtype", "float32"}, {"mins", rest_low}, {"maxs", rest_high},
-               {"quantization", 8}, {"files", {"shN_centroids.webp", "shN_labels.webp"}}}}};
+  const json meta = {{"means",
+                      {{"shape", shape({n, 3})},
+                       {"dtype", "float32"},
+                       {"mins", mean_low},
+                       {"maxs", mean_high},
+                       {"files", {"means_l.webp", "means_u.webp"}}}},
+                     {"scales",
+                      {{"shape", shape({n, 3})},
+                       {"dtype", "float32"},
+                       {"mins", scale_low},
+                       {"maxs", scale_high},
+                       {"files", {"scales.webp"}}}},
+                     {"quats",
+                      {{"shape", shape({n, 4})},
+                       {"dtype", "uint8"},
+                       {"encoding", "quaternion_packed"},
+                       {"files", {"quats.webp"}}}},
+                     {"sh0",
+                      {{"shape", shape({n, 1, 4})},
+                       {"dtype", "float32"},
+                       {"mins", colour_low},
+                       {"maxs", colour_high},
+                       {"files", {"sh0.webp"}}}},
+                     {"shN",
+                      {{"shape", shape({n, 45})},
+                       {"dtype", "float32"},
+                       {"mins", rest_low},
+                       {"maxs", rest_high},
+                       {"quantization", 8},
+                       {"files", {"shN_centroids.webp", "shN_labels.webp"}}}}};
   std::ofstream(dir / "meta.json") << meta.dump(2);
 
   tilesplat::LoadReport report;
@@ -289,10 +322,12 @@ TEST(FormatVersions, SogVersion1ReadsWithinItsQuantization) {
       // Half a 16-bit step of the log-transformed value, times the slope exp(|u|) of its inverse.
       const double step = (mean_high[a] - mean_low[a]) / 65535 / 2 * std::exp(std::abs(mean(i, a)));
       EXPECT_NEAR(sog.positions[3 * i + a], ply.positions[3 * i + a], step * 1.01 + 1e-6) << i;
-      EXPECT_NEAR(sog.log_scales[3 * i + a], scale(i, a), (scale_high[a] - scale_low[a]) / 255 / 2 + 1e-5) << i;
+      EXPECT_NEAR(sog.log_scales[3 * i + a], scale(i, a), (scale_high[a] - scale_low[a]) / 255 / 2 + 1e-5)
+          << i;
     }
     for (size_t c = 0; c < 3; ++c)
-      EXPECT_NEAR(sog.sh[stride * i + c], colour(i, c), (colour_high[c] - colour_low[c]) / 255 / 2 + 1e-5) << i;
+      EXPECT_NEAR(sog.sh[stride * i + c], colour(i, c), (colour_high[c] - colour_low[c]) / 255 / 2 + 1e-5)
+          << i;
     EXPECT_NEAR(sog.opacity_logits[i], colour(i, 3), (colour_high[3] - colour_low[3]) / 255 / 2 + 1e-5) << i;
     expect_same_rotation(sog.rotations.data() + 4 * i, ply.rotations.data() + 4 * i, 1.5e-2, i);
     for (size_t k = 3; k < stride; ++k)

@@ -36,7 +36,8 @@ constexpr size_t kCount = 3;
 // The file's values, glTF axes (y up). Rotations as x y z w.
 constexpr double kPositions[kCount][3] = {{0.25, -0.5, 1.0}, {-1.5, 0.75, 2.0}, {0.0, 0.125, -0.625}};
 constexpr double kScales[kCount][3] = {{0.05, 0.1, 0.2}, {0.3, 0.02, 0.07}, {0.01, 0.01, 0.04}};
-constexpr int16_t kRotationsI16[kCount][4] = {{0, 0, 0, 32767}, {16384, -8192, 4096, 30000}, {-32768, 0, 0, 0}};
+constexpr int16_t kRotationsI16[kCount][4] = {
+    {0, 0, 0, 32767}, {16384, -8192, 4096, 30000}, {-32768, 0, 0, 0}};
 constexpr int8_t kRotationsI8[kCount][4] = {{0, 0, 0, 127}, {64, -32, 16, 117}, {-128, 0, 0, 0}};
 constexpr uint8_t kOpacitiesU8[kCount] = {128, 200, 13};
 constexpr uint16_t kOpacitiesU16[kCount] = {32768, 51400, 3341};
@@ -72,8 +73,11 @@ std::pair<json, std::vector<uint8_t>> make_gltf(const Encoding& encoding, const 
     return views.size() - 1;
   };
   auto add_accessor = [&](size_t view, size_t offset, int component_type, const char* type, bool normalized) {
-    json accessor = {{"bufferView", view}, {"byteOffset", offset}, {"componentType", component_type},
-                     {"count", kCount}, {"type", type}};
+    json accessor = {{"bufferView", view},
+                     {"byteOffset", offset},
+                     {"componentType", component_type},
+                     {"count", kCount},
+                     {"type", type}};
     if (normalized) accessor["normalized"] = true;
     accessors.push_back(accessor);
     return accessors.size() - 1;
@@ -85,26 +89,30 @@ std::pair<json, std::vector<uint8_t>> make_gltf(const Encoding& encoding, const 
     for (double v : kScales[e]) append(bin, float(v));
   }
   const size_t interleaved_view = add_view(interleaved, bin.size() - interleaved, 24);
-  json attributes = {{"POSITION", add_accessor(interleaved_view, 0, 5126, "VEC3", false)},
-                     {"KHR_gaussian_splatting:SCALE", add_accessor(interleaved_view, 12, 5126, "VEC3", false)}};
+  json attributes = {
+      {"POSITION", add_accessor(interleaved_view, 0, 5126, "VEC3", false)},
+      {"KHR_gaussian_splatting:SCALE", add_accessor(interleaved_view, 12, 5126, "VEC3", false)}};
   const size_t rotations = bin.size();
   for (size_t e = 0; e < kCount; ++e)
     for (size_t c = 0; c < 4; ++c)
       encoding.rotation_i8 ? append(bin, kRotationsI8[e][c]) : append(bin, kRotationsI16[e][c]);
-  attributes["KHR_gaussian_splatting:ROTATION"] = add_accessor(
-      add_view(rotations, bin.size() - rotations, std::nullopt), 0, encoding.rotation_i8 ? 5120 : 5122, "VEC4", true);
+  attributes["KHR_gaussian_splatting:ROTATION"] =
+      add_accessor(add_view(rotations, bin.size() - rotations, std::nullopt), 0,
+                   encoding.rotation_i8 ? 5120 : 5122, "VEC4", true);
   align4(bin);
   const size_t opacities = bin.size();
   for (size_t e = 0; e < kCount; ++e)
     encoding.opacity_u16 ? append(bin, kOpacitiesU16[e]) : append(bin, kOpacitiesU8[e]);
-  attributes["KHR_gaussian_splatting:OPACITY"] = add_accessor(
-      add_view(opacities, bin.size() - opacities, std::nullopt), 0, encoding.opacity_u16 ? 5123 : 5121, "SCALAR", true);
+  attributes["KHR_gaussian_splatting:OPACITY"] =
+      add_accessor(add_view(opacities, bin.size() - opacities, std::nullopt), 0,
+                   encoding.opacity_u16 ? 5123 : 5121, "SCALAR", true);
   align4(bin);
   auto add_sh = [&](const std::string& semantic, auto&& value_of) {
     const size_t start = bin.size();
     for (size_t e = 0; e < kCount; ++e)
       for (size_t c = 0; c < 3; ++c) append(bin, float(value_of(e, c)));
-    attributes[semantic] = add_accessor(add_view(start, bin.size() - start, std::nullopt), 0, 5126, "VEC3", false);
+    attributes[semantic] =
+        add_accessor(add_view(start, bin.size() - start, std::nullopt), 0, 5126, "VEC3", false);
   };
   add_sh("KHR_gaussian_splatting:SH_DEGREE_0_COEF_0", [](size_t e, size_t c) { return kShDc[e][c]; });
   for (size_t n = 0; n < 3; ++n)
@@ -141,7 +149,8 @@ void write_glb(const fs::path& path, const json& gltf, std::vector<uint8_t> bin)
   append(out, uint32_t(bin.size()));
   append(out, uint32_t{0x004e4942});  // BIN
   out.insert(out.end(), bin.begin(), bin.end());
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()));
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()));
 }
 
 std::string base64(const std::vector<uint8_t>& bytes) {
@@ -180,7 +189,8 @@ double normalized_rotation(const Encoding& encoding, size_t e, size_t c) {
                               : std::max(kRotationsI16[e][c] / 32767.0, -1.0);
 }
 
-void expect_scene(const tilesplat::GaussianScene& scene, const Encoding& encoding, const Placement& placement) {
+void expect_scene(const tilesplat::GaussianScene& scene, const Encoding& encoding,
+                  const Placement& placement) {
   ASSERT_EQ(scene.size(), kCount);
   ASSERT_EQ(scene.sh_degree, 1);
   const Matrix3 to_engine = multiply(kFlip, placement.rotation);
@@ -214,12 +224,15 @@ void expect_scene(const tilesplat::GaussianScene& scene, const Encoding& encodin
   }
 }
 
-fs::path out_dir() { return tilesplat::testing::fresh_output_dir(); }
+fs::path out_dir() {
+  return tilesplat::testing::fresh_output_dir();
+}
 
 TEST(GltfValues, NormalizedIntegersAndAnInterleavedStrideReadAsTheSpecSays) {
   const fs::path out = out_dir();
   for (const Encoding encoding : {Encoding{false, false}, Encoding{true, true}}) {
-    SCOPED_TRACE(encoding.rotation_i8 ? "int8 rotations, uint16 opacities" : "int16 rotations, uint8 opacities");
+    SCOPED_TRACE(encoding.rotation_i8 ? "int8 rotations, uint16 opacities"
+                                      : "int16 rotations, uint8 opacities");
     const auto [gltf, bin] = make_gltf(encoding, json::array({json{{"mesh", 0}}}));
     write_glb(out / "plain.glb", gltf, bin);
     expect_scene(tilesplat::load_scene(out / "plain.glb"), encoding, {});
@@ -259,7 +272,9 @@ TEST(GltfValues, GltfWithDataUriAndWithExternalBufferReadAsTheGlb) {
   }
   // Without its .bin the external one names the file it misses.
   fs::remove(out / "scene data.bin");
-  EXPECT_NE(tilesplat::testing::error_of([&] { tilesplat::load_scene(out / "external.gltf"); }).find("scene data.bin"),
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              tilesplat::load_scene(out / "external.gltf");
+            }).find("scene data.bin"),
             std::string::npos);
 }
 
@@ -272,11 +287,11 @@ TEST(GltfValues, NodeTransformsMoveRotateScaleAndTurnTheSh) {
   const double s = std::sin(angle / 2), c = std::cos(angle / 2);
   const std::array<double, 4> q = {s / 3, 2 * s / 3, 2 * s / 3, c};  // x y z w
   json parent_matrix = json::array({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -0.25, 0.5, 0.125, 1});
-  json nodes = json::array({json{{"matrix", parent_matrix}, {"children", {1}}},
-                            json{{"mesh", 0},
-                                 {"rotation", {q[0], q[1], q[2], q[3]}},
-                                 {"scale", {2, 2, 2}},
-                                 {"translation", {0.5, -1, 3}}}});
+  json nodes = json::array(
+      {json{{"matrix", parent_matrix}, {"children", {1}}}, json{{"mesh", 0},
+                                                                {"rotation", {q[0], q[1], q[2], q[3]}},
+                                                                {"scale", {2, 2, 2}},
+                                                                {"translation", {0.5, -1, 3}}}});
   const auto [gltf, bin] = make_gltf(encoding, nodes);
   write_glb(out / "placed.glb", gltf, bin);
   Placement placement;

@@ -80,9 +80,10 @@ TEST_P(GpuVsReference, TwoViewsMatchFloat64Reference) {
     } else if (testing::skips_forbidden()) {
       ADD_FAILURE() << "no independent reference " << reference_exr << " (TILESPLAT_NO_SKIPS is set)";
     } else {
-      // Said, not silent: the bundled cases run without ../shared, but then only against the float64 reference.
-      std::printf("[ skipped  ] %s view %d: the check against the independent reference (no %s)\n", c.name.c_str(),
-                  view, reference_exr.string().c_str());
+      // Said, not silent: the bundled cases run without ../shared, but then only against the float64
+      // reference.
+      std::printf("[ skipped  ] %s view %d: the check against the independent reference (no %s)\n",
+                  c.name.c_str(), view, reference_exr.string().c_str());
     }
   }
   EXPECT_EQ(renderer.validation_messages(), 0u);

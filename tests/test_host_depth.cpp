@@ -167,8 +167,8 @@ TEST(HostDepth, ReversedZAndOpenGlWallsMatchTheReference) {
   const Case cases[] = {
       {"reversed-Z", DepthConvention::from_projection(vulkan_projection(0.05, 0, true)), true},
       // Other planes than the standard case's: with the same ones, OpenGL's window depth equals Vulkan's.
-      {"OpenGL", DepthConvention::from_projection(opengl_projection(0.1, 100), tilesplat::ClipSpace::opengl()),
-       false},
+      {"OpenGL",
+       DepthConvention::from_projection(opengl_projection(0.1, 100), tilesplat::ClipSpace::opengl()), false},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
@@ -197,9 +197,10 @@ TEST(HostDepth, ReversedZAndOpenGlWallsMatchTheReference) {
       else
         EXPECT_LE(gpu.host_depth[i], plane[i]) << "pixel " << i;
     }
-    std::printf("host depth, %s wall: PSNR %.1f dB, max abs %.2g; %zu of %zu pixels differ from the standard "
-                "convention's by more than 1e-3; depth out reached at %zu\n",
-                c.name, difference.psnr_db, difference.max_abs, colour_moved, gpu.pixels(), reached);
+    std::printf(
+        "host depth, %s wall: PSNR %.1f dB, max abs %.2g; %zu of %zu pixels differ from the standard "
+        "convention's by more than 1e-3; depth out reached at %zu\n",
+        c.name, difference.psnr_db, difference.max_abs, colour_moved, gpu.pixels(), reached);
     EXPECT_LE(colour_moved, gpu.pixels() / 200);
     EXPECT_GT(reached, gpu.pixels() / 20);
     EXPECT_EQ(differ, 0u);

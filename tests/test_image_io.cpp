@@ -305,14 +305,16 @@ TEST(Colour, SrgbTransferFunctionFollowsIec61966AndInvertsItself) {
 TEST(Colour, ConversionDecodesTheColourNotThePremultipliedValue) {
   // (colour 0.5 at coverage 0.4, premultiplied 0.2), an opaque pixel, and one without coverage.
   const std::vector<float> rgba = {0.2f, 0.4f, 0.0f, 0.4f, 0.5f, 1.0f, 0.25f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f};
-  const std::vector<float> linear = convert_colours(rgba, ColourEncoding::kSrgbDisplay, ColourEncoding::kSceneLinear);
+  const std::vector<float> linear =
+      convert_colours(rgba, ColourEncoding::kSrgbDisplay, ColourEncoding::kSceneLinear);
   EXPECT_NEAR(linear[0], 0.4 * decode_srgb(0.5), 1e-7);
   EXPECT_NEAR(linear[1], 0.4 * decode_srgb(1.0), 1e-7);
   EXPECT_EQ(linear[3], 0.4f) << "alpha is kept";
   EXPECT_NEAR(linear[4], decode_srgb(0.5), 1e-7);
   EXPECT_NEAR(linear[6], decode_srgb(0.25), 1e-7);
   EXPECT_EQ(linear[8], 0.0f);
-  const std::vector<float> back = convert_colours(linear, ColourEncoding::kSceneLinear, ColourEncoding::kSrgbDisplay);
+  const std::vector<float> back =
+      convert_colours(linear, ColourEncoding::kSceneLinear, ColourEncoding::kSrgbDisplay);
   for (size_t i = 0; i < rgba.size(); ++i) EXPECT_NEAR(back[i], rgba[i], 1e-7) << i;
   // Taken as opaque (a file without alpha), the premultiplied value itself is decoded.
   const std::vector<float> opaque =
@@ -379,7 +381,8 @@ TEST(ExrIo, UnknownColourEncodingIsAnErrorNamingIt) {
     FAIL() << "read_exr accepted colours it cannot convert";
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
-    EXPECT_NE(std::string(error.what()).find("colorInteropID 'lin_ap1_scene'"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("colorInteropID 'lin_ap1_scene'"), std::string::npos)
+        << error.what();
   }
 }
 #endif
@@ -649,8 +652,8 @@ TEST(ExrIo, EveryCompressionMethodWritesAReadableFile) {
 
 TEST(ExrIo, AttributesTheWriterOwnsAreRejectedAndNothingIsWritten) {
   const fs::path dir = fresh_dir();
-  for (const std::string name : {"", "channels", "dataWindow", "compression", "chromaticities", "colorInteropID", "worldToNDC",
-                                 "tilesplatVersion", "tilesplatAnything"}) {
+  for (const std::string name : {"", "channels", "dataWindow", "compression", "chromaticities",
+                                 "colorInteropID", "worldToNDC", "tilesplatVersion", "tilesplatAnything"}) {
     const fs::path path = dir / "rejected.exr";
     ExrWriteOptions options;
     options.attributes[name] = "x";
@@ -839,8 +842,9 @@ TEST(AtomicWrite, PathWithoutDirectoryWritesToCurrentDirectory) {
 
 TEST(PngPreview, WritesTheTrainedColoursAsTheyAre) {
   // Rendered colours are display values already: the preview is round(255 * clamp(c)), no encoding.
-  const std::vector<float> colours = {0.0f, 1.0f,  0.5f, 0.0031308f, 0.2f, 0.0001f, 2.0f, -1.0f,
-                                      std::numeric_limits<float>::quiet_NaN(), 0.04f, 0.75f, 0.01f};
+  const std::vector<float> colours = {
+      0.0f,  1.0f,  0.5f, 0.0031308f, 0.2f, 0.0001f, 2.0f, -1.0f, std::numeric_limits<float>::quiet_NaN(),
+      0.04f, 0.75f, 0.01f};
   RenderImage image;
   image.width = 2;
   image.height = 2;

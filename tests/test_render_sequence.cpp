@@ -492,10 +492,11 @@ TEST(RenderSequence, ResumeRendersAgainWhatChangedAndSkipsWhatDidNot) {
   expect_rendered_all(run({"--width", "96", "--height", "54", "--elevation", "35"}), "other cameras");
   expect_rendered_all(run({"--width", "96", "--height", "54", "--elevation", "35", "--mode", "depth16"}),
                       "another accuracy mode");
-  expect_rendered_all(
-      run({"--width", "96", "--height", "54", "--elevation", "35", "--mode", "depth16", "--exr-colour", "display"}),
-      "another EXR encoding");
-  EXPECT_EQ(tilesplat::read_exr_string_attributes(out / "o_03.exr").at("colorInteropID"), "srgb_rec709_display");
+  expect_rendered_all(run({"--width", "96", "--height", "54", "--elevation", "35", "--mode", "depth16",
+                           "--exr-colour", "display"}),
+                      "another EXR encoding");
+  EXPECT_EQ(tilesplat::read_exr_string_attributes(out / "o_03.exr").at("colorInteropID"),
+            "srgb_rec709_display");
   const std::string last = run({"--width", "96", "--height", "54", "--elevation", "35", "--mode", "depth16",
                                 "--exr-colour", "display"});
   EXPECT_TRUE(contains(last, "4 already done")) << last;
@@ -514,8 +515,15 @@ TEST(RenderSequence, ResumeRendersAgainWhatChangedAndSkipsWhatDidNot) {
 // error naming the manifest and the line, before anything is rendered.
 TEST(RenderSequence, TornManifestLineIsCutOffAndMalformedLineIsNamed) {
   const fs::path out = fresh_output_dir();
-  const std::vector<std::string> args = {tilesplat::testing::bundled_playbot().string(), "--orbit", "3", "--width",
-                                         "64", "--height", "36", "-o", (out / "t_%d.exr").string()};
+  const std::vector<std::string> args = {tilesplat::testing::bundled_playbot().string(),
+                                         "--orbit",
+                                         "3",
+                                         "--width",
+                                         "64",
+                                         "--height",
+                                         "36",
+                                         "-o",
+                                         (out / "t_%d.exr").string()};
   ASSERT_EQ(render(args).exit_code, 0);
   const fs::path manifest = out / "manifest.jsonl";
   const std::string complete = read_file(manifest);
@@ -548,8 +556,9 @@ TEST(RenderSequence, MergeRefusesAFrameInTwoShardsAndShardsOfDifferentRuns) {
   const std::string scene = tilesplat::testing::bundled_playbot().string();
   auto shard = [&](const fs::path& folder, int frames, int index) {
     fs::create_directories(folder);
-    const auto result = render({scene, "--orbit", std::to_string(frames), "--width", "48", "--height", "27",
-                                "--shard", std::to_string(index) + "/2", "-o", (folder / "m_%02d.exr").string()});
+    const auto result =
+        render({scene, "--orbit", std::to_string(frames), "--width", "48", "--height", "27", "--shard",
+                std::to_string(index) + "/2", "-o", (folder / "m_%02d.exr").string()});
     EXPECT_EQ(result.exit_code, 0) << result.err;
   };
   const fs::path twice = root / "twice";
@@ -558,12 +567,14 @@ TEST(RenderSequence, MergeRefusesAFrameInTwoShardsAndShardsOfDifferentRuns) {
   ASSERT_EQ(render({"--merge-manifests", twice.string()}).exit_code, 0);
   // Shard 0's manifest also claims frame 1 of shard 1 (its line copied over).
   const std::string shard1 = read_file(twice / "manifest.shard-1-of-2.jsonl");
-  std::ofstream(twice / "manifest.shard-0-of-2.jsonl", std::ios::app) << shard1.substr(0, shard1.find('\n') + 1);
+  std::ofstream(twice / "manifest.shard-0-of-2.jsonl", std::ios::app)
+      << shard1.substr(0, shard1.find('\n') + 1);
   const auto both = render({"--merge-manifests", twice.string()});
   EXPECT_EQ(both.exit_code, 1) << both.err;
   expect_one_error_line(both, "tilesplat-render");
-  EXPECT_TRUE(contains(both.err, "frame 1 is in both 'manifest.shard-0-of-2.jsonl' and "
-                                 "'manifest.shard-1-of-2.jsonl': each frame must belong to exactly one shard"))
+  EXPECT_TRUE(contains(both.err,
+                       "frame 1 is in both 'manifest.shard-0-of-2.jsonl' and "
+                       "'manifest.shard-1-of-2.jsonl': each frame must belong to exactly one shard"))
       << both.err;
 
   const fs::path mixed = root / "mixed";
@@ -572,8 +583,9 @@ TEST(RenderSequence, MergeRefusesAFrameInTwoShardsAndShardsOfDifferentRuns) {
   const auto disagree = render({"--merge-manifests", mixed.string()});
   EXPECT_EQ(disagree.exit_code, 1) << disagree.err;
   expect_one_error_line(disagree, "tilesplat-render");
-  EXPECT_TRUE(contains(disagree.err, "the manifests disagree on the number of frames: "
-                                     "'manifest.shard-0-of-2.jsonl' has 4, 'manifest.shard-1-of-2.jsonl' 6"))
+  EXPECT_TRUE(contains(disagree.err,
+                       "the manifests disagree on the number of frames: "
+                       "'manifest.shard-0-of-2.jsonl' has 4, 'manifest.shard-1-of-2.jsonl' 6"))
       << disagree.err;
   EXPECT_FALSE(fs::exists(mixed / "manifest.jsonl"));
 }

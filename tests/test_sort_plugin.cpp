@@ -171,9 +171,8 @@ TEST(SortPlugin, RegistrationRejectsBadNames) {
   {
     const tilesplat::ScopedSortStrategy throws("throws-on-creation", factory);
     EXPECT_EQ(tilesplat::sort_strategies().back(), "throws-on-creation");
-    EXPECT_EQ(tilesplat::testing::error_of([&] {
-                tilesplat::ScopedSortStrategy again("throws-on-creation", factory);
-              }),
+    EXPECT_EQ(tilesplat::testing::error_of(
+                  [&] { tilesplat::ScopedSortStrategy again("throws-on-creation", factory); }),
               "a sort strategy named 'throws-on-creation' is already registered");
     auto& renderer = tilesplat::testing::validated_renderer();
     EXPECT_EQ(tilesplat::testing::error_of([&] {

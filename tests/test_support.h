@@ -71,17 +71,18 @@ std::string error_of(Action&& action) {
 
 // Skips the test, saying why (`message` may stream: a << " b"), or fails it where skips are forbidden
 // (skips_forbidden(): CI). Like GTEST_SKIP, it returns from the test body.
-#define TILESPLAT_SKIP_OR_FAIL(message)                                                          \
-  do {                                                                                           \
-    if (::tilesplat::testing::skips_forbidden())                                                 \
+#define TILESPLAT_SKIP_OR_FAIL(message)                                                        \
+  do {                                                                                         \
+    if (::tilesplat::testing::skips_forbidden())                                               \
       GTEST_FAIL() << message << " (TILESPLAT_NO_SKIPS is set: this test must run, not skip)"; \
-    else                                                                                         \
-      GTEST_SKIP() << message;                                                                   \
+    else                                                                                       \
+      GTEST_SKIP() << message;                                                                 \
   } while (0)
 
 // Skips the test, visibly, when ../shared/scenes is not available (fails where skips are forbidden).
-#define TILESPLAT_REQUIRE_SHARED_SCENES()                                                                      \
-  do {                                                                                                         \
-    if (::tilesplat::testing::shared_scenes().empty())                                                         \
-      TILESPLAT_SKIP_OR_FAIL("shared scenes not found: set TILESPLAT_SHARED_SCENES or -DTILESPLAT_SHARED_SCENES"); \
+#define TILESPLAT_REQUIRE_SHARED_SCENES()                                                       \
+  do {                                                                                          \
+    if (::tilesplat::testing::shared_scenes().empty())                                          \
+      TILESPLAT_SKIP_OR_FAIL(                                                                   \
+          "shared scenes not found: set TILESPLAT_SHARED_SCENES or -DTILESPLAT_SHARED_SCENES"); \
   } while (0)

@@ -38,7 +38,8 @@ constexpr const char* kViewerExe = TILESPLAT_VIEWER_EXE;
 #define REQUIRE_VIEWER() (void)0
 #else
 constexpr const char* kViewerExe = "";
-#define REQUIRE_VIEWER() TILESPLAT_SKIP_OR_FAIL("tilesplat-viewer is not built (configure with -DTILESPLAT_BUILD_VIEWER=ON)")
+#define REQUIRE_VIEWER() \
+  TILESPLAT_SKIP_OR_FAIL("tilesplat-viewer is not built (configure with -DTILESPLAT_BUILD_VIEWER=ON)")
 #endif
 constexpr const char* kRenderExe = TILESPLAT_RENDER_EXE;
 
@@ -106,7 +107,8 @@ TEST(Viewer, WindowPixelsAreThePngPreviewOfTheSameView) {
   if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
   const fs::path out = fresh_output_dir();
   std::vector<std::string> render_args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
-  render_args.insert(render_args.end(), {"-o", (out / "render.exr").string(), "--png", (out / "render.png").string()});
+  render_args.insert(render_args.end(),
+                     {"-o", (out / "render.exr").string(), "--png", (out / "render.png").string()});
   const ProcessResult render = run_process("", kRenderExe, render_args);
   ASSERT_EQ(render.exit_code, 0) << render.err;
   const DecodedPng preview = tilesplat::testing::read_png_rgb(out / "render.png");
@@ -114,12 +116,14 @@ TEST(Viewer, WindowPixelsAreThePngPreviewOfTheSameView) {
   for (const std::string kind : {"unorm", "srgb"}) {
     std::vector<std::string> viewer_args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
     const fs::path shot = out / ("window_" + kind + ".png");
-    viewer_args.insert(viewer_args.end(), {"--no-mesh", "--validation", "--frames", "2", "--screenshot", shot.string()});
+    viewer_args.insert(viewer_args.end(),
+                       {"--no-mesh", "--validation", "--frames", "2", "--screenshot", shot.string()});
     const ProcessResult viewer =
         run_process("env TILESPLAT_VIEWER_SWAPCHAIN=" + kind + " " + *prefix, kViewerExe, viewer_args);
     ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
     EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
-    EXPECT_NE(viewer.err.find(kind == "srgb" ? "_SRGB window" : "_UNORM window"), std::string::npos) << viewer.err;
+    EXPECT_NE(viewer.err.find(kind == "srgb" ? "_SRGB window" : "_UNORM window"), std::string::npos)
+        << viewer.err;
     const DecodedPng window = tilesplat::testing::read_png_rgb(shot);
     ASSERT_EQ(window.width, preview.width);
     ASSERT_EQ(window.height, preview.height);
@@ -132,8 +136,8 @@ TEST(Viewer, WindowPixelsAreThePngPreviewOfTheSameView) {
       differ += difference > 0;
       lit += preview.rgb[i] > 32;
     }
-    std::printf("[ measure  ] %s window: %zu of %zu values differ from the preview, by at most %d\n", kind.c_str(),
-                differ, window.rgb.size(), worst);
+    std::printf("[ measure  ] %s window: %zu of %zu values differ from the preview, by at most %d\n",
+                kind.c_str(), differ, window.rgb.size(), worst);
     EXPECT_LE(worst, 1) << kind;
     EXPECT_GT(lit, window.rgb.size() / 10) << "the view should show the scene";
   }

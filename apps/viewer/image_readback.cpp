@@ -13,8 +13,8 @@ HostBuffer::HostBuffer(const WindowDevice& device, VkDeviceSize bytes) : device_
     VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     allocate.allocationSize = requirements.size;
     allocate.memoryTypeIndex = device.memory_type(
-        requirements.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, 0,
-        "a readback");
+        requirements.memoryTypeBits,
+        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, 0, "a readback");
     vk_check(vkAllocateMemory(device_, &allocate, nullptr, &memory_), "vkAllocateMemory (a readback)");
     vk_check(vkBindBufferMemory(device_, buffer_, memory_, 0), "vkBindBufferMemory (a readback)");
     vk_check(vkMapMemory(device_, memory_, 0, bytes, 0, &mapped_), "vkMapMemory (a readback)");
@@ -24,7 +24,9 @@ HostBuffer::HostBuffer(const WindowDevice& device, VkDeviceSize bytes) : device_
   }
 }
 
-HostBuffer::~HostBuffer() { destroy(); }
+HostBuffer::~HostBuffer() {
+  destroy();
+}
 
 void HostBuffer::destroy() {
   if (mapped_) vkUnmapMemory(device_, memory_);

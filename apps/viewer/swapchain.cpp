@@ -1,13 +1,13 @@
 #include "viewer/swapchain.h"
 
-#include "viewer/image_readback.h"
-
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "viewer/image_readback.h"
 
 namespace tilesplat::viewer {
 
@@ -21,11 +21,13 @@ bool supports(VkPhysicalDevice device, VkFormat format, VkFormatFeatureFlags fea
   return (properties.optimalTilingFeatures & features) == features;
 }
 
-bool is_srgb(VkFormat format) { return format == VK_FORMAT_B8G8R8A8_SRGB || format == VK_FORMAT_R8G8B8A8_SRGB; }
+bool is_srgb(VkFormat format) {
+  return format == VK_FORMAT_B8G8R8A8_SRGB || format == VK_FORMAT_R8G8B8A8_SRGB;
+}
 
 // The _UNORM format with an _SRGB one's layout (and so its bytes).
 VkFormat unencoded_twin(VkFormat format) {
-  return format == VK_FORMAT_B8G8R8A8_SRGB ? VK_FORMAT_B8G8R8A8_UNORM
+  return format == VK_FORMAT_B8G8R8A8_SRGB   ? VK_FORMAT_B8G8R8A8_UNORM
          : format == VK_FORMAT_R8G8B8A8_SRGB ? VK_FORMAT_R8G8B8A8_UNORM
                                              : format;
 }
@@ -43,8 +45,8 @@ VkSurfaceFormatKHR choose_format(const WindowDevice& device) {
            "vkGetPhysicalDeviceSurfaceFormatsKHR");
   const char* wanted_kind = std::getenv("TILESPLAT_VIEWER_SWAPCHAIN");
   const bool srgb_first = wanted_kind && std::string(wanted_kind) == "srgb";
-  std::vector<VkFormat> preferred = {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_B8G8R8A8_SRGB,
-                                     VK_FORMAT_R8G8B8A8_SRGB};
+  std::vector<VkFormat> preferred = {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM,
+                                     VK_FORMAT_B8G8R8A8_SRGB, VK_FORMAT_R8G8B8A8_SRGB};
   if (srgb_first) std::rotate(preferred.begin(), preferred.begin() + 2, preferred.end());
   for (VkFormat wanted : preferred)
     for (const VkSurfaceFormatKHR& format : formats) {
@@ -78,11 +80,16 @@ void transition(VkCommandBuffer commands, VkImage image, VkImageLayout from, VkI
 
 std::string format_name(VkFormat format) {
   switch (format) {
-    case VK_FORMAT_B8G8R8A8_UNORM: return "B8G8R8A8_UNORM";
-    case VK_FORMAT_R8G8B8A8_UNORM: return "R8G8B8A8_UNORM";
-    case VK_FORMAT_B8G8R8A8_SRGB: return "B8G8R8A8_SRGB";
-    case VK_FORMAT_R8G8B8A8_SRGB: return "R8G8B8A8_SRGB";
-    default: return "format " + std::to_string(int(format));
+    case VK_FORMAT_B8G8R8A8_UNORM:
+      return "B8G8R8A8_UNORM";
+    case VK_FORMAT_R8G8B8A8_UNORM:
+      return "R8G8B8A8_UNORM";
+    case VK_FORMAT_B8G8R8A8_SRGB:
+      return "B8G8R8A8_SRGB";
+    case VK_FORMAT_R8G8B8A8_SRGB:
+      return "R8G8B8A8_SRGB";
+    default:
+      return "format " + std::to_string(int(format));
   }
 }
 
@@ -119,8 +126,8 @@ TransferImage::TransferImage(const WindowDevice& device, VkFormat format, VkForm
     vk_check(vkBindImageMemory(device_, image_, memory_, 0), "vkBindImageMemory (a viewer image)");
     // Once, so that every use finds the image in the layout made for it.
     device.submit_and_wait([&](VkCommandBuffer commands) {
-      transition(commands, image_, VK_IMAGE_LAYOUT_UNDEFINED, layout_, 0, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
-                 VK_PIPELINE_STAGE_TRANSFER_BIT);
+      transition(commands, image_, VK_IMAGE_LAYOUT_UNDEFINED, layout_, 0, 0,
+                 VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
     });
   } catch (...) {
     destroy();  // a throwing constructor runs no destructor
@@ -128,7 +135,9 @@ TransferImage::TransferImage(const WindowDevice& device, VkFormat format, VkForm
   }
 }
 
-TransferImage::~TransferImage() { destroy(); }
+TransferImage::~TransferImage() {
+  destroy();
+}
 
 void TransferImage::destroy() {
   if (image_) vkDestroyImage(device_, image_, nullptr);
@@ -267,7 +276,8 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
                         WindowPixels* shown) {
   if (!swapchain_) return false;
   if (shown && !can_read_back_)
-    throw std::runtime_error(device_.name() + ": the window's images cannot be read back (no TRANSFER_SRC usage)");
+    throw std::runtime_error(device_.name() +
+                             ": the window's images cannot be read back (no TRANSFER_SRC usage)");
   if (source_extent.width != extent_.width || source_extent.height != extent_.height)
     throw std::logic_error("Swapchain::present: the source image is not the swapchain's size");
   VkDevice vk = device_.device();
@@ -327,11 +337,12 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
     VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
-                         nullptr, 0, nullptr);
+    vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                         &to_host, 0, nullptr, 0, nullptr);
   }
   transition(commands_, window_image, window_layout, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-             shown ? VkAccessFlags{0} : VkAccessFlags{VK_ACCESS_TRANSFER_WRITE_BIT}, 0, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+             shown ? VkAccessFlags{0} : VkAccessFlags{VK_ACCESS_TRANSFER_WRITE_BIT}, 0,
+             VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
   vk_check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
 
   // The blit waits for the acquired image at the transfer stage, where the first barrier starts.

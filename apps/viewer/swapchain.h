@@ -24,8 +24,8 @@ namespace tilesplat::viewer {
 class TransferImage {
  public:
   // Throws std::runtime_error when the format lacks any of `features` (optimal tiling).
-  TransferImage(const WindowDevice& device, VkFormat format, VkFormatFeatureFlags features, VkImageLayout layout,
-                uint32_t width, uint32_t height);
+  TransferImage(const WindowDevice& device, VkFormat format, VkFormatFeatureFlags features,
+                VkImageLayout layout, uint32_t width, uint32_t height);
   ~TransferImage();
   TransferImage(const TransferImage&) = delete;
   TransferImage& operator=(const TransferImage&) = delete;

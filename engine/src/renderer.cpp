@@ -314,8 +314,8 @@ struct Renderer::Impl {
       timer.mark(stream.cmd(), "stochastic_composite");
     } else {
       if (modes.resort_window > 0)
-        composite_resort.record(stream.cmd(), inputs, projected.ray_depth, camera, uint32_t(modes.resort_window),
-                                counters.address());
+        composite_resort.record(stream.cmd(), inputs, projected.ray_depth, camera,
+                                uint32_t(modes.resort_window), counters.address());
       else
         composite.record(stream.cmd(), inputs, {composite_chunks, composite_state, counters.address()},
                          host_surface(settings));

@@ -119,7 +119,8 @@ TILESPLAT_API void write_exr(const std::filesystem::path& path, const RenderImag
 /// references in shared/scenes) is taken as it is. Throws std::runtime_error naming the file, also for any
 /// other colorInteropID.
 TILESPLAT_API RenderImage read_exr(const std::filesystem::path& path);
-/// The file's R G B A exactly as stored, with the encoding its header names (kSrgbDisplay when it names none).
+/// The file's R G B A exactly as stored, with the encoding its header names (kSrgbDisplay when it names
+/// none).
 struct StoredExr {
   RenderImage image;        ///< as read_exr(), but the colours not converted
   ColourEncoding encoding;  ///< what its `colorInteropID` says

@@ -158,7 +158,9 @@ struct HostDepth {
 
 /// Everything that changes how one frame is rendered.
 struct RenderSettings {
-  std::array<float, 3> background = {0, 0, 0};         ///< RGB behind the splats, in the splats' display values (docs/colour.md): C + T * background
+  std::array<float, 3> background = {
+      0, 0,
+      0};  ///< RGB behind the splats, in the splats' display values (docs/colour.md): C + T * background
   std::string sort = "radix";                          ///< the key sort strategy (see sort_strategies())
   bool depth = true;                                   ///< produce the expected-depth channel
   bool splat_count = true;                             ///< produce the per-pixel blended-splat count

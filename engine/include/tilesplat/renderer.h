@@ -102,7 +102,8 @@ TILESPLAT_API std::vector<std::string> list_devices();
 /// order of list_devices(). RendererOptions::device accepts them.
 TILESPLAT_API std::vector<std::string> list_device_uuids();
 
-/// The engine's internal access to a Renderer's implementation (engine/src/renderer.cpp): not part of the API.
+/// The engine's internal access to a Renderer's implementation (engine/src/renderer.cpp): not part of the
+/// API.
 struct RendererAccess;
 
 /// The GPU renderer: a Vulkan device, the scene in device memory, and the compute passes of a frame

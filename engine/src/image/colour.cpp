@@ -10,8 +10,10 @@ namespace tilesplat {
 
 std::string to_string(ColourEncoding encoding) {
   switch (encoding) {
-    case ColourEncoding::kSceneLinear: return "lin_rec709_scene";
-    case ColourEncoding::kSrgbDisplay: return "srgb_rec709_display";
+    case ColourEncoding::kSceneLinear:
+      return "lin_rec709_scene";
+    case ColourEncoding::kSrgbDisplay:
+      return "srgb_rec709_display";
   }
   return "unknown";
 }
@@ -25,7 +27,8 @@ double srgb_to_linear(double encoded) {
 
 double linear_to_srgb(double linear) {
   const double magnitude = std::abs(linear);
-  const double encoded = magnitude <= 0.0031308 ? 12.92 * magnitude : 1.055 * std::pow(magnitude, 1.0 / 2.4) - 0.055;
+  const double encoded =
+      magnitude <= 0.0031308 ? 12.92 * magnitude : 1.055 * std::pow(magnitude, 1.0 / 2.4) - 0.055;
   return std::copysign(encoded, linear);
 }
 
@@ -41,8 +44,7 @@ std::vector<float> convert_colours(const std::vector<float>& rgba, ColourEncodin
     const bool divide = !opaque && alpha > 0.0 && alpha < 1.0;
     for (size_t c = 0; c < 3; ++c) {
       const double value = converted[pixel + c];
-      converted[pixel + c] =
-          static_cast<float>(divide ? alpha * transfer(value / alpha) : transfer(value));
+      converted[pixel + c] = static_cast<float>(divide ? alpha * transfer(value / alpha) : transfer(value));
     }
   }
   return converted;

@@ -74,7 +74,7 @@ bool is_written_by_the_writer(const std::string& name) {
   static const std::array<const char*, 15> kOwn = {
       "channels",         "compression",        "dataWindow",        "displayWindow", "lineOrder",
       "pixelAspectRatio", "screenWindowCenter", "screenWindowWidth", "tiles",         "type",
-      "version",          "chromaticities",     "worldToCamera",     "worldToNDC", "colorInteropID"};
+      "version",          "chromaticities",     "worldToCamera",     "worldToNDC",    "colorInteropID"};
   for (const char* own : kOwn)
     if (name == own) return true;
   return name.rfind("tilesplat", 0) == 0;

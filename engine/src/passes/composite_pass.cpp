@@ -95,21 +95,22 @@ void CompositePass::record(VkCommandBuffer cmd, const CompositeInputs& in, const
   if (it == pipelines_.end()) {
     const float alpha_inv = coverage_alpha_inv(variant.cutoffs.alpha);
     it = pipelines_
-             .emplace(variant,
-                      vk::ComputePipeline(
-                          ctx_, variant.texel_buffers ? "composite_texel" : "composite", sizeof(CompositePush),
-                          {{0, variant.write_depth ? 1u : 0u},
-                           {1, variant.write_count ? 1u : 0u},
-                           {2, pixels_per_invocation_},
-                           {3, kTileSize / pixels_per_invocation_},
-                           {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
-                           {5, std::bit_cast<uint32_t>(alpha_inv)},
-                           {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
-                           {7, variant.host_depth_in ? 1u : 0u},
-                           {8, variant.surface_depth_out ? 1u : 0u},
-                           {9, variant.exact_depth_order ? 1u : 0u},
-                           {10, variant.chunked ? 1u : 0u}},
-                          variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
+             .emplace(
+                 variant,
+                 vk::ComputePipeline(
+                     ctx_, variant.texel_buffers ? "composite_texel" : "composite", sizeof(CompositePush),
+                     {{0, variant.write_depth ? 1u : 0u},
+                      {1, variant.write_count ? 1u : 0u},
+                      {2, pixels_per_invocation_},
+                      {3, kTileSize / pixels_per_invocation_},
+                      {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
+                      {5, std::bit_cast<uint32_t>(alpha_inv)},
+                      {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
+                      {7, variant.host_depth_in ? 1u : 0u},
+                      {8, variant.surface_depth_out ? 1u : 0u},
+                      {9, variant.exact_depth_order ? 1u : 0u},
+                      {10, variant.chunked ? 1u : 0u}},
+                     variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);

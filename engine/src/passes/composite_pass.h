@@ -92,11 +92,11 @@ class CompositePass {
     bool write_depth = true;
     bool write_count = true;
     Cutoffs cutoffs;
-    bool host_depth_in = false;       // the host's surfaces test each splat (HOST_DEPTH)
-    bool surface_depth_out = false;   // the depth where alpha reaches surface_alpha is written (SURFACE_DEPTH)
-    bool exact_depth_order = false;   // a pixel is done at its first splat behind the host (HOST_DEPTH_SORTED)
-    bool texel_buffers = false;       // the CPU layout (composite_texel)
-    bool chunked = false;             // a tile's list takes more than one dispatch (CHUNKED)
+    bool host_depth_in = false;      // the host's surfaces test each splat (HOST_DEPTH)
+    bool surface_depth_out = false;  // the depth where alpha reaches surface_alpha is written (SURFACE_DEPTH)
+    bool exact_depth_order = false;  // a pixel is done at its first splat behind the host (HOST_DEPTH_SORTED)
+    bool texel_buffers = false;      // the CPU layout (composite_texel)
+    bool chunked = false;            // a tile's list takes more than one dispatch (CHUNKED)
     auto operator<=>(const Variant&) const = default;
   };
   std::map<Variant, vk::ComputePipeline> pipelines_;

@@ -31,14 +31,15 @@ void CompositeResortPass::record(VkCommandBuffer cmd, const CompositeInputs& in,
   auto it = pipelines_.find(variant);
   if (it == pipelines_.end())
     it = pipelines_
-             .emplace(variant, vk::ComputePipeline(ctx_, "composite_resort", sizeof(CompositeResortPush),
-                                                   {{0, variant.write_depth ? 1u : 0u},
-                                                    {1, variant.write_count ? 1u : 0u},
-                                                    {2, pixels_per_invocation_},
-                                                    {3, kTileSize / pixels_per_invocation_},
-                                                    {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
-                                                    {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
-                                                    {7, variant.window}}))
+             .emplace(variant,
+                      vk::ComputePipeline(ctx_, "composite_resort", sizeof(CompositeResortPush),
+                                          {{0, variant.write_depth ? 1u : 0u},
+                                           {1, variant.write_count ? 1u : 0u},
+                                           {2, pixels_per_invocation_},
+                                           {3, kTileSize / pixels_per_invocation_},
+                                           {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
+                                           {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
+                                           {7, variant.window}}))
              .first;
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);

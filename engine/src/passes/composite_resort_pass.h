@@ -15,8 +15,8 @@ class CompositeResortPass {
   explicit CompositeResortPass(vk::Context& ctx);
   // ray_depth: the projection's per-Gaussian re-sorting data (ProjectedBuffers::ray_depth).
   // `in.tile_lists` in centre-depth order; `window` splats re-sorted per pixel by ray depth.
-  void record(VkCommandBuffer cmd, const CompositeInputs& in, const vk::Buffer& ray_depth, const Camera& camera,
-              uint32_t window, VkDeviceAddress counters);
+  void record(VkCommandBuffer cmd, const CompositeInputs& in, const vk::Buffer& ray_depth,
+              const Camera& camera, uint32_t window, VkDeviceAddress counters);
   // The longest tile list this pass blends on this device; a longer one is written to
   // FrameCounters::max_tile_pairs (and the frame is refused). Unlimited except on CPU drivers,
   // where llvmpipe cuts a shader short after 65535 loop iterations (~130 per batch of 128 here).

@@ -1,8 +1,8 @@
 // Projection: 3D Gaussians -> screen-space splats (mean, conic, opacity, colour, depth, tile rect).
 #pragma once
 
-#include <map>
 #include <compare>
+#include <map>
 #include <utility>
 #include <vector>
 

@@ -28,8 +28,8 @@ StochasticCompositePass::StochasticCompositePass(vk::Context& ctx)
     unused_output_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "stochastic composite unused output");
 }
 
-void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeInputs& in, const Samples& samples,
-                                     const CompositePass::Chunks& chunks) {
+void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeInputs& in,
+                                     const Samples& samples, const CompositePass::Chunks& chunks) {
   OutputBuffers& out = in.out;
   if (samples.count == 0) throw std::logic_error("stochastic composite: no samples");
   const bool with_state = needs_state(samples.count, chunks.count);
@@ -43,17 +43,18 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
   auto it = pipelines_.find(variant);
   if (it == pipelines_.end()) {
     it = pipelines_
-             .emplace(variant,
-                      vk::ComputePipeline(
-                          ctx_, variant.texel_buffers ? "composite_stochastic_texel" : "composite_stochastic",
-                          sizeof(StochasticPush),
-                          {{0, variant.write_depth ? 1u : 0u},
-                           {1, variant.write_count ? 1u : 0u},
-                           {2, pixels_per_invocation_},
-                           {3, kTileSize / pixels_per_invocation_},
-                           {4, std::bit_cast<uint32_t>(variant.alpha_cutoff)},
-                           {5, std::bit_cast<uint32_t>(coverage_alpha_inv(variant.alpha_cutoff))}},
-                          variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
+             .emplace(
+                 variant,
+                 vk::ComputePipeline(
+                     ctx_, variant.texel_buffers ? "composite_stochastic_texel" : "composite_stochastic",
+                     sizeof(StochasticPush),
+                     {{0, variant.write_depth ? 1u : 0u},
+                      {1, variant.write_count ? 1u : 0u},
+                      {2, pixels_per_invocation_},
+                      {3, kTileSize / pixels_per_invocation_},
+                      {4, std::bit_cast<uint32_t>(variant.alpha_cutoff)},
+                      {5, std::bit_cast<uint32_t>(coverage_alpha_inv(variant.alpha_cutoff))}},
+                     variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);

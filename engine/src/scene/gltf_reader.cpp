@@ -253,10 +253,14 @@ class GltfReader {
         continue;
       }
       const auto hex = [](char c) {
-        return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+        return c >= '0' && c <= '9'   ? c - '0'
+               : c >= 'a' && c <= 'f' ? c - 'a' + 10
+               : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                      : -1;
       };
       if (k + 2 >= uri.size() || hex(uri[k + 1]) < 0 || hex(uri[k + 2]) < 0)
-        fail("buffer " + std::to_string(buffer_index) + ": the uri '" + uri + "' has a malformed percent escape");
+        fail("buffer " + std::to_string(buffer_index) + ": the uri '" + uri +
+             "' has a malformed percent escape");
       name += static_cast<char>(hex(uri[k + 1]) * 16 + hex(uri[k + 2]));
       k += 2;
     }

@@ -92,7 +92,8 @@ void register_sort_strategy(const std::string& name, SortStrategyFactory factory
   });
 }
 
-ScopedSortStrategy::ScopedSortStrategy(std::string name, SortStrategyFactory factory) : name_(std::move(name)) {
+ScopedSortStrategy::ScopedSortStrategy(std::string name, SortStrategyFactory factory)
+    : name_(std::move(name)) {
   register_sort_strategy(name_, std::move(factory));
 }
 

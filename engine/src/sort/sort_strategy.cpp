@@ -82,8 +82,9 @@ void remove_sort_strategy(const std::string& name) {
   std::vector<Registration>& strategies = registry();
   // The built-in ones are the first kBuiltIn entries: never removed.
   const auto first_added = strategies.begin() + std::ptrdiff_t(std::min(kBuiltIn, strategies.size()));
-  strategies.erase(std::remove_if(first_added, strategies.end(), [&](const Registration& r) { return r.name == name; }),
-                   strategies.end());
+  strategies.erase(
+      std::remove_if(first_added, strategies.end(), [&](const Registration& r) { return r.name == name; }),
+      strategies.end());
 }
 
 std::unique_ptr<SortStrategy> make_sort_strategy(const std::string& name, vk::Context& ctx) {
