@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -98,7 +97,7 @@ std::string format_name(VkFormat format) {
 
 TransferImage::TransferImage(const WindowDevice& device, VkFormat format, VkFormatFeatureFlags features,
                              VkImageLayout layout, uint32_t width, uint32_t height)
-    : device_(device.device()), format_(format), layout_(layout), width_(width), height_(height) {
+    : device_(device.device()), width_(width), height_(height) {
   if (!supports(device.physical_device(), format, features))
     throw std::runtime_error(device.name() + ": images of " + format_name(format) +
                              " cannot be blitted or copied as the viewer needs");
@@ -126,7 +125,7 @@ TransferImage::TransferImage(const WindowDevice& device, VkFormat format, VkForm
     vk_check(vkBindImageMemory(device_, image_, memory_, 0), "vkBindImageMemory (a viewer image)");
     // Once, so that every use finds the image in the layout made for it.
     device.submit_and_wait([&](VkCommandBuffer commands) {
-      transition(commands, image_, VK_IMAGE_LAYOUT_UNDEFINED, layout_, 0, 0,
+      transition(commands, image_, VK_IMAGE_LAYOUT_UNDEFINED, layout, 0, 0,
                  VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
     });
   } catch (...) {

@@ -23,7 +23,8 @@ namespace tilesplat::viewer {
 // layout between uses.
 class TransferImage {
  public:
-  // Throws std::runtime_error when the format lacks any of `features` (optimal tiling).
+  // Created and moved into `layout` once, where every use then finds it. Throws std::runtime_error when
+  // the format lacks any of `features` (optimal tiling).
   TransferImage(const WindowDevice& device, VkFormat format, VkFormatFeatureFlags features,
                 VkImageLayout layout, uint32_t width, uint32_t height);
   ~TransferImage();
@@ -31,8 +32,6 @@ class TransferImage {
   TransferImage& operator=(const TransferImage&) = delete;
 
   VkImage image() const { return image_; }
-  VkFormat format() const { return format_; }
-  VkImageLayout layout() const { return layout_; }
   uint32_t width() const { return width_; }
   uint32_t height() const { return height_; }
 
@@ -40,8 +39,6 @@ class TransferImage {
   void destroy();
 
   VkDevice device_;
-  VkFormat format_;
-  VkImageLayout layout_;
   VkImage image_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   uint32_t width_, height_;

@@ -320,7 +320,8 @@ StoredExr read_exr_as_stored(const std::filesystem::path& path) {
 
 RenderImage read_exr(const std::filesystem::path& path) {
   StoredExr stored = read_exr_as_stored(path);
-  stored.image.rgba = convert_colours(stored.image.rgba, stored.encoding, ColourEncoding::kSrgbDisplay);
+  if (stored.encoding != ColourEncoding::kSrgbDisplay)  // display values (and unmarked files) as they are
+    stored.image.rgba = convert_colours(stored.image.rgba, stored.encoding, ColourEncoding::kSrgbDisplay);
   return std::move(stored.image);
 }
 
