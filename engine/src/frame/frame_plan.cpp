@@ -1,0 +1,220 @@
+#include "frame/frame_plan.h"
+
+#include <algorithm>
+#include <bit>
+#include <stdexcept>
+
+#include "host_depth.h"
+#include "passes/stochastic_composite_pass.h"
+#include "passes/tile_coverage.h"
+#include "tilesplat/reference.h"
+
+namespace tilesplat {
+
+namespace {
+
+// A camera this device cannot render is a runtime_error (render() documents it so), bad settings an
+// invalid_argument.
+void check_camera(const Camera& camera, const DeviceCaps& device) {
+  try {
+    validate(camera);  // size, intrinsics, pose; then what this device can hold
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(e.what());
+  }
+  auto fail = [](const std::string& why) { throw std::runtime_error("invalid camera: " + why); };
+  // Tile rects pack each coordinate in 16 bits, and the composite dispatches one workgroup per tile.
+  // On CPU drivers a shader invocation may loop over a row or column of tiles, and llvmpipe cuts
+  // loops short after 65535 iterations (key_emission_big.comp): there 16384 tiles per axis.
+  const uint64_t max_tiles =
+      device.cpu_driver ? 16384 : std::min<uint64_t>(0xffff, device.max_workgroup_count_x);
+  const uint64_t tiles_x = (uint64_t(camera.width) + kTileSize - 1) / kTileSize;
+  const uint64_t tiles_y = (uint64_t(camera.height) + kTileSize - 1) / kTileSize;
+  if (tiles_x > max_tiles || tiles_y > std::min<uint64_t>(max_tiles, 0xffff))
+    fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+         " exceeds the renderer's limit of " + std::to_string(max_tiles) + " tiles (of 16 pixels) per axis");
+  const uint64_t rgba_bytes = uint64_t(camera.width) * uint64_t(camera.height) * 16;
+  if (rgba_bytes > device.max_allocation_size)
+    fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + " needs " +
+         std::to_string(rgba_bytes >> 20) +
+         " MiB for its colour buffer, more than the device's largest allocation (" +
+         std::to_string(device.max_allocation_size >> 20) + " MiB)");
+}
+
+// Settings the stochastic compositor cannot honour.
+constexpr uint32_t kMaxStochasticFrames = 4096;
+void validate_compositor(const RenderSettings& settings) {
+  if (settings.compositor != Compositor::kStochastic) return;
+  auto fail = [](const std::string& why) { throw std::invalid_argument("stochastic compositor: " + why); };
+  const AccuracyModes& modes = settings.accuracy;
+  if (modes.resort_window > 0)
+    fail("per-pixel re-sorting (resort" + std::to_string(modes.resort_window) +
+         ") re-orders depth-sorted lists, and this compositor sorts nothing: use the sorted compositor");
+  if (modes.depth_key_bits != 32)
+    fail(std::to_string(modes.depth_key_bits) +
+         "-bit depth keys approximate the depth sort, which this compositor does not run (it compares full "
+         "view "
+         "depths): use 32-bit depth keys");
+  if (settings.stochastic.frames < 1 || settings.stochastic.frames > kMaxStochasticFrames)
+    fail("stochastic.frames must be 1 to " + std::to_string(kMaxStochasticFrames) + ", not " +
+         std::to_string(settings.stochastic.frames));
+}
+
+TileGrid tile_grid(const Camera& camera) {
+  TileGrid grid;
+  grid.width = uint32_t(camera.width);
+  grid.height = uint32_t(camera.height);
+  grid.tiles_x = (grid.width + kTileSize - 1) / kTileSize;
+  grid.tiles_y = (grid.height + kTileSize - 1) / kTileSize;
+  grid.count = grid.tiles_x * grid.tiles_y;
+  grid.tile_bits = uint32_t(std::bit_width(grid.count));
+  return grid;
+}
+
+// The frame's passes in order. The lists are built as
+//   sorted:     projection -> depth sort -> prefix sum (depth order) -> key emission -> tile sort
+//               (stable, so each tile's run stays front to back) -> tile ranges
+//   sorted, a strategy sorting (tile, depth) pairs itself: projection -> prefix sum (index order) ->
+//               key emission -> tile sort of 64-bit keys -> tile ranges
+//   stochastic: projection -> prefix sum (index order) -> key emission -> tile binning -> tile ranges
+// The stochastic frame never sorts by depth: its composite needs each tile's splats, in any order.
+// Its tile binning is the strategy's sort over the tile bits of 32-bit keys, used only to group the
+// pairs by tile. A frame on reused lists runs the composite alone.
+std::vector<FramePass> frame_passes(const FramePlan& plan) {
+  std::vector<FramePass> passes;
+  if (plan.host.from_image) passes.push_back(FramePass::kHostDepthIn);  // every attempt converts it first
+  const bool stochastic = plan.compositor == Compositor::kStochastic;
+  if (plan.build_lists) {
+    passes.push_back(FramePass::kClearCounters);
+    passes.push_back(FramePass::kProjection);
+    if (plan.depth_key_bits == 16) passes.push_back(FramePass::kDepthQuantize);
+    if (!stochastic && plan.depth_first) passes.push_back(FramePass::kDepthSort);
+    passes.push_back(FramePass::kPrefixSum);
+    passes.push_back(FramePass::kKeyEmission);
+    passes.push_back(stochastic ? FramePass::kTileBinning : FramePass::kTileSort);
+    passes.push_back(FramePass::kTileRanges);
+  } else {
+    passes.push_back(FramePass::kResetLongestList);  // the composite's chunk 0 raises it from zero again
+  }
+  passes.push_back(stochastic               ? FramePass::kStochasticComposite
+                   : plan.resort_window > 0 ? FramePass::kResortComposite
+                                            : FramePass::kComposite);
+  return passes;
+}
+
+bool splits_submissions(const FramePlan& plan) {
+  return (plan.build_lists && plan.sort.sorts_on_host) ||
+         plan.stochastic_samples > StochasticCompositePass::kSamplesPerSubmission;
+}
+
+}  // namespace
+
+const char* timed_name(FramePass pass) {
+  switch (pass) {
+    case FramePass::kHostDepthIn:
+      return "host_depth_in";
+    case FramePass::kClearCounters:
+      return nullptr;
+    case FramePass::kResetLongestList:
+      return nullptr;
+    case FramePass::kProjection:
+      return "projection";
+    case FramePass::kDepthQuantize:
+      return "depth_quantize";
+    case FramePass::kDepthSort:
+      return "depth_sort";
+    case FramePass::kPrefixSum:
+      return "prefix_sum";
+    case FramePass::kKeyEmission:
+      return "key_emission";
+    case FramePass::kTileSort:
+      return "tile_sort";
+    case FramePass::kTileBinning:
+      return "tile_binning";
+    case FramePass::kTileRanges:
+      return "tile_ranges";
+    case FramePass::kComposite:
+      return "composite";
+    case FramePass::kResortComposite:
+      return "composite";
+    case FramePass::kStochasticComposite:
+      return "stochastic_composite";
+  }
+  return nullptr;
+}
+
+std::vector<std::string> FramePlan::timed_passes() const {
+  std::vector<std::string> names;
+  for (FramePass pass : passes)
+    if (const char* name = timed_name(pass)) names.emplace_back(name);
+  return names;
+}
+
+std::string choose_sort_strategy(const std::string& requested, const DeviceCaps& device,
+                                 bool into_host_commands) {
+  if (requested != "auto") return requested;
+  return device.cpu_driver && !into_host_commands ? "cpu-radix" : "radix";
+}
+
+ProjectionVariant projection_variant(const RenderSettings& settings, const SceneShape& scene) {
+  const AccuracyModes& modes = settings.accuracy;
+  ProjectionVariant v;
+  v.dilation_tenths = settings.antialiasing == Antialiasing::kMip ? 1 : 3;
+  v.compensate_opacity = settings.antialiasing != Antialiasing::kClassic;
+  v.stored_sh_degree = scene.sh_degree;
+  v.sh_degree = std::min(scene.sh_degree, modes.sh_degree_cap);
+  v.sh_half = modes.fp16_sh;
+  v.covariance_half = modes.fp16_covariance;
+  v.opacity_extent = modes.extent == AccuracyModes::Extent::kOpacityAware;
+  v.square_tiles = modes.tile_test == AccuracyModes::TileTest::kSquare;
+  v.alpha_inv = coverage_alpha_inv(modes.alpha_cutoff);
+  v.depth_key_bits = uint32_t(modes.depth_key_bits);
+  v.ray_depth = modes.resort_window > 0;
+  v.lighting = settings.lighting.enabled();
+  v.file_normals = v.lighting && scene.file_normals;
+  return v;
+}
+
+FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const FrameContext& context) {
+  check_camera(camera, context.device);
+  validate(settings.accuracy);
+  validate_compositor(settings);
+  validate_host_depth(settings, camera);
+
+  FramePlan plan;
+  plan.sort = context.sort;
+  plan.lists = {context.scene.generation, camera,
+                context.sort.name,        settings.accuracy,
+                settings.antialiasing,    settings.lighting,
+                settings.compositor};
+  plan.build_lists = !(settings.reuse_lists && context.lists && *context.lists == plan.lists);
+  plan.projection = projection_variant(settings, context.scene);
+  plan.tiles = tile_grid(camera);
+  plan.compositor = settings.compositor;
+  plan.depth_key_bits = uint32_t(settings.accuracy.depth_key_bits);
+  const bool stochastic = settings.compositor == Compositor::kStochastic;
+  plan.depth_first = context.sort.plan == FrameSortPlan::kDepthThenTile;
+  // The stochastic frame only bins by tile, in 32-bit keys whatever the strategy.
+  plan.wide_keys = !stochastic && !plan.depth_first;
+  // In 64-bit keys the tile id sits above bit 32 whatever the depth key's width.
+  plan.sort_bits = stochastic ? plan.tiles.tile_bits : plan.depth_key_bits + plan.tiles.tile_bits;
+  plan.resort_window = stochastic ? 0 : uint32_t(settings.accuracy.resort_window);
+  plan.stochastic_samples = stochastic ? settings.stochastic.frames : 0;
+  if (settings.host) {
+    plan.host.from_memory = !settings.host->depth.empty();
+    plan.host.from_image = context.depth_image;
+    plan.host.write_depth = settings.host->write_depth;
+  }
+
+  plan.passes = frame_passes(plan);
+  plan.splits_submissions = splits_submissions(plan);
+  return plan;
+}
+
+FramePlan composite_only(FramePlan plan) {
+  plan.build_lists = false;
+  plan.passes = frame_passes(plan);
+  plan.splits_submissions = splits_submissions(plan);
+  return plan;
+}
+
+}  // namespace tilesplat

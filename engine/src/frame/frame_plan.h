@@ -1,0 +1,150 @@
+// The frame as a plan: everything decided about a frame before any Vulkan call. plan_frame() turns
+// the scene's shape, the camera, the settings, what the device can do and what the buffers hold into
+// a FramePlan, a plain value: which passes run in which order, the pipeline variants they use, the
+// key widths and tile bits, and whether the tile lists are built or reused. FrameRecorder records a
+// plan; plans are tested without a device (tests/test_frame_plan.cpp).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "passes/projection_pass.h"
+#include "sort/sort_strategy.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/render_settings.h"
+
+namespace tilesplat {
+
+// One step of a frame, in the order FramePlan::passes lists them. Each is one host-side class's
+// record() (or, for the first two, a fill of the counters).
+enum class FramePass {
+  kHostDepthIn,          // the host's depth image converted to view depths (render_to_image with one)
+  kClearCounters,        // counters and tile ranges to zero: the lists are built from scratch
+  kResetLongestList,     // only the longest-list counter to zero: the composite runs on reused lists
+  kProjection,           // Gaussians -> splats, tile counts, depth keys
+  kDepthQuantize,        // 16-bit depth keys over the visible depth range (depth16)
+  kDepthSort,            // the Gaussians by depth key
+  kPrefixSum,            // where each Gaussian's (tile, Gaussian) pairs start
+  kKeyEmission,          // the pairs, front to back (or in index order for the stochastic frame)
+  kTileSort,             // the pairs by tile, stably
+  kTileBinning,          // the pairs grouped by tile, in any order (the stochastic frame)
+  kTileRanges,           // each tile's [start, end) in the sorted pairs
+  kComposite,            // front-to-back blending (composite.comp)
+  kResortComposite,      // blending with per-pixel re-sorting (composite_resort.comp)
+  kStochasticComposite,  // the sort-free composite (composite_stochastic.comp)
+};
+// The pass's name in FrameStats::passes and the benchmark, or nullptr for a step that is not timed.
+const char* timed_name(FramePass pass);
+
+// What the device offers that shapes a frame (vk::Context's limits), without the device.
+struct DeviceCaps {
+  bool cpu_driver = false;  // lavapipe and the like: different loop limits and pass variants
+  uint32_t max_workgroup_count_x = 65535;
+  uint64_t max_allocation_size = uint64_t(1) << 31;
+};
+
+// The shape of the scene on the device (what set_scene uploaded), which the projection's variant
+// depends on.
+struct SceneShape {
+  uint64_t generation = 0;  // counts set_scene calls: lists built for an earlier scene are stale
+  uint32_t count = 0;
+  int sh_degree = 0;
+  bool file_normals = false;  // the scene has a usable normal (SceneBuffers::file_normals)
+};
+
+// What a frame needs of its sort strategy, read off the strategy (or written out by a test).
+struct SortTraits {
+  std::string name;
+  FrameSortPlan plan = FrameSortPlan::kDepthThenTile;
+  bool sorts_on_host = false;
+};
+
+// RenderSettings::sort "auto": the fastest exact strategy for the device, measured by tilesplat-bench
+// (docs/benchmarks.md, "The default sort"): on a CPU driver cpu-radix, whose host sort skips the
+// per-digit passes that cost most there, unless the frame goes into a host's command buffer (which
+// cannot sort on the host); radix everywhere else. Any other name is returned as it is.
+std::string choose_sort_strategy(const std::string& requested, const DeviceCaps& device,
+                                 bool into_host_commands);
+
+// Everything a frame's tile lists depend on. When it equals the key of the lists in the buffers,
+// a frame runs the composite alone: the background, the outputs requested, the stochastic frames
+// and seed, and the transmittance cut-off change only the composite (the whole AccuracyModes is
+// compared anyway, to keep this simple and safe).
+struct ListKey {
+  uint64_t scene_generation = 0;
+  Camera camera;
+  std::string sort;  // the strategy that ran ("auto" resolved)
+  AccuracyModes accuracy;
+  Antialiasing antialiasing = Antialiasing::kClassic;
+  Lighting lighting;
+  Compositor compositor = Compositor::kSorted;  // sorted and binned-only lists differ
+
+  bool operator==(const ListKey&) const = default;
+};
+
+// The frame's 16x16 tiles. Tile ids run to `count` inclusive (the key emission's padding uses that
+// id), hence tile_bits = bit_width(count).
+struct TileGrid {
+  uint32_t width = 0, height = 0;  // pixels
+  uint32_t tiles_x = 0, tiles_y = 0, count = 0;
+  uint32_t tile_bits = 0;
+};
+
+// A frame's use of RenderSettings::host.
+struct HostDepthPlan {
+  bool from_memory = false;  // HostDepth::depth uploaded as view depths
+  bool from_image = false;   // a depth image converted on the device (kHostDepthIn)
+  bool write_depth = false;  // the composite writes the surface depth
+};
+
+struct FramePlan {
+  ListKey lists;            // what this frame's tile lists are built for
+  bool build_lists = true;  // false: the composite alone, on the lists the previous frame left
+  SortTraits sort;          // the strategy that runs ("auto" resolved)
+  ProjectionVariant projection;
+  TileGrid tiles;
+  // Keys: the per-Gaussian depth key's bits (AccuracyModes::depth_key_bits); whether the pairs are
+  // 64-bit (tile, depth) keys, for a strategy that sorts those itself; and the bits the frame's sorts
+  // order by (FrameStats::sort_bits: depth + tile bits, or the tile bits alone for the stochastic
+  // frame, which sorts no depth).
+  uint32_t depth_key_bits = 32;
+  bool wide_keys = false;
+  uint32_t sort_bits = 0;
+  bool depth_first = true;  // depth sort, then a tile sort of 32-bit keys (FrameSortPlan::kDepthThenTile)
+  Compositor compositor = Compositor::kSorted;
+  uint32_t resort_window = 0;       // kResortComposite's window (AccuracyModes::resort_window)
+  uint32_t stochastic_samples = 0;  // kStochasticComposite's averaged samples (StochasticSettings::frames)
+  HostDepthPlan host;
+  std::vector<FramePass> passes;  // in order
+  // The frame ends its command buffer and goes on in another where the host must act: a host sort
+  // (SortTraits::sorts_on_host) and every averaged sample of the stochastic composite after the first.
+  bool splits_submissions = false;
+
+  // The names of the timed passes in order: what FrameStats::passes lists for a frame without retries.
+  std::vector<std::string> timed_passes() const;
+};
+
+// Inputs of plan_frame that are not settings: what the buffers and the device hold.
+struct FrameContext {
+  SceneShape scene;
+  DeviceCaps device;
+  SortTraits sort;               // of choose_sort_strategy(settings.sort, ...)
+  std::optional<ListKey> lists;  // the lists in the buffers, if whole
+  bool depth_image = false;      // render_to_image with a host depth image
+};
+
+// Validates the camera for this device, the accuracy modes, the compositor's settings and the host
+// depth (throwing std::runtime_error for a camera the device cannot render, std::invalid_argument
+// for settings, as render() documents), then decides the frame.
+FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const FrameContext& context);
+
+// The same frame's composite alone, on the lists its first attempt built: the re-run of a composite
+// that needed more dispatches than it had (FrameRecorder::composite_chunks).
+FramePlan composite_only(FramePlan plan);
+
+// The projection a frame's accuracy modes and effects call for, on a scene of this shape.
+ProjectionVariant projection_variant(const RenderSettings& settings, const SceneShape& scene);
+
+}  // namespace tilesplat

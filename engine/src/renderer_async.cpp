@@ -1,0 +1,176 @@
+// Frames the renderer does not wait for, and the entry points of vulkan_interop.h. render_to_image
+// with HostFrameSync submits the whole frame (its copies into the host's images included) and returns;
+// with HostCommandBuffer it records the frame into the host's command buffer. Either frame is kept as
+// a SubmittedFrame, and its statistics become the last frame's once it has completed
+// (wait_for_submitted_frame: at the next frame, set_scene, sort_keys or wait_for_frame).
+#include <chrono>
+#include <stdexcept>
+#include <string>
+
+#include "host_images.h"
+#include "renderer_impl.h"
+#include "vulkan/vk_check.h"
+
+namespace tilesplat {
+
+namespace {
+
+// Waits for a timeline semaphore (a host's, HostCommandBuffer) to reach `value`.
+VkResult wait_for_value(VkDevice device, VkSemaphore timeline, uint64_t value) {
+  VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+  wait.semaphoreCount = 1;
+  wait.pSemaphores = &timeline;
+  wait.pValues = &value;
+  return vkWaitSemaphores(device, &wait, UINT64_MAX);
+}
+
+}  // namespace
+
+Renderer::Impl::~Impl() {
+  if (submitted && submitted->timeline != VK_NULL_HANDLE)
+    wait_for_value(ctx.device(), submitted->timeline, submitted->value);  // no throwing from a destructor
+}
+
+void Renderer::Impl::submit_frame(const Camera& camera, const RenderSettings& settings,
+                                  const ExternalImage& target, const ExternalDepthImage* depth_image,
+                                  const vk::SubmitSync& sync) {
+  const FrameStart start = begin_frame(camera, settings, depth_image != nullptr);
+  vk::CommandStream stream(ctx);
+  stream.wait_first(sync);
+  record_frame_to_images(stream, start, settings, target, depth_image);
+  stream.submit_in_flight(in_flight, sync);
+  keep_submitted(start, stream.submissions());
+}
+
+void Renderer::Impl::record_frame_into(const HostCommandBuffer& host, const Camera& camera,
+                                       const RenderSettings& settings, const ExternalImage& target,
+                                       const ExternalDepthImage* depth_image) {
+  const DeviceCaps device = device_caps();
+  if (sort(choose_sort_strategy(settings.sort, device, /*into_host_commands=*/true)).sorts_on_host())
+    throw std::invalid_argument(
+        "render_to_image: the sort strategy '" + settings.sort +
+        "' sorts on the host in the middle of the frame, which a command buffer of the "
+        "host's cannot hold: use a GPU strategy, or HostFrameSync");
+  const FrameStart start = begin_frame(camera, settings, depth_image != nullptr, /*into_host_commands=*/true);
+  vk::CommandStream stream(ctx, host.command_buffer);
+  record_frame_to_images(stream, start, settings, target, depth_image);
+  stream.end_borrowed();
+  keep_submitted(start, 0, host.timeline, host.value);
+}
+
+// A frame that goes on without the renderer waiting for it: its whole recording, from the buffers'
+// sizes to the copies into the host's images. It cannot re-render.
+void Renderer::Impl::record_frame_to_images(vk::CommandStream& stream, const FrameStart& start,
+                                            const RenderSettings& settings, const ExternalImage& target,
+                                            const ExternalDepthImage* depth_image) {
+  recorder.prepare(start.plan, resources, *start.sorter);
+  recorder.record(stream, start.plan, settings, resources, *start.sorter, depth_image);
+  recorder.record_copies_to_images(stream.cmd(), settings, resources, target, depth_image);
+}
+
+void Renderer::Impl::keep_submitted(const FrameStart& start, int submissions, VkSemaphore timeline,
+                                    uint64_t value) {
+  const double cpu_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start.time).count();
+  submitted = SubmittedFrame{start, submissions, cpu_ms, timeline, value};
+}
+
+// Waits for the frame in flight, if any, and makes its statistics the last frame's. It cannot
+// re-render: a frame that overflowed the key buffers or had too few composite chunks was drawn
+// without what did not fit (FrameStats::complete false), and the next frame has what it needs.
+void Renderer::Impl::wait_for_submitted_frame() {
+  if (!submitted) return;
+  const SubmittedFrame frame_info = std::move(*submitted);
+  submitted.reset();
+  if (frame_info.timeline != VK_NULL_HANDLE)
+    TS_VK_CHECK(wait_for_value(ctx.device(), frame_info.timeline, frame_info.value));
+  else
+    in_flight.wait();
+  const FrameCounters frame = resources.frame_counters();
+  stats = {};
+  std::vector<PassTiming> passes;
+  add_timings(passes);
+  stats.submissions = frame_info.submissions;
+  stats.cpu_ms = frame_info.cpu_ms;
+  const FramePlan& plan = frame_info.start.plan;
+  uint32_t& chunks = recorder.composite_chunks(plan.compositor);
+  const bool lists_whole = !frame.overflow;
+  if (frame.overflow) {
+    stats.complete = false;
+    resources.grow_keys_for(frame, plan.lists.camera);
+  } else {
+    check_resort_lists(plan, frame);
+    const uint32_t needed = recorder.chunks_for(plan.compositor, frame.max_tile_pairs);
+    stats.complete = needed <= chunks;
+    chunks = needed;
+  }
+  end_frame(frame_info.start, frame, std::move(passes), lists_whole);
+}
+
+std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device,
+                                          const RendererOptions& options) {
+  return RendererAccess::make(std::make_unique<Renderer::Impl>(options, device));
+}
+
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                     const ExternalImage& target) {
+  Renderer::Impl& r = RendererAccess::impl(renderer);
+  check_images(target, nullptr, camera, settings);
+  const auto start = std::chrono::steady_clock::now();
+  r.render_frame(camera, settings);
+  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    r.recorder.record_copies_to_images(cmd, settings, r.resources, target, nullptr);
+  });
+  r.stats.cpu_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                     const ExternalImage& target, const ExternalDepthImage& depth) {
+  Renderer::Impl& r = RendererAccess::impl(renderer);
+  check_images(target, &depth, camera, settings);
+  const auto start = std::chrono::steady_clock::now();
+  r.render_frame(camera, settings, &depth);
+  r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    r.recorder.record_copies_to_images(cmd, settings, r.resources, target, &depth);
+  });
+  r.stats.cpu_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                     const ExternalImage& target, const ExternalDepthImage* depth,
+                     const HostFrameSync& sync) {
+  Renderer::Impl& r = RendererAccess::impl(renderer);
+  check_images(target, depth, camera, settings);
+  auto check_count = [](size_t count, size_t semaphores, const char* what) {
+    if (count != 0 && count != semaphores)
+      throw std::invalid_argument(std::string("render_to_image: HostFrameSync has ") + std::to_string(count) +
+                                  " " + what + " for " + std::to_string(semaphores) +
+                                  " semaphores (give one each, or none)");
+  };
+  check_count(sync.wait_stages.size(), sync.wait.size(), "wait_stages");
+  check_count(sync.wait_values.size(), sync.wait.size(), "wait_values");
+  check_count(sync.signal_values.size(), sync.signal.size(), "signal_values");
+  r.submit_frame(camera, settings, target, depth,
+                 {sync.wait, sync.wait_stages, sync.wait_values, sync.signal, sync.signal_values});
+}
+
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+                     const ExternalImage& target, const ExternalDepthImage* depth,
+                     const HostCommandBuffer& commands) {
+  Renderer::Impl& r = RendererAccess::impl(renderer);
+  check_images(target, depth, camera, settings);
+  if (commands.command_buffer == VK_NULL_HANDLE)
+    throw std::invalid_argument("render_to_image: HostCommandBuffer has no command buffer");
+  if (commands.timeline == VK_NULL_HANDLE)
+    throw std::invalid_argument(
+        "render_to_image: HostCommandBuffer has no timeline semaphore to say when the frame has completed");
+  r.record_frame_into(commands, camera, settings, target, depth);
+}
+
+void wait_for_frame(Renderer& renderer) {
+  RendererAccess::impl(renderer).wait_for_submitted_frame();
+}
+
+}  // namespace tilesplat

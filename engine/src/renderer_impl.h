@@ -1,0 +1,134 @@
+// Renderer::Impl: what a renderer holds between frames, and the frame's life around its plan.
+//   begin_frame  plans the frame (frame/frame_plan.h), sizes the buffers, uploads the camera and lights
+//   run_frame    records the plan (frame/frame_recorder.h) into a command stream and runs it
+//   render_frame the retry loop: keys that overflowed grow and the frame re-renders; a composite that
+//                needed more dispatches re-runs alone
+//   end_frame    the frame's statistics; its lists become reusable
+// A frame may also go on without the renderer waiting (render_to_image with HostFrameSync or
+// HostCommandBuffer, renderer_async.cpp): it is kept as a SubmittedFrame until wait_for_submitted_frame.
+#pragma once
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "frame/frame_plan.h"
+#include "frame/frame_recorder.h"
+#include "frame/frame_resources.h"
+#include "sort/sort_strategy.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/vulkan_interop.h"
+#include "vulkan/command_stream.h"
+#include "vulkan/context.h"
+#include "vulkan/gpu_timer.h"
+
+namespace tilesplat {
+
+struct Renderer::Impl {
+  explicit Impl(const RendererOptions& opts) : Impl(opts, vk::ContextOptions{opts.device, opts.validation}) {}
+  template <typename ContextSource>
+  Impl(const RendererOptions& opts, const ContextSource& source)
+      : options(opts), ctx(source), timer(ctx), recorder(ctx, timer), resources(ctx), in_flight(ctx) {}
+  // A frame recorded into a host's command buffer may still run on the buffers about to go (a frame
+  // the renderer submitted itself is waited for by in_flight's destructor).
+  ~Impl();
+
+  SortStrategy& sort(const std::string& name);
+  DeviceCaps device_caps() const;
+
+  // What a frame was planned as and started from, for its statistics once it completed.
+  struct FrameStart {
+    FramePlan plan;
+    SortStrategy* sorter = nullptr;
+    uint64_t fallbacks_before = 0;
+    std::chrono::steady_clock::time_point time;
+  };
+  // Plans the frame (validating the camera and settings), sizes the outputs and uploads what the
+  // frame reads from the host. Waits for a frame in flight first: its buffers are the same.
+  FrameStart begin_frame(const Camera& camera, const RenderSettings& settings, bool depth_image,
+                         bool into_host_commands = false);
+  // Records and runs one attempt at the plan; returns the counters the GPU wrote. A composite-only
+  // frame rewrites only max_tile_pairs, so the others still describe the lists it read.
+  FrameCounters run_frame(const FramePlan& plan, const RenderSettings& settings, SortStrategy& sorter,
+                          const ExternalDepthImage* depth_image);
+  // Renders into the output buffers with retries, and fills the statistics (all but cpu_ms).
+  void render_frame(const Camera& camera, const RenderSettings& settings,
+                    const ExternalDepthImage* depth_image = nullptr);
+  void end_frame(const FrameStart& start, const FrameCounters& frame, std::vector<PassTiming> passes,
+                 bool lists_whole);
+  void add_timings(std::vector<PassTiming>& passes);
+  void check_resort_lists(const FramePlan& plan, const FrameCounters& frame) const;
+  uint64_t device_bytes() const;
+
+  // Frames the renderer does not wait for (renderer_async.cpp).
+  struct SubmittedFrame {
+    FrameStart start;
+    int submissions = 0;
+    double cpu_ms = 0;
+    // Recorded into a host's command buffer: complete once this timeline semaphore reaches `value`
+    // (else the renderer's own submission, in_flight).
+    VkSemaphore timeline = VK_NULL_HANDLE;
+    uint64_t value = 0;
+  };
+  void submit_frame(const Camera& camera, const RenderSettings& settings, const ExternalImage& target,
+                    const ExternalDepthImage* depth_image, const vk::SubmitSync& sync);
+  void record_frame_into(const HostCommandBuffer& host, const Camera& camera, const RenderSettings& settings,
+                         const ExternalImage& target, const ExternalDepthImage* depth_image);
+  void record_frame_to_images(vk::CommandStream& stream, const FrameStart& start,
+                              const RenderSettings& settings, const ExternalImage& target,
+                              const ExternalDepthImage* depth_image);
+  void keep_submitted(const FrameStart& start, int submissions, VkSemaphore timeline = VK_NULL_HANDLE,
+                      uint64_t value = 0);
+  void wait_for_submitted_frame();
+
+  // Reads a device buffer back (through a staging buffer unless it is host-visible).
+  template <typename T>
+  void read_output(const vk::Buffer& buffer, std::vector<T>& out, size_t count);
+  void read_host_depth(const HostDepth& host, std::vector<float>& out, size_t pixels);
+
+  RendererOptions options;
+  vk::Context ctx;
+  vk::GpuTimer timer;
+  FrameRecorder recorder;
+  FrameResources resources;
+  std::map<std::string, std::unique_ptr<SortStrategy>> sorts;
+  FrameStats stats;
+  // The tile lists in the buffers: what they were built for (none after set_scene or a frame that
+  // failed).
+  std::optional<ListKey> lists;
+  uint64_t scene_generation = 0;            // counts set_scene calls
+  uint64_t uploaded_bytes_reported = 0;     // vk::Context::uploaded_bytes() at the last frame's statistics
+  std::optional<SubmittedFrame> submitted;  // the frame render_to_image submitted without waiting
+  // Its fence and command buffer: declared last, so that it is destroyed first and waits for the
+  // frame before any buffer the frame uses goes.
+  vk::InFlightSubmission in_flight;
+};
+
+// How the functions of vulkan_interop.h, which are not members, reach a renderer's implementation.
+struct RendererAccess {
+  static Renderer::Impl& impl(Renderer& renderer) { return *renderer.impl_; }
+  static std::unique_ptr<Renderer> make(std::unique_ptr<Renderer::Impl> impl) {
+    return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
+  }
+};
+
+template <typename T>
+void Renderer::Impl::read_output(const vk::Buffer& buffer, std::vector<T>& out, size_t count) {
+  out.resize(count);
+  if (count == 0) return;  // memcpy must not see the null data() of an empty vector
+  if (buffer.mapped()) {
+    std::memcpy(out.data(), buffer.mapped(), count * sizeof(T));
+    return;
+  }
+  vk::Buffer staging(ctx, count * sizeof(T), vk::MemoryUse::Readback, buffer.name() + " (readback)");
+  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+    VkBufferCopy region{0, 0, count * sizeof(T)};
+    vkCmdCopyBuffer(cmd, buffer.handle(), staging.handle(), 1, &region);
+  });
+  std::memcpy(out.data(), staging.mapped(), count * sizeof(T));
+}
+
+}  // namespace tilesplat
