@@ -1,0 +1,306 @@
+// The frame as a plan (engine/src/frame/frame_plan.h), tested without a Vulkan device: which passes a
+// frame runs in which order, its keys and variants, list reuse, the sort "auto" picks, and the
+// settings a plan refuses, for every compositor, sort plan, accuracy mode and effect.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "frame/frame_plan.h"
+#include "tilesplat/reference.h"
+
+namespace tilesplat {
+namespace {
+
+using P = FramePass;
+
+Camera camera(int width = 1920, int height = 1080) {
+  Camera c;
+  c.width = width;
+  c.height = height;
+  c.fx = c.fy = 1000;
+  c.cx = width / 2.0;
+  c.cy = height / 2.0;
+  return c;
+}
+
+const DeviceCaps kGpu{false, 2147483647u, uint64_t(4) << 30};
+const DeviceCaps kCpuDriver{true, 65535, uint64_t(2) << 30};
+const SortTraits kRadix{"radix", FrameSortPlan::kDepthThenTile, false};
+const SortTraits kPairs{"tile-local", FrameSortPlan::kTileDepthPairs, false};
+const SortTraits kHostSort{"cpu-radix", FrameSortPlan::kDepthThenTile, true};
+
+FrameContext context(const SortTraits& sort = kRadix, const DeviceCaps& device = kGpu) {
+  FrameContext c;
+  c.scene = {1, 500000, 3, false};
+  c.device = device;
+  c.sort = sort;
+  return c;
+}
+
+TEST(FramePlan, SortedFrameIsDepthSortThenTileSort) {
+  const FramePlan plan = plan_frame(camera(), {}, context());
+  EXPECT_EQ(plan.passes, (std::vector<P>{P::kClearCounters, P::kProjection, P::kDepthSort, P::kPrefixSum,
+                                         P::kKeyEmission, P::kTileSort, P::kTileRanges, P::kComposite}));
+  EXPECT_EQ(plan.timed_passes(),
+            (std::vector<std::string>{"projection", "depth_sort", "prefix_sum", "key_emission", "tile_sort",
+                                      "tile_ranges", "composite"}));
+  EXPECT_TRUE(plan.build_lists);
+  EXPECT_TRUE(plan.depth_first);
+  EXPECT_FALSE(plan.wide_keys);
+  // 1920x1080: 120 x 68 tiles, ids 0..8160 in 13 bits; 32 depth bits besides.
+  EXPECT_EQ(plan.tiles.tiles_x, 120u);
+  EXPECT_EQ(plan.tiles.tiles_y, 68u);
+  EXPECT_EQ(plan.tiles.count, 8160u);
+  EXPECT_EQ(plan.tiles.tile_bits, 13u);
+  EXPECT_EQ(plan.sort_bits, 32u + 13u);
+  EXPECT_FALSE(plan.splits_submissions);
+  EXPECT_EQ(plan.lists.sort, "radix");
+}
+
+TEST(FramePlan, StrategySortingPairsItselfUsesWideKeysAndNoDepthSort) {
+  const FramePlan plan = plan_frame(camera(), {}, context(kPairs));
+  EXPECT_EQ(plan.passes, (std::vector<P>{P::kClearCounters, P::kProjection, P::kPrefixSum, P::kKeyEmission,
+                                         P::kTileSort, P::kTileRanges, P::kComposite}));
+  EXPECT_TRUE(plan.wide_keys);
+  EXPECT_FALSE(plan.depth_first);
+  EXPECT_EQ(plan.sort_bits, 32u + 13u);
+}
+
+TEST(FramePlan, Depth16QuantizesAfterTheProjection) {
+  RenderSettings settings;
+  settings.accuracy = parse_accuracy_modes("depth16");
+  const FramePlan plan = plan_frame(camera(), settings, context());
+  ASSERT_GE(plan.passes.size(), 3u);
+  EXPECT_EQ(plan.passes[1], P::kProjection);
+  EXPECT_EQ(plan.passes[2], P::kDepthQuantize);
+  EXPECT_EQ(plan.depth_key_bits, 16u);
+  EXPECT_EQ(plan.sort_bits, 16u + 13u);
+  EXPECT_EQ(plan.projection.depth_key_bits, 16u);
+}
+
+TEST(FramePlan, StochasticFrameBinsWithoutDepthSort) {
+  RenderSettings settings;
+  settings.compositor = Compositor::kStochastic;
+  for (const SortTraits& sort : {kRadix, kPairs}) {
+    const FramePlan plan = plan_frame(camera(), settings, context(sort));
+    EXPECT_EQ(plan.passes, (std::vector<P>{P::kClearCounters, P::kProjection, P::kPrefixSum, P::kKeyEmission,
+                                           P::kTileBinning, P::kTileRanges, P::kStochasticComposite}))
+        << sort.name;
+    EXPECT_FALSE(plan.wide_keys) << sort.name;  // 32-bit tile keys whatever the strategy
+    EXPECT_EQ(plan.sort_bits, 13u) << sort.name;
+    EXPECT_EQ(plan.stochastic_samples, settings.stochastic.frames);
+  }
+  // Past 64 samples the composite goes on in another submission.
+  settings.stochastic.frames = 65;
+  EXPECT_TRUE(plan_frame(camera(), settings, context()).splits_submissions);
+  settings.stochastic.frames = 64;
+  EXPECT_FALSE(plan_frame(camera(), settings, context()).splits_submissions);
+}
+
+TEST(FramePlan, ResortModesUseTheResortCompositeAndRayDepths) {
+  RenderSettings settings;
+  settings.accuracy = parse_accuracy_modes("resort8");
+  const FramePlan plan = plan_frame(camera(), settings, context());
+  EXPECT_EQ(plan.passes.back(), P::kResortComposite);
+  EXPECT_EQ(plan.resort_window, 8u);
+  EXPECT_TRUE(plan.projection.ray_depth);
+  EXPECT_EQ(plan.timed_passes().back(), "composite");
+}
+
+TEST(FramePlan, HostSortSplitsTheSubmission) {
+  EXPECT_TRUE(plan_frame(camera(), {}, context(kHostSort)).splits_submissions);
+  // Reused lists run no sort.
+  FrameContext c = context(kHostSort);
+  c.lists = plan_frame(camera(), {}, c).lists;
+  EXPECT_FALSE(plan_frame(camera(), {}, c).splits_submissions);
+}
+
+TEST(FramePlan, HostDepthImageIsConvertedFirstOnEveryAttempt) {
+  RenderSettings settings;
+  settings.host = HostDepth{};
+  settings.host->write_depth = true;
+  FrameContext c = context();
+  c.depth_image = true;
+  const FramePlan plan = plan_frame(camera(), settings, c);
+  EXPECT_EQ(plan.passes.front(), P::kHostDepthIn);
+  EXPECT_TRUE(plan.host.from_image);
+  EXPECT_FALSE(plan.host.from_memory);
+  EXPECT_TRUE(plan.host.write_depth);
+  const FramePlan again = composite_only(plan);
+  EXPECT_EQ(again.passes, (std::vector<P>{P::kHostDepthIn, P::kResetLongestList, P::kComposite}));
+  EXPECT_FALSE(again.build_lists);
+}
+
+TEST(FramePlan, ListsAreReusedOnlyWhenEverythingTheyDependOnIsEqual) {
+  FrameContext c = context();
+  const Camera cam = camera();
+  c.lists = plan_frame(cam, {}, c).lists;
+  const FramePlan reused = plan_frame(cam, {}, c);
+  EXPECT_FALSE(reused.build_lists);
+  EXPECT_EQ(reused.passes, (std::vector<P>{P::kResetLongestList, P::kComposite}));
+
+  // What only the composite reads may change.
+  RenderSettings composite_only_changes;
+  composite_only_changes.background = {1, 0, 0};
+  composite_only_changes.depth = false;
+  composite_only_changes.splat_count = false;
+  EXPECT_FALSE(plan_frame(cam, composite_only_changes, c).build_lists);
+
+  // Anything the lists depend on rebuilds them.
+  std::vector<std::pair<std::string, RenderSettings>> changes;
+  RenderSettings s;
+  s.accuracy = parse_accuracy_modes("sh1");
+  changes.push_back({"accuracy", s});
+  s = {};
+  s.antialiasing = Antialiasing::kMip;
+  changes.push_back({"antialiasing", s});
+  s = {};
+  s.lighting.lights.push_back({});
+  changes.push_back({"lighting", s});
+  s = {};
+  s.compositor = Compositor::kStochastic;
+  changes.push_back({"compositor", s});
+  s = {};
+  s.reuse_lists = false;
+  changes.push_back({"reuse_lists off", s});
+  for (const auto& [what, settings] : changes) EXPECT_TRUE(plan_frame(cam, settings, c).build_lists) << what;
+
+  Camera moved = cam;
+  moved.position[0] += 0.01;
+  EXPECT_TRUE(plan_frame(moved, {}, c).build_lists);
+  FrameContext other_sort = c;
+  other_sort.sort = kPairs;
+  EXPECT_TRUE(plan_frame(cam, {}, other_sort).build_lists);
+  FrameContext new_scene = c;
+  new_scene.scene.generation = 2;
+  EXPECT_TRUE(plan_frame(cam, {}, new_scene).build_lists);
+}
+
+TEST(FramePlan, AutoSortIsCpuRadixOnCpuDriversAndRadixElsewhere) {
+  EXPECT_EQ(choose_sort_strategy("auto", kCpuDriver, false), "cpu-radix");
+  EXPECT_EQ(choose_sort_strategy("auto", kGpu, false), "radix");
+  // A host's command buffer cannot hold a host sort: the best device strategy.
+  EXPECT_EQ(choose_sort_strategy("auto", kCpuDriver, true), "radix");
+  EXPECT_EQ(choose_sort_strategy("auto", kGpu, true), "radix");
+  for (const char* named : {"radix", "onesweep", "bitonic", "tile-local", "cpu-radix", "cpu-radix16"}) {
+    EXPECT_EQ(choose_sort_strategy(named, kCpuDriver, false), named);
+    EXPECT_EQ(choose_sort_strategy(named, kGpu, true), named);
+  }
+}
+
+TEST(FramePlan, RefusesWhatTheDeviceOrCompositorCannotDo) {
+  // More tiles per axis than a CPU driver's loops allow, and a colour buffer beyond one allocation.
+  EXPECT_THROW(plan_frame(camera(16384 * 16 + 16, 16), {}, context(kRadix, kCpuDriver)), std::runtime_error);
+  DeviceCaps small = kGpu;
+  small.max_allocation_size = 1 << 20;
+  try {
+    plan_frame(camera(1024, 1024), {}, context(kRadix, small));
+    FAIL() << "a 16 MiB colour buffer on a device of 1 MiB allocations";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("largest allocation"), std::string::npos) << e.what();
+  }
+  Camera bad = camera();
+  bad.fx = -1;
+  EXPECT_THROW(plan_frame(bad, {}, context()), std::runtime_error);
+
+  RenderSettings stochastic;
+  stochastic.compositor = Compositor::kStochastic;
+  for (const char* modes : {"resort4", "depth16", "depth24"}) {
+    stochastic.accuracy = parse_accuracy_modes(modes);
+    EXPECT_THROW(plan_frame(camera(), stochastic, context()), std::invalid_argument) << modes;
+  }
+  stochastic.accuracy = {};
+  stochastic.stochastic.frames = 0;
+  EXPECT_THROW(plan_frame(camera(), stochastic, context()), std::invalid_argument);
+
+  RenderSettings bad_modes;
+  bad_modes.accuracy.resort_window = 99;
+  EXPECT_THROW(plan_frame(camera(), bad_modes, context()), std::invalid_argument);
+}
+
+TEST(FramePlan, EffectsReachTheProjectionVariant) {
+  RenderSettings settings;
+  SceneShape scene{1, 10, 2, true};
+  ProjectionVariant v = projection_variant(settings, scene);
+  EXPECT_EQ(v.sh_degree, 2);
+  EXPECT_EQ(v.stored_sh_degree, 2);
+  EXPECT_FALSE(v.lighting);
+  EXPECT_FALSE(v.file_normals);  // normals are read only when lit
+  EXPECT_EQ(v.dilation_tenths, 3u);
+  EXPECT_FALSE(v.compensate_opacity);
+
+  settings.lighting.lights.push_back({});
+  settings.antialiasing = Antialiasing::kMip;
+  settings.accuracy =
+      parse_accuracy_modes("sh1+fp16-sh+fp16-cov+opacity-extent+square-tiles+alpha-cutoff=1/64");
+  v = projection_variant(settings, scene);
+  EXPECT_TRUE(v.lighting);
+  EXPECT_TRUE(v.file_normals);
+  EXPECT_EQ(v.sh_degree, 1);
+  EXPECT_EQ(v.dilation_tenths, 1u);
+  EXPECT_TRUE(v.compensate_opacity);
+  EXPECT_TRUE(v.sh_half && v.covariance_half && v.opacity_extent && v.square_tiles);
+  EXPECT_EQ(v.alpha_inv, 64.0f);
+  scene.file_normals = false;
+  EXPECT_FALSE(projection_variant(settings, scene).file_normals);
+}
+
+// Every accuracy mode with every sort plan and compositor: a plan clears first (or resets the longest
+// list), ends in exactly one composite, sorts by depth exactly when it should, and times each pass
+// once.
+TEST(FramePlan, EveryModeStrategyAndCompositorGivesAWellFormedPlan) {
+  const std::vector<std::string> modes = {"reference",
+                                          "depth24",
+                                          "depth16",
+                                          "opacity-extent",
+                                          "square-tiles",
+                                          "sh0",
+                                          "sh1",
+                                          "sh2",
+                                          "fp16-sh",
+                                          "fp16-cov",
+                                          "t-cutoff=0.001",
+                                          "alpha-cutoff=1/64",
+                                          "resort4",
+                                          "resort16",
+                                          "depth16+sh1+fp16-cov+opacity-extent"};
+  int plans = 0;
+  for (const std::string& mode : modes)
+    for (const SortTraits& sort : {kRadix, kPairs, kHostSort})
+      for (Compositor compositor : {Compositor::kSorted, Compositor::kStochastic}) {
+        RenderSettings settings;
+        settings.accuracy = parse_accuracy_modes(mode);
+        settings.compositor = compositor;
+        const std::string what = mode + " / " + sort.name + " / " + to_string(compositor);
+        const bool stochastic = compositor == Compositor::kStochastic;
+        if (stochastic && (settings.accuracy.resort_window > 0 || settings.accuracy.depth_key_bits != 32)) {
+          EXPECT_THROW(plan_frame(camera(), settings, context(sort)), std::invalid_argument) << what;
+          continue;
+        }
+        const FramePlan plan = plan_frame(camera(), settings, context(sort));
+        ++plans;
+        EXPECT_EQ(plan.passes.front(), P::kClearCounters) << what;
+        const auto composites = std::count_if(plan.passes.begin(), plan.passes.end(), [](P p) {
+          return p == P::kComposite || p == P::kResortComposite || p == P::kStochasticComposite;
+        });
+        EXPECT_EQ(composites, 1) << what;
+        const bool depth_sort =
+            std::find(plan.passes.begin(), plan.passes.end(), P::kDepthSort) != plan.passes.end();
+        EXPECT_EQ(depth_sort, !stochastic && sort.plan == FrameSortPlan::kDepthThenTile) << what;
+        const bool quantize =
+            std::find(plan.passes.begin(), plan.passes.end(), P::kDepthQuantize) != plan.passes.end();
+        EXPECT_EQ(quantize, settings.accuracy.depth_key_bits == 16) << what;
+        std::vector<std::string> names = plan.timed_passes();
+        std::sort(names.begin(), names.end());
+        EXPECT_EQ(std::adjacent_find(names.begin(), names.end()), names.end()) << what;
+        EXPECT_EQ(plan.splits_submissions, sort.sorts_on_host) << what;
+        EXPECT_EQ(plan.projection.sh_degree, std::min(3, settings.accuracy.sh_degree_cap)) << what;
+      }
+  EXPECT_EQ(plans, 15 * 3 + 10 * 3);  // five of the modes change the depth order
+}
+
+}  // namespace
+}  // namespace tilesplat
