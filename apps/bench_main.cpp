@@ -1013,6 +1013,12 @@ std::string make_sort_svg(const std::vector<SortRow>& rows, const tilesplat::Dev
   return plot::line_chart_svg(chart);
 }
 
+// With "auto" among the sorts: which strategy it stands for on this device (its rows are labelled auto).
+void print_auto_choice(const tilesplat::Renderer& renderer, const std::vector<std::string>& sorts) {
+  if (std::find(sorts.begin(), sorts.end(), "auto") != sorts.end())
+    std::printf("auto    sorts with %s on this device\n", renderer.sort_strategy_for("auto").c_str());
+}
+
 int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
   if (!options.common.scenes.empty())
     throw cli::UsageError("--sort-bench sorts random keys and takes no SCENE");
@@ -1027,6 +1033,7 @@ int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
   const tilesplat::DeviceInfo device = renderer->device_info();
   std::printf("device  %s (driver %s), subgroup size %u\n", device.name.c_str(), device.driver.c_str(),
               device.subgroup_size);
+  print_auto_choice(*renderer, sorts);
   std::printf("sorts   %d warm-up + %d measured per row; GPU rows time the sort alone (timestamps), CPU rows\n"
               "        are one thread of this machine's CPU; every GPU result is checked against the CPU radix sort\n",
               options.warmup, options.repeat);
@@ -1487,6 +1494,7 @@ int run(int argc, char** argv) {
   const int frames_per_row = options.warmup + options.repeat;
   const int rows = static_cast<int>(cases.size() * sorts.size());
   const int total_frames = frames_per_row * rows;
+  print_auto_choice(*renderer, sorts);
   std::printf("frames  %d warm-up + %d measured per camera and sort; %zu cameras x %zu sorts, %d frames\n",
               options.warmup, options.repeat, cases.size(), sorts.size(), total_frames);
   std::fflush(stdout);

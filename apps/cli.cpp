@@ -534,23 +534,27 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                    "load the sort strategies of a plugin (tilesplat/sort_strategy.h) before --sort is read; "
                    "repeatable",
                    [](const std::string&) {});  // loaded by load_sort_plugins before parsing
-  const auto available = available_sorts();
-  const std::string default_sort = available.empty() ? "radix" : available.front();
+  const auto strategies = available_sorts();
+  // "auto" picks one of them per device (RenderSettings::sort); 'all' measures each of them.
+  std::vector<std::string> available = {"auto"};
+  available.insert(available.end(), strategies.begin(), strategies.end());
   if (sort_choice == SortChoice::kOne) {
     parser.add_value("--sort", "NAME",
-                     "key sort strategy: " + join(available, ", ") + " (default " + default_sort + ")",
+                     "key sort strategy: " + join(available, ", ") +
+                         " (default auto: the fastest for the device, cpu-radix on a CPU driver, onesweep on "
+                         "NVIDIA, radix on other GPUs; the same image whichever)",
                      [&options, available](const std::string& text) {
                        options.sorts = {sort_name_checked("--sort", text, available)};
                      });
   } else {
     parser.add_value("--sort", "NAME[,NAME...]",
-                     "key sort strategies to measure, comma-separated, or 'all': " + join(available, ", ") +
-                         " (default all)",
-                     [&options, available](const std::string& text) {
+                     "key sort strategies to measure, comma-separated, or 'all' (every one but auto): " +
+                         join(available, ", ") + " (default all)",
+                     [&options, available, strategies](const std::string& text) {
                        options.sorts.clear();
                        for (const auto& part : split(text, ',')) {
                          if (trim(part) == "all") {
-                           for (const auto& name : available)
+                           for (const auto& name : strategies)
                              if (std::find(options.sorts.begin(), options.sorts.end(), name) ==
                                  options.sorts.end())
                                options.sorts.push_back(name);

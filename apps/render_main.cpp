@@ -118,6 +118,7 @@ void print_frame_stats(const tilesplat::FrameStats& stats, const tilesplat::Devi
   print_row("gaussians", std::to_string(stats.gaussians), "");
   print_row("visible", std::to_string(stats.visible), "");
   print_row("intersections", std::to_string(stats.intersections), "");
+  print_row("sort", stats.sort_strategy, "");
   print_row("sort bits", std::to_string(stats.sort_bits), "");
   print_row("retries", std::to_string(stats.retries), "");
   print_row("device memory", cli::format_fixed(double(stats.device_bytes) / (1024.0 * 1024.0), 2), "MiB");
@@ -456,6 +457,11 @@ class FrameRenderer {
     return image;
   }
 
+  // The strategy the frames sort with ("auto" resolved on the device), for the EXR's provenance.
+  std::string sort_strategy(const tilesplat::RenderSettings& settings) const {
+    return renderer_ ? renderer_->sort_strategy_for(settings.sort) : "none (float64 CPU reference)";
+  }
+
   double gpu_ms() const { return gpu_ms_; }
   double cpu_ms() const { return cpu_ms_; }
   tilesplat::Renderer* gpu() const { return renderer_.get(); }
@@ -478,10 +484,11 @@ std::optional<std::string> environment(const char* name) {
 }
 
 // Renders the shard's frames that are not done yet. Frame i + 1 renders while frame i is encoded
-// and written on another thread; its manifest line is appended once its files are complete.
+// and written on another thread; its manifest line is appended once its files are complete. `writer` is
+// a copy: the EXRs name the sort strategy the device chose.
 int render_sequence(const RenderOptions& options, const std::vector<Frame>& frames, const cli::Shard& shard,
                     const cli::LoadedScene& loaded, const tilesplat::RenderSettings& settings,
-                    const FrameWriter& writer, const std::string& settings_line) {
+                    FrameWriter writer, const std::string& settings_line) {
   fs::path folder = frames.front().exr.parent_path();
   if (folder.empty()) folder = ".";
   const int frame_count = static_cast<int>(frames.size());
@@ -512,6 +519,7 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
   if (!to_render.empty()) {
     // The device first: a run that cannot create it leaves no (empty) manifest behind.
     FrameRenderer renderer(options, loaded.scene);
+    writer.exr.attributes["sortStrategy"] = renderer.sort_strategy(settings);
     cli::ManifestAppender manifest(folder / cli::manifest_file_name(shard));
     cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()), progress_style(options.quiet));
     std::future<void> writing;
@@ -673,6 +681,7 @@ int run(int argc, char** argv) {
 
   const Frame& frame = frames.front();
   FrameRenderer renderer(options, loaded.scene);
+  writer.exr.attributes["sortStrategy"] = renderer.sort_strategy(settings);
   const tilesplat::RenderImage image = renderer.render(frame.camera, settings);
   std::string timing;
   if (const tilesplat::Renderer* gpu = renderer.gpu()) {

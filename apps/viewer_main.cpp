@@ -99,7 +99,7 @@ class Viewer {
         scene_name_(loaded.path.filename().string()),
         views_(std::move(views)),
         view_(options.common.view),
-        sorts_(tilesplat::sort_strategies()) {
+        sorts_(sort_cycle()) {
     cli::apply_scene_settings(loaded, base_settings_);
     if (options.common.antialiasing) base_settings_.antialiasing = *options.common.antialiasing;
     for (const char* mode : kModeCycle) modes_.push_back(tilesplat::parse_accuracy_modes(mode));
@@ -180,6 +180,13 @@ class Viewer {
 
  private:
   static Viewer& self(GLFWwindow* window) { return *static_cast<Viewer*>(glfwGetWindowUserPointer(window)); }
+
+  // What key S steps through: "auto" (the default), then every strategy.
+  static std::vector<std::string> sort_cycle() {
+    std::vector<std::string> sorts = {"auto"};
+    for (const std::string& name : tilesplat::sort_strategies()) sorts.push_back(name);
+    return sorts;
+  }
 
   // The index of `value` in `list`, appended when it is not there (a --mode outside the cycle).
   template <typename T>
@@ -302,7 +309,9 @@ class Viewer {
       const tilesplat::CameraView& view = views_[size_t(view_)];
       title += " | view " + std::to_string(view_) + (view.name.empty() ? "" : " (" + view.name + ")");
     }
-    title += " | " + tilesplat::to_string(modes_[mode_]) + " | " + sorts_[sort_] + " | GPU " +
+    const std::string& ran = renderer_.last_frame_stats().sort_strategy;
+    const std::string sort = sorts_[sort_] == "auto" && !ran.empty() ? "auto (" + ran + ")" : sorts_[sort_];
+    title += " | " + tilesplat::to_string(modes_[mode_]) + " | " + sort + " | GPU " +
              cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
              cli::format_fixed(frame_ms, 1) + " ms (" +
              cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps)";

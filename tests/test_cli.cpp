@@ -487,11 +487,16 @@ TEST(CliRender, ExrRecordsTheCameraOfTheView) {
   EXPECT_EQ(attributes.at("viewName"), views.at(2).name);
   EXPECT_EQ(attributes.at("sceneSha256"), cli::sha256_file_hex(bundled_playbot()));
   EXPECT_EQ(attributes.at("sceneSha256").size(), 64u);
+  // The settings as asked for (the default sort is "auto"), and the strategy it chose on this device.
   EXPECT_EQ(attributes.at("renderSettings"),
-            "sort=radix accuracy=reference antialiasing=classic compositor=sorted lights=0 background=0,0,0");
+            "sort=auto accuracy=reference antialiasing=classic compositor=sorted lights=0 background=0,0,0");
   // Rendering the camera read back gives the file's image again (to float rounding: the file holds
   // scene-linear values, which read_exr encodes back).
   const auto renderer = tilesplat::Renderer::create();
+  EXPECT_EQ(attributes.at("sortStrategy"), renderer->sort_strategy_for("auto"));
+  if (renderer->device_info().cpu) {
+    EXPECT_EQ(attributes.at("sortStrategy"), "cpu-radix");
+  }
   renderer->set_scene(tilesplat::load_scene(bundled_playbot()));
   EXPECT_LE(tilesplat::compare_images(renderer->render(*camera), tilesplat::read_exr(exr)).max_abs, 1e-6);
 }

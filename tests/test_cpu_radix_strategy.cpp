@@ -226,17 +226,31 @@ TEST(CpuRadixStrategy, RegisteredAndExactnessAgrees) {
   EXPECT_THROW(sort_strategy_is_exact("no-such-sort"), std::invalid_argument);
 }
 
-// A frame through the public API: the host sorts split it into several submissions, their pass
-// times include the host sort, cpu-radix's image is radix's to the bit and cpu-radix16's is close
-// to it (40 dB PSNR; the 16-bit depths swap Gaussians only within 1/65535 of the depth range).
+// A frame through the public API: "auto" picks per device type; the host sorts split a frame into
+// several submissions, their pass times include the host sort, cpu-radix's image is radix's to the
+// bit and cpu-radix16's is close to it (40 dB PSNR; the 16-bit depths swap Gaussians only within
+// 1/65535 of the depth range).
 TEST(CpuRadixStrategy, FramesMatchRadix) {
   constexpr double kMinPsnrDb = 40;
   Renderer& renderer = testing::validated_renderer();
   renderer.set_scene(load_ply(testing::bundled_playbot()));
   const Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(1).camera, 480, 270);
+  // The default sort, "auto", is cpu-radix on a CPU driver, onesweep on NVIDIA and radix on other GPUs,
+  // with radix's image.
   RenderSettings settings;
+  const RenderImage automatic = renderer.render(camera, settings);
+  const bool cpu = renderer.device_info().cpu;
+  EXPECT_EQ(renderer.last_frame_stats().sort_strategy, cpu ? "cpu-radix"
+                                                       : renderer.device_info().vendor_id == 0x10DE
+                                                           ? "onesweep"
+                                                           : "radix");
+  EXPECT_EQ(renderer.last_frame_stats().submissions > 1, cpu);
+  settings.sort = "radix";
   const RenderImage exact = renderer.render(camera, settings);
   ASSERT_EQ(renderer.last_frame_stats().submissions, 1);
+  EXPECT_EQ(renderer.last_frame_stats().sort_strategy, "radix");
+  EXPECT_EQ(automatic.rgba, exact.rgba);
+  EXPECT_EQ(automatic.depth, exact.depth);
   const uint64_t intersections = renderer.last_frame_stats().intersections;
   ASSERT_GT(intersections, 10000u);
   for (const char* strategy : {"cpu-radix", "cpu-radix16"}) {

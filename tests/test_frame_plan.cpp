@@ -26,8 +26,9 @@ Camera camera(int width = 1920, int height = 1080) {
   return c;
 }
 
-const DeviceCaps kGpu{false, 2147483647u, uint64_t(4) << 30};
-const DeviceCaps kCpuDriver{true, 65535, uint64_t(2) << 30};
+const DeviceCaps kGpu{false, 0x1002, 2147483647u, uint64_t(4) << 30};  // an AMD GPU
+const DeviceCaps kNvidia{false, 0x10DE, 2147483647u, uint64_t(4) << 30};
+const DeviceCaps kCpuDriver{true, 0x10005, 65535, uint64_t(2) << 30};  // lavapipe's vendor (Mesa)
 const SortTraits kRadix{"radix", FrameSortPlan::kDepthThenTile, false};
 const SortTraits kPairs{"tile-local", FrameSortPlan::kTileDepthPairs, false};
 const SortTraits kHostSort{"cpu-radix", FrameSortPlan::kDepthThenTile, true};
@@ -179,11 +180,13 @@ TEST(FramePlan, ListsAreReusedOnlyWhenEverythingTheyDependOnIsEqual) {
   EXPECT_TRUE(plan_frame(cam, {}, new_scene).build_lists);
 }
 
-TEST(FramePlan, AutoSortIsCpuRadixOnCpuDriversAndRadixElsewhere) {
+TEST(FramePlan, AutoSortIsCpuRadixOnCpuDriversOnesweepOnNvidiaAndRadixElsewhere) {
   EXPECT_EQ(choose_sort_strategy("auto", kCpuDriver, false), "cpu-radix");
+  EXPECT_EQ(choose_sort_strategy("auto", kNvidia, false), "onesweep");
   EXPECT_EQ(choose_sort_strategy("auto", kGpu, false), "radix");
-  // A host's command buffer cannot hold a host sort: the best device strategy.
+  // A frame the renderer does not wait for cannot stop for a host sort: the best device strategy.
   EXPECT_EQ(choose_sort_strategy("auto", kCpuDriver, true), "radix");
+  EXPECT_EQ(choose_sort_strategy("auto", kNvidia, true), "onesweep");
   EXPECT_EQ(choose_sort_strategy("auto", kGpu, true), "radix");
   for (const char* named : {"radix", "onesweep", "bitonic", "tile-local", "cpu-radix", "cpu-radix16"}) {
     EXPECT_EQ(choose_sort_strategy(named, kCpuDriver, false), named);

@@ -82,7 +82,7 @@ TEST(SortPlugin, SortBenchHoldsThePluginToTheExactOrder) {
 TEST(SortPlugin, HelpListsThePluginsStrategies) {
   const ProcessResult with = run_process("", TILESPLAT_RENDER_EXE, {"--sort-plugin", kPlugin, "--help"});
   ASSERT_EQ(with.exit_code, 0) << with.err;
-  EXPECT_TRUE(contains(with.out, std::string(", ") + kName + " (default radix)")) << with.out;
+  EXPECT_TRUE(contains(with.out, std::string(", ") + kName + " (default auto")) << with.out;
   const ProcessResult without = run_process("", TILESPLAT_RENDER_EXE, {"--help"});
   EXPECT_FALSE(contains(without.out, kName)) << without.out;
 }

@@ -35,7 +35,7 @@ SortStrategy& Renderer::Impl::sort(const std::string& name) {
 
 DeviceCaps Renderer::Impl::device_caps() const {
   const vk::DeviceLimits& limits = ctx.limits();
-  return {ctx.is_cpu_device(), limits.max_workgroup_count_x, limits.max_allocation_size};
+  return {ctx.is_cpu_device(), ctx.vendor_id(), limits.max_workgroup_count_x, limits.max_allocation_size};
 }
 
 uint64_t Renderer::Impl::device_bytes() const {
@@ -45,12 +45,12 @@ uint64_t Renderer::Impl::device_bytes() const {
 }
 
 Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, const RenderSettings& settings,
-                                                       bool depth_image, bool into_host_commands) {
+                                                       bool depth_image, bool without_waiting) {
   FrameStart start;
   start.time = std::chrono::steady_clock::now();
   wait_for_submitted_frame();
   const DeviceCaps device = device_caps();
-  start.sorter = &sort(choose_sort_strategy(settings.sort, device, into_host_commands));
+  start.sorter = &sort(choose_sort_strategy(settings.sort, device, without_waiting));
   const SortTraits traits{start.sorter->name(), start.sorter->frame_plan(), start.sorter->sorts_on_host()};
   start.plan = plan_frame(camera, settings,
                           {resources.scene_shape(scene_generation), device, traits, lists, depth_image});
@@ -139,6 +139,7 @@ void Renderer::Impl::end_frame(const FrameStart& start, const FrameCounters& fra
   stats.passes = std::move(passes);
   stats.reused_sorted_lists = !start.plan.build_lists;
   stats.sort_bits = start.plan.build_lists ? start.plan.sort_bits : 0;
+  stats.sort_strategy = start.plan.sort.name;
   stats.gaussians = resources.scene.count;
   stats.visible = frame.visible;
   stats.intersections = frame.tile_sort.count;
@@ -202,7 +203,7 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
                                   std::to_string(key_bits) + " key bits");
 
   Impl& r = *impl_;
-  SortStrategy& sorter = r.sort(strategy);
+  SortStrategy& sorter = r.sort(sort_strategy_for(strategy));
   const uint32_t n = uint32_t(keys.size());
   const uint32_t capacity = std::max<uint32_t>(n, 1);
   KeyBuffers kb = KeyBuffers::allocate(r.ctx, capacity, key_bits, "sort_keys");
@@ -239,14 +240,21 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
 
 DeviceInfo Renderer::device_info() const {
   const auto& l = impl_->ctx.limits();
-  return {impl_->ctx.device_name(), impl_->ctx.driver_name(), l.subgroup_size, l.max_storage_buffer_range,
-          l.max_shared_memory,      l.timestamp_period_ns,    l.max_image_dimension_2d};
+  return {impl_->ctx.device_name(),   impl_->ctx.driver_name(),   l.subgroup_size,
+          l.max_storage_buffer_range, l.max_shared_memory,        l.timestamp_period_ns,
+          l.max_image_dimension_2d,   impl_->ctx.is_cpu_device(), impl_->ctx.vendor_id()};
 }
 
 uint64_t Renderer::validation_messages() const { return impl_->ctx.validation_messages(); }
 
 std::vector<std::string> sort_strategies() { return available_sort_strategies(); }
-bool sort_strategy_is_exact(const std::string& name) { return sort_strategy_exact(name); }
+bool sort_strategy_is_exact(const std::string& name) {
+  return name == "auto" || sort_strategy_exact(name);
+}
+
+std::string Renderer::sort_strategy_for(const std::string& requested) const {
+  return choose_sort_strategy(requested, impl_->device_caps(), /*without_waiting=*/false);
+}
 std::vector<std::string> list_devices() { return vk::Context::list_devices(); }
 std::vector<std::string> list_device_uuids() {
   return vk::Context::list_device_uuids();

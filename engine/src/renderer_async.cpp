@@ -34,7 +34,7 @@ Renderer::Impl::~Impl() {
 void Renderer::Impl::submit_frame(const Camera& camera, const RenderSettings& settings,
                                   const ExternalImage& target, const ExternalDepthImage* depth_image,
                                   const vk::SubmitSync& sync) {
-  const FrameStart start = begin_frame(camera, settings, depth_image != nullptr);
+  const FrameStart start = begin_frame(camera, settings, depth_image != nullptr, /*without_waiting=*/true);
   vk::CommandStream stream(ctx);
   stream.wait_first(sync);
   record_frame_to_images(stream, start, settings, target, depth_image);
@@ -46,12 +46,12 @@ void Renderer::Impl::record_frame_into(const HostCommandBuffer& host, const Came
                                        const RenderSettings& settings, const ExternalImage& target,
                                        const ExternalDepthImage* depth_image) {
   const DeviceCaps device = device_caps();
-  if (sort(choose_sort_strategy(settings.sort, device, /*into_host_commands=*/true)).sorts_on_host())
+  if (sort(choose_sort_strategy(settings.sort, device, /*without_waiting=*/true)).sorts_on_host())
     throw std::invalid_argument(
         "render_to_image: the sort strategy '" + settings.sort +
         "' sorts on the host in the middle of the frame, which a command buffer of the "
         "host's cannot hold: use a GPU strategy, or HostFrameSync");
-  const FrameStart start = begin_frame(camera, settings, depth_image != nullptr, /*into_host_commands=*/true);
+  const FrameStart start = begin_frame(camera, settings, depth_image != nullptr, /*without_waiting=*/true);
   vk::CommandStream stream(ctx, host.command_buffer);
   record_frame_to_images(stream, start, settings, target, depth_image);
   stream.end_borrowed();

@@ -48,8 +48,9 @@ struct Renderer::Impl {
   };
   // Plans the frame (validating the camera and settings), sizes the outputs and uploads what the
   // frame reads from the host. Waits for a frame in flight first: its buffers are the same.
+  // without_waiting: a frame render_to_image submits or records and returns (choose_sort_strategy).
   FrameStart begin_frame(const Camera& camera, const RenderSettings& settings, bool depth_image,
-                         bool into_host_commands = false);
+                         bool without_waiting = false);
   // Records and runs one attempt at the plan; returns the counters the GPU wrote. A composite-only
   // frame rewrites only max_tile_pairs, so the others still describe the lists it read.
   FrameCounters run_frame(const FramePlan& plan, const RenderSettings& settings, SortStrategy& sorter,

@@ -161,7 +161,12 @@ struct RenderSettings {
   std::array<float, 3> background = {
       0, 0,
       0};  ///< RGB behind the splats, in the splats' display values (docs/colour.md): C + T * background
-  std::string sort = "radix";                          ///< the key sort strategy (see sort_strategies())
+  /// The key sort strategy: a name of sort_strategies(), or "auto" (the default), the fastest exact
+  /// strategy for the renderer's device by the rule of docs/benchmarks.md ("The default sort"): cpu-radix
+  /// on a CPU driver such as lavapipe (radix for frames the renderer does not wait for: render_to_image
+  /// with HostFrameSync or HostCommandBuffer), onesweep on NVIDIA GPUs, radix on other GPUs. The images
+  /// are the same to the bit whatever it picks; FrameStats::sort_strategy says what ran.
+  std::string sort = "auto";
   bool depth = true;                                   ///< produce the expected-depth channel
   bool splat_count = true;                             ///< produce the per-pixel blended-splat count
   AccuracyModes accuracy;                              ///< approximations (default: none, the reference)

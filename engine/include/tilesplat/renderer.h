@@ -48,6 +48,8 @@ struct FrameStats {
   uint64_t visible = 0;            ///< Gaussians touching at least one tile
   uint64_t intersections = 0;      ///< (Gaussian, tile) pairs sorted
   uint32_t sort_bits = 0;  ///< key bits sorted: 32 depth bits (per Gaussian) + the tile bits (per pair)
+  /// The sort strategy that ran: RenderSettings::sort, or the one "auto" chose for this device.
+  std::string sort_strategy;
   int retries = 0;         ///< re-renders after growing the intersection buffers
   /// Command buffers the frame took: 1, more for a strategy that sorts on the host; 0 when recorded
   /// into a host's (HostCommandBuffer).
@@ -81,6 +83,11 @@ struct DeviceInfo {
   uint32_t max_shared_memory = 0;         ///< workgroup shared memory, in bytes
   double timestamp_period_ns = 0;         ///< nanoseconds per timestamp tick
   uint32_t max_image_dimension = 0;  ///< the largest width or height a frame may have (maxImageDimension2D)
+  /// A CPU implementation of Vulkan (lavapipe, SwiftShader: VK_PHYSICAL_DEVICE_TYPE_CPU), where "auto"
+  /// sorts with cpu-radix.
+  bool cpu = false;
+  uint32_t vendor_id =
+      0;  ///< VkPhysicalDeviceProperties::vendorID, the PCI vendor (0x10DE NVIDIA, 0x1002 AMD, ...)
 };
 
 struct ExternalVulkanDevice;  // tilesplat/vulkan_interop.h
@@ -89,11 +96,12 @@ struct ExternalDepthImage;
 struct HostFrameSync;
 struct HostCommandBuffer;
 
-/// Names of the available sort strategies, default first.
+/// Names of the available sort strategies: the built-in ones, then those registered at run time.
+/// RenderSettings::sort also takes "auto", which picks one of them per device.
 TILESPLAT_API std::vector<std::string> sort_strategies();
 /// Whether a strategy gives the exact order that all exact strategies share (and so bit-identical
 /// images); false for one that sorts by approximated keys (cpu-radix16: 16-bit quantized depths).
-/// Throws std::invalid_argument for an unknown name.
+/// True for "auto", which picks only exact strategies. Throws std::invalid_argument for an unknown name.
 TILESPLAT_API bool sort_strategy_is_exact(const std::string& name);
 
 /// Lists the Vulkan devices this machine has, in the order RendererOptions::device indexes them.
@@ -150,6 +158,10 @@ class TILESPLAT_API Renderer {
   /// Runs the sort described at SortRun. Throws std::invalid_argument for an unknown strategy or a
   /// key with bits above key_bits.
   SortRun sort_keys(const std::string& strategy, const std::vector<uint64_t>& keys, uint32_t key_bits);
+
+  /// The strategy a frame with RenderSettings::sort = `requested` runs on this renderer's device (when
+  /// the renderer waits for the frame): `requested` itself, or for "auto" the strategy it picks here.
+  std::string sort_strategy_for(const std::string& requested) const;
 
   /// The device this renderer runs on.
   DeviceInfo device_info() const;

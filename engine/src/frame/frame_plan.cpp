@@ -150,9 +150,10 @@ std::vector<std::string> FramePlan::timed_passes() const {
 }
 
 std::string choose_sort_strategy(const std::string& requested, const DeviceCaps& device,
-                                 bool into_host_commands) {
+                                 bool without_waiting) {
   if (requested != "auto") return requested;
-  return device.cpu_driver && !into_host_commands ? "cpu-radix" : "radix";
+  if (device.cpu_driver) return without_waiting ? "radix" : "cpu-radix";
+  return device.vendor_id == kVendorNvidia ? "onesweep" : "radix";
 }
 
 ProjectionVariant projection_variant(const RenderSettings& settings, const SceneShape& scene) {

@@ -41,6 +41,7 @@ const char* timed_name(FramePass pass);
 // What the device offers that shapes a frame (vk::Context's limits), without the device.
 struct DeviceCaps {
   bool cpu_driver = false;  // lavapipe and the like: different loop limits and pass variants
+  uint32_t vendor_id = 0;   // VkPhysicalDeviceProperties::vendorID: which GPU strategy "auto" picks
   uint32_t max_workgroup_count_x = 65535;
   uint64_t max_allocation_size = uint64_t(1) << 31;
 };
@@ -61,12 +62,19 @@ struct SortTraits {
   bool sorts_on_host = false;
 };
 
-// RenderSettings::sort "auto": the fastest exact strategy for the device, measured by tilesplat-bench
-// (docs/benchmarks.md, "The default sort"): on a CPU driver cpu-radix, whose host sort skips the
-// per-digit passes that cost most there, unless the frame goes into a host's command buffer (which
-// cannot sort on the host); radix everywhere else. Any other name is returned as it is.
+// RenderSettings::sort "auto": the fastest exact strategy for the device, by the rule tilesplat-bench
+// measured (docs/benchmarks.md, "The default sort"):
+//   - a CPU driver: cpu-radix, whose host sort replaces the per-digit passes that cost most there
+//     (383 against 478 ms a 1080p frame of the 500k playbot on lavapipe); radix for a frame that goes
+//     on without the renderer waiting for it (render_to_image with HostFrameSync or HostCommandBuffer),
+//     since a host sort would stop it mid-frame and a host's command buffer cannot hold one;
+//   - NVIDIA (vendor 0x10DE): onesweep, whose single-pass digits with decoupled look-back beat radix's
+//     (1.74 against 2.53 ms on an H200);
+//   - any other GPU: radix, which needs no forward-progress guarantee between workgroups.
+// Any other name is returned as it is.
+constexpr uint32_t kVendorNvidia = 0x10DE;
 std::string choose_sort_strategy(const std::string& requested, const DeviceCaps& device,
-                                 bool into_host_commands);
+                                 bool without_waiting);
 
 // Everything a frame's tile lists depend on. When it equals the key of the lists in the buffers,
 // a frame runs the composite alone: the background, the outputs requested, the stochastic frames

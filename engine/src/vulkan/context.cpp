@@ -289,6 +289,7 @@ void Context::read_device_properties() {
   const VkPhysicalDeviceProperties& props = props2.properties;
   device_name_ = props.deviceName;
   is_cpu_ = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  vendor_id_ = props.vendorID;
   driver_name_ = std::string(driver.driverName) + " " + driver.driverInfo;
   if (props.apiVersion < VK_API_VERSION_1_2)
     throw std::runtime_error(device_name_ + ": Vulkan 1.2 is required");

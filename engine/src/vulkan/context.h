@@ -70,6 +70,7 @@ class Context {
   const std::string& driver_name() const { return driver_name_; }
   // A CPU implementation (lavapipe, SwiftShader): passes pick CPU-friendly layouts.
   bool is_cpu_device() const { return is_cpu_; }
+  uint32_t vendor_id() const { return vendor_id_; }  // VkPhysicalDeviceProperties::vendorID (PCI)
   // vkCmdPushDescriptorSetKHR when features().push_descriptor, else null.
   PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set() const { return cmd_push_descriptor_set_; }
 
@@ -135,6 +136,7 @@ class Context {
   std::string device_name_;
   std::string driver_name_;
   bool is_cpu_ = false;
+  uint32_t vendor_id_ = 0;
   PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set_ = nullptr;
   std::atomic<uint64_t> validation_messages_{0};
   std::atomic<uint64_t> uploaded_bytes_{0};
