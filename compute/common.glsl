@@ -3,6 +3,10 @@
 // sets, and no maxStorageBufferRange limit (lavapipe caps a binding at 128 MiB; scenes exceed it).
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+// Texel buffers (the CPU-driver variants) are declared as textureBuffer and read with texelFetch, no
+// sampler: a sampled image of a buffer is invalid SPIR-V from version 1.6 on, which the validation
+// layer checks against on drivers of Vulkan 1.3 and later (Mesa 25's lavapipe).
+#extension GL_EXT_samplerless_texture_functions : require
 
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer FloatArray { float v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer UintArray { uint v[]; };

@@ -39,10 +39,10 @@ layout(push_constant) uniform Push {
 // buffers, which llvmpipe reads and writes with SIMD gathers and scatters, where a load or store at a
 // per-invocation address is a loop over the SIMD lanes (vk::texel_buffers_wanted). Narrow keys are
 // R32_UINT texels, wide ones R32G32_UINT (low word first); the same buffers as the addresses.
-layout(set = 0, binding = 0) uniform samplerBuffer splat_texels;
-layout(set = 0, binding = 1) uniform usamplerBuffer rect_texels;
-layout(set = 0, binding = 2) uniform usamplerBuffer tile_count_texels;
-layout(set = 0, binding = 3) uniform usamplerBuffer offset_texels;
+layout(set = 0, binding = 0) uniform textureBuffer splat_texels;
+layout(set = 0, binding = 1) uniform utextureBuffer rect_texels;
+layout(set = 0, binding = 2) uniform utextureBuffer tile_count_texels;
+layout(set = 0, binding = 3) uniform utextureBuffer offset_texels;
 layout(set = 0, binding = 4, r32ui) uniform writeonly uimageBuffer narrow_key_texels;
 layout(set = 0, binding = 5, rg32ui) uniform writeonly uimageBuffer wide_key_texels;
 layout(set = 0, binding = 6, r32ui) uniform writeonly uimageBuffer value_texels;

@@ -107,17 +107,17 @@ layout(push_constant) uniform Push {
 // through texel buffers, which llvmpipe reads and writes with SIMD gathers and scatters, where a load or
 // store at a per-invocation address is a loop over the SIMD lanes per component (vk::
 // texel_buffers_wanted). The same buffers as the push constants' addresses; nothing else differs.
-layout(set = 0, binding = 0) uniform samplerBuffer position_texels;   // R32_SFLOAT
-layout(set = 0, binding = 1) uniform samplerBuffer log_scale_texels;  // R32_SFLOAT
-layout(set = 0, binding = 2) uniform samplerBuffer rotation_texels;   // R32G32B32A32_SFLOAT
-layout(set = 0, binding = 3) uniform samplerBuffer opacity_texels;    // R32_SFLOAT
-layout(set = 0, binding = 4) uniform usamplerBuffer sh_texels;        // R32_UINT: float bits or half pairs
+layout(set = 0, binding = 0) uniform textureBuffer position_texels;   // R32_SFLOAT
+layout(set = 0, binding = 1) uniform textureBuffer log_scale_texels;  // R32_SFLOAT
+layout(set = 0, binding = 2) uniform textureBuffer rotation_texels;   // R32G32B32A32_SFLOAT
+layout(set = 0, binding = 3) uniform textureBuffer opacity_texels;    // R32_SFLOAT
+layout(set = 0, binding = 4) uniform utextureBuffer sh_texels;        // R32_UINT: float bits or half pairs
 layout(set = 0, binding = 5, rgba32f) uniform writeonly imageBuffer splat_texels;
 layout(set = 0, binding = 6, rg32ui) uniform writeonly uimageBuffer rect_texels;
 layout(set = 0, binding = 7, r32ui) uniform writeonly uimageBuffer tile_count_texels;
 layout(set = 0, binding = 8, r32ui) uniform writeonly uimageBuffer depth_key_texels;
 layout(set = 0, binding = 9, r32ui) uniform writeonly uimageBuffer depth_value_texels;
-layout(set = 0, binding = 10) uniform usamplerBuffer camera_texels;  // R32G32_UINT: CameraParams' uvec2s
+layout(set = 0, binding = 10) uniform utextureBuffer camera_texels;  // R32G32_UINT: CameraParams' uvec2s
 uvec2 camera_word(uint k) { return texelFetch(camera_texels, int(k)).xy; }
 vec3 position_of(uint i) {
   return vec3(texelFetch(position_texels, int(3 * i)).x, texelFetch(position_texels, int(3 * i + 1)).x,

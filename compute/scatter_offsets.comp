@@ -17,8 +17,8 @@ layout(push_constant) uniform Push {
 #ifdef TS_TEXEL_BUFFERS
 // The CPU-driver variant (scatter_offsets_texel): the same buffers through texel buffers, which llvmpipe
 // reads with SIMD gathers (vk::texel_buffers_wanted).
-layout(set = 0, binding = 0) uniform usamplerBuffer depth_order_texels;
-layout(set = 0, binding = 1) uniform usamplerBuffer depth_offset_texels;
+layout(set = 0, binding = 0) uniform utextureBuffer depth_order_texels;
+layout(set = 0, binding = 1) uniform utextureBuffer depth_offset_texels;
 layout(set = 0, binding = 2, r32ui) uniform writeonly uimageBuffer offset_texels;
 uint gaussian_at(uint position) { return texelFetch(depth_order_texels, int(position)).x; }
 uint offset_at(uint position) { return texelFetch(depth_offset_texels, int(position)).x; }

@@ -3,8 +3,8 @@
 // a load or store at a per-invocation address is a loop over the SIMD lanes (vk::texel_buffers_wanted).
 // Narrow keys are R32_UINT texels, wide ones R32G32_UINT (low word first, as in memory); the same
 // buffers as the push constants' addresses. The including shader declares WIDE_KEYS.
-layout(set = 0, binding = 0) uniform usamplerBuffer keys_in_texels;
-layout(set = 0, binding = 1) uniform usamplerBuffer values_in_texels;
+layout(set = 0, binding = 0) uniform utextureBuffer keys_in_texels;
+layout(set = 0, binding = 1) uniform utextureBuffer values_in_texels;
 layout(set = 0, binding = 2, r32ui) uniform writeonly uimageBuffer narrow_keys_out_texels;
 layout(set = 0, binding = 3, rg32ui) uniform writeonly uimageBuffer wide_keys_out_texels;
 layout(set = 0, binding = 4, r32ui) uniform writeonly uimageBuffer values_out_texels;

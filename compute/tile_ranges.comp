@@ -20,8 +20,8 @@ layout(push_constant) uniform Push {
 // The CPU-driver variant (tile_ranges_texel): the sorted keys and the frame's counters through texel
 // buffers, which llvmpipe reads with SIMD gathers (vk::texel_buffers_wanted). Narrow keys are R32_UINT
 // texels, wide ones R32G32_UINT (low word first: the tile is the second word).
-layout(set = 0, binding = 0) uniform usamplerBuffer key_texels;
-layout(set = 0, binding = 1) uniform usamplerBuffer counter_texels;  // R32_UINT
+layout(set = 0, binding = 0) uniform utextureBuffer key_texels;
+layout(set = 0, binding = 1) uniform utextureBuffer counter_texels;  // R32_UINT
 uint tile_of(uint i) {
   uvec2 words = texelFetch(key_texels, int(i)).xy;
   return WIDE_KEYS ? words.y : words.x;
