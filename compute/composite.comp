@@ -28,6 +28,7 @@
 // which the host turns into its own depth convention. Both off, the pipeline is the one without them.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
+#define TS_COMPOSITE_PUSH
 #include "common.glsl"
 #include "tile_coverage.glsl"
 #include "composite_reach.glsl"
@@ -49,34 +50,15 @@ layout(constant_id = 9) const bool HOST_DEPTH_SORTED = false;
 // compile away: CPU drivers run both sides of a branch, so even skipped they cost loops over the lanes.
 layout(constant_id = 10) const bool CHUNKED = true;
 
-layout(push_constant) uniform Push {
-  Vec4Array splats;
-  UintArray sorted_indices;
-  Uvec2Array ranges;
-  Vec4Array out_rgba;
-  FloatArray out_depth;
-  UintArray out_count;
-  Vec4Array state;     // 2 vec4 per pixel between chunks: (colour, T), (depth sum, weight sum, blended, surface z)
-  UintArray counters;  // COUNTER_MAX_TILE_PAIRS
-  FloatArray host_z;     // HOST_DEPTH: per pixel, the host's surface as view depth (+inf: none)
-  FloatArray surface_z;  // SURFACE_DEPTH: per pixel, the depth at which alpha reached surface_alpha
-  vec4 background;
-  uint width;
-  uint height;
-  uint tiles_x;
-  uint chunk_start;  // position in each tile's list where this dispatch starts
-  uint chunk_size;   // splats per tile this dispatch blends at most
-  uint last_chunk;   // 1: write the outputs whatever is left
-  float surface_alpha;
-} pc;
+// The push constants: CompositePush in shader_io.h.
 
 #ifdef TS_TEXEL_BUFFERS
 // The CPU-driver variant (composite_texel): the splat records, the sorted list and the outputs go
 // through texel buffers, which llvmpipe reads and writes with SIMD gathers and scatters, where a load
 // or store at a per-invocation address is a loop over the SIMD lanes per component (vk::
 // texel_buffers_wanted). The same buffers as the push constants' addresses; nothing else differs.
-layout(set = 0, binding = 0) uniform samplerBuffer splat_texels;
-layout(set = 0, binding = 1) uniform usamplerBuffer sorted_index_texels;
+layout(set = 0, binding = 0) uniform textureBuffer splat_texels;
+layout(set = 0, binding = 1) uniform utextureBuffer sorted_index_texels;
 layout(set = 0, binding = 2, rgba32f) uniform writeonly imageBuffer rgba_texels;
 layout(set = 0, binding = 3, r32f) uniform writeonly imageBuffer depth_texels;
 layout(set = 0, binding = 4, r32ui) uniform writeonly uimageBuffer count_texels;

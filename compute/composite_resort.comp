@@ -11,6 +11,7 @@
 // composite.comp), the tile's splats staged through shared memory in batches.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
+#define TS_COMPOSITE_RESORT_PUSH
 #include "common.glsl"
 
 layout(local_size_x = 16, local_size_y_id = 3) in;  // local_size_y = 16 / PIXELS_PER_INVOCATION
@@ -21,22 +22,7 @@ layout(constant_id = 4) const float ALPHA_MIN = 1.0 / 255.0;
 layout(constant_id = 6) const float T_MIN = 1e-4;
 layout(constant_id = 7) const uint WINDOW = 8;  // 2 to 16
 
-layout(push_constant) uniform Push {
-  Vec4Array splats;
-  Vec4Array ray_depth;  // RAY_DEPTH_VEC4S per Gaussian (write_ray_depth in projection.comp)
-  UintArray sorted_indices;
-  Uvec2Array ranges;
-  Vec4Array out_rgba;
-  FloatArray out_depth;
-  UintArray out_count;
-  uint width;
-  uint height;
-  vec4 background;
-  vec4 intrinsics;  // fx, fy, cx, cy
-  uint tiles_x;
-  uint max_splats;     // the longest list a tile may have (llvmpipe's loop limit; see composite.comp)
-  UintArray counters;  // COUNTER_MAX_TILE_PAIRS: a longer list, which the host reports as an error
-} pc;
+// The push constants: CompositeResortPush in shader_io.h.
 
 const uint P = PIXELS_PER_INVOCATION;
 const uint BATCH = 128;

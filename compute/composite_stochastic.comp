@@ -22,6 +22,7 @@
 // lists split into chunks of `chunk_size` splats, one dispatch each, for llvmpipe's loop limit; the
 // nearest kept splat so far is carried through `state` between chunks.
 #extension GL_GOOGLE_include_directive : require
+#define TS_STOCHASTIC_COMPOSITE_PUSH
 #include "common.glsl"
 #include "tile_coverage.glsl"
 #include "composite_reach.glsl"
@@ -33,35 +34,13 @@ layout(constant_id = 2) const uint PIXELS_PER_INVOCATION = 1;  // 1, 2, 4, 8 or 
 layout(constant_id = 4) const float ALPHA_MIN = 1.0 / 255.0;   // the alpha cut-off (AccuracyModes)
 layout(constant_id = 5) const float ALPHA_INV = 255.0;         // 1 / ALPHA_MIN, as the tile coverage uses it
 
-layout(push_constant) uniform Push {
-  Vec4Array splats;
-  UintArray indices;  // each tile's Gaussians, binned by tile, in no depth order
-  Uvec2Array ranges;
-  Vec4Array out_rgba;
-  FloatArray out_depth;
-  UintArray out_count;
-  // 32 bytes per pixel: vec4 (sum of the winners' rgb, samples with a winner), float (sum of the
-  // winners' depths), float unused, uint64 (the nearest kept splat's order key, carried between
-  // chunks). Unused (0) with one sample in one chunk.
-  Vec4Array state;
-  UintArray counters;  // COUNTER_MAX_TILE_PAIRS
-  vec4 background;
-  uint width;
-  uint height;
-  uint tiles_x;
-  uint chunk_start;  // position in each tile's list where this dispatch starts
-  uint chunk_size;   // splats per tile this dispatch tests at most
-  uint last_chunk;   // 1: finish the sample whatever is left
-  uint sample_index; // this dispatch's sample, 0 .. samples - 1
-  uint samples;      // samples averaged: the last one writes the outputs
-  uint seed;
-} pc;
+// The push constants: StochasticCompositePush in shader_io.h.
 
 #ifdef TS_TEXEL_BUFFERS
 // The CPU-driver variant (composite_stochastic_texel): the splat records, the binned list and the
 // outputs through texel buffers, as composite.comp's (vk::texel_buffers_wanted).
-layout(set = 0, binding = 0) uniform samplerBuffer splat_texels;
-layout(set = 0, binding = 1) uniform usamplerBuffer index_texels;
+layout(set = 0, binding = 0) uniform textureBuffer splat_texels;
+layout(set = 0, binding = 1) uniform utextureBuffer index_texels;
 layout(set = 0, binding = 2, rgba32f) uniform writeonly imageBuffer rgba_texels;
 layout(set = 0, binding = 3, r32f) uniform writeonly imageBuffer depth_texels;
 layout(set = 0, binding = 4, r32ui) uniform writeonly uimageBuffer count_texels;

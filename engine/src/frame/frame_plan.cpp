@@ -7,9 +7,12 @@
 #include "host_depth.h"
 #include "passes/stochastic_composite_pass.h"
 #include "passes/tile_coverage.h"
+#include "shader_io.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
+
+static_assert(kTileSize == int(shader_io::TILE_SIZE), "the public tile size is the shaders'");
 
 namespace {
 

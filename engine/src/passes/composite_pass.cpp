@@ -8,18 +8,13 @@
 #include <string>
 
 #include "passes/tile_coverage.h"
+#include "shader_io.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
 
 namespace {
-struct CompositePush {
-  VkDeviceAddress splats, sorted_indices, ranges, out_rgba, out_depth, out_count, state, counters;
-  VkDeviceAddress host_z, surface_z;
-  float background[4];
-  uint32_t width, height, tiles_x, chunk_start, chunk_size, last_chunk;
-  float surface_alpha;
-};
+using shader_io::CompositePush;  // composite.comp's push constants
 static_assert(sizeof(CompositePush) <= 128, "Vulkan guarantees 128 bytes of push constants");
 
 // llvmpipe ends any shader invocation after 65535 loop iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS),

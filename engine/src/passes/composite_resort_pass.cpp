@@ -2,21 +2,15 @@
 
 #include <bit>
 
+#include "shader_io.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
 
 namespace {
-struct CompositeResortPush {
-  VkDeviceAddress splats, ray_depth, sorted_indices, ranges, out_rgba, out_depth, out_count;
-  uint32_t width, height;
-  float background[4];
-  float intrinsics[4];  // fx, fy, cx, cy
-  uint32_t tiles_x, max_splats;
-  VkDeviceAddress counters;
-};
-static_assert(offsetof(CompositeResortPush, background) == 64);
+using shader_io::CompositeResortPush;  // composite_resort.comp's push constants
+static_assert(sizeof(CompositeResortPush) <= 128, "Vulkan guarantees 128 bytes of push constants");
 }  // namespace
 
 // One pixel an invocation everywhere: its window lives in registers. On lavapipe 4 pixels an

@@ -1,9 +1,11 @@
-// Layout of the small GPU counter buffer each frame writes and the host reads after it.
-// Must match the COUNTER_* and SORT_* constants in compute/common.glsl.
+// Layout of the small GPU counter buffer each frame writes and the host reads after it, checked
+// against the COUNTER_* and SORT_* indices of compute/shader_io.h, which the shaders use.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+
+#include "shader_io.h"
 
 namespace tilesplat {
 
@@ -15,7 +17,10 @@ struct SortState {
   uint32_t args[3];  // indirect dispatch of the strategy's per-block passes
   uint32_t own[3];   // for the running strategy's own use (SORT_OWN)
 };
-static_assert(sizeof(SortState) == 32);
+static_assert(sizeof(SortState) == shader_io::SORT_STATE_UINTS * 4 &&
+              offsetof(SortState, count) == shader_io::SORT_COUNT * 4 &&
+              offsetof(SortState, blocks) == shader_io::SORT_BLOCKS * 4 &&
+              offsetof(SortState, args) == shader_io::SORT_ARGS * 4 && offsetof(SortState, own) == shader_io::SORT_OWN * 4);
 
 struct FrameCounters {
   uint32_t intersections;       // (Gaussian, tile) pairs wanted, modulo 2^32
@@ -33,10 +38,23 @@ struct FrameCounters {
 
   uint64_t wanted_intersections() const { return uint64_t(intersections_high) << 32 | intersections; }
 };
-static_assert(sizeof(FrameCounters) == 128);
-static_assert(offsetof(FrameCounters, intersections_high) == 1 * 4 && offsetof(FrameCounters, pairs_low) == 26 * 4 &&
-                  offsetof(FrameCounters, max_tile_pairs) == 27 * 4 && offsetof(FrameCounters, big_splats) == 28 * 4,
-              "must match the COUNTER_* constants in compute/common.glsl");
+// The shaders' indices (shader_io.h), field by field.
+#define TS_COUNTER_AT(field, index) static_assert(offsetof(FrameCounters, field) == shader_io::index * 4, #field)
+static_assert(sizeof(FrameCounters) == shader_io::COUNTER_UINTS * 4);
+TS_COUNTER_AT(intersections, COUNTER_INTERSECTIONS);
+TS_COUNTER_AT(intersections_high, COUNTER_PAIRS_HIGH);
+TS_COUNTER_AT(overflow, COUNTER_OVERFLOW);
+TS_COUNTER_AT(visible, COUNTER_VISIBLE);
+TS_COUNTER_AT(ranges_args, COUNTER_RANGES_ARGS);
+TS_COUNTER_AT(depth_sort, COUNTER_DEPTH_SORT);
+TS_COUNTER_AT(tile_sort, COUNTER_TILE_SORT);
+TS_COUNTER_AT(tile_sort.count, COUNTER_SORT_COUNT);
+TS_COUNTER_AT(depth_range, COUNTER_DEPTH_MIN);
+TS_COUNTER_AT(depth_range[1], COUNTER_DEPTH_MAX);
+TS_COUNTER_AT(pairs_low, COUNTER_PAIRS_LOW);
+TS_COUNTER_AT(max_tile_pairs, COUNTER_MAX_TILE_PAIRS);
+TS_COUNTER_AT(big_splats, COUNTER_BIG_SPLATS);
+#undef TS_COUNTER_AT
 
 constexpr uint32_t kRangesArgsOffset = offsetof(FrameCounters, ranges_args);
 constexpr uint32_t kDepthSortOffset = offsetof(FrameCounters, depth_sort);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "passes/key_buffers.h"
+#include "shader_io.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
 
@@ -48,8 +49,8 @@ struct ProjectionVariant {
   auto operator<=>(const ProjectionVariant&) const = default;
 };
 
-// Bytes of one projected splat record (SPLAT_VEC4S vec4 in compute/common.glsl).
-constexpr uint32_t kSplatRecordBytes = 4 * 16;
+// Bytes of one projected splat record (SPLAT_VEC4S vec4, compute/shader_io.h).
+constexpr uint32_t kSplatRecordBytes = shader_io::SPLAT_VEC4S * 16;
 
 // Per-Gaussian outputs of the projection, inputs of the later passes.
 struct ProjectedBuffers {
@@ -63,8 +64,8 @@ struct ProjectedBuffers {
   vk::Buffer big_splats;   // uint per Gaussian: the splats whose keys key_emission_big.comp writes
 };
 
-// Bytes of one Gaussian's per-pixel re-sorting data (RAY_DEPTH_VEC4S in compute/common.glsl).
-constexpr uint32_t kRayDepthBytes = 3 * 16;
+// Bytes of one Gaussian's per-pixel re-sorting data (RAY_DEPTH_VEC4S, compute/shader_io.h).
+constexpr uint32_t kRayDepthBytes = shader_io::RAY_DEPTH_VEC4S * 16;
 
 class ProjectionPass {
  public:

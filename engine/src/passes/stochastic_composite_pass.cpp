@@ -4,18 +4,15 @@
 #include <stdexcept>
 
 #include "passes/tile_coverage.h"
+#include "shader_io.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
 
 namespace {
 // Mirrors the push constants of compute/composite_stochastic.comp.
-struct StochasticPush {
-  VkDeviceAddress splats, indices, ranges, out_rgba, out_depth, out_count, state, counters;
-  float background[4];
-  uint32_t width, height, tiles_x, chunk_start, chunk_size, last_chunk, sample_index, samples, seed, pad;
-};
-static_assert(sizeof(StochasticPush) == 120);
+using shader_io::StochasticCompositePush;  // composite_stochastic.comp's push constants
+static_assert(sizeof(StochasticCompositePush) <= 128, "Vulkan guarantees 128 bytes of push constants");
 
 }  // namespace
 
@@ -47,7 +44,7 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
                  variant,
                  vk::ComputePipeline(
                      ctx_, variant.texel_buffers ? "composite_stochastic_texel" : "composite_stochastic",
-                     sizeof(StochasticPush),
+                     sizeof(StochasticCompositePush),
                      {{0, variant.write_depth ? 1u : 0u},
                       {1, variant.write_count ? 1u : 0u},
                       {2, pixels_per_invocation_},
@@ -64,7 +61,7 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
     for (uint32_t chunk = 0; chunk < chunks.count; ++chunk) {
       // Each dispatch reads what the previous one left in the state buffer.
       if (sample > 0 || chunk > 0) vk::barrier(stream.cmd());
-      StochasticPush push{in.splats.address(),
+      StochasticCompositePush push{in.splats.address(),
                           in.tile_lists.address(),
                           in.ranges.address(),
                           out.rgba.address(),
@@ -81,8 +78,7 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
                           chunk + 1 == chunks.count ? 1u : 0u,
                           sample,
                           samples.count,
-                          samples.seed,
-                          0};
+                          samples.seed};
       it->second.bind(stream.cmd(), push);
       if (variant.texel_buffers) it->second.push_texel_views(stream.cmd(), views);
       it->second.dispatch(stream.cmd(), tiles_x, tiles_y);
