@@ -40,19 +40,23 @@ void scatter_lane_runs(uint block, uint blocks, uint n) {
 }
 #else
 // GPUs: the subgroup walks the block 8 keys a step, ranking each step's equal digits with 8 ballots;
-// its running offsets per digit are in shared memory.
+// its running offsets per digit are in shared memory. Every subgroup of the workgroup takes the same
+// number of steps, the last block's and those past the last block (`has_block` false) included, storing
+// nothing there: Mesa 25's lavapipe synchronises subgroupBarrier() across the whole workgroup, and
+// with uneven step counts the barriers mismatched and no key was scattered (the pass then wrote nothing).
 shared uint s_offsets[SUBGROUPS_PER_WORKGROUP * RADIX];
-void scatter_multisplit(uint block, uint blocks, uint n) {
+void scatter_multisplit(uint block, uint blocks, uint n, bool has_block) {
   uint my = gl_SubgroupID * RADIX;
-  for (uint d = gl_SubgroupInvocationID; d < RADIX; d += gl_SubgroupSize)
-    s_offsets[my + d] = s_digit_base[d] + pc.histogram.v[d * blocks + block];
+  if (has_block)
+    for (uint d = gl_SubgroupInvocationID; d < RADIX; d += gl_SubgroupSize)
+      s_offsets[my + d] = s_digit_base[d] + pc.histogram.v[d * blocks + block];
   subgroupMemoryBarrierShared();
   subgroupBarrier();
 
   uint start = block * block_keys();
-  uint end = min(start + block_keys(), n);
-  for (uint base = start; base < end; base += gl_SubgroupSize) {
-    uint k = base + gl_SubgroupInvocationID;
+  uint end = has_block ? min(start + block_keys(), n) : start;
+  for (uint step = 0; step < block_keys(); step += gl_SubgroupSize) {
+    uint k = start + step + gl_SubgroupInvocationID;
     bool valid = k < end;
     uint64_t key = valid ? radix_load_key(k) : uint64_t(0);
     uint digit = digit_of(key);
@@ -90,10 +94,9 @@ void main() {
   barrier();
 
   uint block = gl_WorkGroupID.x * SUBGROUPS_PER_WORKGROUP + gl_SubgroupID;
-  if (block >= blocks) return;
 #ifdef TS_TEXEL_BUFFERS
-  scatter_lane_runs(block, blocks, n);
+  if (block < blocks) scatter_lane_runs(block, blocks, n);
 #else
-  scatter_multisplit(block, blocks, n);
+  scatter_multisplit(block, blocks, n, block < blocks);
 #endif
 }
