@@ -391,7 +391,9 @@ TEST(DatasetCameras, NerfstudioTransformsJsonReadsAndItsOffCentreFrameRendersShi
         worst = std::max(worst, double(std::abs(shifted.rgba[at] - centred.rgba[from])));
         changed = std::max(changed, double(std::abs(shifted.rgba[at] - centred.rgba[at])));
       }
-  EXPECT_LT(worst, 1e-4) << "the off-centre frame is not the centred one moved by (16, 32)";
+  // 2e-4: the two frames' float rounding differs by up to 1.05e-4 on Mesa 25's lavapipe (below 1e-4
+  // on Mesa 22); a wrong shift differs by more than 0.1.
+  EXPECT_LT(worst, 2e-4) << "the off-centre frame is not the centred one moved by (16, 32)";
   EXPECT_GT(changed, 0.1) << "the principal point did not move the image";
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }

@@ -62,9 +62,9 @@ TEST_P(GpuVsReference, TwoViewsMatchFloat64Reference) {
     std::printf("[ measure  ] %s view %d: GPU vs float64 reference PSNR %.2f dB, max abs %.2e (alpha %.2e)\n",
                 c.name.c_str(), view, d.psnr_db, d.max_abs, d.max_abs_alpha);
     EXPECT_GE(d.psnr_db, 60.0) << c.name << " view " << view;
-    EXPECT_LE(d.max_abs, 2e-3) << c.name << " view " << view << " worst pixel (" << d.worst_x << ", " << d.worst_y
-                               << ") channel " << d.worst_channel;
-    EXPECT_LE(d.max_abs_alpha, 2e-3) << c.name << " view " << view;
+    // Within 2e-3 wherever both blended the same splats; a cut-off decision that float rounding flips
+    // (a few pixels on some drivers) changes a pixel by one splat (testing::expect_matches_reference).
+    testing::expect_matches_reference(gpu, ref, 2e-3, c.name + " view " + std::to_string(view));
 
     // Splat counts and depth agree with the reference wherever both blended the same splats.
     size_t count_mismatch = 0;

@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 #include <png.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace tilesplat::testing {
@@ -66,6 +69,39 @@ Renderer& validated_renderer() {
     return Renderer::create(options);
   }();
   return *renderer;
+}
+
+CutoffAwareDifference compare_allowing_cutoff_flips(const RenderImage& gpu, const RenderImage& reference) {
+  if (gpu.splat_count.size() != gpu.pixels() || reference.splat_count.size() != reference.pixels())
+    throw std::invalid_argument("compare_allowing_cutoff_flips: both images need splat counts");
+  CutoffAwareDifference result;
+  RenderImage masked = gpu;
+  for (size_t i = 0; i < gpu.pixels() && i < reference.pixels(); ++i) {
+    if (gpu.splat_count[i] == reference.splat_count[i]) continue;
+    ++result.flipped;
+    const uint32_t a = gpu.splat_count[i], b = reference.splat_count[i];
+    result.flipped_splats = std::max(result.flipped_splats, a > b ? a - b : b - a);
+    for (size_t c = 0; c < 4; ++c) {
+      result.flipped_max_abs =
+          std::max(result.flipped_max_abs, double(std::abs(gpu.rgba[4 * i + c] - reference.rgba[4 * i + c])));
+      masked.rgba[4 * i + c] = reference.rgba[4 * i + c];
+    }
+  }
+  result.agreeing = compare_images(masked, reference);
+  return result;
+}
+
+void expect_matches_reference(const RenderImage& gpu, const RenderImage& reference, double max_abs,
+                              const std::string& what) {
+  const CutoffAwareDifference d = compare_allowing_cutoff_flips(gpu, reference);
+  EXPECT_LE(d.agreeing.max_abs, max_abs) << what << ": worst pixel (" << d.agreeing.worst_x << ", "
+                                         << d.agreeing.worst_y << ") channel " << d.agreeing.worst_channel;
+  EXPECT_LE(d.agreeing.max_abs_alpha, max_abs) << what;
+  EXPECT_LE(double(d.flipped), 1e-3 * double(gpu.pixels())) << what << ": pixels whose splat count differs";
+  if (d.flipped > 0) {
+    EXPECT_EQ(d.flipped_splats, 1u) << what << ": a cut-off decision flips one splat, not more";
+    EXPECT_LT(d.flipped_max_abs, 1.0 / 64) << what;
+  }
 }
 
 void expect_composite_layouts_identical(const GaussianScene& scene, const Camera& camera,
