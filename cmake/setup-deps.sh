@@ -8,7 +8,44 @@
 # --fuzz adds clang and its compiler-rt (libFuzzer) for tests/fuzz/run.sh; the normal build needs neither.
 # --cluster adds Slurm (slurm-wlm: slurmctld, slurmd, sbatch) and munge for tests/cluster/slurm_test.sh,
 # which runs a one-node cluster of its own; nothing is configured or started here.
+# --mesa25 [DIR] unpacks the Mesa 25 lavapipe of Debian bookworm-backports (mesa-vulkan-drivers 25.0.7
+# and the libdrm it needs) into DIR (default /opt/tilesplat-mesa25), beside the system's Mesa 22, and
+# writes DIR/lvp_icd.json; tests/ci/with_mesa25.sh runs a command on it. Nothing system-wide changes
+# but the bookworm-backports source, which apt ranks below bookworm (priority 100).
 set -euo pipefail
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+
+mesa25() {
+  local dir="${1:-/opt/tilesplat-mesa25}" version="25.0.7-2~bpo12+1"
+  if [ -f "$dir/lvp_icd.json" ] && grep -q "$version" "$dir/version" 2>/dev/null; then
+    echo "setup: Mesa $version lavapipe present in $dir"
+    return 0
+  fi
+  if ! apt-cache policy mesa-vulkan-drivers | grep -q "$version"; then
+    echo "setup: adding the bookworm-backports source"
+    printf 'Types: deb\nURIs: http://deb.debian.org/debian\nSuites: bookworm-backports\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' |
+      $SUDO tee /etc/apt/sources.list.d/bookworm-backports.sources >/dev/null
+    $SUDO apt-get update -qq
+  fi
+  local debs
+  debs=$(mktemp -d)
+  chmod 755 "$debs"  # apt downloads as its _apt user where it can
+  (cd "$debs" && apt-get download -q "mesa-vulkan-drivers=$version" libdrm2/bookworm-backports \
+    libdrm-amdgpu1/bookworm-backports)
+  $SUDO rm -rf "$dir"
+  $SUDO mkdir -p "$dir"
+  for deb in "$debs"/*.deb; do $SUDO dpkg -x "$deb" "$dir/root"; done
+  rm -rf "$debs"
+  local lib="$dir/root/usr/lib/x86_64-linux-gnu"
+  [ -f "$lib/libvulkan_lvp.so" ] || { echo "setup: $lib/libvulkan_lvp.so missing after unpacking" >&2; return 1; }
+  # The package's manifest names the library bare (found on the system's path); this one names ours.
+  sed "s|\"library_path\": *\"[^\"]*\"|\"library_path\": \"$lib/libvulkan_lvp.so\"|" \
+    "$dir/root/usr/share/vulkan/icd.d/lvp_icd.json" | $SUDO tee "$dir/lvp_icd.json" >/dev/null
+  echo "$version" | $SUDO tee "$dir/version" >/dev/null
+  echo "setup: Mesa $version lavapipe unpacked into $dir (tests/ci/with_mesa25.sh runs commands on it)"
+}
+
 pkgs=(
   build-essential cmake ninja-build pkg-config
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
@@ -21,8 +58,9 @@ pkgs=(
 case "${1:-}" in
   --fuzz) pkgs+=(clang libclang-rt-dev) ;;
   --cluster) pkgs+=(slurm-wlm munge) ;;
+  --mesa25) mesa25 "${2:-}"; exit ;;
   "") ;;
-  *) echo "setup: unknown option '$1' (--fuzz or --cluster)" >&2; exit 2 ;;
+  *) echo "setup: unknown option '$1' (--fuzz, --cluster or --mesa25 [DIR])" >&2; exit 2 ;;
 esac
 missing=()
 for p in "${pkgs[@]}"; do
@@ -33,7 +71,5 @@ if [ ${#missing[@]} -eq 0 ]; then
   exit 0
 fi
 echo "setup: installing ${missing[*]}"
-SUDO=""
-[ "$(id -u)" -eq 0 ] || SUDO="sudo"
 $SUDO apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
