@@ -53,9 +53,10 @@ void scatter_multisplit(uint block, uint blocks, uint n, bool has_block) {
   subgroupMemoryBarrierShared();
   subgroupBarrier();
 
-  uint start = block * block_keys();
-  uint end = has_block ? min(start + block_keys(), n) : start;
-  for (uint step = 0; step < block_keys(); step += gl_SubgroupSize) {
+  uint keys_per_block = block_keys();  // read once: the loop's stores could alias it
+  uint start = block * keys_per_block;
+  uint end = has_block ? min(start + keys_per_block, n) : start;
+  for (uint step = 0; step < keys_per_block; step += gl_SubgroupSize) {
     uint k = start + step + gl_SubgroupInvocationID;
     bool valid = k < end;
     uint64_t key = valid ? radix_load_key(k) : uint64_t(0);
