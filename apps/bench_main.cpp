@@ -845,7 +845,7 @@ std::string write_outputs(const std::vector<std::pair<std::string, std::function
   std::string written;
   for (const auto& [path, make] : files) {
     if (path.empty()) continue;
-    cli::write_file_atomic(path, make());
+    tilesplat::write_file_atomically(path, make());
     written += (written.empty() ? " -> " : ", ") + path;
   }
   if (validation_messages > 0)

@@ -893,39 +893,6 @@ void check_distinct_paths(const std::vector<std::pair<std::string, fs::path>>& p
   }
 }
 
-void write_file_atomic(const fs::path& path, std::string_view contents) {
-  const fs::path temporary =
-      path.parent_path() / ("." + path.filename().string() + ".tmp." + std::to_string(::getpid()));
-  auto fail = [&](const std::string& why) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot write " + single_quoted(path.string()) + ": " + why);
-  };
-
-  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) fail(std::strerror(errno));
-  size_t written = 0;
-  while (written < contents.size()) {
-    const ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int saved = errno;
-      ::close(fd);
-      fail(std::strerror(saved));
-    }
-    written += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0 && errno != EINVAL) {
-    const int saved = errno;
-    ::close(fd);
-    fail(std::strerror(saved));
-  }
-  if (::close(fd) != 0) fail(std::strerror(errno));
-  std::error_code ec;
-  fs::rename(temporary, path, ec);
-  if (ec) fail(ec.message());
-}
-
 // ---------------------------------------------------------------------------------------------
 // Formatting
 

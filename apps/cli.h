@@ -1,6 +1,6 @@
 // What tilesplat-render and tilesplat-bench share: a small declarative flag parser, the
-// "scene + camera + device" options, error reporting with the apps' exit codes, and atomic
-// writes of text outputs.
+// "scene + camera + device" options and error reporting with the apps' exit codes. Text outputs are
+// written with tilesplat::write_file_atomically (tilesplat/image.h), as the engine writes its images.
 #pragma once
 
 #include <array>
@@ -275,9 +275,6 @@ void check_distinct_paths(const std::vector<std::pair<std::string, std::filesyst
 // Whether the path's extension is `extension` (".exr"), ignoring case.
 bool has_extension(const std::filesystem::path& path, std::string_view extension);
 
-// Writes `contents` to a temporary file beside `path`, then renames it over `path`, so a
-// failure never leaves a partial file. Throws std::runtime_error naming the file.
-void write_file_atomic(const std::filesystem::path& path, std::string_view contents);
 
 // Collapses an exception message to one line.
 std::string one_line(std::string_view message);

@@ -257,7 +257,7 @@ MergeResult merge_manifests(const fs::path& folder) {
   result.manifests = manifests.size();
   result.frames = static_cast<size_t>(frames);
   result.merged = folder / "manifest.jsonl";
-  write_file_atomic(result.merged, merged);
+  tilesplat::write_file_atomically(result.merged, merged);
   return result;
 }
 

@@ -838,6 +838,26 @@ TEST(AtomicWrite, PathWithoutDirectoryWritesToCurrentDirectory) {
   EXPECT_EQ(directory_entries(dir), std::set<std::string>{"plain.txt"});
 }
 
+// The public writer of contents (the apps' CSV, JSON, SVG and manifests): whole contents, replaced
+// whole, a clear error for a missing directory, and nothing left behind either way.
+TEST(AtomicWrite, ContentsWriterReplacesWholeAndLeavesNoTemporaryFile) {
+  const fs::path dir = fresh_dir();
+  const fs::path target = dir / "results.json";
+  tilesplat::write_file_atomically(target, "{\"first\": 1}\n");
+  EXPECT_EQ(read_bytes(target), (std::vector<char>{'{', '"', 'f', 'i', 'r', 's', 't', '"', ':', ' ', '1', '}', '\n'}));
+  const std::string large(3 << 20, 'x');  // several write() calls
+  tilesplat::write_file_atomically(target, large);
+  EXPECT_EQ(fs::file_size(target), large.size());
+  tilesplat::write_file_atomically(target, "");
+  EXPECT_EQ(fs::file_size(target), 0u);
+  EXPECT_EQ(directory_entries(dir), std::set<std::string>{"results.json"});
+
+  const fs::path missing = dir / "missing" / "out.csv";
+  EXPECT_EQ(error_message_of([&] { tilesplat::write_file_atomically(missing, "a,b\n"); }),
+            "cannot write " + missing.string() + ": directory '" + (dir / "missing").string() + "' does not exist");
+  EXPECT_EQ(directory_entries(dir), std::set<std::string>{"results.json"});
+}
+
 // ---------------------------------------------------------------------------------------------
 // PNG previews
 

@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tilesplat/camera.h"
@@ -99,6 +100,13 @@ struct ExrWriteOptions {
 /// Blender's Z for pixels that show no surface: finite, so that filters and resampling stay finite,
 /// and far beyond any scene.
 inline constexpr float kFarDepth = 1e10f;
+
+/// Writes `contents` to `path` as write_exr() and write_png() write their files: into a temporary file
+/// beside it, synced to the storage, then renamed over it (and the directory synced), so that readers
+/// and a crash see the old file or the whole new one, never a part. For the files that accompany
+/// renders: the apps write their CSV, JSON, SVG, Markdown and manifests through it. Throws
+/// std::runtime_error "cannot write PATH: why" (a missing directory named), leaving no temporary file.
+TILESPLAT_API void write_file_atomically(const std::filesystem::path& path, std::string_view contents);
 
 /// Writes channels R G B A (A unless options.alpha is false), Z when depth is present, and "splats"
 /// (FLOAT, so that compositing tools read counts as numbers; exact up to 2^24) when counts are present.

@@ -1,9 +1,14 @@
 #include "image/atomic_file.h"
 
+#include "tilesplat/image.h"
+
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -30,6 +35,18 @@ std::filesystem::path temp_path_beside(const std::filesystem::path& target) {
   name += '-';
   name += std::to_string(serial);
   return directory_of(target) / name;
+}
+
+// Flushes a file's (or a directory's) data to the storage, so that a rename that survives a crash
+// names complete contents. File systems that cannot sync (EINVAL: pipes, some FUSE mounts) are let be.
+void sync_path(const std::filesystem::path& path, bool directory) {
+  const int fd = ::open(path.c_str(), (directory ? O_RDONLY | O_DIRECTORY : O_RDONLY) | O_CLOEXEC);
+  if (fd < 0) throw std::runtime_error("cannot open " + path.string() + " to sync it: " + std::strerror(errno));
+  const int status = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  if (status != 0 && error != EINVAL && error != EROFS)
+    throw std::runtime_error("cannot sync " + path.string() + ": " + std::strerror(error));
 }
 
 std::string describe_current_exception() {
@@ -63,12 +80,42 @@ void write_file_atomically(const std::filesystem::path& target,
   const std::filesystem::path temp = temp_path_beside(target);
   try {
     write(temp);
+    sync_path(temp, false);
     std::filesystem::rename(temp, target);
   } catch (...) {
     std::error_code ignored;
     std::filesystem::remove(temp, ignored);
     std::throw_with_nested(std::runtime_error(prefix + describe_current_exception()));
   }
+  // The rename itself is durable once the directory is synced; the target is complete either way.
+  try {
+    sync_path(directory, true);
+  } catch (...) {
+    std::throw_with_nested(std::runtime_error(prefix + describe_current_exception()));
+  }
 }
 
 }  // namespace tilesplat::detail
+
+namespace tilesplat {
+
+void write_file_atomically(const std::filesystem::path& path, std::string_view contents) {
+  detail::write_file_atomically(path, [&](const std::filesystem::path& temp) {
+    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0) throw std::runtime_error(std::strerror(errno));
+    size_t written = 0;
+    while (written < contents.size()) {
+      const ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        const int error = errno;
+        ::close(fd);
+        throw std::runtime_error(std::strerror(error));
+      }
+      written += size_t(n);
+    }
+    if (::close(fd) != 0) throw std::runtime_error(std::strerror(errno));
+  });
+}
+
+}  // namespace tilesplat
