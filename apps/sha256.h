@@ -1,31 +1,31 @@
-// SHA-256 (FIPS 180-4) of files, for outputs that name what they were made from (the EXR's scene
-// checksum) and, later, for checking finished frames. Small enough to keep here rather than pull a
-// crypto library into the apps.
+// SHA-256 of files, for outputs that name what they were made from (the EXR's scene checksum) and for
+// checking finished frames (the render manifest): OpenSSL's libcrypto (EVP), which the apps link.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 
 namespace tilesplat::cli {
 
+// An incremental digest: update() with the pieces, then finish() once.
 class Sha256 {
  public:
   Sha256();
+  ~Sha256();
+  Sha256(const Sha256&) = delete;
+  Sha256& operator=(const Sha256&) = delete;
   void update(std::span<const std::byte> data);
   // The digest of everything updated so far; the object is spent afterwards.
   std::array<uint8_t, 32> finish();
 
  private:
-  void compress(const uint8_t* block);
-
-  std::array<uint32_t, 8> state_;
-  std::array<uint8_t, 64> buffer_{};
-  size_t buffered_ = 0;
-  uint64_t total_bytes_ = 0;
+  struct Context;  // OpenSSL's EVP_MD_CTX, kept out of this header
+  std::unique_ptr<Context> context_;
 };
 
 // Lower-case hex of the digest of `bytes`.

@@ -2,6 +2,7 @@
 # Installs the Debian packages tilesplat builds and tests with, only when one is missing.
 # Safe to run repeatedly; needs root (or sudo) only when something must be installed.
 # zlib, zstd, libwebp and libzip are the containers of the compressed splat formats (.spz, .sog).
+# libssl-dev's libcrypto gives the apps SHA-256 (the EXRs' scene checksum, the render manifest).
 # xvfb and xauth give the viewer's tests a display (xvfb-run) on a machine without one.
 # doxygen builds the API reference (the docs target and its test); file is what cpack -G DEB asks
 # to find the binaries whose library dependencies it lists.
@@ -51,7 +52,7 @@ pkgs=(
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
   glslang-tools spirv-tools doxygen file
   libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev
-  zlib1g-dev libzstd-dev libwebp-dev libzip-dev
+  zlib1g-dev libzstd-dev libwebp-dev libzip-dev libssl-dev
   libgtest-dev googletest
   xvfb xauth
 )
