@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <numeric>
 #include <random>
 #include <string>
@@ -449,8 +450,9 @@ void print_group(const Group& group, const BenchScene& scene, const BenchOptions
   print_comparison(group.over_views, "median over the views of the median gpu frame");
 }
 
-// Exact for counts (integers up to 2^53), 9 significant digits otherwise; null when not finite.
-std::string json_number(double value) {
+// A CSV number: exact for counts (integers up to 2^53), 9 significant digits otherwise; "null" when
+// not finite, as the JSON says.
+std::string number_text(double value) {
   if (!std::isfinite(value)) return "null";
   char buffer[64];
   if (value == std::floor(value) && std::fabs(value) < 9007199254740992.0)
@@ -460,42 +462,31 @@ std::string json_number(double value) {
   return buffer;
 }
 
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    const auto byte = static_cast<unsigned char>(c);
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (byte < 0x20) {
-          char escape[8];
-          std::snprintf(escape, sizeof escape, "\\u%04x", unsigned(byte));
-          out += escape;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
+// JSON outputs are built as nlohmann::ordered_json (members in the order written here) and dumped
+// once; a value that is not finite becomes null.
+using Json = nlohmann::ordered_json;
+
+// A JSON number: a count stays an integer, anything else a double (null when not finite).
+Json json_number(double value) {
+  if (!std::isfinite(value)) return nullptr;
+  if (value == std::floor(value) && std::fabs(value) < 9007199254740992.0) return int64_t(value);
+  return value;
 }
 
 // The "tilesplat" build and "command" members that every JSON output starts with.
-std::string json_provenance(const std::string& command) {
+void add_provenance(Json& json, const std::string& tool, const std::string& command) {
   const tilesplat::BuildInfo build = tilesplat::build_info();
-  return "  \"tilesplat\": {\"version\": " + json_string(build.version) +
-         ", \"commit\": " + json_string(build.git_commit) +
-         ", \"build_type\": " + json_string(build.build_type) + "},\n" +
-         "  \"command\": " + json_string(command) + ",\n";
+  json["tool"] = tool;
+  json["tilesplat"] = {
+      {"version", build.version}, {"commit", build.git_commit}, {"build_type", build.build_type}};
+  json["command"] = command;
 }
 
-std::string json_device(const tilesplat::DeviceInfo& device) {
-  return "{\"name\": " + json_string(device.name) + ", \"driver\": " + json_string(device.driver) +
-         ", \"subgroup_size\": " + std::to_string(device.subgroup_size) +
-         ", \"timestamp_period_ns\": " + json_number(device.timestamp_period_ns) + "}";
+Json json_device(const tilesplat::DeviceInfo& device) {
+  return {{"name", device.name},
+          {"driver", device.driver},
+          {"subgroup_size", device.subgroup_size},
+          {"timestamp_period_ns", json_number(device.timestamp_period_ns)}};
 }
 
 // Calls visit(row) for every metric of a result, passes first.
@@ -515,11 +506,11 @@ std::string make_csv(const std::vector<Group>& groups, const std::vector<BenchSc
                  const char* over) {
     for_each_metric(result, [&](const Series& row) {
       const Summary summary = summarize(row.samples);
-      csv += cli::csv_field(device.name) + "," + cli::csv_field(scene) + "," + width + "," + height + "," + cli::csv_field(view) +
-             "," + cli::csv_field(camera) + "," + cli::csv_field(result.sort) + "," + row.kind + "," + cli::csv_field(row.name) +
-             "," + unit_name(row.unit) + "," + over + "," + json_number(summary.median) + "," +
-             json_number(summary.min) + "," + json_number(summary.max) + "," + std::to_string(row.samples.size()) +
-             "\n";
+      csv += cli::csv_field(device.name) + "," + cli::csv_field(scene) + "," + width + "," + height + "," +
+             cli::csv_field(view) + "," + cli::csv_field(camera) + "," + cli::csv_field(result.sort) + "," +
+             row.kind + "," + cli::csv_field(row.name) + "," + unit_name(row.unit) + "," + over + "," +
+             number_text(summary.median) + "," + number_text(summary.min) + "," + number_text(summary.max) +
+             "," + std::to_string(row.samples.size()) + "\n";
     });
   };
   for (const auto& group : groups) {
@@ -539,24 +530,24 @@ std::string make_csv(const std::vector<Group>& groups, const std::vector<BenchSc
   return csv;
 }
 
-std::string json_metrics(const StrategyResult& result, bool with_samples) {
-  std::string json = "[";
-  bool first = true;
+Json json_metrics(const StrategyResult& result, bool with_samples) {
+  Json metrics = Json::array();
   for_each_metric(result, [&](const Series& row) {
     const Summary summary = summarize(row.samples);
-    json += first ? "\n" : ",\n";
-    first = false;
-    json += "        {\"name\": " + json_string(row.name) + ", \"kind\": \"" + row.kind + "\", \"unit\": \"" +
-            unit_name(row.unit) + "\", \"median\": " + json_number(summary.median) +
-            ", \"min\": " + json_number(summary.min) + ", \"max\": " + json_number(summary.max);
+    Json metric = {{"name", row.name},
+                   {"kind", row.kind},
+                   {"unit", unit_name(row.unit)},
+                   {"median", json_number(summary.median)},
+                   {"min", json_number(summary.min)},
+                   {"max", json_number(summary.max)}};
     if (with_samples) {
-      json += ", \"samples\": [";
-      for (size_t i = 0; i < row.samples.size(); ++i) json += (i ? ", " : "") + json_number(row.samples[i]);
-      json += "]";
+      Json samples = Json::array();
+      for (const double sample : row.samples) samples.push_back(json_number(sample));
+      metric["samples"] = std::move(samples);
     }
-    json += "}";
+    metrics.push_back(std::move(metric));
   });
-  return json + "\n      ]";
+  return metrics;
 }
 
 // "results": one entry per camera and sort, every sample included; "summaries" (for paths of several
@@ -564,51 +555,42 @@ std::string json_metrics(const StrategyResult& result, bool with_samples) {
 // of each view's median.
 std::string make_json(const std::vector<Group>& groups, const std::vector<BenchScene>& scenes,
                       const tilesplat::DeviceInfo& device, const BenchOptions& options) {
-  std::string json = "{\n  \"tool\": \"tilesplat-bench\",\n" + json_provenance(options.command);
-  json += "  \"device\": " + json_device(device) + ",\n";
-  json += "  \"warmup\": " + std::to_string(options.warmup) + ",\n";
-  json += "  \"repeat\": " + std::to_string(options.repeat) + ",\n";
-  json += "  \"scenes\": [";
-  for (size_t s = 0; s < scenes.size(); ++s)
-    json += std::string(s ? ",\n" : "\n") + "    {\"path\": " + json_string(scenes[s].loaded.path.string()) +
-            ", \"gaussians\": " + json_number(double(scenes[s].gaussians)) +
-            ", \"sh_degree\": " + std::to_string(scenes[s].sh_degree) +
-            ", \"cameras\": " +
-            (cameras_source(scenes[s]).empty() ? "null" : json_string(cameras_source(scenes[s]))) + "}";
-  json += "\n  ],\n  \"results\": [";
-  bool first = true;
-  for (const auto& group : groups) {
-    for (const Case* c : group.cases) {
-      for (const auto& result : c->results) {
-        json += first ? "\n" : ",\n";
-        first = false;
-        json += "    {\n      \"scene\": " + json_string(scenes[c->scene].loaded.path.string()) +
-                ",\n      \"width\": " + std::to_string(c->camera.camera.width) +
-                ", \"height\": " + std::to_string(c->camera.camera.height) +
-                ",\n      \"view\": " + json_string(c->view_label) +
-                ", \"camera\": " + json_string(c->camera.description) +
-                ",\n      \"sort\": " + json_string(result.sort) +
-                ",\n      \"metrics\": " + json_metrics(result, true) + "\n    }";
-      }
-    }
+  Json json;
+  add_provenance(json, "tilesplat-bench", options.command);
+  json["device"] = json_device(device);
+  json["warmup"] = options.warmup;
+  json["repeat"] = options.repeat;
+  Json& scene_list = json["scenes"] = Json::array();
+  for (const auto& scene : scenes) {
+    const std::string cameras = cameras_source(scene);
+    scene_list.push_back({{"path", scene.loaded.path.string()},
+                          {"gaussians", scene.gaussians},
+                          {"sh_degree", scene.sh_degree},
+                          {"cameras", cameras.empty() ? Json(nullptr) : Json(cameras)}});
   }
-  json += "\n  ],\n  \"summaries\": [";
-  first = true;
+  Json& results = json["results"] = Json::array();
+  for (const auto& group : groups)
+    for (const Case* c : group.cases)
+      for (const auto& result : c->results)
+        results.push_back({{"scene", scenes[c->scene].loaded.path.string()},
+                           {"width", c->camera.camera.width},
+                           {"height", c->camera.camera.height},
+                           {"view", c->view_label},
+                           {"camera", c->camera.description},
+                           {"sort", result.sort},
+                           {"metrics", json_metrics(result, true)}});
+  Json& summaries = json["summaries"] = Json::array();
   for (const auto& group : groups) {
     if (group.cases.size() < 2) continue;
     const Case& c = *group.cases.front();
-    for (const auto& summary : group.over_views) {
-      json += first ? "\n" : ",\n";
-      first = false;
-      json += "    {\n      \"scene\": " + json_string(scenes[c.scene].loaded.path.string()) +
-              ",\n      \"size\": " + json_string(size_label(group)) +
-              ", \"views\": " + std::to_string(group.cases.size()) +
-              ",\n      \"sort\": " + json_string(summary.sort) +
-              ",\n      \"metrics\": " + json_metrics(summary, false) + "\n    }";
-    }
+    for (const auto& summary : group.over_views)
+      summaries.push_back({{"scene", scenes[c.scene].loaded.path.string()},
+                           {"size", size_label(group)},
+                           {"views", group.cases.size()},
+                           {"sort", summary.sort},
+                           {"metrics", json_metrics(summary, false)}});
   }
-  json += "\n  ]\n}\n";
-  return json;
+  return json.dump(2) + "\n";
 }
 
 template <typename T>
@@ -941,36 +923,40 @@ std::string make_sort_csv(const std::vector<SortRow>& rows, const tilesplat::Dev
       "device,key_bits,keys,sorter,where,median_ms,min_ms,max_ms,mkeys_per_s,vs_std_sort,misordered,fallbacks,samples\n";
   for (const auto& row : rows) {
     const Summary s = summarize(row.ms);
-    csv += cli::csv_field(device.name) + "," + std::to_string(row.key_bits) + "," + std::to_string(row.keys) + "," +
-           cli::csv_field(row.sorter) + "," + row.where + "," + json_number(s.median) + "," + json_number(s.min) + "," +
-           json_number(s.max) + "," + json_number(mkeys_per_s(row)) + "," + json_number(vs_std_sort(rows, row)) +
-           "," + json_number(row.misordered) + "," + std::to_string(row.fallbacks) + "," +
-           std::to_string(row.ms.size()) + "\n";
+    csv += cli::csv_field(device.name) + "," + std::to_string(row.key_bits) + "," + std::to_string(row.keys) +
+           "," + cli::csv_field(row.sorter) + "," + row.where + "," + number_text(s.median) + "," +
+           number_text(s.min) + "," + number_text(s.max) + "," + number_text(mkeys_per_s(row)) + "," +
+           number_text(vs_std_sort(rows, row)) + "," + number_text(row.misordered) + "," +
+           std::to_string(row.fallbacks) + "," + std::to_string(row.ms.size()) + "\n";
   }
   return csv;
 }
 
 std::string make_sort_json(const std::vector<SortRow>& rows, const tilesplat::DeviceInfo& device,
                            const BenchOptions& options) {
-  std::string json = "{\n  \"tool\": \"tilesplat-bench --sort-bench\",\n" + json_provenance(options.command);
-  json += "  \"device\": {\"name\": " + json_string(device.name) + ", \"driver\": " + json_string(device.driver) +
-          ", \"subgroup_size\": " + std::to_string(device.subgroup_size) + "},\n";
-  json += "  \"warmup\": " + std::to_string(options.warmup) + ",\n  \"repeat\": " + std::to_string(options.repeat) +
-          ",\n  \"results\": [";
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const auto& row = rows[i];
+  Json json;
+  add_provenance(json, "tilesplat-bench --sort-bench", options.command);
+  json["device"] = {
+      {"name", device.name}, {"driver", device.driver}, {"subgroup_size", device.subgroup_size}};
+  json["warmup"] = options.warmup;
+  json["repeat"] = options.repeat;
+  Json& results = json["results"] = Json::array();
+  for (const auto& row : rows) {
     const Summary s = summarize(row.ms);
-    json += i ? ",\n" : "\n";
-    json += "    {\"key_bits\": " + std::to_string(row.key_bits) + ", \"keys\": " + std::to_string(row.keys) +
-            ", \"sorter\": " + json_string(row.sorter) + ", \"where\": \"" + row.where +
-            "\", \"median_ms\": " + json_number(s.median) + ", \"min_ms\": " + json_number(s.min) +
-            ", \"max_ms\": " + json_number(s.max) + ", \"misordered\": " + json_number(row.misordered) +
-            ", \"fallbacks\": " + std::to_string(row.fallbacks) + ", \"samples_ms\": [";
-    for (size_t k = 0; k < row.ms.size(); ++k) json += (k ? ", " : "") + json_number(row.ms[k]);
-    json += "]}";
+    Json samples = Json::array();
+    for (const double ms : row.ms) samples.push_back(json_number(ms));
+    results.push_back({{"key_bits", row.key_bits},
+                       {"keys", row.keys},
+                       {"sorter", row.sorter},
+                       {"where", row.where},
+                       {"median_ms", json_number(s.median)},
+                       {"min_ms", json_number(s.min)},
+                       {"max_ms", json_number(s.max)},
+                       {"misordered", json_number(row.misordered)},
+                       {"fallbacks", row.fallbacks},
+                       {"samples_ms", std::move(samples)}});
   }
-  json += "\n  ]\n}\n";
-  return json;
+  return json.dump(2) + "\n";
 }
 
 // A line per sorter and key width: the colour tells the sorter, the dash the key width.
