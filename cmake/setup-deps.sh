@@ -31,7 +31,7 @@ mesa25() {
   fi
   local debs
   debs=$(mktemp -d)
-  chmod 755 "$debs"  # apt downloads as its _apt user where it can
+  chown _apt "$debs" 2>/dev/null || true  # apt downloads as its _apt user where it can write
   (cd "$debs" && apt-get download -q "mesa-vulkan-drivers=$version" libdrm2/bookworm-backports \
     libdrm-amdgpu1/bookworm-backports)
   $SUDO rm -rf "$dir"
