@@ -107,6 +107,7 @@ struct HostDepthPlan {
   bool write_depth = false;  // the composite writes the surface depth
 };
 
+// Everything decided about one frame before any Vulkan call (plan_frame); FrameRecorder records it.
 struct FramePlan {
   ListKey lists;            // what this frame's tile lists are built for
   bool build_lists = true;  // false: the composite alone, on the lists the previous frame left
@@ -127,7 +128,8 @@ struct FramePlan {
   HostDepthPlan host;
   std::vector<FramePass> passes;  // in order
   // The frame ends its command buffer and goes on in another where the host must act: a host sort
-  // (SortTraits::sorts_on_host) and every averaged sample of the stochastic composite after the first.
+  // (SortTraits::sorts_on_host), and the stochastic composite after every 64 samples
+  // (StochasticCompositePass::kSamplesPerSubmission, so that no submission runs long enough for a watchdog).
   bool splits_submissions = false;
 
   // The names of the timed passes in order: what FrameStats::passes lists for a frame without retries.
