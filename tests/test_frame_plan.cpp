@@ -10,6 +10,7 @@
 
 #include "frame/frame_plan.h"
 #include "tilesplat/reference.h"
+#include "vulkan/compute_pipeline.h"
 
 namespace tilesplat {
 namespace {
@@ -303,6 +304,17 @@ TEST(FramePlan, EveryModeStrategyAndCompositorGivesAWellFormedPlan) {
         EXPECT_EQ(plan.projection.sh_degree, std::min(3, settings.accuracy.sh_degree_cap)) << what;
       }
   EXPECT_EQ(plans, 15 * 3 + 10 * 3);  // five of the modes change the depth order
+}
+
+// CPU drivers take the texel-buffer layouts before Mesa 25 only (vk::texel_buffers_wanted), by the
+// driver's description.
+TEST(TexelLayouts, MesaMajorVersionFromTheDriverDescription) {
+  EXPECT_EQ(vk::mesa_major_version("llvmpipe Mesa 22.3.6 (LLVM 15.0.6)"), 22);
+  EXPECT_EQ(vk::mesa_major_version("llvmpipe Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)"), 25);
+  EXPECT_EQ(vk::mesa_major_version("llvmpipe Mesa 100.1"), 100);
+  EXPECT_EQ(vk::mesa_major_version("NVIDIA 580.159.04"), 0);
+  EXPECT_EQ(vk::mesa_major_version("SwiftShader driver 5.0.0"), 0);
+  EXPECT_EQ(vk::mesa_major_version("Mesa "), 0);
 }
 
 }  // namespace

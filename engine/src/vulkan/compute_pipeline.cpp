@@ -150,7 +150,16 @@ bool texel_buffers_wanted(const Context& ctx) {
       throw std::invalid_argument("TILESPLAT_TEXEL_BUFFERS must be 0 or 1, got '" + value + "'");
     return value == "1";
   }
-  return ctx.is_cpu_device();
+  return ctx.is_cpu_device() && mesa_major_version(ctx.driver_name()) < 25;  // other CPU drivers: 0
+}
+
+int mesa_major_version(const std::string& driver_name) {
+  const size_t at = driver_name.find("Mesa ");
+  if (at == std::string::npos) return 0;
+  int major = 0;
+  for (size_t i = at + 5; i < driver_name.size() && driver_name[i] >= '0' && driver_name[i] <= '9'; ++i)
+    major = major * 10 + (driver_name[i] - '0');
+  return major;
 }
 
 void barrier(VkCommandBuffer cmd) {

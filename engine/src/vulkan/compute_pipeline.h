@@ -59,12 +59,17 @@ class ComputePipeline {
 // The passes form a strict chain, so one full barrier between them is both correct and cheap.
 void barrier(VkCommandBuffer cmd);
 
-// Whether the CPU-driver layouts read and write through texel buffers: llvmpipe turns a load or store
-// at a per-invocation buffer address into a loop over the SIMD lanes, one per component, while texel
-// fetches and image stores are SIMD gathers and scatters (docs/benchmarks.md, "Where the time goes on
-// the CPU driver"). A CPU device with push descriptors; TILESPLAT_TEXEL_BUFFERS=0 or 1 overrides it,
-// so that the tests hold both layouts to the same images.
+// Whether the CPU-driver layouts read and write through texel buffers: llvmpipe before Mesa 25 turns
+// a load or store at a per-invocation buffer address into a loop over the SIMD lanes, one per
+// component, while texel fetches and image stores are SIMD gathers and scatters (docs/benchmarks.md,
+// "Where the time goes on the CPU driver"). Mesa 25's llvmpipe compiles those accesses well, and there
+// the address layouts are faster (1080p 500k frame 318 against 374 ms; "Mesa 22 against Mesa 25").
+// So: a CPU device with push descriptors, unless it is Mesa 25 or later; TILESPLAT_TEXEL_BUFFERS=0 or 1
+// overrides it, so that the tests hold both layouts to the same images.
 bool texel_buffers_wanted(const Context& ctx);
+// The Mesa major version in a driver description ("llvmpipe Mesa 25.0.7 (LLVM 15.0.6)" -> 25), 0 when
+// it names none.
+int mesa_major_version(const std::string& driver_name);
 
 // A pass's texel views, all of them or none: empty when any is VK_NULL_HANDLE (a buffer with more texels
 // than the device allows, Buffer::texel_view), and the pass then takes its address variant.
