@@ -19,7 +19,6 @@
 
 #include "host_depth.h"
 #include "passes/frame_counters.h"
-#include "vulkan/vk_check.h"
 
 namespace tilesplat {
 

@@ -5,7 +5,6 @@
 
 #include "host_images.h"
 #include "passes/frame_counters.h"
-#include "vulkan/vk_check.h"
 
 namespace tilesplat {
 

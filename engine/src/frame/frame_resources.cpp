@@ -10,8 +10,6 @@
 
 #include "host_depth.h"
 #include "passes/stochastic_composite_pass.h"
-#include "tilesplat/reference.h"
-#include "vulkan/command_stream.h"
 
 namespace tilesplat {
 
