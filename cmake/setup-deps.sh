@@ -51,7 +51,7 @@ pkgs=(
   build-essential cmake ninja-build pkg-config
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
   glslang-tools spirv-tools doxygen file
-  libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev
+  libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev libcli11-dev
   zlib1g-dev libzstd-dev libwebp-dev libzip-dev libssl-dev
   libgtest-dev googletest
   xvfb xauth

@@ -1,4 +1,4 @@
-#include "viewer/image_readback.h"
+#include "image_readback.h"
 
 namespace tilesplat::viewer {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "viewer/window_device.h"
+#include "window_device.h"
 
 namespace tilesplat::viewer {
 

@@ -1,4 +1,4 @@
-#include "viewer/mesh_layer.h"
+#include "mesh_layer.h"
 
 #include <algorithm>
 #include <cmath>

@@ -15,7 +15,7 @@
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
-#include "viewer/window_device.h"
+#include "window_device.h"
 
 namespace tilesplat::viewer {
 

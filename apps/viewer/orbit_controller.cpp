@@ -1,4 +1,4 @@
-#include "viewer/orbit_controller.h"
+#include "orbit_controller.h"
 
 #include <algorithm>
 #include <cmath>

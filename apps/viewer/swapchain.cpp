@@ -1,4 +1,4 @@
-#include "viewer/swapchain.h"
+#include "swapchain.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "viewer/image_readback.h"
+#include "image_readback.h"
 
 namespace tilesplat::viewer {
 

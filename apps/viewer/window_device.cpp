@@ -1,4 +1,4 @@
-#include "viewer/window_device.h"
+#include "window_device.h"
 
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>

@@ -23,11 +23,11 @@
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
-#include "viewer/image_readback.h"
-#include "viewer/mesh_layer.h"
-#include "viewer/orbit_controller.h"
-#include "viewer/swapchain.h"
-#include "viewer/window_device.h"
+#include "image_readback.h"
+#include "mesh_layer.h"
+#include "orbit_controller.h"
+#include "swapchain.h"
+#include "window_device.h"
 
 namespace {
 

@@ -1,0 +1,41 @@
+// tilesplat-bench: times the renderer's passes over repeated frames, per scene, image size, camera
+// and sort strategy; or, with --sort-bench, the sort strategies alone on random keys against CPU
+// sorts on the same keys; or one of the reports (--accuracy, --effects, --formats, --scaling).
+#include "bench_options.h"
+#include "cli.h"
+#include "frame_bench.h"
+#include "report_runs.h"
+#include "sort_bench.h"
+
+namespace {
+
+namespace cli = tilesplat::cli;
+using namespace tilesplat::bench;
+
+int run(int argc, char** argv) {
+  cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
+  BenchOptions options;
+  cli::ArgParser parser(
+      kProgram, "tilesplat-bench SCENE.ply|SCENE.json [SCENE...] [options]",
+      "Renders 3D Gaussian Splatting scenes repeatedly and prints the GPU time of every pass "
+      "(median, min, max over the measured frames) for each sort strategy, with the frame's "
+      "CPU time, visible Gaussians, intersections and device memory. Every scene is measured "
+      "at every size (--resolutions) from every camera of its path (--views of --cameras, or "
+      "--orbit); a progress bar on stderr counts the frames of the whole run.");
+  add_bench_options(parser, options);
+  if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
+  options.command = cli::command_line(kProgram, argc, argv);
+  if (options.sort_bench) return run_sort_bench(parser, options);
+  check_frame_options(parser, options);
+  if (options.accuracy) return run_accuracy_report(parser, options);
+  if (options.effects) return run_effects_report(parser, options);
+  if (options.formats) return run_formats_report(parser, options);
+  if (options.scaling) return run_scaling_report(parser, options);
+  return run_frame_bench(parser, options);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return cli::run_app(kProgram, [argc, argv] { return run(argc, argv); });
+}

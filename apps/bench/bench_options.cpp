@@ -1,0 +1,242 @@
+#include "bench_options.h"
+
+#include <limits>
+
+#include "bench_results.h"
+
+namespace tilesplat::bench {
+
+namespace cli = tilesplat::cli;
+namespace fs = std::filesystem;
+
+std::vector<int> parse_int_list(std::string_view flag, const std::string& text, int min, int max) {
+  std::vector<int> values;
+  for (const auto& part : cli::split(text, ',')) add_unique(values, cli::parse_int(flag, part, min, max));
+  if (values.empty()) throw cli::UsageError(std::string(flag) + " needs at least one value");
+  return values;
+}
+
+void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
+  cli::add_common_options(parser, options.common, cli::SortChoice::kList, cli::SceneChoice::kList);
+
+  parser.section("camera path and sizes");
+  parser.add_value(
+      "--views", "N[,N...]|all",
+      "several views of --cameras, comma-separated, or 'all': a row of results per view, then the "
+      "median, min and max over the views of each view's median (default: --view alone)",
+      [&options](const std::string& text) {
+        options.all_views = text == "all";
+        options.views.clear();
+        if (!options.all_views)
+          options.views = parse_int_list("--views", text, 0, std::numeric_limits<int>::max());
+      });
+  parser.add_int("--orbit", "N",
+                 "N orbit cameras evenly spaced in azimuth, from --azimuth on (0, 360/N, ... by default), "
+                 "with --elevation, --fov and --distance as given; not with --cameras",
+                 &options.orbit, 1, 3600);
+  parser.add_value("--resolutions", "WxH[,WxH...]",
+                   "image sizes to measure each camera at, e.g. 1920x1080,1280x720 (instead of --width and "
+                   "--height)",
+                   [&options](const std::string& text) {
+                     options.resolutions = cli::parse_resolutions("--resolutions", text);
+                   });
+
+  parser.section("benchmark");
+  parser.add_int("--warmup", "N",
+                 "frames rendered and discarded before measuring, per camera and sort (default 2)",
+                 &options.warmup, 0, 1000000);
+  parser.add_int("--repeat", "N",
+                 "frames measured per camera and sort (default 10): the median, min and max are over these",
+                 &options.repeat, 1, 1000000);
+  parser.add_string(
+      "--csv", "FILE.csv",
+      "also write the results as CSV: one line per scene, size, view, sort and metric; with several "
+      "views also view 'all', the statistics over the views of each view's median",
+      &options.csv);
+  parser.add_string("--json", "FILE.json", "also write the results, every sample included, as JSON",
+                    &options.json);
+  parser.add_string(
+      "--plot", "FILE.svg",
+      "also draw an SVG chart: the median GPU time of each pass as stacked bars, one per scene, "
+      "size and sort; with --sort-bench, Mkeys/s against key count per sort and key width; with "
+      "--accuracy, per scene PSNR against time and, beside it (..._consistency.svg), the view "
+      "inconsistency against time",
+      &options.plot);
+
+  parser.section("accuracy report");
+  parser.add_switch(
+      "--accuracy",
+      "measure what each accuracy mode costs: per --mode combination (default: each approximation "
+      "alone and the combinations that matter), the GPU time per pass and frame and the error "
+      "against the float64 CPU reference (PSNR, SSIM, max abs) at each view, and the popping "
+      "along a short camera path from the first view (--path) and the view consistency under a turn "
+      "(--consistency-angle); --plot draws the Pareto charts",
+      &options.accuracy);
+  parser.add_string(
+      "--markdown", "FILE.md",
+      "with --accuracy, --effects, --formats or --scaling: also write the report as Markdown tables",
+      &options.markdown);
+  parser.add_value("--path", "dolly|pan|orbit",
+                   "with --accuracy: the camera path the popping is measured on, from the first view: 'pan' "
+                   "(turning in place, default), 'orbit' (around the scene centre) or 'dolly' (sideways; "
+                   "centre-depth order never changes on it, so the reference cannot pop there)",
+                   [&options](const std::string& text) {
+                     const auto path = tilesplat::accuracy::parse_camera_path(text);
+                     if (!path) throw cli::UsageError("--path: '" + text + "' is not dolly, pan or orbit");
+                     options.path = *path;
+                   });
+  parser.add_int("--path-frames", "N",
+                 "with --accuracy: frames of the camera path the popping is measured on (default 6; 0: none)",
+                 &options.path_frames, 0, 1000);
+  parser.add_value(
+      "--consistency-angle", "RAD",
+      "with --accuracy: the view-consistency pair turns the first view in place by RAD radians "
+      "(default 0.08; 0: no pair), rendered at twice its size, and measures what does not follow the "
+      "rotation: the popping per-pixel re-sorting removes",
+      [&options](const std::string& text) {
+        options.consistency_angle = cli::parse_double("--consistency-angle", text);
+        if (!(options.consistency_angle >= 0 && options.consistency_angle <= 0.5))
+          throw cli::UsageError("--consistency-angle: " + text + " is not in [0, 0.5]");
+      });
+  parser.add_value(
+      "--path-step", "F",
+      "with --accuracy: the path's step per frame: radians for the orbit and the pan, a fraction of "
+      "the distance to the scene centre for the dolly (default 0.0005), in (0, 0.1]",
+      [&options](const std::string& text) {
+        options.path_step = cli::parse_double("--path-step", text);
+        if (!(options.path_step > 0 && options.path_step <= 0.1))
+          throw cli::UsageError("--path-step: " + text + " is not in (0, 0.1]");
+      });
+
+  parser.section("effect costs");
+  parser.add_switch(
+      "--effects",
+      "measure what each scene effect costs: GPU time per pass with one effect changed at a time "
+      "from all off (SH degree 0..3, relighting, antialiasing modes, depth and splat-count outputs), "
+      "and beside the 'off' rows a scene that never had the effect (SH stored at degree 0, no "
+      "normals); one SCENE, --views or --orbit cameras; --markdown and --csv write the table",
+      &options.effects);
+
+  parser.section("format costs");
+  parser.add_switch(
+      "--formats",
+      "measure what each file format costs: the first SCENE is the lossless reference (a PLY), the "
+      "others the same scene in other formats; per file its size and bytes per Gaussian, load time "
+      "(median of --repeat loads after --warmup) and peak memory, the largest error of every decoded "
+      "attribute, and the image PSNR and max abs error against the reference's at each view (default: "
+      "the first and the middle view of --cameras, else two orbit views); --markdown, --csv and --plot "
+      "(bytes per Gaussian against PSNR) write the report",
+      &options.formats);
+
+  parser.section("scaling report");
+  parser.add_switch(
+      "--scaling",
+      "measure how the frame's cost and device memory grow: every SCENE from the orbit camera that "
+      "frames it at every size of --resolutions (default 960x540,1920x1080,2560x1440,3840x2160), "
+      "GPU time per pass, pairs and device memory, then a non-negative least-squares fit of each "
+      "pass's time and of the memory per Gaussian, per pair and per pixel; --markdown, --csv and "
+      "--plot (PLOT.svg time against Gaussians, PLOT_pixels.svg against image size, PLOT_memory.svg) "
+      "write the report",
+      &options.scaling);
+  parser.add_value(
+      "--tile-copies", "N",
+      "with --scaling: also measure a scene of N copies of the largest SCENE side by side (2 to 64), "
+      "for Gaussian counts no file has",
+      [&options](const std::string& text) {
+        options.tile_copies = cli::parse_int("--tile-copies", text, 2, 64);
+      });
+
+  parser.section("sort micro-benchmark");
+  parser.add_switch("--sort-bench",
+                    "time the sort strategies alone on random keys (no SCENE), with std::sort and a CPU "
+                    "radix sort on the same keys for comparison; --warmup and --repeat count sorts",
+                    &options.sort_bench);
+  parser.add_value("--sort-sizes", "E[,E...]",
+                   "key counts as powers of two, each 0 to 26 (default 10,12,14,16,18,20,22,24)",
+                   [&options](const std::string& text) {
+                     options.sort_sizes = parse_int_list("--sort-sizes", text, 0, 26);
+                   });
+  parser.add_value(
+      "--key-bits", "B[,B...]", "key widths in bits, each 1 to 64 (default 32,64)",
+      [&options](const std::string& text) { options.key_bits = parse_int_list("--key-bits", text, 1, 64); });
+}
+
+void check_outputs(const BenchOptions& options, const std::vector<std::pair<std::string, fs::path>>& inputs) {
+  if (!options.plot.empty() && !cli::has_extension(options.plot, ".svg"))
+    throw cli::UsageError("--plot writes SVG: its file name must end in .svg, got '" + options.plot + "'");
+  const std::vector<std::pair<std::string, fs::path>> outputs = {{"--csv", options.csv},
+                                                                 {"--json", options.json},
+                                                                 {"--plot", options.plot},
+                                                                 {"--markdown", options.markdown}};
+  cli::check_distinct_paths(outputs);
+  // Inputs may repeat (one cameras.json for every scene); only an output may not be one of them.
+  for (const auto& input : inputs) {
+    auto paths = outputs;
+    paths.insert(paths.begin(), input);
+    cli::check_distinct_paths(paths);
+  }
+  for (const auto& [flag, path] : outputs)
+    if (!path.empty()) cli::check_output_path(path, flag);
+}
+
+std::vector<std::pair<std::string, fs::path>> scene_and_camera_inputs(const BenchOptions& options) {
+  std::vector<std::pair<std::string, fs::path>> inputs;
+  for (const auto& scene : options.common.scenes) inputs.emplace_back("SCENE", scene);
+  for (const auto& cameras : options.common.cameras_files) inputs.emplace_back("--cameras", cameras);
+  return inputs;
+}
+
+std::string write_outputs(const std::vector<std::pair<std::string, std::function<std::string()>>>& files,
+                          uint64_t validation_messages) {
+  std::string written;
+  for (const auto& [path, make] : files) {
+    if (path.empty()) continue;
+    tilesplat::write_file_atomically(path, make());
+    written += (written.empty() ? " -> " : ", ") + path;
+  }
+  if (validation_messages > 0)
+    cli::print_warning(kProgram,
+                       std::to_string(validation_messages) + " Vulkan validation messages (see above)");
+  return written;
+}
+
+// What the parser cannot check flag by flag. Throws UsageError.
+void check_frame_options(const cli::ArgParser& parser, const BenchOptions& options) {
+  for (const char* flag : {"--sort-sizes", "--key-bits"})
+    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --sort-bench");
+  if (int(options.accuracy) + int(options.effects) + int(options.formats) + int(options.scaling) > 1)
+    throw cli::UsageError("--accuracy, --effects, --formats and --scaling are separate runs");
+  if (parser.seen("--tile-copies") && !options.scaling)
+    throw cli::UsageError("--tile-copies applies only with --scaling");
+  if (!options.accuracy) {
+    if (parser.seen("--path-frames")) throw cli::UsageError("--path-frames applies only with --accuracy");
+    if (parser.seen("--markdown") && !options.effects && !options.formats && !options.scaling)
+      throw cli::UsageError("--markdown applies only with --accuracy, --effects, --formats or --scaling");
+    if (options.common.modes.size() > 1)
+      throw cli::UsageError(
+          "several --mode combinations are compared by --accuracy; the frame benchmark takes one");
+  }
+  cli::check_common_options(parser, options.common);
+  const size_t cameras = options.common.cameras_files.size();
+  const size_t scenes = options.common.scenes.size();
+  if (cameras > 1 && cameras != scenes)
+    throw cli::UsageError("--cameras was given " + std::to_string(cameras) + " times for " +
+                          std::to_string(scenes) +
+                          " scenes: give it once for every scene, or once per scene in "
+                          "the order of the scenes");
+  if (parser.seen("--views")) {
+    if (cameras == 0 && !cli::any_scene_file(options.common))
+      throw cli::UsageError(
+          "--views needs --cameras FILE.json (without it the cameras orbit the scene: see --orbit)");
+    if (parser.seen("--view")) throw cli::UsageError("--view and --views cannot be combined");
+  }
+  if (parser.seen("--orbit") && cameras > 0)
+    throw cli::UsageError("--orbit applies only to the orbit camera and cannot be combined with --cameras");
+  if (parser.seen("--resolutions"))
+    for (const char* flag : {"--width", "--height"})
+      if (parser.seen(flag))
+        throw cli::UsageError(std::string("--resolutions and ") + flag +
+                              " cannot be combined: give every size in --resolutions");
+}
+
+}  // namespace tilesplat::bench

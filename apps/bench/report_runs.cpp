@@ -1,0 +1,320 @@
+#include "report_runs.h"
+
+#include <cstdio>
+
+#include "bench_plot.h"
+#include "bench_progress.h"
+#include "bench_results.h"
+#include "effects_report.h"
+#include "formats_report.h"
+#include "frame_bench.h"
+#include "scaling_report.h"
+
+namespace tilesplat::bench {
+
+namespace cli = tilesplat::cli;
+namespace fs = std::filesystem;
+namespace plot = tilesplat::plot;
+
+// ---------------------------------------------------------------------------------------------
+// The accuracy report (accuracy_report.h): every mode against the float64 reference, per scene.
+
+// --plot FILE.svg with several scenes: FILE_<scene>.svg for each.
+fs::path scene_plot_path(const std::string& plot, const std::string& scene_file, size_t scenes) {
+  if (scenes == 1) return plot;
+  fs::path path(plot);
+  return path.parent_path() / (path.stem().string() + "_" + fs::path(scene_file).stem().string() + ".svg");
+}
+
+// The report renders every mode against the reference itself, so a scene file's sh_degree effect is
+// applied to the scene (dropping the bands it excludes gives the same images as the cap) rather than
+// to the modes, whose SH cap is one of the things measured.
+int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& options) {
+  for (const char* flag : {"--resolutions", "--orbit", "--json"})
+    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");
+  if (options.common.sorts.size() > 1)
+    throw cli::UsageError("--accuracy measures with one --sort strategy (the modes do not depend on it)");
+  check_outputs(options, scene_and_camera_inputs(options));
+
+  const std::string& command = options.command;
+
+  // Every scene and camera first: a bad file or view fails now, not after an hour of measuring.
+  struct Planned {
+    BenchScene scene;
+    tilesplat::accuracy::Options options;
+  };
+  std::vector<Planned> planned;
+  const cli::ImageSize size{options.common.width, options.common.height};
+  for (size_t s = 0; s < options.common.scenes.size(); ++s) {
+    Planned p;
+    p.scene.loaded = cli::load_scene_file(options.common.scenes[s], options.common.strict, kProgram);
+    p.scene.name = p.scene.loaded.path.filename().string();
+    p.scene.description = cli::describe_scene(p.scene.loaded.scene);
+    p.scene.sh_degree = p.scene.loaded.scene.sh_degree;
+    const auto& cameras = options.common.cameras_files;
+    if (!cameras.empty()) p.scene.cameras = cameras.size() == 1 ? cameras.front() : cameras[s];
+    for (const Case& c : plan_cases(options, p.scene, s, {size})) {
+      p.options.views.push_back(c.camera.camera);
+      p.options.view_names.push_back(c.view_label);
+    }
+    p.options.modes = options.common.modes;
+    p.options.warmup = options.warmup;
+    p.options.repeat = options.repeat;
+    p.options.path = options.path;
+    p.options.path_frames = options.path_frames;
+    p.options.path_step = options.path_step;
+    p.options.consistency_angle = options.consistency_angle;
+    if (!options.common.sorts.empty()) p.options.sort = options.common.sorts.front();
+    planned.push_back(std::move(p));
+  }
+
+  const auto renderer = tilesplat::Renderer::create(cli::renderer_options(options.common));
+  const tilesplat::DeviceInfo device = renderer->device_info();
+  std::printf("device  %s (driver %s)\n", device.name.c_str(), device.driver.c_str());
+  std::fflush(stdout);
+  int total = 0;
+  for (const auto& p : planned) total += tilesplat::accuracy::work_units(p.options, p.scene.sh_degree);
+  Progress progress(total, cli::stderr_is_terminal(), "renders");
+  int done_before = 0;
+  std::vector<tilesplat::accuracy::SceneReport> reports;
+  for (auto& p : planned) {
+    auto report = tilesplat::accuracy::measure_scene(
+        *renderer, p.scene.loaded.scene, p.options, [&](int done, int, const std::string& what) {
+          progress.update(done_before + done, p.scene.name + ": " + what);
+        });
+    done_before += tilesplat::accuracy::work_units(p.options, p.scene.sh_degree);
+    report.scene = p.scene.name;
+    report.description = p.scene.description;
+    std::string views;
+    for (const auto& name : p.options.view_names) views += (views.empty() ? "" : ", ") + name;
+    report.views =
+        views + " at " + cli::format_size(p.options.views.front().width, p.options.views.front().height);
+    p.scene.loaded.scene = {};  // measured: release its memory
+    progress.finish();
+    std::printf("\n%s", tilesplat::accuracy::text_table(report).c_str());
+    std::fflush(stdout);
+    reports.push_back(std::move(report));
+  }
+
+  std::vector<std::pair<std::string, std::function<std::string()>>> files = {
+      {options.markdown, [&] { return tilesplat::accuracy::markdown(reports, device, command); }},
+      {options.csv,
+       [&] { return cli::with_provenance_columns(tilesplat::accuracy::csv(reports, device), command); }}};
+  std::vector<std::string> plot_paths;
+  if (!options.plot.empty())
+    for (const auto& report : reports) {
+      plot_paths.push_back(scene_plot_path(options.plot, report.scene, reports.size()).string());
+      files.emplace_back(plot_paths.back(),
+                         [&report, &device] { return tilesplat::accuracy::pareto_svg(report, device); });
+      if (report.consistency_angle > 0) {
+        fs::path consistency = plot_paths.back();
+        consistency.replace_filename(consistency.stem().string() + "_consistency.svg");
+        plot_paths.push_back(consistency.string());
+        files.emplace_back(plot_paths.back(), [&report, &device] {
+          return tilesplat::accuracy::consistency_svg(report, device);
+        });
+      }
+    }
+  const std::string written = write_outputs(files, renderer->validation_messages());
+  std::fprintf(stderr, "%s: accuracy report, %d renders%s\n", kProgram, total, written.c_str());
+  return cli::kExitOk;
+}
+
+int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options) {
+  for (const char* flag : {"--resolutions", "--json", "--plot"})
+    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --effects");
+  if (options.common.scenes.size() != 1) throw cli::UsageError("--effects measures one SCENE");
+  if (options.common.sorts.size() > 1) throw cli::UsageError("--effects measures with one --sort strategy");
+  if (parser.seen("--antialiasing"))
+    throw cli::UsageError("--antialiasing does not apply to --effects (it measures every mode)");
+  check_outputs(options, {{"SCENE", options.common.scenes.front()}});
+  const std::string& command = options.command;
+
+  BenchScene scene;
+  scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
+  scene.name = scene.loaded.path.filename().string();
+  scene.description = cli::describe_scene(scene.loaded.scene);
+  scene.sh_degree = scene.loaded.scene.sh_degree;
+  if (!options.common.cameras_files.empty()) scene.cameras = options.common.cameras_files.front();
+  tilesplat::effects::Options effect_options;
+  for (const Case& c : plan_cases(options, scene, 0, {{options.common.width, options.common.height}}))
+    effect_options.views.push_back(c.camera.camera);
+  effect_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
+  effect_options.repeat = options.repeat;
+  if (!options.common.sorts.empty()) effect_options.sort = options.common.sorts.front();
+
+  tilesplat::RenderSettings base;
+  if (!options.common.modes.empty()) base.accuracy = options.common.modes.front();
+  cli::apply_scene_settings(scene.loaded, base);
+  std::vector<tilesplat::effects::Row> rows = tilesplat::effects::plan_rows(scene.loaded.scene, base);
+  std::printf(
+      "scene   %s: %s, %s\n", scene.name.c_str(), scene.description.c_str(),
+      cli::format_size(effect_options.views.front().width, effect_options.views.front().height).c_str());
+  std::fflush(stdout);
+  tilesplat::effects::Run run;
+  {
+    Progress progress(tilesplat::effects::work_units(rows, effect_options), cli::stderr_is_terminal());
+    run = tilesplat::effects::measure(
+        cli::renderer_options(options.common), scene.loaded.scene, rows, effect_options,
+        [&](int done, int, const std::string& what) { progress.update(done, what); });
+  }
+  std::printf("device  %s (driver %s)\n\n%s", run.device.name.c_str(), run.device.driver.c_str(),
+              tilesplat::effects::text_table(rows).c_str());
+  std::fflush(stdout);
+  const std::string written = write_outputs(
+      {{options.markdown,
+        [&] { return tilesplat::effects::markdown(rows, scene.name, run.device, command); }},
+       {options.csv,
+        [&] {
+          return cli::with_provenance_columns(tilesplat::effects::csv(rows, scene.name, run.device), command);
+        }}},
+      run.validation_messages);
+  std::fprintf(stderr, "%s: effect costs, %zu rows%s\n", kProgram, rows.size(), written.c_str());
+  return cli::kExitOk;
+}
+
+// "PLOT.svg" -> "PLOT_SUFFIX.svg": the scaling report's second and third charts.
+std::string plot_with_suffix(const std::string& plot, const std::string& suffix) {
+  return plot.substr(0, plot.size() - 4) + "_" + suffix + ".svg";
+}
+
+int run_scaling_report(const cli::ArgParser& parser, const BenchOptions& options) {
+  for (const char* flag : {"--json", "--view", "--views", "--orbit", "--cameras", "--width", "--height"})
+    if (parser.seen(flag))
+      throw cli::UsageError(std::string(flag) +
+                            " does not apply to --scaling (it measures each scene from the "
+                            "orbit camera that frames it, at every --resolutions size)");
+  if (options.common.sorts.size() > 1) throw cli::UsageError("--scaling measures with one --sort strategy");
+  check_outputs(options, scene_and_camera_inputs(options));
+  tilesplat::scaling::Options scaling_options;
+  const std::vector<cli::ImageSize> sizes =
+      options.resolutions.empty()
+          ? std::vector<cli::ImageSize>{{960, 540}, {1920, 1080}, {2560, 1440}, {3840, 2160}}
+          : options.resolutions;
+  for (const cli::ImageSize& size : sizes) scaling_options.sizes.push_back({size.width, size.height});
+  scaling_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
+  scaling_options.repeat = options.repeat;
+  if (!options.common.sorts.empty()) scaling_options.sort = options.common.sorts.front();
+
+  std::vector<tilesplat::scaling::Scene> scenes;
+  for (const std::string& file : options.common.scenes) {
+    cli::LoadedScene loaded = cli::load_scene_file(file, options.common.strict, kProgram);
+    if (loaded.scene.empty()) throw cli::UsageError("'" + file + "' has no Gaussians to measure");
+    std::printf("scene   %s: %s\n", loaded.path.filename().string().c_str(),
+                cli::describe_scene(loaded.scene).c_str());
+    scenes.push_back({loaded.path.filename().string(), std::move(loaded.scene)});
+  }
+  if (options.tile_copies > 0) {
+    const auto largest = std::max_element(scenes.begin(), scenes.end(), [](const auto& a, const auto& b) {
+      return a.scene.size() < b.scene.size();
+    });
+    tilesplat::scaling::Scene tiled{largest->name + " x" + std::to_string(options.tile_copies) + " (tiled)",
+                                    tilesplat::scaling::tile_scene(largest->scene, options.tile_copies)};
+    std::printf("scene   %s: %s\n", tiled.name.c_str(), cli::describe_scene(tiled.scene).c_str());
+    scenes.push_back(std::move(tiled));
+  }
+  std::fflush(stdout);
+  tilesplat::scaling::Run run;
+  {
+    Progress progress(tilesplat::scaling::work_units(scenes, scaling_options), cli::stderr_is_terminal());
+    run = tilesplat::scaling::measure(
+        cli::renderer_options(options.common), scenes, scaling_options,
+        [&](int done, int, const std::string& what) { progress.update(done, what); });
+  }
+  const std::vector<tilesplat::scaling::Fit> fits = tilesplat::scaling::fit(run.points);
+  std::printf("device  %s (driver %s)\n\n%s", run.device.name.c_str(), run.device.driver.c_str(),
+              tilesplat::scaling::text_report(run, fits).c_str());
+  std::fflush(stdout);
+  std::vector<std::pair<std::string, std::function<std::string()>>> files = {
+      {options.markdown, [&] { return tilesplat::scaling::markdown(run, fits, options.command); }},
+      {options.csv,
+       [&] { return cli::with_provenance_columns(tilesplat::scaling::csv(run), options.command); }},
+      {options.plot, [&] { return tilesplat::scaling::svg_time_vs_gaussians(run); }}};
+  if (!options.plot.empty()) {
+    files.push_back({plot_with_suffix(options.plot, "pixels"),
+                     [&] { return tilesplat::scaling::svg_time_vs_pixels(run); }});
+    files.push_back(
+        {plot_with_suffix(options.plot, "memory"), [&] { return tilesplat::scaling::svg_memory(run); }});
+  }
+  const std::string written = write_outputs(files, run.validation_messages);
+  std::fprintf(stderr, "%s: scaling, %zu scenes x %zu sizes%s\n", kProgram, scenes.size(),
+               scaling_options.sizes.size(), written.c_str());
+  return cli::kExitOk;
+}
+
+// The views the format report compares images at: those asked for, else two that see the scene
+// from different sides (the first and the middle view of its cameras, or two opposite orbit views).
+std::vector<Case> plan_format_views(const cli::ArgParser& parser, BenchOptions options,
+                                    const BenchScene& reference) {
+  const bool chosen = parser.seen("--view") || parser.seen("--views") || parser.seen("--orbit");
+  if (!chosen) {
+    const cli::SceneViews own = cli::scene_views(reference.loaded);
+    const size_t count =
+        !reference.cameras.empty() ? cli::load_camera_views(reference.cameras).size() : own.views.size();
+    if (count > 0) {
+      options.views = {0};
+      if (count > 1) options.views.push_back(int(count / 2));
+    } else {
+      options.orbit = 2;
+    }
+  }
+  return plan_cases(options, reference, 0, {{options.common.width, options.common.height}});
+}
+
+int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options) {
+  for (const char* flag : {"--resolutions", "--json"})
+    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --formats");
+  if (options.common.scenes.size() < 2)
+    throw cli::UsageError(
+        "--formats compares files with a reference: give the lossless PLY first, then one or more "
+        "files of the same scene");
+  if (options.common.sorts.size() > 1) throw cli::UsageError("--formats renders with one --sort strategy");
+  if (options.common.cameras_files.size() > 1)
+    throw cli::UsageError("--formats takes one --cameras for all its files");
+  check_outputs(options, scene_and_camera_inputs(options));
+  const std::string& command = options.command;
+
+  BenchScene reference;
+  reference.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
+  if (!options.common.cameras_files.empty()) reference.cameras = options.common.cameras_files.front();
+  tilesplat::formats::Options format_options;
+  std::string view_names;
+  for (const Case& c : plan_format_views(parser, options, reference)) {
+    format_options.views.push_back(c.camera.camera);
+    format_options.view_names.push_back(c.view_label);
+    view_names += (view_names.empty() ? "" : ", ") + c.view_label;
+  }
+  reference.loaded.scene = {};  // measure() loads every file itself, the reference included
+  format_options.warmup = options.warmup;
+  format_options.repeat = options.repeat;
+  if (!options.common.sorts.empty()) format_options.settings.sort = options.common.sorts.front();
+  if (!options.common.modes.empty()) format_options.settings.accuracy = options.common.modes.front();
+  if (options.common.antialiasing) format_options.settings.antialiasing = *options.common.antialiasing;
+
+  const std::vector<fs::path> files(options.common.scenes.begin() + 1, options.common.scenes.end());
+  const auto renderer = tilesplat::Renderer::create(cli::renderer_options(options.common));
+  tilesplat::formats::Report report;
+  {
+    const int total = tilesplat::formats::work_units(files.size(), format_options);
+    Progress progress(total, cli::stderr_is_terminal(), "steps");
+    report = tilesplat::formats::measure(
+        *renderer, options.common.scenes.front(), files, format_options,
+        [&](int done, int, const std::string& what) { progress.update(done, what); });
+  }
+  report.views_label =
+      view_names + " at " +
+      cli::format_size(format_options.views.front().width, format_options.views.front().height);
+  std::printf("device  %s (driver %s)\n\n%s", report.device.name.c_str(), report.device.driver.c_str(),
+              tilesplat::formats::text_table(report).c_str());
+  std::fflush(stdout);
+  const std::string written = write_outputs(
+      {{options.markdown, [&] { return tilesplat::formats::markdown(report, command); }},
+       {options.csv, [&] { return cli::with_provenance_columns(tilesplat::formats::csv(report), command); }},
+       {options.plot, [&] { return tilesplat::formats::size_psnr_svg(report); }}},
+      report.validation_messages);
+  std::fprintf(stderr, "%s: format costs, %zu files against %s%s\n", kProgram, files.size(),
+               report.reference_name.c_str(), written.c_str());
+  return cli::kExitOk;
+}
+
+}  // namespace tilesplat::bench

@@ -1,0 +1,15 @@
+// The bench's reports, each a run of its own: --accuracy (what each accuracy mode costs against the
+// float64 reference), --effects (what each scene effect costs), --scaling (how time and memory grow)
+// and --formats (what each file format costs against the lossless PLY). Each returns the exit code.
+#pragma once
+
+#include "bench_options.h"
+
+namespace tilesplat::bench {
+
+int run_accuracy_report(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
+int run_effects_report(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
+int run_scaling_report(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
+int run_formats_report(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
+
+}  // namespace tilesplat::bench

@@ -1,0 +1,72 @@
+// The options every app has: which scene, which camera, which device, which sort and accuracy modes.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "arg_parser.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/renderer.h"
+
+namespace tilesplat::cli {
+
+struct CommonOptions {
+  std::string scene;
+  std::string cameras;
+  // With SceneChoice::kList, every SCENE and every --cameras in command-line order, and scene and
+  // cameras stay empty.
+  std::vector<std::string> scenes;
+  std::vector<std::string> cameras_files;
+  int view = 0;
+  bool view_given = false;  // --view appeared (a scene file's cameras make it valid without --cameras)
+  int width = 0;  // 0: the view's size (or kOrbitDefaultWidth), keeping the aspect when one is given
+  int height = 0;
+  OrbitParams orbit;
+  bool orbit_given = false;  // an orbit flag (--azimuth, --elevation, --fov, --distance) appeared
+  bool strict = false;
+  std::string device;
+  bool list_devices = false;
+  bool validation = false;
+  std::vector<std::string> sorts;  // validated against sort_strategies(); empty = the app's default
+  // --mode: accuracy mode combinations (parse_accuracy_modes); empty = the reference alone.
+  std::vector<AccuracyModes> modes;
+  // --antialiasing: the footprint filter the asset was trained with; unset = the scene file's, else classic.
+  std::optional<Antialiasing> antialiasing;
+};
+
+inline constexpr int kOrbitDefaultWidth = 1920;
+inline constexpr int kOrbitDefaultHeight = 1080;
+
+enum class SortChoice { kOne, kList };
+// kList: one or more SCENE arguments, and --cameras may be given several times.
+enum class SceneChoice { kOne, kList };
+
+// Declares SCENE, --cameras, --view, --width, --height, the orbit flags, --strict, --device,
+// --list-devices, --validation, --sort (one name, or a comma list / "all" for kList) and --mode
+// (one accuracy mode combination, or a comma list of them for kList), and --antialiasing.
+void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice,
+                        SceneChoice scene_choice = SceneChoice::kOne);
+
+// Loads the sort plugins that --sort-plugin FILE names (tilesplat::load_sort_plugin), before the
+// parser is built: their strategies must be known when --sort is checked and --help lists the
+// names. add_common_options declares the flag itself for --help. Throws what loading throws.
+void load_sort_plugins(int argc, const char* const* argv);
+
+// Checks what the parser cannot check flag by flag (a SCENE was given, orbit flags are not
+// mixed with --cameras, --view has cameras to pick from, ...). Throws UsageError.
+void check_common_options(const ArgParser& parser, const CommonOptions& options);
+
+// parse_and_handle_help, and --list-devices.
+bool parse_and_handle_info_flags(ArgParser& parser, int argc, const char* const* argv,
+                                 const CommonOptions& common);
+
+// Prints list_devices() with the indices --device accepts.
+void print_devices();
+
+RendererOptions renderer_options(const CommonOptions& options);
+
+// Whether any SCENE of the options is a scene file (.json).
+bool any_scene_file(const CommonOptions& options);
+
+}  // namespace tilesplat::cli

@@ -1,0 +1,207 @@
+#include "scene_loading.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <new>
+#include <system_error>
+
+#include "app_run.h"
+#include "text.h"
+#include "tilesplat/camera_sets.h"
+
+namespace tilesplat::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// An error message that names `path`: library messages normally do; this makes sure.
+std::string naming_file(const fs::path& path, std::string_view message) {
+  const std::string text = one_line(message);
+  if (text.find(path.filename().string()) != std::string::npos) return text;
+  return path.string() + ": " + text;
+}
+
+void require_input_file(const fs::path& path, std::string_view what) {
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (!fs::exists(status))
+    throw std::runtime_error("cannot read " + std::string(what) + " " + single_quoted(path.string()) +
+                             ": no such file");
+  if (fs::is_directory(status))
+    throw std::runtime_error("cannot read " + std::string(what) + " " + single_quoted(path.string()) +
+                             ": it is a directory");
+}
+
+void check_camera_size(const Camera& camera) {
+  if (camera.width < 1 || camera.height < 1 || camera.width > kMaxImageSide || camera.height > kMaxImageSide)
+    throw UsageError("the image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                     " is out of range (1 to " + std::to_string(kMaxImageSide) + " pixels a side)");
+}
+
+double elapsed_ms(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view program) {
+  LoadedScene loaded;
+  loaded.path = path;
+  require_input_file(loaded.path, "scene");
+
+  const auto start = std::chrono::steady_clock::now();
+  LoadOptions load_options;
+  load_options.strict = strict;
+  try {
+    if (is_scene_description(loaded.path)) {
+      loaded.description = load_scene_description(loaded.path);
+      loaded.scene = load_described_scene(*loaded.description, load_options, &loaded.report);
+    } else {
+      loaded.scene = load_scene(loaded.path, load_options, &loaded.report);
+    }
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(loaded.path.string() + ": out of memory while loading the scene");
+  } catch (const std::exception& error) {
+    throw std::runtime_error(naming_file(loaded.path, error.what()));
+  }
+  loaded.load_ms = elapsed_ms(start);
+  if (loaded.report.dropped > 0) {
+    std::string summary = loaded.report.summary();
+    if (summary.empty())
+      summary = "dropped " + group_thousands(loaded.report.dropped) + " Gaussians with non-finite values";
+    print_warning(program, naming_file(loaded.path, summary));
+  }
+  return loaded;
+}
+
+SceneViews scene_views(const LoadedScene& loaded) {
+  SceneViews out;
+  if (!loaded.description) return out;
+  out.views = loaded.description->cameras;
+  out.file = loaded.description->cameras_file.empty() ? loaded.path : loaded.description->cameras_file;
+  return out;
+}
+
+Lighting scene_lighting(const SceneEffects& effects) {
+  Lighting lighting;
+  for (const SceneLight& source : effects.lights) {
+    Light light;
+    light.type = source.type == SceneLight::Type::kPoint ? Light::Type::kPoint : Light::Type::kDirectional;
+    for (size_t c = 0; c < 3; ++c) {
+      light.direction[c] = float(source.direction[c]);
+      light.position[c] = float(source.position[c]);
+      light.color[c] = float(source.color[c]);
+    }
+    light.intensity = float(source.intensity);
+    lighting.lights.push_back(light);
+  }
+  for (size_t c = 0; c < 3; ++c) lighting.ambient[c] = float(effects.ambient[c]);
+  return lighting;
+}
+
+void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings) {
+  if (!loaded.description) return;
+  const SceneDescription& description = *loaded.description;
+  settings.background = description.background;
+  settings.depth = description.outputs.depth;
+  settings.splat_count = description.outputs.splat_count;
+  settings.antialiasing = description.effects.antialiasing;
+  settings.lighting = scene_lighting(description.effects);
+  if (description.effects.sh_degree)
+    settings.accuracy.sh_degree_cap =
+        std::min(settings.accuracy.sh_degree_cap, *description.effects.sh_degree);
+}
+
+std::vector<CameraView> load_camera_views(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec))
+    throw std::runtime_error("cannot read cameras " + single_quoted(path.string()) +
+                             ": no such file or folder");
+  std::vector<CameraView> views;
+  try {
+    views = load_camera_set(path);  // a cameras.json, a transforms.json or a COLMAP model
+  } catch (const std::exception& error) {
+    throw std::runtime_error(naming_file(path, error.what()));
+  }
+  if (views.empty()) throw std::runtime_error(single_quoted(path.string()) + " has no views");
+  return views;
+}
+
+NamedCamera view_camera(const std::vector<CameraView>& views, int index, const fs::path& cameras_path,
+                        int width, int height, std::string_view flag) {
+  if (index < 0 || static_cast<size_t>(index) >= views.size())
+    throw UsageError(std::string(flag) + " " + std::to_string(index) +
+                     " is out of range: " + single_quoted(cameras_path.string()) + " has " +
+                     std::to_string(views.size()) + " views (0.." + std::to_string(views.size() - 1) + ")");
+  const auto& view = views[static_cast<size_t>(index)];
+  check_camera_size(view.camera);
+  NamedCamera named;
+  named.camera = resize_camera(view.camera, width, height);
+  named.description = "view " + std::to_string(index);
+  if (!view.name.empty()) named.description += " (" + view.name + ")";
+  named.description += " of " + cameras_path.filename().string();
+  check_camera_size(named.camera);
+  return named;
+}
+
+ImageSize orbit_image_size(int width, int height) {
+  const double aspect = double(kOrbitDefaultWidth) / double(kOrbitDefaultHeight);
+  if (width <= 0 && height <= 0) return {kOrbitDefaultWidth, kOrbitDefaultHeight};
+  if (height <= 0) return {width, static_cast<int>(std::max(1.0, std::round(double(width) / aspect)))};
+  if (width <= 0)
+    return {static_cast<int>(
+                std::min(double(kMaxImageSide) + 1, std::max(1.0, std::round(double(height) * aspect)))),
+            height};
+  return {width, height};
+}
+
+NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const OrbitParams& orbit) {
+  if (loaded.scene.empty())
+    throw std::runtime_error(single_quoted(loaded.path.string()) +
+                             " has no Gaussians for the orbit camera to frame; pass --cameras FILE.json");
+  const ImageSize size = orbit_image_size(width, height);
+  NamedCamera named;
+  named.camera = orbit_camera(loaded.scene, size.width, size.height, orbit);
+  named.description = "orbit azimuth " + format_fixed(orbit.azimuth_deg, 1) + " elevation " +
+                      format_fixed(orbit.elevation_deg, 1) + " fov " +
+                      format_fixed(orbit.vertical_fov_deg, 1);
+  check_camera_size(named.camera);
+  return named;
+}
+
+SceneViews camera_views(const CommonOptions& options, const LoadedScene& loaded) {
+  if (options.cameras.empty()) return scene_views(loaded);
+  return {load_camera_views(options.cameras), options.cameras};
+}
+
+LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program) {
+  LoadedScene loaded = load_scene_file(options.scene, options.strict, program);
+  const SceneViews cameras = camera_views(options, loaded);
+  NamedCamera named;
+  if (!cameras.views.empty()) {
+    if (options.cameras.empty() && options.orbit_given)
+      throw UsageError("--azimuth, --elevation, --fov and --distance apply only to the orbit camera, and " +
+                       single_quoted(loaded.path.string()) +
+                       " has cameras of its own (pick one with --view)");
+    named = view_camera(cameras.views, options.view, cameras.file, options.width, options.height);
+    loaded.view_index = options.view;
+    loaded.view_name = cameras.views[size_t(options.view)].name;  // in range: view_camera checked it
+  } else {
+    if (options.view_given)
+      throw UsageError(
+          "--view needs cameras: " + single_quoted(loaded.path.string()) +
+          " has none, and no --cameras FILE.json was given (without them the camera is an orbit)");
+    named = orbit_view(loaded, options.width, options.height, options.orbit);
+  }
+  loaded.camera = named.camera;
+  loaded.camera_description = named.description;
+  return loaded;
+}
+
+std::string describe_scene(const GaussianScene& scene) {
+  return group_thousands(scene.size()) + " Gaussians (SH" + std::to_string(scene.sh_degree) + ")";
+}
+
+}  // namespace tilesplat::cli

@@ -1,0 +1,87 @@
+// Loading what the command line names: the scene (a splat file or a scene file), its cameras, and
+// the camera of the frame, with errors that name the file.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "arg_parser.h"
+#include "common_options.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+#include "tilesplat/scene_description.h"
+
+namespace tilesplat::cli {
+
+struct LoadedScene {
+  std::filesystem::path path;
+  GaussianScene scene;
+  // Set when the SCENE is a scene file (.json, docs/scene-format.md): its cameras, background,
+  // effects and outputs. Its models are already loaded, transformed and merged into `scene`.
+  std::optional<SceneDescription> description;
+  LoadReport report;
+  Camera camera;
+  std::string camera_description;  // "view 0 of cams.json" or "orbit azimuth 0 elevation 20 fov 50"
+  std::optional<int> view_index;   // the view's index in its cameras, when the camera is a view
+  std::string view_name;           // its img_name (may be empty); empty for the orbit camera
+  double load_ms = 0;
+};
+
+// Loads the scene (printing LoadReport::summary() to stderr as a warning when Gaussians were
+// dropped) and builds the camera at the requested size: --cameras, else the scene file's cameras,
+// else the orbit. A missing or unreadable file throws std::runtime_error naming it; an
+// out-of-range --view throws UsageError naming the file and its number of views.
+LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program);
+
+// The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
+// load_scene_file fills path, scene, description, report and load_ms only.
+LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program);
+
+// The views a scene file brings ("cameras") and the file that names them (the cameras.json it
+// refers to, else the scene file). No views for a .ply, or a scene file without cameras.
+struct SceneViews {
+  std::vector<CameraView> views;
+  std::filesystem::path file;
+};
+SceneViews scene_views(const LoadedScene& loaded);
+// The views a run picks from: those of --cameras (loaded) when given, else the scene file's own.
+// No views when neither has any.
+SceneViews camera_views(const CommonOptions& options, const LoadedScene& loaded);
+
+// A scene file's lights and ambient as the renderer's Lighting (off when the file has no lights).
+Lighting scene_lighting(const SceneEffects& effects);
+
+// What a scene file asks of every frame: its background, its outputs (depth, splat_count), its
+// antialiasing, its lights (lighting) and its sh_degree effect (accuracy.sh_degree_cap: the smaller
+// of it and the --mode's cap). A .ply leaves the settings as they are. Flags that override the scene
+// file are applied after this.
+void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings);
+
+// The views of a camera set: a cameras.json, a transforms.json or a COLMAP model (folder or file;
+// tilesplat::load_camera_set). Throws std::runtime_error naming the file when it is missing,
+// malformed or has no views.
+std::vector<CameraView> load_camera_views(const std::filesystem::path& path);
+
+struct NamedCamera {
+  Camera camera;
+  std::string description;  // as LoadedScene::camera_description
+};
+// View `index` of `views` (read from `cameras_path`) at width x height (0: see CommonOptions).
+// An out-of-range index throws UsageError naming `flag`, the file and its number of views.
+NamedCamera view_camera(const std::vector<CameraView>& views, int index,
+                        const std::filesystem::path& cameras_path, int width, int height,
+                        std::string_view flag = "--view");
+// The size of a camera of its own making (orbit, path) for --width W --height H (0: not given):
+// 1920x1080 by default, one side given keeps that aspect.
+ImageSize orbit_image_size(int width, int height);
+// The orbit camera framing the scene (which must not be empty) at width x height (0: see CommonOptions).
+NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const OrbitParams& orbit);
+
+// "SH3" style summary of the scene: "64 Gaussians (SH3)".
+std::string describe_scene(const GaussianScene& scene);
+
+}  // namespace tilesplat::cli
