@@ -15,23 +15,17 @@ using namespace tilesplat::bench;
 int run(int argc, char** argv) {
   cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
   BenchOptions options;
-  cli::ArgParser parser(
-      kProgram, "tilesplat-bench SCENE.ply|SCENE.json [SCENE...] [options]",
-      "Renders 3D Gaussian Splatting scenes repeatedly and prints the GPU time of every pass "
-      "(median, min, max over the measured frames) for each sort strategy, with the frame's "
-      "CPU time, visible Gaussians, intersections and device memory. Every scene is measured "
-      "at every size (--resolutions) from every camera of its path (--views of --cameras, or "
-      "--orbit); a progress bar on stderr counts the frames of the whole run.");
+  cli::ArgParser parser(kProgram, kUsage, kDescription);
   add_bench_options(parser, options);
   if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
   options.command = cli::command_line(kProgram, argc, argv);
-  if (options.sort_bench) return run_sort_bench(parser, options);
-  check_frame_options(parser, options);
-  if (options.accuracy) return run_accuracy_report(parser, options);
-  if (options.effects) return run_effects_report(parser, options);
-  if (options.formats) return run_formats_report(parser, options);
-  if (options.scaling) return run_scaling_report(parser, options);
-  return run_frame_bench(parser, options);
+  check_bench_flags(parser, options);
+  if (options.sort_bench) return run_sort_bench(options);
+  if (options.accuracy) return run_accuracy_report(options);
+  if (options.effects) return run_effects_report(options);
+  if (options.formats) return run_formats_report(options);
+  if (options.scaling) return run_scaling_report(options);
+  return run_frame_bench(options);
 }
 
 }  // namespace

@@ -239,4 +239,46 @@ void check_frame_options(const cli::ArgParser& parser, const BenchOptions& optio
                               " cannot be combined: give every size in --resolutions");
 }
 
+void check_bench_flags(const cli::ArgParser& parser, const BenchOptions& options) {
+  if (options.sort_bench) {
+    if (!options.common.scenes.empty())
+      throw cli::UsageError("--sort-bench sorts random keys and takes no SCENE");
+    for (const char* flag : {"--cameras", "--view", "--views", "--orbit", "--width", "--height",
+                             "--resolutions", "--azimuth", "--elevation", "--fov", "--distance", "--strict"})
+      if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --sort-bench");
+    return;
+  }
+  check_frame_options(parser, options);
+  if (options.accuracy) {
+    for (const char* flag : {"--resolutions", "--orbit", "--json"})
+      if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");
+    if (options.common.sorts.size() > 1)
+      throw cli::UsageError("--accuracy measures with one --sort strategy (the modes do not depend on it)");
+  } else if (options.effects) {
+    for (const char* flag : {"--resolutions", "--json", "--plot"})
+      if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --effects");
+    if (options.common.scenes.size() != 1) throw cli::UsageError("--effects measures one SCENE");
+    if (options.common.sorts.size() > 1) throw cli::UsageError("--effects measures with one --sort strategy");
+    if (parser.seen("--antialiasing"))
+      throw cli::UsageError("--antialiasing does not apply to --effects (it measures every mode)");
+  } else if (options.scaling) {
+    for (const char* flag : {"--json", "--view", "--views", "--orbit", "--cameras", "--width", "--height"})
+      if (parser.seen(flag))
+        throw cli::UsageError(std::string(flag) +
+                              " does not apply to --scaling (it measures each scene from the "
+                              "orbit camera that frames it, at every --resolutions size)");
+    if (options.common.sorts.size() > 1) throw cli::UsageError("--scaling measures with one --sort strategy");
+  } else if (options.formats) {
+    for (const char* flag : {"--resolutions", "--json"})
+      if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --formats");
+    if (options.common.scenes.size() < 2)
+      throw cli::UsageError(
+          "--formats compares files with a reference: give the lossless PLY first, then one or more "
+          "files of the same scene");
+    if (options.common.sorts.size() > 1) throw cli::UsageError("--formats renders with one --sort strategy");
+    if (options.common.cameras_files.size() > 1)
+      throw cli::UsageError("--formats takes one --cameras for all its files");
+  }
+}
+
 }  // namespace tilesplat::bench

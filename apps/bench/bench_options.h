@@ -14,6 +14,13 @@
 namespace tilesplat::bench {
 
 inline constexpr const char* kProgram = "tilesplat-bench";
+inline constexpr const char* kUsage = "tilesplat-bench SCENE.ply|SCENE.json [SCENE...] [options]";
+inline constexpr const char* kDescription =
+    "Renders 3D Gaussian Splatting scenes repeatedly and prints the GPU time of every pass "
+    "(median, min, max over the measured frames) for each sort strategy, with the frame's "
+    "CPU time, visible Gaussians, intersections and device memory. Every scene is measured "
+    "at every size (--resolutions) from every camera of its path (--views of --cameras, or "
+    "--orbit); a progress bar on stderr counts the frames of the whole run.";
 
 struct BenchOptions {
   tilesplat::cli::CommonOptions common;
@@ -51,6 +58,10 @@ std::vector<int> parse_int_list(std::string_view flag, const std::string& text, 
 
 // What the parser cannot check flag by flag, for the frame benchmark and the reports. Throws UsageError.
 void check_frame_options(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
+
+// Every check of a parsed command line that needs no file, for whichever mode it asks for
+// (--sort-bench, a report, or the frame benchmark: check_frame_options). Throws UsageError.
+void check_bench_flags(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
 
 // Before any work: no output may overwrite an input or another output, the plot must be an SVG, and
 // every output's directory must exist, so that a long run never ends in a file it cannot write.

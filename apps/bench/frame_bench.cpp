@@ -345,7 +345,7 @@ void print_auto_choice(const tilesplat::Renderer& renderer, const std::vector<st
     std::printf("auto    sorts with %s on this device\n", renderer.sort_strategy_for("auto").c_str());
 }
 
-int run_frame_bench(const cli::ArgParser&, const BenchOptions& options) {
+int run_frame_bench(const BenchOptions& options) {
   check_outputs(options, scene_and_camera_inputs(options));
 
   std::vector<std::string> sorts = options.common.sorts;

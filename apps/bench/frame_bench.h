@@ -43,7 +43,7 @@ std::vector<Case> plan_cases(const BenchOptions& options, const BenchScene& scen
                              const std::vector<tilesplat::cli::ImageSize>& sizes);
 
 // The frame benchmark (tilesplat-bench without a report flag). Returns the exit code.
-int run_frame_bench(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
+int run_frame_bench(const BenchOptions& options);
 
 // With "auto" among the sorts: which strategy it stands for on this device (its rows are labelled auto).
 void print_auto_choice(const Renderer& renderer, const std::vector<std::string>& sorts);

@@ -29,11 +29,7 @@ fs::path scene_plot_path(const std::string& plot, const std::string& scene_file,
 // The report renders every mode against the reference itself, so a scene file's sh_degree effect is
 // applied to the scene (dropping the bands it excludes gives the same images as the cap) rather than
 // to the modes, whose SH cap is one of the things measured.
-int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& options) {
-  for (const char* flag : {"--resolutions", "--orbit", "--json"})
-    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");
-  if (options.common.sorts.size() > 1)
-    throw cli::UsageError("--accuracy measures with one --sort strategy (the modes do not depend on it)");
+int run_accuracy_report(const BenchOptions& options) {
   check_outputs(options, scene_and_camera_inputs(options));
 
   const std::string& command = options.command;
@@ -120,13 +116,7 @@ int run_accuracy_report(const cli::ArgParser& parser, const BenchOptions& option
   return cli::kExitOk;
 }
 
-int run_effects_report(const cli::ArgParser& parser, const BenchOptions& options) {
-  for (const char* flag : {"--resolutions", "--json", "--plot"})
-    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --effects");
-  if (options.common.scenes.size() != 1) throw cli::UsageError("--effects measures one SCENE");
-  if (options.common.sorts.size() > 1) throw cli::UsageError("--effects measures with one --sort strategy");
-  if (parser.seen("--antialiasing"))
-    throw cli::UsageError("--antialiasing does not apply to --effects (it measures every mode)");
+int run_effects_report(const BenchOptions& options) {
   check_outputs(options, {{"SCENE", options.common.scenes.front()}});
   const std::string& command = options.command;
 
@@ -178,13 +168,7 @@ std::string plot_with_suffix(const std::string& plot, const std::string& suffix)
   return plot.substr(0, plot.size() - 4) + "_" + suffix + ".svg";
 }
 
-int run_scaling_report(const cli::ArgParser& parser, const BenchOptions& options) {
-  for (const char* flag : {"--json", "--view", "--views", "--orbit", "--cameras", "--width", "--height"})
-    if (parser.seen(flag))
-      throw cli::UsageError(std::string(flag) +
-                            " does not apply to --scaling (it measures each scene from the "
-                            "orbit camera that frames it, at every --resolutions size)");
-  if (options.common.sorts.size() > 1) throw cli::UsageError("--scaling measures with one --sort strategy");
+int run_scaling_report(const BenchOptions& options) {
   check_outputs(options, scene_and_camera_inputs(options));
   tilesplat::scaling::Options scaling_options;
   const std::vector<cli::ImageSize> sizes =
@@ -244,9 +228,9 @@ int run_scaling_report(const cli::ArgParser& parser, const BenchOptions& options
 
 // The views the format report compares images at: those asked for, else two that see the scene
 // from different sides (the first and the middle view of its cameras, or two opposite orbit views).
-std::vector<Case> plan_format_views(const cli::ArgParser& parser, BenchOptions options,
-                                    const BenchScene& reference) {
-  const bool chosen = parser.seen("--view") || parser.seen("--views") || parser.seen("--orbit");
+std::vector<Case> plan_format_views(BenchOptions options, const BenchScene& reference) {
+  const bool chosen =
+      options.common.view_given || !options.views.empty() || options.all_views || options.orbit > 0;
   if (!chosen) {
     const cli::SceneViews own = cli::scene_views(reference.loaded);
     const size_t count =
@@ -261,16 +245,7 @@ std::vector<Case> plan_format_views(const cli::ArgParser& parser, BenchOptions o
   return plan_cases(options, reference, 0, {{options.common.width, options.common.height}});
 }
 
-int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options) {
-  for (const char* flag : {"--resolutions", "--json"})
-    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --formats");
-  if (options.common.scenes.size() < 2)
-    throw cli::UsageError(
-        "--formats compares files with a reference: give the lossless PLY first, then one or more "
-        "files of the same scene");
-  if (options.common.sorts.size() > 1) throw cli::UsageError("--formats renders with one --sort strategy");
-  if (options.common.cameras_files.size() > 1)
-    throw cli::UsageError("--formats takes one --cameras for all its files");
+int run_formats_report(const BenchOptions& options) {
   check_outputs(options, scene_and_camera_inputs(options));
   const std::string& command = options.command;
 
@@ -279,7 +254,7 @@ int run_formats_report(const cli::ArgParser& parser, const BenchOptions& options
   if (!options.common.cameras_files.empty()) reference.cameras = options.common.cameras_files.front();
   tilesplat::formats::Options format_options;
   std::string view_names;
-  for (const Case& c : plan_format_views(parser, options, reference)) {
+  for (const Case& c : plan_format_views(options, reference)) {
     format_options.views.push_back(c.camera.camera);
     format_options.view_names.push_back(c.view_label);
     view_names += (view_names.empty() ? "" : ", ") + c.view_label;

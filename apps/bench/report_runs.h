@@ -7,9 +7,9 @@
 
 namespace tilesplat::bench {
 
-int run_accuracy_report(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
-int run_effects_report(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
-int run_scaling_report(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
-int run_formats_report(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
+int run_accuracy_report(const BenchOptions& options);
+int run_effects_report(const BenchOptions& options);
+int run_scaling_report(const BenchOptions& options);
+int run_formats_report(const BenchOptions& options);
 
 }  // namespace tilesplat::bench

@@ -187,12 +187,7 @@ std::string make_sort_svg(const std::vector<SortRow>& rows, const tilesplat::Dev
 
 }  // namespace
 
-int run_sort_bench(const cli::ArgParser& parser, const BenchOptions& options) {
-  if (!options.common.scenes.empty())
-    throw cli::UsageError("--sort-bench sorts random keys and takes no SCENE");
-  for (const char* flag : {"--cameras", "--view", "--views", "--orbit", "--width", "--height",
-                           "--resolutions", "--azimuth", "--elevation", "--fov", "--distance", "--strict"})
-    if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --sort-bench");
+int run_sort_bench(const BenchOptions& options) {
   check_outputs(options, {});
 
   std::vector<std::string> sorts = options.common.sorts;

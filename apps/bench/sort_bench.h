@@ -7,6 +7,6 @@
 namespace tilesplat::bench {
 
 // Returns the exit code.
-int run_sort_bench(const tilesplat::cli::ArgParser& parser, const BenchOptions& options);
+int run_sort_bench(const BenchOptions& options);
 
 }  // namespace tilesplat::bench

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli.h"
+#include "info_options.h"
 #include "tilesplat/scene.h"
 
 namespace {
@@ -15,7 +16,7 @@ namespace {
 namespace cli = tilesplat::cli;
 namespace fs = std::filesystem;
 
-constexpr const char* kProgram = "tilesplat-info";
+using namespace tilesplat::info;
 
 struct FileInfo {
   cli::LoadedScene loaded;
@@ -110,19 +111,14 @@ nlohmann::json to_json(const FileInfo& info) {
 }
 
 int run(int argc, char** argv) {
-  std::vector<std::string> files;
-  bool json = false;
-  bool strict = false;
-  cli::ArgParser parser(
-      kProgram, "tilesplat-info [options] FILE...",
-      "Prints what each scene file holds: format and version, Gaussians, SH degree, size, boxes, "
-      "opacity and scale ranges, non-finite values, and the time and memory loading it took. Reads "
-      ".ply, compressed .ply, .splat, .spz, .sog, SOG meta.json, .glb and .gltf.");
-  parser.add_switch("--json", "one JSON array of objects on stdout, for scripts", &json);
-  parser.add_switch("--strict", "fail on a non-finite value instead of dropping the Gaussian", &strict);
-  parser.add_positional_list("FILE", "scene files", &files);
+  InfoOptions options;
+  cli::ArgParser parser(kProgram, kUsage, kDescription);
+  add_info_options(parser, options);
   if (cli::parse_and_handle_help(parser, argc, argv)) return cli::kExitOk;
-  if (files.empty()) throw cli::UsageError("missing the FILE argument (see --help)");
+  check_info_flags(options);
+  const auto& files = options.files;
+  const bool json = options.json;
+  const bool strict = options.strict;
   nlohmann::json all = nlohmann::json::array();
   int status = cli::kExitOk;
   for (size_t i = 0; i < files.size(); ++i) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cli.h"
+#include "viewer_options.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
@@ -39,19 +40,12 @@ using tilesplat::viewer::OrbitController;
 using tilesplat::viewer::Swapchain;
 using tilesplat::viewer::WindowDevice;
 
-constexpr const char* kProgram = "tilesplat-viewer";
+using namespace tilesplat::viewer;
 constexpr int kDefaultWindowWidth = 960;  // the height follows the view's aspect
 // What key M steps through: the reference; depth16, the web viewers' sort keys; resort8, per-pixel
 // re-sorting, more exact than the reference; and the web viewers' shortcuts all together.
 constexpr const char* kModeCycle[] = {"reference", "depth16", "resort8", "depth16+opacity-extent+fp16-sh+fp16-cov"};
 
-struct ViewerOptions {
-  cli::CommonOptions common;
-  int frames = 0;  // 0: until the window is closed
-  std::string screenshot;
-  bool no_mesh = false;       // the splats alone, straight into the float image
-  bool no_depth_out = false;  // the splats write no depth: the grid is drawn over them
-};
 
 bool validation_from_environment() {
   const char* value = std::getenv("TILESPLAT_VALIDATION");
@@ -380,41 +374,11 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewe
 int run(int argc, char** argv) {
   cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
   ViewerOptions options;
-  cli::ArgParser parser(kProgram, "tilesplat-viewer SCENE.ply|SCENE.json [options]",
-                        "Shows a 3D Gaussian Splatting scene in a window. Left-drag orbits around the "
-                        "scene's centre, right- or "
-                        "middle-drag pans, the wheel zooms; N and P (or the arrow keys) step through the "
-                        "views of --cameras or the "
-                        "scene file, M cycles accuracy modes, S cycles sort strategies, D turns the splats' "
-                        "depth out off and on, "
-                        "Esc or Q quits. The window starts at --width x --height (default 960 wide, the "
-                        "view's aspect) and the image "
-                        "follows its size. A box at the scene's centre is drawn before the splats (it hides "
-                        "what is behind it) and a "
-                        "ground grid after (the splats hide it where they are dense), as a host "
-                        "application's meshes would be.");
-  cli::add_common_options(parser, options.common, cli::SortChoice::kOne);
-  parser.section("scripting");
-  parser.add_int("--frames", "N", "render N frames, then exit (default: run until the window is closed)",
-                 &options.frames, 1, 1000000);
-  parser.add_string(
-      "--screenshot", "FILE",
-      "on exit, write the last frame: an .exr of the splats as tilesplat-render writes it, or a .png "
-      "of the window as shown",
-      &options.screenshot);
-  parser.section("mesh");
-  parser.add_switch("--no-mesh", "show the splats alone, without the box and the grid", &options.no_mesh);
-  parser.add_switch("--no-depth-out", "the splats write no depth, so the grid is drawn over them (key D)",
-                    &options.no_depth_out);
+  cli::ArgParser parser(kProgram, kUsage, kDescription);
+  add_viewer_options(parser, options);
   if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
-  cli::check_common_options(parser, options.common);
-  if (!options.screenshot.empty()) {
-    if (!cli::has_extension(options.screenshot, ".exr") && !cli::has_extension(options.screenshot, ".png"))
-      throw cli::UsageError("--screenshot expects an .exr or .png file, got '" + options.screenshot + "'");
-    cli::check_distinct_paths(
-        {{"SCENE", options.common.scene}, {"--cameras", options.common.cameras}, {"--screenshot", options.screenshot}});
-    cli::check_output_path(options.screenshot, "--screenshot");
-  }
+  check_viewer_flags(parser, options);
+  if (!options.screenshot.empty()) cli::check_output_path(options.screenshot, "--screenshot");
   if (!parser.seen("--width") && !parser.seen("--height")) options.common.width = kDefaultWindowWidth;
   options.common.validation = options.common.validation || validation_from_environment();
 

@@ -1,0 +1,216 @@
+#include "render_options.h"
+
+#include <cmath>
+#include <filesystem>
+#include <utility>
+
+#include "frame_sequence.h"
+
+namespace tilesplat::render_app {
+
+namespace cli = tilesplat::cli;
+namespace fs = std::filesystem;
+
+bool renders_sequence(const cli::ArgParser& parser) {
+  return parser.seen("--views") || parser.seen("--orbit") || parser.seen("--path");
+}
+
+namespace {
+
+std::string single_quoted(const std::string& text) {
+  return "'" + text + "'";
+}
+
+// The flag mistakes of a many-frame run, before anything is loaded.
+void check_sequence_flags(const cli::ArgParser& parser, const RenderOptions& options) {
+  const int sources = int(parser.seen("--views")) + int(parser.seen("--orbit")) + int(parser.seen("--path"));
+  if (sources > 1)
+    throw cli::UsageError("--views, --orbit and --path each choose the frames: give one of them");
+  if (parser.seen("--frames") != parser.seen("--path"))
+    throw cli::UsageError(parser.seen("--path")
+                              ? "--path needs --frames N: how many frames to render along it"
+                              : "--frames applies to --path KEYS.json");
+  if (!renders_sequence(parser)) {
+    for (const char* flag : {"--shard", "--shard-count", "--force"})
+      if (parser.seen(flag))
+        throw cli::UsageError(std::string(flag) + " applies to many frames (--views, --orbit or --path)");
+    return;
+  }
+  if (parser.seen("--view"))
+    throw cli::UsageError("--view renders one view; --views chooses several, not both");
+  if (!options.common.cameras.empty() && !parser.seen("--views"))
+    throw cli::UsageError(
+        "--cameras gives the views that --views chooses from; --orbit and --path make their own");
+  if (parser.seen("--path"))
+    for (const char* orbit_flag : {"--azimuth", "--elevation", "--fov", "--distance"})
+      if (parser.seen(orbit_flag))
+        throw cli::UsageError(std::string(orbit_flag) +
+                              " shapes the orbit; the keyframes of --path set the camera");
+  if (options.stats)
+    throw cli::UsageError(
+        "--stats prints one frame's statistics; with many frames the manifest records each one's GPU ms");
+  if (parser.seen("--shard-count") && parser.seen("--shard"))
+    throw cli::UsageError("--shard-count is for Kubernetes Indexed Jobs; --shard I/N names the count itself");
+}
+
+}  // namespace
+
+void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
+  cli::add_common_options(parser, options.common, cli::SortChoice::kOne);
+
+  parser.section("output");
+  parser.add_string(
+      "--output", "OUT.exr",
+      "the EXR to write (required): R G B A, plus Z (expected depth) and 'splats' (blended "
+      "splats per pixel) unless turned off; for a scene file, the channels its \"outputs\" list",
+      &options.output, "-o");
+  parser.add_string(
+      "--png", "FILE.png",
+      "also write an 8-bit sRGB preview: the trained colours, round(255 c), as other viewers show "
+      "them",
+      &options.png);
+  parser.add_value(
+      "--exposure", "STOPS",
+      "brighten (or darken, if negative) the --png preview by 2^STOPS of linear light, -20 to 20 "
+      "(default: the scene file's, else 0)",
+      [&options](const std::string& text) {
+        const double stops = cli::parse_double("--exposure", text);
+        if (!(std::abs(stops) <= 20))
+          throw cli::UsageError("--exposure must be from -20 to 20 stops, got " + single_quoted(text));
+        options.preview.exposure_stops = stops;
+      });
+  parser.add_value(
+      "--tone-map", "CURVE",
+      "the --png preview's tone curve, on linear light: none (clip at 1), aces (filmic) or reinhard "
+      "(x / (1 + x)) (default: the scene file's, else none)",
+      [&options](const std::string& text) {
+        if (text == "none")
+          options.preview.tone_map = tilesplat::ToneMap::kNone;
+        else if (text == "aces")
+          options.preview.tone_map = tilesplat::ToneMap::kAces;
+        else if (text == "reinhard")
+          options.preview.tone_map = tilesplat::ToneMap::kReinhard;
+        else
+          throw cli::UsageError("--tone-map must be none, aces or reinhard, got " + single_quoted(text));
+      });
+  parser.add_switch("--half", "store the EXR channels as 16-bit HALF instead of 32-bit FLOAT", &options.half);
+  parser.add_value(
+      "--exr-compression", "METHOD",
+      "zip (default, lossless), piz (lossless wavelet), dwaa (lossy on R G B, small files for review; A and "
+      "Z stay lossless), or none",
+      [&options](const std::string& text) {
+        using tilesplat::ExrCompression;
+        for (const ExrCompression c :
+             {ExrCompression::kZip, ExrCompression::kPiz, ExrCompression::kDwaa, ExrCompression::kNone})
+          if (text == tilesplat::to_string(c)) {
+            options.compression = c;
+            return;
+          }
+        throw cli::UsageError("--exr-compression must be zip, piz, dwaa or none, got " + single_quoted(text));
+      });
+  parser.add_value(
+      "--exr-colour", "ENCODING",
+      "what the EXR's R G B hold: linear (default: scene-linear Rec.709, the sRGB decoding of the "
+      "trained colours, as compositing tools expect) or display (the trained colours as rendered, "
+      "bit for bit); the header's colorInteropID says which (docs/colour.md)",
+      [&options](const std::string& text) {
+        if (text == "linear")
+          options.exr_colour = tilesplat::ColourEncoding::kSceneLinear;
+        else if (text == "display")
+          options.exr_colour = tilesplat::ColourEncoding::kSrgbDisplay;
+        else
+          throw cli::UsageError("--exr-colour must be linear or display, got " + single_quoted(text));
+      });
+  parser.add_switch("--no-depth", "do not compute or store the depth channel (Z)", &options.no_depth);
+  parser.add_switch("--no-count", "do not compute or store the per-pixel splat count", &options.no_count);
+
+  parser.section("rendering");
+  parser.add_value(
+      "--background", "R,G,B",
+      "background colour, in the trained colours' display values (default: the scene file's, else "
+      "0,0,0)",
+      [&options](const std::string& text) { options.background = cli::parse_rgb("--background", text); });
+  parser.add_int(
+      "--stochastic", "N",
+      "composite without a depth sort: each splat kept per pixel with probability alpha, nearest kept "
+      "wins, the mean of N such frames (1 to 4096; converges to the sorted image as 1/sqrt(N))",
+      &options.stochastic_frames, 1, 4096);
+  parser.add_switch("--reference",
+                    "render with the float64 CPU reference instead of the GPU (slow; for checking)",
+                    &options.reference);
+  parser.add_switch("--stats",
+                    "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
+                    "intersections, retries",
+                    &options.stats);
+
+  parser.section("many frames (one process; -o and --png then take a frame number: out/view_%04d.exr)");
+  parser.add_string(
+      "--views", "SELECTION",
+      "render these views of the cameras: all, a list such as 0,3,8-11, or every:K (0, K, 2K, ...; "
+      "every:8 is the 3DGS evaluation split); the frame number is the view index",
+      &options.views);
+  parser.add_int("--orbit", "N",
+                 "render N frames around the scene (from --azimuth, 360/N degrees apart, at --elevation, "
+                 "--fov, --distance)",
+                 &options.orbit_frames, 1, 1000000);
+  parser.add_string("--path", "KEYS.json",
+                    "render --frames N frames along a keyframed camera path (Catmull-Rom positions, slerped "
+                    "rotations; the format is docs/camera-paths.md)",
+                    &options.path_file);
+  parser.add_int("--frames", "N", "how many frames --path renders", &options.path_frames, 1, 1000000);
+  parser.add_value("--shard", "I/N",
+                   "render only frames k with k mod N == I (default: from a Slurm job array's "
+                   "SLURM_ARRAY_TASK_ID/COUNT/MIN, or a Kubernetes Indexed Job's JOB_COMPLETION_INDEX)",
+                   [&options](const std::string& text) { options.shard = text; });
+  parser.add_value("--shard-count", "N",
+                   "the number of shards of a Kubernetes Indexed Job (its completions; default: "
+                   "TILESPLAT_SHARD_COUNT)",
+                   [&options](const std::string& text) {
+                     options.shard_count = cli::parse_int("--shard-count", text, 1, 1000000);
+                   });
+  parser.add_switch("--force",
+                    "render every frame again, even those the manifest lists as done with matching files",
+                    &options.force);
+  parser.add_switch("--quiet", "no progress bar or progress lines (errors and warnings still print)",
+                    &options.quiet);
+  parser.add_string("--merge-manifests", "FOLDER",
+                    "check that the shards' manifests in FOLDER cover every frame exactly once with intact "
+                    "files, and write their union to FOLDER/manifest.jsonl (no rendering)",
+                    &options.merge_folder);
+}
+
+void check_render_flags(const cli::ArgParser& parser, const RenderOptions& options) {
+  cli::check_common_options(parser, options.common);
+  check_sequence_flags(parser, options);
+  if (options.output.empty())
+    throw cli::UsageError("missing -o OUT.exr: where to write the image (see --help)");
+  if (!cli::has_extension(options.output, ".exr"))
+    throw cli::UsageError("-o expects an .exr file, got " + single_quoted(options.output) +
+                          " (use --png for a PNG preview)");
+  if (!options.png.empty() && !cli::has_extension(options.png, ".png"))
+    throw cli::UsageError("--png expects a .png file, got " + single_quoted(options.png));
+  for (const char* preview_flag : {"--exposure", "--tone-map"})
+    if (parser.seen(preview_flag) && options.png.empty())
+      throw cli::UsageError(std::string(preview_flag) +
+                            " applies to the --png preview, and no --png was given");
+  cli::check_distinct_paths({{"SCENE", options.common.scene},
+                             {"--cameras", options.common.cameras},
+                             {"-o", options.output},
+                             {"--png", options.png}});
+  if (options.reference && parser.seen("--stochastic"))
+    throw cli::UsageError("--stochastic is a GPU compositor; the --reference renderer blends sorted lists");
+  const bool sequence = renders_sequence(parser);
+  // Fail before the (possibly long) load and render when the outputs cannot be written.
+  if (sequence)
+    for (const auto& [flag, pattern] : {std::pair{"-o", options.output}, std::pair{"--png", options.png}}) {
+      if (pattern.empty()) continue;
+      cli::frame_file(flag, pattern, 0);  // throws for a malformed pattern
+      if (cli::has_frame_number(fs::path(pattern).parent_path().string()))
+        throw cli::UsageError(
+            std::string(flag) + " " + single_quoted(pattern) +
+            ": the frame number belongs in the file name, not the folder (the folder holds the "
+            "manifest)");
+    }
+}
+
+}  // namespace tilesplat::render_app

@@ -1,0 +1,62 @@
+// tilesplat-render's command line: its options, their declarations and the checks that need no
+// file. The library part of the app, so that a test can parse every documented command as the app does.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+
+#include "cli.h"
+#include "tilesplat/image.h"
+#include "tilesplat/renderer.h"
+
+namespace tilesplat::render_app {
+
+inline constexpr const char* kProgram = "tilesplat-render";
+inline constexpr const char* kUsage = "tilesplat-render SCENE.ply|SCENE.json -o OUT.exr [options]";
+inline constexpr const char* kDescription =
+    "Renders a view of a 3D Gaussian Splatting scene with the Vulkan compute renderer "
+    "and writes it as an EXR. The camera comes from a camera set (--cameras: the "
+    "trainer's cameras.json, a transforms.json or a COLMAP model; --view), from the scene "
+    "file's cameras (--view), or orbits the scene (--azimuth, --elevation, --fov). "
+    "--views, --orbit N and --path render many frames in one process, resumably "
+    "(out/manifest.jsonl) and in shards (--shard). A scene file's background and outputs "
+    "apply unless --background, --no-depth or --no-count say otherwise.";
+
+struct RenderOptions {
+  tilesplat::cli::CommonOptions common;
+  std::string output;
+  std::string png;
+  std::array<float, 3> background = {0, 0, 0};
+  PreviewOptions preview;
+  bool half = false;
+  ExrCompression compression = ExrCompression::kZip;
+  ColourEncoding exr_colour = ColourEncoding::kSceneLinear;
+  bool no_depth = false;
+  bool no_count = false;
+  bool reference = false;
+  int stochastic_frames = 0;  // --stochastic N: the sort-free compositor averaging N frames; 0 = sorted
+  bool stats = false;
+  // Many frames in one run.
+  std::string views;      // --views: a selection of the camera set's views
+  int orbit_frames = 0;   // --orbit N
+  std::string path_file;  // --path KEYFRAMES.json
+  int path_frames = 0;    // --frames N (with --path)
+  std::optional<std::string> shard;
+  std::optional<int> shard_count;
+  bool force = false;
+  bool quiet = false;
+  std::string merge_folder;  // --merge-manifests
+};
+
+// Declares every flag of tilesplat-render.
+void add_render_options(tilesplat::cli::ArgParser& parser, RenderOptions& options);
+
+// Whether the flags ask for a sequence of frames rather than one view.
+bool renders_sequence(const tilesplat::cli::ArgParser& parser);
+
+// The mistakes a parsed command line can show before any file is read: flags that do not go together,
+// a missing or misnamed -o, --png or frame pattern, an output that is also an input. Throws UsageError.
+void check_render_flags(const tilesplat::cli::ArgParser& parser, const RenderOptions& options);
+
+}  // namespace tilesplat::render_app

@@ -1,0 +1,34 @@
+#include "viewer_options.h"
+
+namespace tilesplat::viewer {
+
+namespace cli = tilesplat::cli;
+
+void add_viewer_options(cli::ArgParser& parser, ViewerOptions& options) {
+  cli::add_common_options(parser, options.common, cli::SortChoice::kOne);
+  parser.section("scripting");
+  parser.add_int("--frames", "N", "render N frames, then exit (default: run until the window is closed)",
+                 &options.frames, 1, 1000000);
+  parser.add_string(
+      "--screenshot", "FILE",
+      "on exit, write the last frame: an .exr of the splats as tilesplat-render writes it, or a .png "
+      "of the window as shown",
+      &options.screenshot);
+  parser.section("mesh");
+  parser.add_switch("--no-mesh", "show the splats alone, without the box and the grid", &options.no_mesh);
+  parser.add_switch("--no-depth-out", "the splats write no depth, so the grid is drawn over them (key D)",
+                    &options.no_depth_out);
+}
+
+void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& options) {
+  cli::check_common_options(parser, options.common);
+  if (!options.screenshot.empty()) {
+    if (!cli::has_extension(options.screenshot, ".exr") && !cli::has_extension(options.screenshot, ".png"))
+      throw cli::UsageError("--screenshot expects an .exr or .png file, got '" + options.screenshot + "'");
+    cli::check_distinct_paths({{"SCENE", options.common.scene},
+                               {"--cameras", options.common.cameras},
+                               {"--screenshot", options.screenshot}});
+  }
+}
+
+}  // namespace tilesplat::viewer
