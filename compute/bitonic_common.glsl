@@ -27,22 +27,6 @@ layout(constant_id = 1) const bool WIDE_KEYS = true;
 const uint GROUP_BITS = 4;
 const uint GROUP = 16;
 
-layout(push_constant) uniform Push {
-  uint64_t keys_in;      // the keys to sort (read by the first pass only; see sort_keys.glsl)
-  UintArray values_in;   // the payloads, gathered by the last pass
-  uint64_t keys;         // the network's keys, in place (keys_alt, or 64-bit scratch when PACKED)
-  uint64_t keys_out;     // the sorted keys, written by the last pass (keys_alt)
-  UintArray positions;   // each key's input position while the network runs (not PACKED)
-  UintArray values_out;  // the gathered payloads: values_alt, the same memory as the positions (a
-                         // pass stores the indices it loaded, so the last one replaces each position)
-  UintArray state;       // the sort's state block (SORT_COUNT)
-  uint capacity;         // the key buffers' size: a larger count is clamped rather than overrun
-  uint position_bits;    // PACKED: the low bits of a network key that hold the position
-  uint stage;            // k (merge passes)
-  uint stride;           // the largest stride of this pass
-  uint steps;            // the steps this pass runs (strides stride ... stride >> (steps - 1))
-} pc;
-
 uint sort_count() { return min(pc.state.v[SORT_COUNT], pc.capacity); }
 
 // The network's length for this frame's count. A pass recorded for a longer network finds its stage

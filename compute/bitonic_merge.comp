@@ -4,6 +4,7 @@
 // the steps never leave the invocation's registers. The last pass of the network's last stage
 // (strides down to 1) gathers the payloads.
 #extension GL_GOOGLE_include_directive : require
+#define TS_BITONIC_PASS_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "bitonic_common.glsl"
 

@@ -2,17 +2,10 @@
 // Bitonic sort setup: sizes the sort's dispatches from this frame's key count (read on the GPU), so
 // that the passes, recorded for the capacity, launch only the invocations the count needs.
 #extension GL_GOOGLE_include_directive : require
+#define TS_BITONIC_SETUP_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 1) in;
-
-layout(push_constant) uniform Push {
-  UintArray state;  // the sort's state block
-  uint capacity;
-  uint group_keys;      // keys per invocation
-  uint workgroup_size;
-  uint max_workgroups;  // the dispatch limit (lower on CPU drivers); the kernels loop over the rest
-} pc;
 
 void main() {
   uint n = min(pc.state.v[SORT_COUNT], pc.capacity);

@@ -3,6 +3,7 @@
 // 16) and tags each with its input position. When the count fits one group this is the whole sort,
 // and the pass gathers the payloads itself.
 #extension GL_GOOGLE_include_directive : require
+#define TS_BITONIC_PASS_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "bitonic_common.glsl"
 

@@ -4,15 +4,10 @@
 // as the classic web viewers do. The depth sort then needs two radix digits instead of four; the
 // price is that splats closer in depth than range / 65535 tie and keep index order.
 #extension GL_GOOGLE_include_directive : require
+#define TS_DEPTH_QUANTIZE_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 256) in;
-
-layout(push_constant) uniform Push {
-  UintArray depth_keys;
-  UintArray counters;
-  uint count;
-} pc;
 
 const uint CULLED_BITS = 0xffffffffu;
 const uint CULLED_KEY = 0xffffu;  // culled Gaussians sort last, after every visible one

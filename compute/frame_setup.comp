@@ -3,14 +3,10 @@
 // sorts (never more than the buffers hold) and writes the indirect dispatch sizes that depend on
 // it, so the frame needs no CPU round trip. An overflow is flagged for the host to grow and retry.
 #extension GL_GOOGLE_include_directive : require
+#define TS_FRAME_SETUP_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 1) in;
-
-layout(push_constant) uniform Push {
-  UintArray counters;
-  uint capacity;  // keys the key/value buffers hold
-} pc;
 
 void main() {
   uint total = pc.counters.v[COUNTER_INTERSECTIONS];

@@ -9,22 +9,11 @@
 // In float64, as host_depth.cpp computes it for depths in host memory, so that both give the same
 // floats; in float32 on devices without float64 (TS_FP32_HOST_DEPTH).
 #extension GL_GOOGLE_include_directive : require
+#define TS_HOST_DEPTH_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 16, local_size_y = 16) in;
 layout(constant_id = 0) const uint DIRECTION = 0;
-
-layout(push_constant) uniform Push {
-  FloatArray window;  // the host's window depths, one float a pixel
-  FloatArray view;    // view depths, written (DIRECTION 0) or the splats' surface depths, read (1)
-  uvec2 a_bits;       // the convention's a and b as float64 bits
-  uvec2 b_bits;
-  float a32;          // and as float32
-  float b32;
-  uint width;
-  uint height;
-}
-pc;
 
 #ifdef TS_FP32_HOST_DEPTH
 #define real float

@@ -8,6 +8,7 @@
 // the offsets are in Gaussian order and the key is tile << 32 | the Gaussian's depth key (the view
 // depth's float bits, or fewer bits in an accuracy mode).
 #extension GL_GOOGLE_include_directive : require
+#define TS_KEY_EMISSION_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "tile_coverage.glsl"
 
@@ -17,22 +18,6 @@ layout(constant_id = 2) const float ALPHA_INV = 255.0;     // 1 / the alpha cut-
 #include "sort_keys.glsl"
 
 layout(local_size_x = 256) in;
-
-layout(push_constant) uniform Push {
-  Vec4Array splats;
-  Uvec2Array rects;
-  UintArray tile_counts;
-  UintArray offsets;  // per Gaussian: where its pairs start (scatter_offsets.comp)
-  uint64_t keys;  // see sort_keys.glsl
-  UintArray values;
-  UintArray depth_keys;  // WIDE_KEYS: per Gaussian, written by the projection
-  UintArray big_splats;  // Gaussians with more than BIG_SPLAT_PAIRS pairs, for key_emission_big.comp
-  UintArray counters;
-  uint count;
-  uint tiles_x;
-  uint capacity;
-  uint tiles;
-} pc;
 
 #ifdef TS_TEXEL_BUFFERS
 // The CPU-driver variant (key_emission_texel): the per-Gaussian inputs and the pairs through texel

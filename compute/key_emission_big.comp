@@ -7,6 +7,7 @@
 // thousands of pairs over 256 invocations instead of one.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#define TS_KEY_EMISSION_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "tile_coverage.glsl"
 #include "workgroup_scan.glsl"
@@ -17,21 +18,6 @@ layout(constant_id = 2) const float ALPHA_INV = 255.0;     // 1 / the alpha cut-
 #include "sort_keys.glsl"
 
 // The same push constants as key_emission.comp.
-layout(push_constant) uniform Push {
-  Vec4Array splats;
-  Uvec2Array rects;
-  UintArray tile_counts;
-  UintArray offsets;
-  uint64_t keys;
-  UintArray values;
-  UintArray depth_keys;
-  UintArray big_splats;
-  UintArray counters;
-  uint count;
-  uint tiles_x;
-  uint capacity;
-  uint tiles;
-} pc;
 
 void main() {
   uint i = pc.big_splats.v[gl_WorkGroupID.x];

@@ -6,19 +6,12 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_memory_scope_semantics : require
+#define TS_ONESWEEP_HISTOGRAM_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint PARTITION_KEYS = 2048;
 layout(constant_id = 2) const bool WIDE_KEYS = true;
-
-layout(push_constant) uniform Push {
-  uint64_t keys;      // see sort_keys.glsl
-  UintArray control;  // CTRL_UINTS (onesweep_common.glsl)
-  UintArray status;   // the first digit pass's status rows, RADIX per partition
-  UintArray state;    // the sort's state block
-  uint passes;
-} pc;
 
 #include "sort_keys.glsl"
 #include "onesweep_common.glsl"

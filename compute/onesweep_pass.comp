@@ -10,28 +10,13 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_memory_scope_semantics : require
+#define TS_ONESWEEP_PASS_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint SUBGROUPS_PER_WORKGROUP = 8;
 layout(constant_id = 2) const uint KEYS_PER_LANE = 128;  // partition = workgroup size * KEYS_PER_LANE keys
 layout(constant_id = 3) const bool WIDE_KEYS = true;
-
-layout(push_constant) uniform Push {
-  uint64_t keys_in;  // see sort_keys.glsl
-  UintArray values_in;
-  uint64_t keys_out;
-  UintArray values_out;
-  UintArray control;      // CTRL_UINTS (onesweep_common.glsl)
-  UintArray status;       // this pass's status rows, RADIX per partition
-  UintArray status_next;  // the next pass's rows, cleared here (the pass before last used them)
-  UintArray state;        // the sort's state block
-  UintArray fallbacks;    // [0]: look-back steps that gave up waiting, over the strategy's life
-  uint shift;             // which 8-bit digit this pass sorts on
-  uint pass;
-  uint spin_limit;        // polling rounds on an unpublished status before counting it here; 0 forces it
-  uint clear_next;
-} pc;
 
 #include "sort_keys.glsl"
 #include "onesweep_common.glsl"

@@ -4,16 +4,11 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_memory_scope_semantics : require
+#define TS_ONESWEEP_SETUP_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "onesweep_common.glsl"
 
 layout(local_size_x = 256) in;
-
-layout(push_constant) uniform Push {
-  UintArray state;    // the sort's state block
-  UintArray control;  // CTRL_UINTS
-  uint partition_keys;
-} pc;
 
 void main() {
   if (gl_LocalInvocationIndex == 0) {

@@ -6,18 +6,11 @@
 //             colours are already sRGB-encoded display values (docs/colour.md), so an _SRGB image gets the
 //             same bytes: a host sampling it reads linear light, and a second encoding would wash it out.
 #extension GL_GOOGLE_include_directive : require
+#define TS_PACK_COLOUR_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 16, local_size_y = 16) in;
 layout(constant_id = 0) const uint FORMAT = 0;
-
-layout(push_constant) uniform Push {
-  Vec4Array rgba;
-  UintArray packed;
-  uint width;
-  uint height;
-}
-pc;
 
 void main() {
   uvec2 pixel = gl_GlobalInvocationID.xy;

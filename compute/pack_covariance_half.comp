@@ -5,16 +5,10 @@
 // rounding to half: entries under 6e-8 flush to zero (needles flatten) and over 65504 become
 // infinite (the projection then culls the splat).
 #extension GL_GOOGLE_include_directive : require
+#define TS_PACK_COVARIANCE_HALF_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 256) in;
-
-layout(push_constant) uniform Push {
-  FloatArray log_scales;
-  FloatArray rotations;
-  UintArray covariances;
-  uint count;
-} pc;
 
 void main() {
   uint i = gl_GlobalInvocationID.x;

@@ -3,15 +3,10 @@
 // output word packs two consecutive float coefficients into 16-bit halves. Halving the SH bytes is
 // what the mode buys: SH are most of a scene's memory and of the projection's reads.
 #extension GL_GOOGLE_include_directive : require
+#define TS_PACK_SH_HALF_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 256) in;
-
-layout(push_constant) uniform Push {
-  FloatArray sh;
-  UintArray sh_half;
-  uint values;  // floats in sh
-} pc;
 
 void main() {
   uint w = gl_GlobalInvocationID.x;

@@ -2,14 +2,9 @@
 // Exclusive prefix sum, step 2: adds each block's scanned offset to its already locally scanned values.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#define TS_PREFIX_SUM_ADD_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "workgroup_scan.glsl"
-
-layout(push_constant) uniform Push {
-  UintArray data;
-  UintArray block_offsets;
-  uint count;
-} pc;
 
 void main() {
   uint offset = pc.block_offsets.v[gl_WorkGroupID.x];

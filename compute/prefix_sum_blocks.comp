@@ -4,17 +4,9 @@
 // element order follows (subgroup id, lane), never an assumed mapping of invocations to subgroups.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#define TS_PREFIX_SUM_BLOCKS_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "workgroup_scan.glsl"
-
-layout(push_constant) uniform Push {
-  UintArray src;
-  UintArray dst;         // may alias src
-  UintArray block_sums;  // one per workgroup
-  UintArray order;       // when gather != 0, value k is src[order[k]] instead of src[k]
-  uint count;
-  uint gather;
-} pc;
 
 void main() {
   uint linear = gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;

@@ -10,6 +10,7 @@
 // decisions. TS_FP32_PROJECTION builds the float32 variant for devices without shaderFloat64.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#define TS_PROJECTION_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "tile_coverage.glsl"
 
@@ -52,55 +53,7 @@ layout(constant_id = 10) const bool COMPENSATE_OPACITY = false;
 layout(constant_id = 11) const bool LIGHTING = false;
 layout(constant_id = 12) const bool FILE_NORMALS = false;
 
-// Camera, written by the host each frame. Doubles are stored as bit pairs so that the float32
-// variant's SPIR-V needs no Float64 capability.
-layout(buffer_reference, std430, buffer_reference_align = 8) buffer CameraParams {
-  uvec2 rotation[9];         // world-to-camera rotation, row-major, as doubles
-  uvec2 centre[3];           // camera centre (world), as doubles
-  uvec2 focal_principal[4];  // fx, fy, cx, cy, as doubles
-  // 1.3 tan(fov_x/2), 1.3 tan(fov_y/2), the near plane, as doubles: the reference compares in
-  // double, and a float 0.2 would cull a splat on the plane that the reference keeps.
-  uvec2 clip[4];
-  uvec4 grid;                // tiles x, tiles y, width, height
-};
-// The same as uvec2 words (camera_word): where each field starts.
-const uint CAMERA_ROTATION = 0, CAMERA_CENTRE = 9, CAMERA_FOCAL = 12, CAMERA_CLIP = 16, CAMERA_GRID = 20;
-
-// The frame's lights, written by the host (ProjectionPass::set_lighting) in float64 from the same
-// prepared values as the reference's (engine/src/lighting.h). Doubles as bit pairs, as above.
-struct LightRecord {
-  uvec2 vector[3];    // directional: the unit vector toward the light; point: its position
-  uvec2 radiance[3];  // colour * intensity
-  uint point;         // 1: a point light
-  uint pad;
-};
-layout(buffer_reference, std430, buffer_reference_align = 8) buffer LightParams {
-  uint64_t normals;   // FILE_NORMALS: 3 floats per Gaussian (the PLY's nx ny nz, possibly zero)
-  uvec2 ambient[3];
-  uint count;
-  uint pad;
-  LightRecord lights[];
-};
-
-// 128 bytes: the most every Vulkan device must accept.
-layout(push_constant) uniform Push {
-  FloatArray positions;
-  FloatArray log_scales;
-  FloatArray rotations;
-  FloatArray opacity_logits;
-  uint64_t sh;  // floats, or packed halves (SH_HALF)
-  CameraParams camera;
-  Vec4Array splats;
-  Uvec2Array rects;
-  UintArray tile_counts;
-  UintArray depth_keys;  // the depth sort's input (32-bit keys): view depth bits, culled last
-  UintArray depth_values;
-  UintArray counters;
-  UintArray covariances;  // COV_HALF: 3 uints (xx xy, xz yy, yz zz as halves) per Gaussian
-  Vec4Array ray_depth;    // RAY_DEPTH: RAY_DEPTH_VEC4S per Gaussian (composite_resort.comp)
-  LightParams lighting;   // LIGHTING
-  uint count;
-} pc;
+// CameraParams and LightParams, the blocks the host writes for this pass, are in shader_io.h.
 
 #ifdef TS_TEXEL_BUFFERS
 // The CPU-driver variant (projection_texel): the Gaussians' attributes in and the projected records out
@@ -165,7 +118,6 @@ void write_depth_pair(uint i, uint key) {
 
 #include "sh.glsl"  // after sh_word
 
-
 #ifndef TS_FP32_PROJECTION
 real to_real(uvec2 bits) { return packDouble2x32(bits); }
 #endif
@@ -192,7 +144,7 @@ real3 lighting_normal(uint i, real3 rel) {
   real3 n;
   bool from_file = false;
   if (FILE_NORMALS) {
-    FloatArray normals = FloatArray(pc.lighting.normals);
+    FloatArray normals = FloatArray(LightParams(pc.lighting).normals);
     vec3 f = vec3(normals.v[3 * i], normals.v[3 * i + 1], normals.v[3 * i + 2]);
     float largest = max(max(abs(f.x), abs(f.y)), abs(f.z));
     if (!any(isnan(f)) && !any(isinf(f)) && largest >= FLT_MIN) {
@@ -214,7 +166,7 @@ real3 lighting_normal(uint i, real3 rel) {
 // The factor the unlit colour is multiplied by: ambient + sum of radiance max(0, n . w) falloff, in the
 // operations and order of the reference's light_factor (engine/src/lighting.cpp).
 real3 light_factor(real3 world, real3 n) {
-  LightParams lp = pc.lighting;
+  LightParams lp = LightParams(pc.lighting);
   real3 factor = real3(to_real(lp.ambient[0]), to_real(lp.ambient[1]), to_real(lp.ambient[2]));
   for (uint l = 0; l < lp.count; ++l) {
     real3 v = real3(to_real(lp.lights[l].vector[0]), to_real(lp.lights[l].vector[1]),

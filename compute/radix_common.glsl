@@ -9,17 +9,6 @@ layout(constant_id = 3) const bool WIDE_KEYS = true;
 
 const uint RADIX = 256;
 
-layout(push_constant) uniform Push {
-  uint64_t keys_in;  // see sort_keys.glsl
-  UintArray values_in;
-  uint64_t keys_out;
-  UintArray values_out;
-  UintArray histogram;     // RADIX * blocks, digit-major: histogram[digit * blocks + block]
-  UintArray digit_totals;  // RADIX
-  UintArray state;         // the sort's state block (SORT_COUNT, SORT_BLOCKS)
-  uint shift;              // which 8-bit digit this pass sorts on
-} pc;
-
 #include "sort_keys.glsl"
 
 const uint RADIX_BLOCK_KEYS = SORT_OWN;  // written by radix_setup.comp

@@ -9,6 +9,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#define TS_RADIX_PASS_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "radix_common.glsl"
 

@@ -6,18 +6,13 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#define TS_RADIX_SCAN_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x_id = 0) in;
 layout(constant_id = 1) const uint DIGITS_PER_WORKGROUP = 8;  // subgroups per workgroup
 
 const uint RADIX = 256;
-
-layout(push_constant) uniform Push {
-  UintArray histogram;
-  UintArray digit_totals;
-  UintArray state;  // the sort's state block
-} pc;
 
 void main() {
   // The loop keeps every digit covered once even where the driver picks another subgroup size than

@@ -1,18 +1,12 @@
 #version 460
 // Radix sort setup: sizes the per-block dispatches from this frame's key count (read on the GPU).
 #extension GL_GOOGLE_include_directive : require
+#define TS_RADIX_SETUP_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 const uint RADIX_BLOCK_KEYS = SORT_OWN;
 
 layout(local_size_x = 1) in;
-
-layout(push_constant) uniform Push {
-  UintArray state;  // the sort's state block
-  uint block_keys;        // the block size for counts below large_count
-  uint large_count;       // from this count on, blocks are twice as large
-  uint subgroups_per_workgroup;
-} pc;
 
 void main() {
   uint n = pc.state.v[SORT_COUNT];

@@ -3,16 +3,10 @@
 // Gaussian its offset, so that the emission reads its per-Gaussian inputs in index order
 // (sequential) instead of in depth order (four random reads per Gaussian instead of one write).
 #extension GL_GOOGLE_include_directive : require
+#define TS_SCATTER_OFFSETS_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 256) in;
-
-layout(push_constant) uniform Push {
-  UintArray depth_order;    // Gaussian indices, front to back
-  UintArray depth_offsets;  // exclusive prefix sum of the tile counts, in depth order
-  UintArray offsets;        // out: the same offsets, per Gaussian
-  uint count;
-} pc;
 
 #ifdef TS_TEXEL_BUFFERS
 // The CPU-driver variant (scatter_offsets_texel): the same buffers through texel buffers, which llvmpipe

@@ -1,5 +1,5 @@
 // One definition of what the compute shaders and the host share: the frame's counter indices, a
-// sort's state block, the per-splat record sizes, and the push-constant blocks of the composites.
+// sort's state block, the per-splat record sizes, and the push-constant block of every pass.
 // Compiled as GLSL (common.glsl includes it) and as C++ (engine/src/passes/frame_counters.h and the
 // passes), in the manner of nvpro's vk_gaussian_splatting shaderio.h: a layout is written once here,
 // and the C++ side checks its structs against these numbers at compile time (static_assert).
@@ -16,16 +16,32 @@ using uint = uint32_t;
 struct alignas(16) vec4 {
   float x = 0, y = 0, z = 0, w = 0;
 };
+struct alignas(8) uvec2 {
+  uint x = 0, y = 0;
+};
+struct alignas(16) uvec4 {
+  uint x = 0, y = 0, z = 0, w = 0;
+};
 #define TS_CONST inline constexpr
 #define TS_REF(Type) uint64_t
 #define TS_PUSH_CONSTANTS(Name) struct Name
 #define TS_PUSH_INSTANCE
+// A block the host writes and a shader reads through its address.
+#define TS_BUFFER(Name) struct Name
+// A double: one in C++, its bits as a uvec2 in GLSL (unpackDouble2x32), so that the float32 variants'
+// SPIR-V needs no Float64 capability.
+#define TS_F64 double
+// A block's trailing runtime-sized array: GLSL's alone; the C++ struct is the block's header.
+#define TS_RUNTIME_ARRAY(Type, name)
 #else
 #define TS_CONST const
 #define TS_REF(Type) Type
 // The block's instance is `pc` in every shader: pc.width, pc.splats, ...
 #define TS_PUSH_CONSTANTS(Name) layout(push_constant) uniform Name
 #define TS_PUSH_INSTANCE pc
+#define TS_BUFFER(Name) layout(buffer_reference, std430, buffer_reference_align = 8) buffer Name
+#define TS_F64 uvec2
+#define TS_RUNTIME_ARRAY(Type, name) Type name[];
 #endif
 
 TS_CONST uint TILE_SIZE = 16;  // pixels per tile side (tilesplat::kTileSize)
@@ -71,7 +87,7 @@ TS_CONST uint SPLAT_VEC4S = 4;
 // mode: see write_ray_depth in projection.comp (kRayDepthBytes).
 TS_CONST uint RAY_DEPTH_VEC4S = 3;
 
-// The push constants of the three composites. A shader declares the block of its pass by defining
+// The push constants, the composites first. A shader declares the block of its pass by defining
 // the macro before including common.glsl; C++ sees them all.
 
 #if defined(__cplusplus) || defined(TS_COMPOSITE_PUSH)
@@ -149,7 +165,376 @@ TS_PUSH_CONSTANTS(StochasticCompositePush) {
 TS_PUSH_INSTANCE;
 #endif
 
+// ---------------------------------------------------------------------------------------------
+// The push constants of the frame's other passes (engine/src/passes/), in frame order.
+
+#if defined(__cplusplus) || defined(TS_PACK_SH_HALF_PUSH)
+// pack_sh_half.comp (ProjectionPass, fp16-sh): the SH as 16-bit floats.
+TS_PUSH_CONSTANTS(PackShHalfPush) {
+  TS_REF(FloatArray) sh;
+  TS_REF(UintArray) sh_half;
+  uint values;  // floats in sh
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_PACK_COVARIANCE_HALF_PUSH)
+// pack_covariance_half.comp (ProjectionPass, fp16-cov): the 3D covariances as 16-bit floats.
+TS_PUSH_CONSTANTS(PackCovarianceHalfPush) {
+  TS_REF(FloatArray) log_scales;
+  TS_REF(FloatArray) rotations;
+  TS_REF(UintArray) covariances;
+  uint count;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_PROJECTION_PUSH)
+// The camera of projection.comp, written by the host each frame (ProjectionPass::set_camera).
+TS_BUFFER(CameraParams) {
+  TS_F64 rotation[9];         // world-to-camera rotation, row-major
+  TS_F64 centre[3];           // camera centre (world)
+  TS_F64 focal_principal[4];  // fx, fy, cx, cy
+  // 1.3 tan(fov_x/2), 1.3 tan(fov_y/2), the near plane, unused: the reference compares in double, and
+  // a float 0.2 would cull a splat on the plane that the reference keeps.
+  TS_F64 clip[4];
+  uvec4 grid;  // tiles x, tiles y, width, height
+};
+// The same as uvec2 words (projection.comp's camera_word): where each field starts.
+TS_CONST uint CAMERA_ROTATION = 0, CAMERA_CENTRE = 9, CAMERA_FOCAL = 12, CAMERA_CLIP = 16, CAMERA_GRID = 20;
+
+// The frame's lights, written by the host (ProjectionPass::set_lighting) in float64 from the same
+// prepared values as the reference's (engine/src/lighting.h).
+struct LightRecord {
+  TS_F64 vector[3];    // directional: the unit vector toward the light; point: its position
+  TS_F64 radiance[3];  // colour * intensity
+  uint point;          // 1: a point light
+  uint pad;
+};
+TS_BUFFER(LightParams) {
+  uint64_t normals;  // FILE_NORMALS: 3 floats per Gaussian (the PLY's nx ny nz, possibly zero)
+  TS_F64 ambient[3];
+  uint count;
+  uint pad;
+  TS_RUNTIME_ARRAY(LightRecord, lights)  // count of them
+};
+
+// projection.comp (ProjectionPass). camera and lighting are the addresses of the blocks above.
+TS_PUSH_CONSTANTS(ProjectionPush) {
+  TS_REF(FloatArray) positions;
+  TS_REF(FloatArray) log_scales;
+  TS_REF(FloatArray) rotations;
+  TS_REF(FloatArray) opacity_logits;
+  uint64_t sh;      // floats, or packed halves (SH_HALF)
+  uint64_t camera;  // CameraParams
+  TS_REF(Vec4Array) splats;
+  TS_REF(Uvec2Array) rects;
+  TS_REF(UintArray) tile_counts;
+  TS_REF(UintArray) depth_keys;  // the depth sort's input (32-bit keys): view depth bits, culled last
+  TS_REF(UintArray) depth_values;
+  TS_REF(UintArray) counters;
+  TS_REF(UintArray) covariances;  // COV_HALF: 3 uints (xx xy, xz yy, yz zz as halves) per Gaussian
+  TS_REF(Vec4Array) ray_depth;    // RAY_DEPTH: RAY_DEPTH_VEC4S per Gaussian (composite_resort.comp)
+  uint64_t lighting;              // LIGHTING: LightParams
+  uint count;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_DEPTH_QUANTIZE_PUSH)
+// depth_quantize.comp (DepthQuantizePass, depth16).
+TS_PUSH_CONSTANTS(DepthQuantizePush) {
+  TS_REF(UintArray) depth_keys;
+  TS_REF(UintArray) counters;
+  uint count;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_PREFIX_SUM_BLOCKS_PUSH)
+// prefix_sum_blocks.comp (PrefixSumPass).
+TS_PUSH_CONSTANTS(PrefixSumBlocksPush) {
+  TS_REF(UintArray) src;
+  TS_REF(UintArray) dst;         // may alias src
+  TS_REF(UintArray) block_sums;  // one per workgroup
+  TS_REF(UintArray) order;       // when gather != 0, value k is src[order[k]] instead of src[k]
+  uint count;
+  uint gather;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_PREFIX_SUM_ADD_PUSH)
+// prefix_sum_add.comp (PrefixSumPass).
+TS_PUSH_CONSTANTS(PrefixSumAddPush) {
+  TS_REF(UintArray) data;
+  TS_REF(UintArray) block_offsets;
+  uint count;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_FRAME_SETUP_PUSH)
+// frame_setup.comp (KeyEmissionPass).
+TS_PUSH_CONSTANTS(FrameSetupPush) {
+  TS_REF(UintArray) counters;
+  uint capacity;  // keys the key/value buffers hold
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_SCATTER_OFFSETS_PUSH)
+// scatter_offsets.comp (KeyEmissionPass).
+TS_PUSH_CONSTANTS(ScatterOffsetsPush) {
+  TS_REF(UintArray) depth_order;    // Gaussian indices, front to back
+  TS_REF(UintArray) depth_offsets;  // exclusive prefix sum of the tile counts, in depth order
+  TS_REF(UintArray) offsets;        // out: the same offsets, per Gaussian
+  uint count;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_KEY_EMISSION_PUSH)
+// key_emission.comp and key_emission_big.comp (KeyEmissionPass).
+TS_PUSH_CONSTANTS(KeyEmissionPush) {
+  TS_REF(Vec4Array) splats;
+  TS_REF(Uvec2Array) rects;
+  TS_REF(UintArray) tile_counts;
+  TS_REF(UintArray) offsets;  // per Gaussian: where its pairs start (scatter_offsets.comp)
+  uint64_t keys;              // see sort_keys.glsl
+  TS_REF(UintArray) values;
+  TS_REF(UintArray) depth_keys;  // WIDE_KEYS: per Gaussian, written by the projection
+  TS_REF(UintArray) big_splats;  // Gaussians with more than BIG_SPLAT_PAIRS pairs, for key_emission_big.comp
+  TS_REF(UintArray) counters;
+  uint count;
+  uint tiles_x;
+  uint capacity;
+  uint tiles;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_TILE_RANGES_PUSH)
+// tile_ranges.comp (TileRangesPass).
+TS_PUSH_CONSTANTS(TileRangesPush) {
+  uint64_t keys;              // the sorted keys: tile ids, or tile << 32 | depth bits (64-bit keys)
+  TS_REF(Uvec2Array) ranges;  // zero-filled before this pass
+  TS_REF(UintArray) counters;
+  uint tiles;  // keys with a tile id >= tiles are padding (see key_emission.comp)
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_HOST_DEPTH_PUSH)
+// host_depth.comp (HostDepthPass).
+TS_PUSH_CONSTANTS(HostDepthPush) {
+  TS_REF(FloatArray) window;  // the host's window depths, one float a pixel
+  TS_REF(FloatArray) view;    // view depths, written (DIRECTION 0) or the splats' surface depths, read (1)
+  uvec2 a_bits;               // the convention's a and b as float64 bits
+  uvec2 b_bits;
+  float a32;  // and as float32
+  float b32;
+  uint width;
+  uint height;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_PACK_COLOUR_PUSH)
+// pack_colour.comp (PackColourPass).
+TS_PUSH_CONSTANTS(PackColourPush) {
+  TS_REF(Vec4Array) rgba;
+  TS_REF(UintArray) packed;
+  uint width;
+  uint height;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+// ---------------------------------------------------------------------------------------------
+// The push constants of the built-in sort strategies (engine/src/sort/). Each sorts the keys of a
+// KeyBuffers in place with its state block (SORT_STATE_UINTS) counting them.
+
+#if defined(__cplusplus) || defined(TS_RADIX_SETUP_PUSH)
+// radix_setup.comp (RadixSort).
+TS_PUSH_CONSTANTS(RadixSetupPush) {
+  TS_REF(UintArray) state;  // the sort's state block
+  uint block_keys;          // the block size for counts below large_count
+  uint large_count;         // from this count on, blocks are twice as large
+  uint subgroups_per_workgroup;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_RADIX_PASS_PUSH)
+// radix_histogram.comp and radix_scatter.comp (RadixSort), one digit a pass.
+TS_PUSH_CONSTANTS(RadixPassPush) {
+  uint64_t keys_in;  // see sort_keys.glsl
+  TS_REF(UintArray) values_in;
+  uint64_t keys_out;
+  TS_REF(UintArray) values_out;
+  TS_REF(UintArray) histogram;     // RADIX * blocks, digit-major: histogram[digit * blocks + block]
+  TS_REF(UintArray) digit_totals;  // RADIX
+  TS_REF(UintArray) state;         // the sort's state block (SORT_COUNT, SORT_BLOCKS)
+  uint shift;                      // which 8-bit digit this pass sorts on
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_RADIX_SCAN_PUSH)
+// radix_scan.comp (RadixSort).
+TS_PUSH_CONSTANTS(RadixScanPush) {
+  TS_REF(UintArray) histogram;
+  TS_REF(UintArray) digit_totals;
+  TS_REF(UintArray) state;  // the sort's state block
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_ONESWEEP_SETUP_PUSH)
+// onesweep_setup.comp (OnesweepSort).
+TS_PUSH_CONSTANTS(OnesweepSetupPush) {
+  TS_REF(UintArray) state;    // the sort's state block
+  TS_REF(UintArray) control;  // CTRL_UINTS
+  uint partition_keys;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_ONESWEEP_HISTOGRAM_PUSH)
+// onesweep_histogram.comp (OnesweepSort).
+TS_PUSH_CONSTANTS(OnesweepHistogramPush) {
+  uint64_t keys;              // see sort_keys.glsl
+  TS_REF(UintArray) control;  // CTRL_UINTS (onesweep_common.glsl)
+  TS_REF(UintArray) status;   // the first digit pass's status rows, RADIX per partition
+  TS_REF(UintArray) state;    // the sort's state block
+  uint passes;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_ONESWEEP_PASS_PUSH)
+// onesweep_pass.comp (OnesweepSort), one digit a pass.
+TS_PUSH_CONSTANTS(OnesweepPassPush) {
+  uint64_t keys_in;  // see sort_keys.glsl
+  TS_REF(UintArray) values_in;
+  uint64_t keys_out;
+  TS_REF(UintArray) values_out;
+  TS_REF(UintArray) control;      // CTRL_UINTS (onesweep_common.glsl)
+  TS_REF(UintArray) status;       // this pass's status rows, RADIX per partition
+  TS_REF(UintArray) status_next;  // the next pass's rows, cleared here (the pass before last used them)
+  TS_REF(UintArray) state;        // the sort's state block
+  TS_REF(UintArray) fallbacks;    // [0]: look-back steps that gave up waiting, over the strategy's life
+  uint shift;                     // which 8-bit digit this pass sorts on
+  uint pass;
+  uint spin_limit;  // polling rounds on an unpublished status before counting it here; 0 forces it
+  uint clear_next;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_BITONIC_SETUP_PUSH)
+// bitonic_setup.comp (BitonicSort).
+TS_PUSH_CONSTANTS(BitonicSetupPush) {
+  TS_REF(UintArray) state;  // the sort's state block
+  uint capacity;
+  uint group_keys;  // keys per invocation
+  uint workgroup_size;
+  uint max_workgroups;  // the dispatch limit (lower on CPU drivers); the kernels loop over the rest
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_BITONIC_PASS_PUSH)
+// bitonic_sort_groups.comp and bitonic_merge.comp (BitonicSort).
+TS_PUSH_CONSTANTS(BitonicPassPush) {
+  uint64_t keys_in;             // the keys to sort (read by the first pass only; see sort_keys.glsl)
+  TS_REF(UintArray) values_in;  // the payloads, gathered by the last pass
+  uint64_t keys;                // the network's keys, in place (keys_alt, or 64-bit scratch when PACKED)
+  uint64_t keys_out;            // the sorted keys, written by the last pass (keys_alt)
+  TS_REF(UintArray) positions;  // each key's input position while the network runs (not PACKED)
+  // The gathered payloads: values_alt, the same memory as the positions (a pass stores the indices it
+  // loaded, so the last one replaces each position).
+  TS_REF(UintArray) values_out;
+  TS_REF(UintArray) state;  // the sort's state block (SORT_COUNT)
+  uint capacity;            // the key buffers' size: a larger count is clamped rather than overrun
+  uint position_bits;       // PACKED: the low bits of a network key that hold the position
+  uint stage;               // k (merge passes)
+  uint stride;              // the largest stride of this pass
+  uint steps;               // the steps this pass runs (strides stride ... stride >> (steps - 1))
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_TILE_LOCAL_SETUP_PUSH)
+// tile_local_setup.comp (TileLocalSort).
+TS_PUSH_CONSTANTS(TileLocalSetupPush) {
+  TS_REF(UintArray) state;  // the sort's state block
+  uint capacity;
+  uint workgroup_size;
+  uint max_workgroups;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_TILE_LOCAL_BIN_PUSH)
+// tile_local_bin.comp (TileLocalSort).
+TS_PUSH_CONSTANTS(TileLocalBinPush) {
+  uint64_t keys_in;                 // see sort_keys.glsl
+  uint64_t keys_out;                // keys_alt (scatter)
+  TS_REF(UintArray) positions_out;  // values_alt (scatter)
+  TS_REF(UintArray) bins;           // see tile_local_bins.glsl
+  TS_REF(UintArray) state;          // the sort's state block
+  uint capacity;
+  uint bin_count;
+  uint shift;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_TILE_LOCAL_SCAN_PUSH)
+// tile_local_scan.comp (TileLocalSort).
+TS_PUSH_CONSTANTS(TileLocalScanPush) {
+  TS_REF(UintArray) bins;  // see tile_local_bins.glsl
+  uint bin_count;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_TILE_LOCAL_SORT_PUSH)
+// tile_local_sort.comp (TileLocalSort).
+TS_PUSH_CONSTANTS(TileLocalSortPush) {
+  uint64_t keys;       // keys_alt: the binned keys; the sorted keys at the end
+  uint64_t positions;  // values_alt: each binned key's input position; the gathered payloads at the end
+  TS_REF(UintArray) values_in;  // the payloads, by input position
+  TS_REF(UintArray) bins;       // see tile_local_bins.glsl
+  uint bin_count;
+  uint shift;           // local key bits: a key is bin << shift | local key
+  uint big_workgroups;  // the most workgroups of the BIG variant's indirect dispatch
+}
+TS_PUSH_INSTANCE;
+#endif
+
 #ifdef __cplusplus
+// What the C++ compiler can check of the layouts: the blocks' sizes (std430 lays the members out as
+// C++ does here: scalars, 8-byte addresses and doubles, 16-byte vec4) and the 128 bytes of push
+// constants that every Vulkan device accepts (maxPushConstantsSize).
+static_assert(sizeof(CameraParams) == 176 && CAMERA_GRID * sizeof(uvec2) == 160);
+static_assert(sizeof(LightRecord) == 56 && sizeof(LightParams) == 40);
+static_assert(sizeof(CompositePush) <= 128 && sizeof(CompositeResortPush) <= 128 &&
+              sizeof(StochasticCompositePush) <= 128 && sizeof(PackShHalfPush) <= 128 &&
+              sizeof(PackCovarianceHalfPush) <= 128 && sizeof(ProjectionPush) <= 128 &&
+              sizeof(DepthQuantizePush) <= 128 && sizeof(PrefixSumBlocksPush) <= 128 &&
+              sizeof(PrefixSumAddPush) <= 128 && sizeof(FrameSetupPush) <= 128 &&
+              sizeof(ScatterOffsetsPush) <= 128 && sizeof(KeyEmissionPush) <= 128 &&
+              sizeof(TileRangesPush) <= 128 && sizeof(HostDepthPush) <= 128 &&
+              sizeof(PackColourPush) <= 128 && sizeof(RadixSetupPush) <= 128 &&
+              sizeof(RadixPassPush) <= 128 && sizeof(RadixScanPush) <= 128 &&
+              sizeof(OnesweepSetupPush) <= 128 && sizeof(OnesweepHistogramPush) <= 128 &&
+              sizeof(OnesweepPassPush) <= 128 && sizeof(BitonicSetupPush) <= 128 &&
+              sizeof(BitonicPassPush) <= 128 && sizeof(TileLocalSetupPush) <= 128 &&
+              sizeof(TileLocalBinPush) <= 128 && sizeof(TileLocalScanPush) <= 128 &&
+              sizeof(TileLocalSortPush) <= 128);
 }  // namespace tilesplat::shader_io
 #endif
 #endif  // TILESPLAT_SHADER_IO_H

@@ -6,23 +6,13 @@
 // the stable order. On a CPU driver global atomics cost no more than shared ones, and the bins
 // (up to 2^16) are too many for a shared histogram per workgroup.
 #extension GL_GOOGLE_include_directive : require
+#define TS_TILE_LOCAL_BIN_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "tile_local_bins.glsl"
 
 layout(local_size_x = 256) in;
 layout(constant_id = 0) const bool WIDE_KEYS = true;
 layout(constant_id = 1) const bool SCATTER = false;
-
-layout(push_constant) uniform Push {
-  uint64_t keys_in;         // see sort_keys.glsl
-  uint64_t keys_out;        // keys_alt (scatter)
-  UintArray positions_out;  // values_alt (scatter)
-  UintArray bins;           // see tile_local_bins.glsl
-  UintArray state;          // the sort's state block
-  uint capacity;
-  uint bin_count;
-  uint shift;
-} pc;
 
 #include "sort_keys.glsl"
 

@@ -4,14 +4,10 @@
 // scan, one dispatch where the multi-level prefix sum would take three.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#define TS_TILE_LOCAL_SCAN_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 #include "workgroup_scan.glsl"
 #include "tile_local_bins.glsl"
-
-layout(push_constant) uniform Push {
-  UintArray bins;  // see tile_local_bins.glsl
-  uint bin_count;
-} pc;
 
 void main() {
   uint linear = gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;

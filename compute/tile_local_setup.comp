@@ -2,16 +2,10 @@
 // Tile-local sort setup: sizes the dispatch of the passes over the keys from this frame's key count
 // (read on the GPU). Those passes loop over the keys, so a capped workgroup count covers any count.
 #extension GL_GOOGLE_include_directive : require
+#define TS_TILE_LOCAL_SETUP_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 1) in;
-
-layout(push_constant) uniform Push {
-  UintArray state;  // the sort's state block
-  uint capacity;
-  uint workgroup_size;
-  uint max_workgroups;
-} pc;
 
 void main() {
   uint n = min(pc.state.v[SORT_COUNT], pc.capacity);

@@ -14,6 +14,7 @@
 // values_alt.
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
+#define TS_TILE_LOCAL_SORT_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x_id = 0) in;
@@ -29,16 +30,6 @@ layout(constant_id = 5) const uint HI_CAPACITY = 0;     // CAPACITY when WIDE_LO
 // The BIG variant's invocations read what others of the workgroup wrote in the previous pass.
 layout(buffer_reference, std430, buffer_reference_align = 8) coherent buffer CoherentUint64s { uint64_t v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) coherent buffer CoherentUints { uint v[]; };
-
-layout(push_constant) uniform Push {
-  uint64_t keys;       // keys_alt: the binned keys; the sorted keys at the end
-  uint64_t positions;  // values_alt: each binned key's input position; the gathered payloads at the end
-  UintArray values_in; // the payloads, by input position
-  UintArray bins;      // see tile_local_bins.glsl
-  uint bin_count;
-  uint shift;          // local key bits: a key is bin << shift | local key
-  uint big_workgroups; // the most workgroups of the BIG variant's indirect dispatch
-} pc;
 
 // Two buffers of CAPACITY elements: a merge reads runs from one and writes the merged runs to the other.
 // Element j of buffer b is s_w[b * CAPACITY + j], its hi part (WIDE_LOCAL) s_w[HI_BASE + b * HI_CAPACITY

@@ -2,17 +2,11 @@
 // Tile ranges: after the tile sort, each tile's keys are contiguous. One invocation per key finds the
 // boundaries where the tile id changes and records [start, end) for the tiles on either side.
 #extension GL_GOOGLE_include_directive : require
+#define TS_TILE_RANGES_PUSH  // its push constants (shader_io.h)
 #include "common.glsl"
 
 layout(local_size_x = 256) in;
 layout(constant_id = 0) const bool WIDE_KEYS = false;
-
-layout(push_constant) uniform Push {
-  uint64_t keys;  // the sorted keys: tile ids, or tile << 32 | depth bits (64-bit keys)
-  Uvec2Array ranges;  // zero-filled before this pass
-  UintArray counters;
-  uint tiles;  // keys with a tile id >= tiles are padding (see key_emission.comp)
-} pc;
 
 #include "sort_keys.glsl"
 

@@ -1,12 +1,11 @@
 #include "passes/depth_quantize_pass.h"
 
+#include "shader_io.h"
+
 namespace tilesplat {
 
 namespace {
-struct DepthQuantizePush {
-  VkDeviceAddress depth_keys, counters;
-  uint32_t count, pad;
-};
+using shader_io::DepthQuantizePush;  // compute/shader_io.h
 }  // namespace
 
 DepthQuantizePass::DepthQuantizePass(vk::Context& ctx)
@@ -14,7 +13,7 @@ DepthQuantizePass::DepthQuantizePass(vk::Context& ctx)
 
 void DepthQuantizePass::record(VkCommandBuffer cmd, ProjectedBuffers& projected, uint32_t gaussians,
                                VkDeviceAddress counters) {
-  pipeline_.bind(cmd, DepthQuantizePush{projected.depth_order.keys.address(), counters, gaussians, 0});
+  pipeline_.bind(cmd, DepthQuantizePush{projected.depth_order.keys.address(), counters, gaussians});
   pipeline_.dispatch(cmd, vk::div_ceil(gaussians, 256));
 }
 

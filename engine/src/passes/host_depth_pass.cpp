@@ -2,20 +2,17 @@
 
 #include <bit>
 
+#include "shader_io.h"
+
 namespace tilesplat {
 
 namespace {
-struct HostDepthPush {
-  VkDeviceAddress window, view;
-  uint32_t a_bits[2], b_bits[2];
-  float a32, b32;
-  uint32_t width, height;
-};
+using shader_io::HostDepthPush;  // compute/shader_io.h
 
-void split_bits(double value, uint32_t (&bits)[2]) {
+void split_bits(double value, shader_io::uvec2& bits) {
   const uint64_t all = std::bit_cast<uint64_t>(value);
-  bits[0] = uint32_t(all);  // packDouble2x32 takes the low word first
-  bits[1] = uint32_t(all >> 32);
+  bits.x = uint32_t(all);  // packDouble2x32 takes the low word first
+  bits.y = uint32_t(all >> 32);
 }
 }  // namespace
 

@@ -9,14 +9,8 @@
 namespace tilesplat {
 
 namespace {
-struct SetupPush {
-  VkDeviceAddress counters;
-  uint32_t capacity, pad;
-};
-struct ScatterPush {
-  VkDeviceAddress depth_order, depth_offsets, offsets;
-  uint32_t count, pad;
-};
+using SetupPush = shader_io::FrameSetupPush;        // compute/shader_io.h
+using ScatterPush = shader_io::ScatterOffsetsPush;  // compute/shader_io.h
 // key_emission_texel's bindings: splat records, rects, tile counts and offsets in; narrow keys, wide
 // keys and values out.
 const std::vector<VkDescriptorType> kTexelBindings = {
@@ -26,10 +20,7 @@ const std::vector<VkDescriptorType> kTexelBindings = {
     VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER};
 
 // key_emission.comp and key_emission_big.comp.
-struct EmitPush {
-  VkDeviceAddress splats, rects, tile_counts, offsets, keys, values, depth_keys, big_splats, counters;
-  uint32_t count, tiles_x, capacity, tiles;
-};
+using EmitPush = shader_io::KeyEmissionPush;  // compute/shader_io.h
 }  // namespace
 
 KeyEmissionPass::KeyEmissionPass(vk::Context& ctx)
@@ -49,7 +40,7 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
                              KeyBuffers& keys, uint32_t gaussians, uint32_t tiles_x, uint32_t tiles,
                              const vk::Buffer& counters_buffer, bool square_tiles, float alpha_inv) {
   const VkDeviceAddress counters = counters_buffer.address();
-  frame_setup_.bind(cmd, SetupPush{counters, keys.capacity, 0});
+  frame_setup_.bind(cmd, SetupPush{counters, keys.capacity});
   frame_setup_.dispatch(cmd, 1);
   if (depth_order) {
     std::vector<VkBufferView> views;
@@ -61,7 +52,7 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
     }
     const vk::ComputePipeline& scatter = views.empty() ? scatter_offsets_ : scatter_offsets_texel_;
     scatter.bind(cmd, ScatterPush{depth_order->address(), projected.depth_offsets.address(),
-                                  projected.offsets.address(), gaussians, 0});
+                                  projected.offsets.address(), gaussians});
     if (!views.empty()) scatter.push_texel_views(cmd, views);
     scatter.dispatch(cmd, vk::div_ceil(gaussians, 256));
   }

@@ -2,13 +2,12 @@
 
 #include <stdexcept>
 
+#include "shader_io.h"
+
 namespace tilesplat {
 
 namespace {
-struct PackColourPush {
-  VkDeviceAddress rgba, packed;
-  uint32_t width, height;
-};
+using shader_io::PackColourPush;  // compute/shader_io.h
 
 // pack_colour.comp's FORMAT.
 uint32_t shader_format(VkFormat format) {

@@ -1,16 +1,12 @@
 #include "passes/prefix_sum_pass.h"
 
+#include "shader_io.h"
+
 namespace tilesplat {
 
 namespace {
-struct BlocksPush {
-  VkDeviceAddress src, dst, block_sums, order;
-  uint32_t count, gather;
-};
-struct AddPush {
-  VkDeviceAddress data, block_offsets;
-  uint32_t count, pad;
-};
+using BlocksPush = shader_io::PrefixSumBlocksPush;  // compute/shader_io.h
+using AddPush = shader_io::PrefixSumAddPush;        // compute/shader_io.h
 }  // namespace
 
 PrefixSumPass::PrefixSumPass(vk::Context& ctx)
@@ -48,7 +44,7 @@ void PrefixSumPass::record(VkCommandBuffer cmd, VkDeviceAddress src, VkDeviceAdd
   }
   // Back up: add each scanned block total to its block.
   for (size_t k = levels.size() - 1; k-- > 0;) {
-    add_offsets_.bind(cmd, AddPush{levels[k].data, levels[k + 1].data, levels[k].count, 0});
+    add_offsets_.bind(cmd, AddPush{levels[k].data, levels[k + 1].data, levels[k].count});
     add_offsets_.dispatch(cmd, vk::div_ceil(levels[k].count, kBlock));
     vk::barrier(cmd);
   }

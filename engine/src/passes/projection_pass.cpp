@@ -23,52 +23,13 @@ const std::vector<VkDescriptorType> kTexelBindings = {
     VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
     VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER};
 
-// Mirrors CameraParams in compute/projection.comp.
-struct CameraParams {
-  double rotation[9];  // world to camera, row-major
-  double centre[3];
-  double focal_principal[4];
-  double clip[4];  // 1.3 tan(fov_x / 2), 1.3 tan(fov_y / 2), near, unused
-  uint32_t grid[4];
-};
-static_assert(sizeof(CameraParams) == 176);
-
-struct ProjectionPush {
-  VkDeviceAddress positions, log_scales, rotations, opacity_logits, sh, camera;
-  VkDeviceAddress splats, rects, tile_counts, depth_keys, depth_values, counters;
-  VkDeviceAddress covariances, ray_depth, lighting;
-  uint32_t count;
-  uint32_t pad;
-};
-// maxPushConstantsSize is at least 128 on every Vulkan device: what does not fit goes in a buffer
-// (the normals' address sits in the light buffer for this reason).
-static_assert(sizeof(ProjectionPush) <= 128);
-
-// Mirrors LightParams and LightRecord in compute/projection.comp (std430).
-struct LightRecord {
-  double vector[3];
-  double radiance[3];
-  uint32_t point;
-  uint32_t pad;
-};
-static_assert(sizeof(LightRecord) == 56);
-struct LightParamsHeader {
-  VkDeviceAddress normals;
-  double ambient[3];
-  uint32_t count;
-  uint32_t pad;
-};
-static_assert(sizeof(LightParamsHeader) == 40);
-
-struct PackShPush {
-  VkDeviceAddress sh, sh_half;
-  uint32_t values, pad;
-};
-
-struct PackCovariancePush {
-  VkDeviceAddress log_scales, rotations, covariances;
-  uint32_t count, pad;
-};
+// compute/shader_io.h: the pass's push constants and the blocks it writes (the camera, the lights).
+using shader_io::CameraParams;
+using shader_io::LightParams;
+using shader_io::LightRecord;
+using shader_io::ProjectionPush;
+using PackShPush = shader_io::PackShHalfPush;
+using PackCovariancePush = shader_io::PackCovarianceHalfPush;
 
 constexpr double kNearPlane = 0.2;
 
@@ -92,10 +53,9 @@ void ProjectionPass::set_camera(const Camera& camera) {
   p.clip[0] = 1.3 * camera.tan_half_fov_x();
   p.clip[1] = 1.3 * camera.tan_half_fov_y();
   p.clip[2] = kNearPlane;
-  p.grid[0] = uint32_t((camera.width + kTileSize - 1) / kTileSize);
-  p.grid[1] = uint32_t((camera.height + kTileSize - 1) / kTileSize);
-  p.grid[2] = uint32_t(camera.width);
-  p.grid[3] = uint32_t(camera.height);
+  p.grid = {uint32_t((camera.width + kTileSize - 1) / kTileSize),
+            uint32_t((camera.height + kTileSize - 1) / kTileSize), uint32_t(camera.width),
+            uint32_t(camera.height)};
   vk::upload(ctx_, camera_params_, &p, sizeof(p));
 }
 
@@ -108,10 +68,10 @@ void ProjectionPass::set_lighting(const Lighting& lighting, SceneBuffers& scene)
     vk::upload(ctx_, scene.normals, scene.pending_normals.data(), normal_bytes);
     scene.pending_normals = {};  // the device copy is the scene's now: free the host one
   }
-  const VkDeviceSize bytes = sizeof(LightParamsHeader) + prepared.lights.size() * sizeof(LightRecord);
+  const VkDeviceSize bytes = sizeof(LightParams) + prepared.lights.size() * sizeof(LightRecord);
   if (light_params_.size() < bytes) light_params_ = vk::Buffer(ctx_, bytes, vk::MemoryUse::Upload, "light params");
   std::vector<std::byte> data(bytes);
-  LightParamsHeader header{};
+  LightParams header{};
   header.normals = scene.normals ? scene.normals.address() : 0;
   std::copy(prepared.ambient.begin(), prepared.ambient.end(), header.ambient);
   header.count = uint32_t(prepared.lights.size());
@@ -163,12 +123,13 @@ void ProjectionPass::prepare(SceneBuffers& scene, const ProjectionVariant& varia
                                         vk::MemoryUse::Device, "covariances (fp16)");
   ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
     if (pack_sh && sh_values > 0) {
-      pack_sh_half_.bind(cmd, PackShPush{scene.sh.address(), scene.sh_half.address(), sh_values, 0});
+      pack_sh_half_.bind(cmd, PackShPush{scene.sh.address(), scene.sh_half.address(), sh_values});
       pack_sh_half_.dispatch(cmd, vk::div_ceil(vk::div_ceil(sh_values, 2), 256));
     }
     if (pack_covariance && scene.count > 0) {
-      pack_covariance_half_.bind(cmd, PackCovariancePush{scene.log_scales.address(), scene.rotations.address(),
-                                                         scene.covariances_half.address(), scene.count, 0});
+      pack_covariance_half_.bind(cmd,
+                                 PackCovariancePush{scene.log_scales.address(), scene.rotations.address(),
+                                                    scene.covariances_half.address(), scene.count});
       pack_covariance_half_.dispatch(cmd, vk::div_ceil(scene.count, 256));
     }
   });
@@ -192,8 +153,7 @@ void ProjectionPass::record(VkCommandBuffer cmd, const SceneBuffers& scene, Proj
                       variant.covariance_half ? scene.covariances_half.address() : 0,
                       variant.ray_depth ? out.ray_depth.address() : 0,
                       variant.lighting ? light_params_.address() : 0,
-                      scene.count,
-                      0};
+                      scene.count};
   // Texel views in binding order (projection.comp, TS_TEXEL_BUFFERS); none where a buffer has more
   // texels than the device allows, and then this frame takes the address path.
   std::vector<VkBufferView> views;

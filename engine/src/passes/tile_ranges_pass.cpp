@@ -2,13 +2,12 @@
 
 #include <vector>
 
+#include "shader_io.h"
+
 namespace tilesplat {
 
 namespace {
-struct RangesPush {
-  VkDeviceAddress keys, ranges, counters;
-  uint32_t tiles, pad;
-};
+using RangesPush = shader_io::TileRangesPush;  // compute/shader_io.h
 // tile_ranges_texel's bindings: the sorted keys and the frame's counters.
 const std::vector<VkDescriptorType> kTexelBindings = {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
                                                       VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER};
@@ -33,7 +32,7 @@ void TileRangesPass::record(VkCommandBuffer cmd, const vk::Buffer& sorted_keys, 
          counters.texel_view(VK_FORMAT_R32_UINT, 4)});
   }
   const vk::ComputePipeline& pipeline = (views.empty() ? pipeline_ : texel_pipeline_)[wide_keys ? 1 : 0];
-  pipeline.bind(cmd, RangesPush{sorted_keys.address(), ranges.address(), counters.address(), tiles, 0});
+  pipeline.bind(cmd, RangesPush{sorted_keys.address(), ranges.address(), counters.address(), tiles});
   if (!views.empty()) pipeline.push_texel_views(cmd, views);
   pipeline.dispatch_indirect(cmd, counters.handle(), ranges_args_offset);
 }

@@ -19,14 +19,8 @@ constexpr uint32_t kGroupBits = 4;
 constexpr uint32_t kGroupKeys = 1u << kGroupBits;
 constexpr uint32_t kWorkgroupSize = 256;  // local_size_x in compute/bitonic_common.glsl
 
-struct SetupPush {
-  VkDeviceAddress state;
-  uint32_t capacity, group_keys, workgroup_size, max_workgroups;
-};
-struct PassPush {
-  VkDeviceAddress keys_in, values_in, keys, keys_out, positions, values_out, state;
-  uint32_t capacity, position_bits, stage, stride, steps, pad;
-};
+using SetupPush = shader_io::BitonicSetupPush;  // compute/shader_io.h
+using PassPush = shader_io::BitonicPassPush;    // compute/shader_io.h
 
 // The passes loop over their groups, so any workgroup count covers the keys. GPUs want as many as
 // the keys fill. A CPU driver runs each workgroup on one thread and pays a setup per workgroup (about
@@ -74,9 +68,17 @@ bool BitonicSort::record(vk::CommandStream& stream, SortInput& input) {
   // The network runs in keys_alt and values_alt, so the input values stay intact for the final
   // gather. Each pass loads and stores the same indices in one invocation, which lets the last pass
   // read a key's position from values_alt and overwrite it with the payload.
-  PassPush push{kb.keys.address(), kb.values.address(),     network,     kb.keys_alt.address(),
-                kb.values_alt.address(), kb.values_alt.address(), state, kb.capacity,
-                index_bits,       0,                       0,           0,
+  PassPush push{kb.keys.address(),
+                kb.values.address(),
+                network,
+                kb.keys_alt.address(),
+                kb.values_alt.address(),
+                kb.values_alt.address(),
+                state,
+                kb.capacity,
+                index_bits,
+                0,
+                0,
                 0};
   sort_groups_[variant].bind(cmd, push);
   sort_groups_[variant].dispatch_indirect(cmd, input.state.handle(), args_offset);

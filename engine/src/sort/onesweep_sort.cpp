@@ -29,18 +29,9 @@ constexpr uint32_t kPartitionKeys = 4096;
 // (8 lanes) 4 subgroups, whose 4 x 256 counters are cheaper to clear and offset than 8 x 256.
 constexpr uint32_t kMinWorkgroupSize = 32;
 
-struct SetupPush {
-  VkDeviceAddress state, control;
-  uint32_t partition_keys, pad;
-};
-struct HistogramPush {
-  VkDeviceAddress keys, control, status, state;
-  uint32_t passes, pad;
-};
-struct PassPush {
-  VkDeviceAddress keys_in, values_in, keys_out, values_out, control, status, status_next, state, fallbacks;
-  uint32_t shift, pass, spin_limit, clear_next;
-};
+using SetupPush = shader_io::OnesweepSetupPush;          // compute/shader_io.h
+using HistogramPush = shader_io::OnesweepHistogramPush;  // compute/shader_io.h
+using PassPush = shader_io::OnesweepPassPush;            // compute/shader_io.h
 
 uint32_t spin_limit_from_environment() {
   const char* text = std::getenv("TILESPLAT_ONESWEEP_SPIN");
@@ -125,7 +116,7 @@ bool OnesweepSort::record(vk::CommandStream& stream, SortInput& input) {
   const VkDeviceSize args_offset = input.state_offset + kSortArgsOffset;
   const VkDeviceAddress status[2] = {status_.address(),
                                      status_.address() + VkDeviceSize(status_rows_) * kRadix * sizeof(uint32_t)};
-  setup_.bind(cmd, SetupPush{state, control_.address(), partition_keys_, 0});
+  setup_.bind(cmd, SetupPush{state, control_.address(), partition_keys_});
   setup_.dispatch(cmd, 1);
   vk::barrier(cmd);
 
@@ -138,7 +129,7 @@ bool OnesweepSort::record(vk::CommandStream& stream, SortInput& input) {
       texel_buffers_ ? kb.texel_views(true, unused_keys_) : std::vector<VkBufferView>{}};
   const bool texel = !views[0].empty() && !views[1].empty();
   const vk::ComputePipeline& histogram = texel ? histogram_texel_[wide] : histogram_[wide];
-  histogram.bind(cmd, HistogramPush{kb.keys.address(), control_.address(), status[0], state, passes, 0});
+  histogram.bind(cmd, HistogramPush{kb.keys.address(), control_.address(), status[0], state, passes});
   if (texel) histogram.push_texel_views(cmd, views[0]);
   histogram.dispatch_indirect(cmd, input.state.handle(), args_offset);
   vk::barrier(cmd);

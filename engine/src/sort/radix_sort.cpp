@@ -21,17 +21,9 @@ constexpr uint32_t kLargeCount = 1u << 20;
 // The scan gives each digit one subgroup; a workgroup of 8 covers 8 digits.
 constexpr uint32_t kScanDigitsPerWorkgroup = 8;
 
-struct SetupPush {
-  VkDeviceAddress state;
-  uint32_t block_keys, large_count, subgroups_per_workgroup;
-};
-struct PassPush {
-  VkDeviceAddress keys_in, values_in, keys_out, values_out, histogram, digit_totals, state;
-  uint32_t shift, pad;
-};
-struct ScanPush {
-  VkDeviceAddress histogram, digit_totals, state;
-};
+using SetupPush = shader_io::RadixSetupPush;  // compute/shader_io.h
+using PassPush = shader_io::RadixPassPush;    // compute/shader_io.h
+using ScanPush = shader_io::RadixScanPush;    // compute/shader_io.h
 
 uint32_t workgroup_subgroups(const vk::Context& ctx) {
   // Four subgroups per workgroup keeps the per-subgroup shared counters small (4 KiB) on every device.
@@ -93,8 +85,14 @@ bool RadixSort::record(vk::CommandStream& stream, SortInput& input) {
   bool in_alt = false;
   for (uint32_t p = 0; p < passes; ++p) {
     const auto [keys_in, values_in, keys_out, values_out] = kb.pass(in_alt);
-    PassPush push{keys_in.address(),    values_in.address(),     keys_out.address(), values_out.address(),
-                  histogram_.address(), digit_totals_.address(), state,              p * kDigitBits, 0};
+    PassPush push{keys_in.address(),
+                  values_in.address(),
+                  keys_out.address(),
+                  values_out.address(),
+                  histogram_.address(),
+                  digit_totals_.address(),
+                  state,
+                  p * kDigitBits};
     // Texel views (none where a buffer has more texels than the device allows: the address variants run).
     const std::vector<VkBufferView> views =
         texel_buffers_ ? kb.texel_views(in_alt, unused_keys_) : std::vector<VkBufferView>{};

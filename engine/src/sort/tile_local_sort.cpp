@@ -36,22 +36,10 @@ constexpr uint32_t kBigWorkgroupSize = 1024;
 constexpr uint32_t kMaxBinsPerWorkgroup = 64;
 constexpr uint32_t kMaxSharedCapacity = 4096;
 
-struct SetupPush {
-  VkDeviceAddress state;
-  uint32_t capacity, workgroup_size, max_workgroups, pad;
-};
-struct BinPush {
-  VkDeviceAddress keys_in, keys_out, positions_out, bins, state;
-  uint32_t capacity, bin_count, shift, pad;
-};
-struct ScanPush {
-  VkDeviceAddress bins;
-  uint32_t bin_count, pad;
-};
-struct SortPush {
-  VkDeviceAddress keys, positions, values_in, bins;
-  uint32_t bin_count, shift, big_workgroups, pad;
-};
+using SetupPush = shader_io::TileLocalSetupPush;  // compute/shader_io.h
+using BinPush = shader_io::TileLocalBinPush;      // compute/shader_io.h
+using ScanPush = shader_io::TileLocalScanPush;    // compute/shader_io.h
+using SortPush = shader_io::TileLocalSortPush;    // compute/shader_io.h
 
 // The most elements, a multiple of the 16 of a group, whose two merge buffers fill the device's
 // shared memory (the shader has no other shared memory). A wide local key's high part takes a 64-bit
@@ -128,16 +116,17 @@ bool TileLocalSort::record(vk::CommandStream& stream, SortInput& input) {
   vkCmdFillBuffer(cmd, bins_.handle(), 0, 2 * sizeof(uint32_t), 0);
   vkCmdFillBuffer(cmd, bins_.handle(), 2 * sizeof(uint32_t), 2 * sizeof(uint32_t), 1);
   vkCmdFillBuffer(cmd, bins_.handle(), kBinsHeader * sizeof(uint32_t), bin_count * sizeof(uint32_t), 0);
-  setup_.bind(cmd, SetupPush{state, kb.capacity, kKeyWorkgroupSize, key_workgroups_, 0});
+  setup_.bind(cmd, SetupPush{state, kb.capacity, kKeyWorkgroupSize, key_workgroups_});
   setup_.dispatch(cmd, 1);
   vk::barrier(cmd);
 
-  BinPush bin_push{kb.keys.address(), kb.keys_alt.address(), kb.values_alt.address(), bins_.address(), state,
-                   kb.capacity,       bin_count,             binning.shift,           0};
+  BinPush bin_push{
+      kb.keys.address(), kb.keys_alt.address(), kb.values_alt.address(), bins_.address(), state, kb.capacity,
+      bin_count,         binning.shift};
   count_[wide].bind(cmd, bin_push);
   count_[wide].dispatch_indirect(cmd, input.state.handle(), args_offset);
   vk::barrier(cmd);
-  scan_.bind(cmd, ScanPush{bins_.address(), bin_count, 0});
+  scan_.bind(cmd, ScanPush{bins_.address(), bin_count});
   scan_.dispatch(cmd, 1);
   vk::barrier(cmd);
   scatter_[wide].bind(cmd, bin_push);
@@ -146,8 +135,9 @@ bool TileLocalSort::record(vk::CommandStream& stream, SortInput& input) {
 
   // The small-bin variant lists the bins over the shared capacity for the big-bin variant, so that
   // its few workgroups of up to 1024 invocations do not scan every bin.
-  const SortPush sort_push{kb.keys_alt.address(), kb.values_alt.address(), kb.values.address(), bins_.address(),
-                           bin_count,             binning.shift,           bin_workgroups_,    0};
+  const SortPush sort_push{
+      kb.keys_alt.address(), kb.values_alt.address(), kb.values.address(), bins_.address(), bin_count,
+      binning.shift,         bin_workgroups_};
   const vk::ComputePipeline& sort_small = sort_pipeline(kb.wide_keys, wide_local, false);
   sort_small.bind(cmd, sort_push);
   sort_small.dispatch(cmd, std::min(bin_count, std::max(bin_workgroups_, vk::div_ceil(bin_count, kMaxBinsPerWorkgroup))));
