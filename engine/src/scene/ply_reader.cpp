@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "scene/ply_header.h"
+#include "scene/ply_vertex_properties.h"
 #include "scene/scene_readers.h"
 #include "scene/scene_reading.h"
 #include "tilesplat/scene.h"
@@ -36,13 +37,6 @@ struct Column {
   float* first = nullptr;
   size_t stride = 0;
   const std::string* name = nullptr;
-};
-
-enum class Target { kIgnored, kPosition, kNormal, kShDc, kShRest, kOpacity, kScale, kRotation };
-
-struct ColumnTarget {
-  Target target = Target::kIgnored;
-  size_t component = 0;  // x/y/z, rgb channel, f_rest index, ...
 };
 
 // Decodes a PLY held in memory. `name` (the file's path, for load_ply) prefixes every error.
@@ -93,33 +87,6 @@ class PlyReader {
     return {reinterpret_cast<const char*>(bytes_) + begin, end - begin};
   }
 
-  ColumnTarget classify(const std::string& name) const {
-    static constexpr std::string_view kAxes[] = {"x", "y", "z"};
-    static constexpr std::string_view kNormals[] = {"nx", "ny", "nz"};
-    static constexpr std::string_view kDc[] = {"f_dc_0", "f_dc_1", "f_dc_2"};
-    static constexpr std::string_view kScales[] = {"scale_0", "scale_1", "scale_2"};
-    static constexpr std::string_view kRotations[] = {"rot_0", "rot_1", "rot_2", "rot_3"};
-    for (size_t i = 0; i < 3; ++i) {
-      if (name == kAxes[i]) return {Target::kPosition, i};
-      if (name == kNormals[i]) return {Target::kNormal, i};
-      if (name == kDc[i]) return {Target::kShDc, i};
-      if (name == kScales[i]) return {Target::kScale, i};
-    }
-    for (size_t i = 0; i < 4; ++i)
-      if (name == kRotations[i]) return {Target::kRotation, i};
-    if (name == "opacity") return {Target::kOpacity, 0};
-    if (name.starts_with("f_rest_")) {
-      const std::string_view digits = std::string_view(name).substr(7);
-      size_t index = 0;
-      const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), index);
-      const bool canonical = !digits.empty() && error == std::errc() &&
-                             end == digits.data() + digits.size() && (digits.size() == 1 || digits[0] != '0');
-      if (!canonical) fail("property '" + name + "' is not a valid f_rest_<index> name");
-      return {Target::kShRest, index};
-    }
-    return {Target::kIgnored, 0};
-  }
-
   // Works out which vertex properties are used and the SH degree, and checks the required
   // ones are present, all before any data is touched.
   void plan_vertex_columns() {
@@ -130,7 +97,7 @@ class PlyReader {
     std::string max_rest_name;
     bool normal_present[3] = {false, false, false};
     for (const PlyProperty& property : element.properties) {
-      const ColumnTarget target = classify(property.name);
+      const ColumnTarget target = classify_property(name_, property.name);
       if (property.is_list)
         fail("the vertex element has a list property '" + property.name +
              "'; list properties in the vertex element are not supported");
@@ -434,7 +401,7 @@ class PlyReader {
         if (!line)
           fail("truncated ASCII data: expected " + std::to_string(count) + " vertices, the file ends after " +
                std::to_string(i) + " (line " + std::to_string(cursor.line_number) + ")");
-        parse_ascii_vertex(*line, cursor.line_number, i, values);
+        parse_ascii_vertex(name_, vertex(), *line, cursor.line_number, i, values);
         bool finite = true;
         for (const Column& column : columns) {
           const float value = to_float(values[column.property_index]);
@@ -460,40 +427,6 @@ class PlyReader {
            "); the vertex count in the header may be wrong");
     }
     if (count > 0) shrink(scene, kept);
-  }
-
-  void parse_ascii_vertex(std::string_view line, size_t line_number, size_t vertex_index,
-                          std::vector<double>& values) const {
-    const PlyElement& element = vertex();
-    const size_t expected = element.properties.size();
-    const std::string where =
-        "line " + std::to_string(line_number) + " (vertex " + std::to_string(vertex_index) + "): ";
-    size_t pos = 0;
-    for (size_t p = 0; p < expected; ++p) {
-      while (pos < line.size() && is_blank(line[pos])) ++pos;
-      if (pos == line.size())
-        fail(where + "too few values, expected " + std::to_string(expected) + ", found " + std::to_string(p));
-      size_t end = pos;
-      while (end < line.size() && !is_blank(line[end])) ++end;
-      std::string_view token = line.substr(pos, end - pos);
-      // from_chars rejects a leading '+', which some writers emit.
-      std::string_view digits = token;
-      if (digits.size() > 1 && digits[0] == '+') digits.remove_prefix(1);
-      double value = 0;
-      const auto [parsed_end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-      if (error == std::errc::result_out_of_range)
-        fail(where + "value '" + std::string(token) + "' of " + element.properties[p].name +
-             " is out of range");
-      if (error != std::errc() || parsed_end != digits.data() + digits.size())
-        fail(where + "'" + std::string(token) + "' is not a number (property " + element.properties[p].name +
-             ")");
-      values[p] = value;
-      pos = end;
-    }
-    while (pos < line.size() && is_blank(line[pos])) ++pos;
-    if (pos != line.size())
-      fail(where + "too many values, expected " + std::to_string(expected) +
-           "; the properties in the header may not match the data");
   }
 
   std::string_view name_;

@@ -1,0 +1,158 @@
+#include "vulkan/device_selection.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstring>
+#include <stdexcept>
+
+#include "vulkan/context.h"
+#include "vulkan/vk_check.h"
+
+namespace tilesplat::vk {
+
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return s;
+}
+
+// The 32 hex digits of a selector that names a device by UUID ("GPU-" prefix and dashes optional,
+// any case), or "" when it is not a UUID.
+std::string uuid_digits(const std::string& selector) {
+  std::string text = lower(selector);
+  if (text.rfind("gpu-", 0) == 0) text = text.substr(4);
+  std::string digits;
+  for (const char c : text) {
+    if (c == '-') continue;
+    if (!std::isxdigit(static_cast<unsigned char>(c))) return "";
+    digits += c;
+  }
+  return digits.size() == 2 * VK_UUID_SIZE ? digits : "";
+}
+
+}  // namespace
+
+std::vector<VkPhysicalDevice> enumerate_devices(VkInstance instance) {
+  uint32_t count = 0;
+  TS_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+  std::vector<VkPhysicalDevice> devices(count);
+  TS_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
+  return devices;
+}
+
+VkInstance create_bare_instance(bool validation) {
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "tilesplat";
+  app.pEngineName = "tilesplat";
+  app.apiVersion = VK_API_VERSION_1_2;
+  std::vector<const char*> layers;
+  std::vector<const char*> extensions;
+  if (validation) {
+    uint32_t count = 0;
+    vkEnumerateInstanceLayerProperties(&count, nullptr);
+    std::vector<VkLayerProperties> available(count);
+    vkEnumerateInstanceLayerProperties(&count, available.data());
+    bool found = std::any_of(available.begin(), available.end(), [](const VkLayerProperties& p) {
+      return std::strcmp(p.layerName, kValidationLayer) == 0;
+    });
+    if (!found)
+      throw std::runtime_error(std::string("validation requested but ") + kValidationLayer +
+                               " is not installed (Debian: vulkan-validationlayers)");
+    layers.push_back(kValidationLayer);
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  info.pApplicationInfo = &app;
+  info.enabledLayerCount = uint32_t(layers.size());
+  info.ppEnabledLayerNames = layers.data();
+  info.enabledExtensionCount = uint32_t(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
+  VkInstance instance = VK_NULL_HANDLE;
+  TS_VK_CHECK(vkCreateInstance(&info, nullptr, &instance));
+  return instance;
+}
+
+std::string physical_device_name(VkPhysicalDevice device) {
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(device, &props);
+  return props.deviceName;
+}
+
+std::string physical_device_uuid(VkPhysicalDevice device) {
+  VkPhysicalDeviceIDProperties id{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ID_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props.pNext = &id;
+  vkGetPhysicalDeviceProperties2(device, &props);
+  static constexpr char kDigits[] = "0123456789abcdef";
+  std::string text;
+  for (size_t i = 0; i < VK_UUID_SIZE; ++i) {
+    if (i == 4 || i == 6 || i == 8 || i == 10) text += '-';
+    text += kDigits[id.deviceUUID[i] >> 4];
+    text += kDigits[id.deviceUUID[i] & 15];
+  }
+  return text;
+}
+
+VkPhysicalDevice select_physical_device(VkInstance instance, const std::string& selector) {
+  std::vector<VkPhysicalDevice> devices = enumerate_devices(instance);
+  VkPhysicalDevice chosen = VK_NULL_HANDLE;
+  if (devices.empty())
+    throw std::runtime_error(
+        "no Vulkan device found (install a driver, e.g. Debian's mesa-vulkan-drivers for lavapipe)");
+  if (selector.empty()) {
+    // Prefer a discrete GPU, then an integrated one, then anything (lavapipe).
+    auto rank = [](VkPhysicalDevice d) {
+      VkPhysicalDeviceProperties p;
+      vkGetPhysicalDeviceProperties(d, &p);
+      switch (p.deviceType) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+          return 0;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+          return 1;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+          return 2;
+        default:
+          return 3;
+      }
+    };
+    return *std::min_element(devices.begin(), devices.end(),
+                             [&](auto a, auto b) { return rank(a) < rank(b); });
+  } else {
+    const bool numeric =
+        std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
+    const std::string uuid = numeric ? std::string() : uuid_digits(selector);
+    std::string names;
+    for (size_t i = 0; i < devices.size(); ++i) {
+      const std::string name = physical_device_name(devices[i]);
+      const std::string device_uuid = physical_device_uuid(devices[i]);
+      names += (i ? ", " : "") + std::to_string(i) + ": " + name + " (" + device_uuid + ")";
+      if (chosen) continue;
+      const bool match = numeric         ? std::stoul(selector) == i
+                         : !uuid.empty() ? uuid_digits(device_uuid) == uuid
+                                         : lower(name).find(lower(selector)) != std::string::npos;
+      if (match) chosen = devices[i];
+    }
+    if (!chosen)
+      throw std::runtime_error("no Vulkan device matches '" + selector + "' (devices: " + names + ")");
+  }
+  return chosen;
+}
+
+std::vector<std::string> Context::list_device_uuids() {
+  VkInstance instance = create_bare_instance(false);
+  std::vector<std::string> uuids;
+  for (VkPhysicalDevice d : enumerate_devices(instance)) uuids.push_back(physical_device_uuid(d));
+  vkDestroyInstance(instance, nullptr);
+  return uuids;
+}
+
+std::vector<std::string> Context::list_devices() {
+  VkInstance instance = create_bare_instance(false);
+  std::vector<std::string> names;
+  for (VkPhysicalDevice d : enumerate_devices(instance)) names.push_back(physical_device_name(d));
+  vkDestroyInstance(instance, nullptr);
+  return names;
+}
+
+}  // namespace tilesplat::vk

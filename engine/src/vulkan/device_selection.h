@@ -1,0 +1,27 @@
+// Which Vulkan device a context runs on: the instance tilesplat creates, the devices it enumerates,
+// and the selector of RendererOptions::device (an index, part of a name, or a UUID).
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <string>
+#include <vector>
+
+namespace tilesplat::vk {
+
+inline constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+// An instance of API 1.2; with `validation`, the Khronos layer and debug utils (throws when the layer
+// is not installed).
+VkInstance create_bare_instance(bool validation);
+std::vector<VkPhysicalDevice> enumerate_devices(VkInstance instance);
+std::string physical_device_name(VkPhysicalDevice device);
+// The device's UUID (VkPhysicalDeviceIDProperties::deviceUUID) as 8-4-4-4-12 lower-case hex. On
+// NVIDIA it is the GPU UUID CUDA and nvidia-smi report (they print it after "GPU-").
+std::string physical_device_uuid(VkPhysicalDevice device);
+// The device `selector` names: an index into enumerate_devices, a UUID ("GPU-" prefix and dashes
+// optional), or part of a name (any case); empty: the first discrete GPU, else integrated, else any.
+// Throws listing the devices when none matches, or when there is none.
+VkPhysicalDevice select_physical_device(VkInstance instance, const std::string& selector);
+
+}  // namespace tilesplat::vk
