@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -166,6 +167,9 @@ TEST(FramePlan, ListsAreReusedOnlyWhenEverythingTheyDependOnIsEqual) {
   s.compositor = Compositor::kStochastic;
   changes.push_back({"compositor", s});
   s = {};
+  s.near_plane = 0.01;
+  changes.push_back({"near_plane", s});
+  s = {};
   s.reuse_lists = false;
   changes.push_back({"reuse_lists off", s});
   for (const auto& [what, settings] : changes) EXPECT_TRUE(plan_frame(cam, settings, c).build_lists) << what;
@@ -223,6 +227,11 @@ TEST(FramePlan, RefusesWhatTheDeviceOrCompositorCannotDo) {
   RenderSettings bad_modes;
   bad_modes.accuracy.resort_window = 99;
   EXPECT_THROW(plan_frame(camera(), bad_modes, context()), std::invalid_argument);
+  for (const double near_plane : {0.0, -0.5, std::numeric_limits<double>::infinity()}) {
+    RenderSettings bad_near;
+    bad_near.near_plane = near_plane;
+    EXPECT_THROW(plan_frame(camera(), bad_near, context()), std::invalid_argument) << near_plane;
+  }
 }
 
 TEST(FramePlan, EffectsReachTheProjectionVariant) {

@@ -178,6 +178,50 @@ TEST(GpuRenderer, EqualDepthsBlendInGaussianIndexOrder) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+TEST(GpuRenderer, NearPlaneCullsWhereTheSettingSaysOnTheGpuAndInTheReference) {
+  // Splats from 0.15 to 3 in front of the camera: the default near plane (0.2) culls the first ones,
+  // a near plane of 1.27 also every splat up to 1.25, 0.01 (gsplat's default) none.
+  GaussianScene scene;
+  scene.sh_degree = 0;
+  for (int i = 0; i < 60; ++i) {
+    const float z = 0.15f + 0.05f * float(i);
+    const float x = 0.04f * float(i % 7) - 0.12f, y = 0.03f * float(i % 5) - 0.06f;
+    scene.positions.insert(scene.positions.end(), {x * z, y * z, z});
+    scene.log_scales.insert(scene.log_scales.end(), {-3.5f, -3.2f, -3.4f});
+    scene.rotations.insert(scene.rotations.end(), {1, 0, 0, 0});
+    scene.opacity_logits.push_back(0.5f);
+    scene.sh.insert(scene.sh.end(), {float(i % 3) - 1.0f, float(i % 4) * 0.5f - 0.7f, 0.3f});
+  }
+  const Camera camera = look_at_camera({0, 0, 0}, {0, 0, 1}, {0, -1, 0}, 160, 120, 60);
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(scene);
+  RenderSettings settings;
+  std::vector<uint64_t> visible;
+  std::vector<RenderImage> images;
+  for (const double near_plane : {kDefaultNearPlane, 1.27, 0.01}) {
+    settings.near_plane = near_plane;
+    images.push_back(renderer.render(camera, settings));
+    visible.push_back(renderer.last_frame_stats().visible);
+    const RenderImage ref = render_reference(scene, camera, settings);
+    const ImageDifference d = compare_images(images.back(), ref);
+    EXPECT_GE(d.psnr_db, 60.0) << "near plane " << near_plane;
+    EXPECT_EQ(project_gaussian(scene, 0, camera, Antialiasing::kClassic, {}, near_plane).visible,
+              near_plane < 0.15);
+  }
+  EXPECT_EQ(visible[0], 59u);  // the splat at 0.15
+  EXPECT_EQ(visible[1], 37u);  // and those at 0.2 .. 1.25
+  EXPECT_EQ(visible[2], 60u);
+  EXPECT_LT(compare_images(images[0], images[1]).psnr_db, 40.0);
+  // The default is the setting's default: the same frame to the bit.
+  EXPECT_EQ(renderer.render(camera).rgba, images[0].rgba);
+  for (const double bad : {0.0, -1.0, std::nan("")}) {
+    settings.near_plane = bad;
+    EXPECT_THROW(renderer.render(camera, settings), std::invalid_argument) << bad;
+    EXPECT_THROW(render_reference(scene, camera, settings), std::invalid_argument) << bad;
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 TEST(GpuRenderer, ReportsPassTimingsAndCounts) {
   Renderer& renderer = testing::validated_renderer();
   GaussianScene scene = load_scene(testing::bundled_playbot());

@@ -31,11 +31,13 @@ struct ProjectedGaussian {
 /// Width and height of a screen tile in pixels: the unit of binning and sorting.
 constexpr int kTileSize = 16;
 
-/// Projects Gaussian i of the scene with the reference math, lit when `lighting` has lights.
-/// Throws std::invalid_argument for invalid lights (validate).
+/// Projects Gaussian i of the scene with the reference math, lit when `lighting` has lights, culled
+/// at or before `near_plane` (RenderSettings::near_plane). Throws std::invalid_argument for invalid
+/// lights (validate).
 TILESPLAT_API ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
                                                  Antialiasing antialiasing = Antialiasing::kClassic,
-                                                 const Lighting& lighting = {});
+                                                 const Lighting& lighting = {},
+                                                 double near_plane = kDefaultNearPlane);
 
 /// Evaluates real spherical harmonics up to `degree` for the (normalized) direction dir.
 /// coeffs: K * 3 values, coefficient-major RGB innermost. Returns the raw sum (no +0.5, no clamp).

@@ -156,6 +156,10 @@ struct HostDepth {
   float alpha_threshold = 0.5f;  ///< in (0, 1]
 };
 
+/// The view depth at or below which a Gaussian is culled (RenderSettings::near_plane): the 3DGS
+/// trainer's and its rasterizer's.
+inline constexpr double kDefaultNearPlane = 0.2;
+
 /// Everything that changes how one frame is rendered.
 struct RenderSettings {
   std::array<float, 3> background = {
@@ -181,6 +185,10 @@ struct RenderSettings {
   /// Depth-test the splats against a host's depth image, and give the host a depth back. Unset (the
   /// default): neither, and the composite is the one without them (a specialization constant).
   std::optional<HostDepth> host;
+  /// A Gaussian whose mean's view depth (z, world units) is at or below this is culled, on the GPU and
+  /// in the reference alike: kDefaultNearPlane (0.2) as the 3DGS trainer renders, or what a caller's
+  /// camera uses (gsplat's rasterization() defaults to 0.01). Finite and positive.
+  double near_plane = kDefaultNearPlane;
 };
 
 }  // namespace tilesplat

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <stdexcept>
 
 #include "host_depth.h"
@@ -183,13 +184,16 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
   validate(settings.accuracy);
   validate_compositor(settings);
   validate_host_depth(settings, camera);
+  if (!(std::isfinite(settings.near_plane) && settings.near_plane > 0))
+    throw std::invalid_argument("RenderSettings::near_plane must be a positive, finite view depth, got " +
+                                std::to_string(settings.near_plane));
 
   FramePlan plan;
   plan.sort = context.sort;
   plan.lists = {context.scene.generation, camera,
                 context.sort.name,        settings.accuracy,
                 settings.antialiasing,    settings.lighting,
-                settings.compositor};
+                settings.compositor,      settings.near_plane};
   plan.build_lists = !(settings.reuse_lists && context.lists && *context.lists == plan.lists);
   plan.projection = projection_variant(settings, context.scene);
   plan.tiles = tile_grid(camera);

@@ -88,6 +88,7 @@ struct ListKey {
   Antialiasing antialiasing = Antialiasing::kClassic;
   Lighting lighting;
   Compositor compositor = Compositor::kSorted;  // sorted and binned-only lists differ
+  double near_plane = kDefaultNearPlane;
 
   bool operator==(const ListKey&) const = default;
 };

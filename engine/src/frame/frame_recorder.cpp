@@ -25,7 +25,7 @@ FrameRecorder::FrameRecorder(vk::Context& ctx, vk::GpuTimer& timer)
 void FrameRecorder::set_frame_inputs(const Camera& camera, const RenderSettings& settings,
                                      SceneBuffers& scene) {
   projection_.set_lighting(settings.lighting, scene);  // validates the lights; uploads normals on first use
-  projection_.set_camera(camera);
+  projection_.set_camera(camera, settings.near_plane);
 }
 
 uint32_t FrameRecorder::chunks_for(Compositor compositor, uint64_t longest_tile_list) const {

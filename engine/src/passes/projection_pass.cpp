@@ -31,8 +31,6 @@ using shader_io::ProjectionPush;
 using PackShPush = shader_io::PackShHalfPush;
 using PackCovariancePush = shader_io::PackCovarianceHalfPush;
 
-constexpr double kNearPlane = 0.2;
-
 }  // namespace
 
 ProjectionPass::ProjectionPass(vk::Context& ctx)
@@ -42,7 +40,7 @@ ProjectionPass::ProjectionPass(vk::Context& ctx)
       pack_covariance_half_(ctx, "pack_covariance_half", sizeof(PackCovariancePush)),
       texel_buffers_(vk::texel_buffers_wanted(ctx) && ctx.features().shader_float64) {}
 
-void ProjectionPass::set_camera(const Camera& camera) {
+void ProjectionPass::set_camera(const Camera& camera, double near_plane) {
   CameraParams p{};
   std::copy(camera.rotation.begin(), camera.rotation.end(), p.rotation);
   std::copy(camera.position.begin(), camera.position.end(), p.centre);
@@ -52,7 +50,7 @@ void ProjectionPass::set_camera(const Camera& camera) {
   p.focal_principal[3] = camera.cy;
   p.clip[0] = 1.3 * camera.tan_half_fov_x();
   p.clip[1] = 1.3 * camera.tan_half_fov_y();
-  p.clip[2] = kNearPlane;
+  p.clip[2] = near_plane;
   p.grid = {uint32_t((camera.width + kTileSize - 1) / kTileSize),
             uint32_t((camera.height + kTileSize - 1) / kTileSize), uint32_t(camera.width),
             uint32_t(camera.height)};

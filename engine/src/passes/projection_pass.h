@@ -71,7 +71,7 @@ class ProjectionPass {
  public:
   explicit ProjectionPass(vk::Context& ctx);
   // Writes this frame's camera; must be called before record(), outside the command buffer.
-  void set_camera(const Camera& camera);
+  void set_camera(const Camera& camera, double near_plane);
   // Validates this frame's lights (tilesplat::validate) and, when there are any, writes them and
   // uploads the scene's pending normals (once per scene). Must be called before record(), outside the
   // command buffer; record() of a lit variant reads what the last call wrote.

@@ -29,7 +29,6 @@ constexpr double kShC2[5] = {1.0925484305920792, -1.0925484305920792, 0.31539156
 constexpr double kShC3[7] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658, 0.3731763325901154,
                              -0.4570457994644658, 1.445305721320277,  -0.5900435899266435};
 
-constexpr double kNearPlane = 0.2;
 constexpr double kFrustumClampFactor = 1.3;  // x/z, y/z clamp before the Jacobian, in units of tan(fov/2)
 // The low-pass filter added to every 2D covariance, per antialiasing mode.
 double low_pass_dilation(Antialiasing mode) { return mode == Antialiasing::kMip ? 0.1 : 0.3; }
@@ -214,14 +213,14 @@ std::array<double, 3> eval_sh(int degree, const float* coeffs, const std::array<
 
 namespace {
 
-ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& camera, Antialiasing antialiasing,
-                          const PreparedLighting& lighting) {
+ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& camera,
+                          Antialiasing antialiasing, const PreparedLighting& lighting, double near_plane) {
   ProjectedGaussian out;
   const std::array<double, 3> mean = {scene.positions[3 * i], scene.positions[3 * i + 1], scene.positions[3 * i + 2]};
   const std::array<double, 3> t = camera.to_camera(mean);
   out.depth = t[2];
   // Written as a negated comparison so that a NaN depth is culled too.
-  if (!(t[2] > kNearPlane) || !all_finite({t[0], t[1], t[2]})) return out;
+  if (!(t[2] > near_plane) || !all_finite({t[0], t[1], t[2]})) return out;
 
   // Scales are float32 values: a log scale whose exp overflows a float is an infinite scale (the GPU
   // evaluates exp in float32), and an infinite scale has no usable covariance.
@@ -314,19 +313,28 @@ ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& ca
   return out;
 }
 
+// A near plane the reference can cull at (the GPU's plan refuses the same values).
+void check_near_plane(double near_plane) {
+  if (!(std::isfinite(near_plane) && near_plane > 0))
+    throw std::invalid_argument("RenderSettings::near_plane must be a positive, finite view depth, got " +
+                                std::to_string(near_plane));
+}
+
 }  // namespace
 
 ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
-                                   Antialiasing antialiasing, const Lighting& lighting) {
+                                   Antialiasing antialiasing, const Lighting& lighting, double near_plane) {
   if (i >= scene.size()) throw std::out_of_range("project_gaussian: index out of range");
+  check_near_plane(near_plane);
   if (lighting.enabled()) check_normals(scene);
-  return project(scene, i, camera, antialiasing, prepare_lighting(lighting));
+  return project(scene, i, camera, antialiasing, prepare_lighting(lighting), near_plane);
 }
 
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings) {
   validate(camera);
   check_scene(scene);
   validate_host_depth(settings, camera);
+  check_near_plane(settings.near_plane);
   // A host's surfaces, as view depths: a splat blends only in front of them (RenderSettings::host).
   const std::vector<float> host_z = settings.host ? host_view_depths(*settings.host) : std::vector<float>{};
   const bool surface_out = settings.host && settings.host->write_depth;
@@ -338,7 +346,8 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
 
   std::vector<ProjectedGaussian> projected(n);
   parallel_chunks(n, 4096, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) projected[i] = project(scene, i, camera, settings.antialiasing, lighting);
+    for (size_t i = begin; i < end; ++i)
+      projected[i] = project(scene, i, camera, settings.antialiasing, lighting, settings.near_plane);
   });
 
   // Front to back by the float32 depth the GPU sorts on, ties by Gaussian index.
