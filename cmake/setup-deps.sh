@@ -54,6 +54,7 @@ pkgs=(
   libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev libcli11-dev
   zlib1g-dev libzstd-dev libwebp-dev libzip-dev libssl-dev
   libgtest-dev googletest
+  python3-dev python3-venv
   xvfb xauth
 )
 case "${1:-}" in

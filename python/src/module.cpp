@@ -1,0 +1,490 @@
+// tilesplat._core: the engine's public API for Python, numpy arrays in and out (nanobind).
+//
+// Scenes, cameras, the renderer and its images are the C++ types with thin wrappers: a scene's arrays
+// and an image's channels are numpy views of the C++ vectors, kept alive by the Python object that
+// owns them; render() releases the GIL while the frame runs. C++ exceptions reach Python with their
+// messages: SceneError as tilesplat.SceneError (a ValueError), std::invalid_argument as ValueError, a
+// missing file as FileNotFoundError, anything else as RuntimeError.
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/array.h>
+#include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/unique_ptr.h>
+#include <nanobind/stl/vector.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tilesplat/camera.h"
+#include "tilesplat/camera_path.h"
+#include "tilesplat/camera_sets.h"
+#include "tilesplat/image.h"
+#include "tilesplat/render_settings.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+#include "tilesplat/scene_description.h"
+#include "tilesplat/version.h"
+
+namespace nb = nanobind;
+using namespace nb::literals;
+
+namespace tilesplat::python {
+namespace {
+
+template <typename T>
+using NumpyArray = nb::ndarray<nb::numpy, T>;
+
+// A numpy view of `values` with the given shape, kept alive by `owner` (the Python object that holds
+// the vector).
+template <typename T>
+NumpyArray<T> view_of(std::vector<T>& values, std::initializer_list<size_t> shape, nb::handle owner) {
+  return NumpyArray<T>(values.data(), shape, owner);
+}
+
+// A C-contiguous float32 array on the CPU; other dtypes and layouts are converted (copied) on the way in.
+using FloatInput = nb::ndarray<const float, nb::c_contig, nb::device::cpu>;
+
+// The values of `array`, which must have the shape given (-1: any size on that axis), all finite.
+std::vector<float> finite_values(const FloatInput& array, const char* name,
+                                 std::initializer_list<int64_t> shape) {
+  std::string expected = "(";
+  for (auto it = shape.begin(); it != shape.end(); ++it)
+    expected += (it == shape.begin() ? "" : ", ") + (*it < 0 ? std::string("N") : std::to_string(*it));
+  expected += shape.size() == 1 ? ",)" : ")";
+  bool matches = array.ndim() == shape.size();
+  size_t axis = 0;
+  for (const int64_t size : shape) {
+    if (matches && size >= 0 && array.shape(axis) != size_t(size)) matches = false;
+    ++axis;
+  }
+  if (!matches) {
+    std::string got = "(";
+    for (size_t a = 0; a < array.ndim(); ++a) got += (a ? ", " : "") + std::to_string(array.shape(a));
+    got += array.ndim() == 1 ? ",)" : ")";
+    throw std::invalid_argument(std::string(name) + " must have the shape " + expected + ", got " + got);
+  }
+  std::vector<float> values(array.data(), array.data() + array.size());
+  for (size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i]))
+      throw std::invalid_argument(std::string(name) + " holds a non-finite value (" +
+                                  std::to_string(values[i]) + ") at flat index " + std::to_string(i));
+  return values;
+}
+
+template <typename Enum, size_t N>
+Enum parse_choice(const std::string& name, const std::string& text, const std::array<Enum, N>& choices) {
+  std::string allowed;
+  for (const Enum choice : choices) {
+    if (to_string(choice) == text) return choice;
+    allowed += (allowed.empty() ? "" : ", ") + to_string(choice);
+  }
+  throw std::invalid_argument(name + " must be one of " + allowed + ", got '" + text + "'");
+}
+
+// Raises FileNotFoundError naming the file, as open() would, before the engine reads it.
+void check_exists(const std::filesystem::path& path, const char* what) {
+  std::error_code error;
+  if (std::filesystem::exists(path, error)) return;
+  const std::string message = std::string("cannot read ") + what + " '" + path.string() + "': no such file";
+  PyErr_SetString(PyExc_FileNotFoundError, message.c_str());
+  throw nb::python_error();
+}
+
+// RenderSettings from render()'s keyword arguments (the C++ names).
+RenderSettings make_settings(const std::string& sort, bool depth, bool splat_count,
+                             const std::string& accuracy, const std::string& antialiasing,
+                             const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
+                             const std::array<float, 3>& background, bool reuse_lists, double near_plane) {
+  RenderSettings settings;
+  settings.sort = sort;
+  settings.depth = depth;
+  settings.splat_count = splat_count;
+  settings.accuracy = parse_accuracy_modes(accuracy);
+  settings.antialiasing =
+      parse_choice("antialiasing", antialiasing,
+                   std::array{Antialiasing::kClassic, Antialiasing::kAntialiased, Antialiasing::kMip});
+  settings.compositor =
+      parse_choice("compositor", compositor, std::array{Compositor::kSorted, Compositor::kStochastic});
+  settings.stochastic.frames = stochastic_frames;
+  settings.stochastic.seed = seed;
+  settings.background = background;
+  settings.reuse_lists = reuse_lists;
+  settings.near_plane = near_plane;
+  return settings;
+}
+
+nb::dict stats_dict(const FrameStats& stats) {
+  nb::dict out;
+  nb::list passes;
+  for (const PassTiming& pass : stats.passes) passes.append(nb::make_tuple(pass.name, pass.gpu_ms));
+  out["passes"] = passes;
+  out["gpu_ms"] = stats.gpu_ms;
+  out["cpu_ms"] = stats.cpu_ms;
+  out["gaussians"] = stats.gaussians;
+  out["visible"] = stats.visible;
+  out["intersections"] = stats.intersections;
+  out["sort_bits"] = stats.sort_bits;
+  out["sort_strategy"] = stats.sort_strategy;
+  out["retries"] = stats.retries;
+  out["submissions"] = stats.submissions;
+  out["device_bytes"] = stats.device_bytes;
+  out["reused_sorted_lists"] = stats.reused_sorted_lists;
+  return out;
+}
+
+// The Python Renderer: the engine's renderer, which is neither copyable nor movable, behind a pointer.
+struct RendererHandle {
+  std::unique_ptr<Renderer> renderer;
+};
+
+nb::dict device_dict(const DeviceInfo& device) {
+  nb::dict out;
+  out["name"] = device.name;
+  out["driver"] = device.driver;
+  out["subgroup_size"] = device.subgroup_size;
+  out["cpu"] = device.cpu;
+  out["vendor_id"] = device.vendor_id;
+  out["max_image_dimension"] = device.max_image_dimension;
+  return out;
+}
+
+}  // namespace
+
+void bind(nb::module_& m) {
+  m.attr("__version__") = build_info().version;
+  nb::exception<SceneError>(m, "SceneError", PyExc_ValueError);
+
+  // --- scenes
+  nb::class_<GaussianScene>(
+      m, "Scene",
+      "N Gaussians as the trainer stores them (log scales, opacity logits, SH), structure "
+      "of arrays; the arrays are numpy views of the scene's own memory.")
+      .def_prop_ro("size", &GaussianScene::size, "N, the number of Gaussians")
+      .def_prop_ro(
+          "sh_degree", [](const GaussianScene& s) { return s.sh_degree; }, "0..3")
+      .def_prop_ro(
+          "positions",
+          [](nb::handle self) {
+            auto& s = nb::cast<GaussianScene&>(self);
+            return view_of(s.positions, {s.size(), 3}, self);
+          },
+          "(N, 3) world-space means")
+      .def_prop_ro(
+          "log_scales",
+          [](nb::handle self) {
+            auto& s = nb::cast<GaussianScene&>(self);
+            return view_of(s.log_scales, {s.size(), 3}, self);
+          },
+          "(N, 3) log of the scales")
+      .def_prop_ro(
+          "rotations",
+          [](nb::handle self) {
+            auto& s = nb::cast<GaussianScene&>(self);
+            return view_of(s.rotations, {s.size(), 4}, self);
+          },
+          "(N, 4) unit quaternions w x y z")
+      .def_prop_ro(
+          "opacity_logits",
+          [](nb::handle self) {
+            auto& s = nb::cast<GaussianScene&>(self);
+            return view_of(s.opacity_logits, {s.size()}, self);
+          },
+          "(N,) logits of the opacities")
+      .def_prop_ro(
+          "sh",
+          [](nb::handle self) {
+            auto& s = nb::cast<GaussianScene&>(self);
+            return view_of(s.sh, {s.size(), size_t(s.sh_coefficients()), 3}, self);
+          },
+          "(N, K, 3) SH coefficients, K = (sh_degree + 1)^2; k = 0 is the DC term")
+      .def_static(
+          "from_arrays",
+          [](const FloatInput& positions, const FloatInput& log_scales, const FloatInput& rotations,
+             const FloatInput& opacity_logits, const FloatInput& sh) {
+            GaussianScene scene;
+            scene.positions = finite_values(positions, "positions", {-1, 3});
+            const size_t n = scene.positions.size() / 3;
+            scene.log_scales = finite_values(log_scales, "log_scales", {int64_t(n), 3});
+            scene.rotations = finite_values(rotations, "rotations", {int64_t(n), 4});
+            scene.opacity_logits = finite_values(opacity_logits, "opacity_logits", {int64_t(n)});
+            scene.sh = finite_values(sh, "sh", {int64_t(n), -1, 3});
+            const size_t k = sh.ndim() == 3 ? sh.shape(1) : 0;
+            int degree = 0;
+            while (degree <= 3 && size_t((degree + 1) * (degree + 1)) != k) ++degree;
+            if (degree > 3)
+              throw std::invalid_argument("sh must have 1, 4, 9 or 16 coefficients, got " +
+                                          std::to_string(k));
+            scene.sh_degree = degree;
+            return scene;
+          },
+          "positions"_a, "log_scales"_a, "rotations"_a, "opacity_logits"_a, "sh"_a,
+          "A scene from arrays: positions (N, 3), log_scales (N, 3), rotations (N, 4) w x y z, "
+          "opacity_logits "
+          "(N,), sh (N, K, 3) with K = 1, 4, 9 or 16. Values are copied as given (a quaternion of any "
+          "length: the "
+          "renderer normalizes it, and a zero one is the identity); non-finite ones raise ValueError.")
+      .def("__repr__", [](const GaussianScene& s) {
+        return "<tilesplat.Scene " + std::to_string(s.size()) + " Gaussians, SH degree " +
+               std::to_string(s.sh_degree) + ">";
+      });
+
+  m.def(
+      "load_scene",
+      [](const std::filesystem::path& path, bool strict) {
+        check_exists(path, "scene");
+        LoadOptions options;
+        options.strict = strict;
+        nb::gil_scoped_release release;
+        if (is_scene_description(path)) return load_described_scene(load_scene_description(path), options);
+        return load_scene(path, options);
+      },
+      "path"_a, "strict"_a = false,
+      "Loads a scene: a splat file of any format the library reads (.ply, .compressed.ply, .splat, .spz, "
+      ".sog, "
+      "SOG meta.json, .glb, .gltf) or a scene file (.json). strict: fail on a non-finite value instead of "
+      "dropping the Gaussian.");
+
+  // --- cameras
+  nb::class_<Camera>(
+      m, "Camera",
+      "A pinhole camera: image size, intrinsics in pixels, world-to-camera rotation (row-major) "
+      "and centre; x right, y down, z forward, as the 3DGS trainer's cameras.")
+      .def(nb::init<>())
+      .def_rw("width", &Camera::width)
+      .def_rw("height", &Camera::height)
+      .def_rw("fx", &Camera::fx)
+      .def_rw("fy", &Camera::fy)
+      .def_rw("cx", &Camera::cx)
+      .def_rw("cy", &Camera::cy)
+      .def_rw("rotation", &Camera::rotation, "world to camera, row-major 3x3 as 9 numbers")
+      .def_rw("position", &Camera::position, "the camera centre in world space")
+      .def(
+          "resized", [](const Camera& c, int width, int height) { return resize_camera(c, width, height); },
+          "width"_a, "height"_a, "The same view at another size (the field of view kept).")
+      .def_static(
+          "look_at",
+          [](const std::array<double, 3>& eye, const std::array<double, 3>& target,
+             const std::array<double, 3>& up, int width, int height, double vertical_fov_deg) {
+            return look_at_camera(eye, target, up, width, height, vertical_fov_deg);
+          },
+          "eye"_a, "target"_a, "up"_a, "width"_a, "height"_a, "vertical_fov_deg"_a = 50.0)
+      .def_static(
+          "orbit",
+          [](const GaussianScene& scene, int width, int height, double azimuth_deg, double elevation_deg,
+             double vertical_fov_deg, double distance_scale) {
+            OrbitParams orbit;
+            orbit.azimuth_deg = azimuth_deg;
+            orbit.elevation_deg = elevation_deg;
+            orbit.vertical_fov_deg = vertical_fov_deg;
+            orbit.distance_scale = distance_scale;
+            return orbit_camera(scene, width, height, orbit);
+          },
+          "scene"_a, "width"_a = 1920, "height"_a = 1080, "azimuth_deg"_a = 0.0, "elevation_deg"_a = 20.0,
+          "vertical_fov_deg"_a = 50.0, "distance_scale"_a = 1.0,
+          "The camera that orbits the scene and frames it.")
+      .def_static(
+          "from_matrices",
+          [](const std::array<double, 16>& view, const std::array<double, 16>& projection, int width,
+             int height, const std::string& clip) {
+            if (clip != "vulkan" && clip != "opengl")
+              throw std::invalid_argument("clip must be vulkan or opengl, got '" + clip + "'");
+            return Camera::from_matrices(view, projection, width, height,
+                                         clip == "vulkan" ? ClipSpace::vulkan() : ClipSpace::opengl());
+          },
+          "view"_a, "projection"_a, "width"_a, "height"_a, "clip"_a = "vulkan",
+          "The camera of a host's view and projection matrices, 16 numbers each, column-major (glm's "
+          "layout); "
+          "clip: the projection's convention, 'vulkan' (y down, depth 0..1) or 'opengl'.")
+      .def("__eq__", [](const Camera& a, const Camera& b) { return a == b; })
+      .def("__repr__", [](const Camera& c) {
+        return "<tilesplat.Camera " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+               " fx=" + std::to_string(c.fx) + " fy=" + std::to_string(c.fy) + ">";
+      });
+
+  nb::class_<CameraView>(m, "CameraView", "A view of a camera set: its id, its image name and its camera.")
+      .def_ro("id", &CameraView::id)
+      .def_ro("name", &CameraView::name)
+      .def_ro("camera", &CameraView::camera);
+
+  m.def(
+      "load_cameras",
+      [](const std::filesystem::path& path) {
+        check_exists(path, "cameras");
+        return load_camera_set(path);
+      },
+      "path"_a,
+      "The views of a camera set: the trainer's cameras.json, a transforms.json, or a COLMAP model (its "
+      "folder, "
+      "or its cameras/images .bin or .txt).");
+
+  m.def(
+      "orbit_cameras",
+      [](const GaussianScene& scene, int frames, int width, int height, double azimuth_deg,
+         double elevation_deg, double vertical_fov_deg, double distance_scale) {
+        OrbitParams orbit;
+        orbit.azimuth_deg = azimuth_deg;
+        orbit.elevation_deg = elevation_deg;
+        orbit.vertical_fov_deg = vertical_fov_deg;
+        orbit.distance_scale = distance_scale;
+        return orbit_cameras(scene, frames, width, height, orbit);
+      },
+      "scene"_a, "frames"_a, "width"_a = 1920, "height"_a = 1080, "azimuth_deg"_a = 0.0,
+      "elevation_deg"_a = 20.0, "vertical_fov_deg"_a = 50.0, "distance_scale"_a = 1.0,
+      "`frames` orbit cameras evenly spaced in azimuth around the scene, as tilesplat-render --orbit N.");
+  m.def(
+      "camera_path",
+      [](const std::filesystem::path& path, int frames, int width, int height) {
+        check_exists(path, "camera path");
+        return sample_camera_path(load_camera_path(path), frames, width, height);
+      },
+      "path"_a, "frames"_a, "width"_a = 1920, "height"_a = 1080,
+      "`frames` cameras along a keyframe file (docs/camera-paths.md), as tilesplat-render --path.");
+
+  // --- images
+  nb::class_<RenderImage>(m, "Image",
+                          "A rendered frame: rgba (H, W, 4) premultiplied over the background, depth (H, W) "
+                          "expected view depth, splat_count (H, W) blended splats; numpy views of the image.")
+      .def_ro("width", &RenderImage::width)
+      .def_ro("height", &RenderImage::height)
+      .def_prop_ro("rgba",
+                   [](nb::handle self) {
+                     auto& image = nb::cast<RenderImage&>(self);
+                     return view_of(image.rgba, {size_t(image.height), size_t(image.width), 4}, self);
+                   })
+      .def_prop_ro("depth",
+                   [](nb::handle self) -> std::optional<NumpyArray<float>> {
+                     auto& image = nb::cast<RenderImage&>(self);
+                     if (image.depth.empty()) return std::nullopt;
+                     return view_of(image.depth, {size_t(image.height), size_t(image.width)}, self);
+                   })
+      .def_prop_ro("splat_count",
+                   [](nb::handle self) -> std::optional<NumpyArray<uint32_t>> {
+                     auto& image = nb::cast<RenderImage&>(self);
+                     if (image.splat_count.empty()) return std::nullopt;
+                     return view_of(image.splat_count, {size_t(image.height), size_t(image.width)}, self);
+                   })
+      .def(
+          "write_exr",
+          [](const RenderImage& image, const std::filesystem::path& path, bool half,
+             const std::string& compression, std::optional<Camera> camera, float empty_depth) {
+            ExrWriteOptions options;
+            options.half = half;
+            options.empty_depth = empty_depth;
+            options.compression = parse_choice("compression", compression,
+                                               std::array{ExrCompression::kZip, ExrCompression::kPiz,
+                                                          ExrCompression::kDwaa, ExrCompression::kNone});
+            options.camera = camera;
+            write_exr(path, image, options);
+          },
+          "path"_a, "half"_a = false, "compression"_a = "zip", "camera"_a = nb::none(),
+          "empty_depth"_a = kFarDepth,
+          "Writes the image as tilesplat-render does: R G B A, Z and 'splats', scene-linear, atomically; Z "
+          "is "
+          "empty_depth where no splat was blended (default: far, behind everything, as the app writes).")
+      .def(
+          "write_png",
+          [](const RenderImage& image, const std::filesystem::path& path, double exposure_stops,
+             const std::string& tone_map) {
+            PreviewOptions options;
+            options.exposure_stops = exposure_stops;
+            options.tone_map = parse_choice("tone_map", tone_map,
+                                            std::array{ToneMap::kNone, ToneMap::kAces, ToneMap::kReinhard});
+            write_png_preview(path, image, options);
+          },
+          "path"_a, "exposure_stops"_a = 0.0, "tone_map"_a = "none", "Writes an 8-bit sRGB preview.");
+
+  m.def(
+      "read_exr",
+      [](const std::filesystem::path& path) {
+        check_exists(path, "EXR");
+        return read_exr(path);
+      },
+      "path"_a, "Reads an EXR that write_exr (or tilesplat-render) wrote.");
+
+  m.def(
+      "compare_images",
+      [](const RenderImage& a, const RenderImage& b) {
+        const ImageDifference difference = compare_images(a, b);
+        nb::dict out;
+        out["psnr_db"] = difference.psnr_db;
+        out["max_abs"] = difference.max_abs;
+        out["max_abs_alpha"] = difference.max_abs_alpha;
+        return out;
+      },
+      "a"_a, "b"_a, "PSNR (RGB, peak 1) and the largest differences of two images of one size.");
+
+  // --- the renderer
+  m.def("devices", &list_devices, "The Vulkan devices, in the order Renderer(device=INDEX) counts them.");
+  m.def("sort_strategies", &sort_strategies,
+        "The sort strategies Renderer.render(sort=...) accepts, besides auto.");
+
+  nb::class_<RendererHandle>(
+      m, "Renderer", "The GPU renderer on one Vulkan device. render() releases the GIL while the frame runs.")
+      .def(
+          "__init__",
+          [](RendererHandle* self, const std::string& device, bool validation) {
+            RendererOptions options;
+            options.device = device;
+            options.validation = validation;
+            std::unique_ptr<Renderer> renderer;
+            {
+              nb::gil_scoped_release release;
+              renderer = Renderer::create(options);
+            }
+            new (self) RendererHandle{std::move(renderer)};
+          },
+          "device"_a = "", "validation"_a = false,
+          "device: an index into devices(), part of a device's name or its UUID; '' = $TILESPLAT_DEVICE, "
+          "else the "
+          "first discrete GPU, else the first device. validation: the Khronos validation layer.")
+      .def(
+          "set_scene",
+          [](RendererHandle& self, const GaussianScene& scene) {
+            nb::gil_scoped_release release;
+            self.renderer->set_scene(scene);
+          },
+          "scene"_a, "Uploads the scene (a copy: the Python scene stays free to change).")
+      .def(
+          "render",
+          [](RendererHandle& self, const Camera& camera, const std::string& sort, bool depth,
+             bool splat_count, const std::string& accuracy, const std::string& antialiasing,
+             const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
+             const std::array<float, 3>& background, bool reuse_lists, double near_plane) {
+            const RenderSettings settings =
+                make_settings(sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames,
+                              seed, background, reuse_lists, near_plane);
+            nb::gil_scoped_release release;
+            return self.renderer->render(camera, settings);
+          },
+          "camera"_a, "sort"_a = "auto", "depth"_a = true, "splat_count"_a = true, "accuracy"_a = "reference",
+          "antialiasing"_a = "classic", "compositor"_a = "sorted", "stochastic_frames"_a = 16, "seed"_a = 1,
+          "background"_a = std::array<float, 3>{0, 0, 0}, "reuse_lists"_a = true,
+          "near_plane"_a = kDefaultNearPlane,
+          "Renders the scene from `camera`. Keyword arguments are RenderSettings' fields: accuracy is a mode "
+          "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
+          "compositor 'sorted' or 'stochastic'; near_plane the view depth at or below which a Gaussian is "
+          "culled.")
+      .def_prop_ro("last_frame_stats",
+                   [](const RendererHandle& self) { return stats_dict(self.renderer->last_frame_stats()); })
+      .def_prop_ro("device_info",
+                   [](const RendererHandle& self) { return device_dict(self.renderer->device_info()); })
+      .def(
+          "sort_strategy_for",
+          [](const RendererHandle& self, const std::string& requested) {
+            return self.renderer->sort_strategy_for(requested);
+          },
+          "requested"_a,
+          "The strategy a requested name stands for on this device ('auto': the one it picks).")
+      .def_prop_ro("validation_messages",
+                   [](const RendererHandle& self) { return self.renderer->validation_messages(); });
+}
+
+}  // namespace tilesplat::python
+
+NB_MODULE(_core, m) {
+  tilesplat::python::bind(m);
+}

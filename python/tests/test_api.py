@@ -1,0 +1,226 @@
+"""The engine's API from Python: scenes as numpy views, cameras, the renderer, images, errors."""
+
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import tilesplat
+from conftest import BUNDLED_PLAYBOT, BUNDLED_SH3, REPO
+
+
+def test_version_is_the_projects():
+    cmake = (REPO / "CMakeLists.txt").read_text()
+    assert f"project(tilesplat VERSION {tilesplat.__version__}" in cmake
+    assert tilesplat.devices(), "no Vulkan device"
+    assert "radix" in tilesplat.sort_strategies()
+
+
+def test_scene_arrays_are_views_of_the_scene():
+    scene = tilesplat.load_scene(BUNDLED_SH3)
+    assert scene.size == 64 and scene.sh_degree == 3
+    assert scene.positions.shape == (64, 3) and scene.positions.dtype == np.float32
+    assert scene.log_scales.shape == (64, 3)
+    assert scene.rotations.shape == (64, 4)
+    assert scene.opacity_logits.shape == (64,)
+    assert scene.sh.shape == (64, 16, 3)
+    np.testing.assert_allclose(np.linalg.norm(scene.rotations, axis=1), 1, rtol=1e-6)
+    # A view: what the scene holds, not a copy taken once.
+    view = scene.positions
+    view[0, 0] = 123.0
+    assert scene.positions[0, 0] == 123.0
+
+
+def test_every_format_loads(shared_scenes):
+    formats = shared_scenes / "formats"
+    reference = tilesplat.load_scene(BUNDLED_SH3)
+    for name in ["playcanvas_test_64_sh3.compressed.ply", "playcanvas_test_64_sh3.glb",
+                 "playcanvas_test_64_sh3.sog", "playcanvas_test_64_sh3.v3.spz", "playcanvas_test_64_sh3.v4.spz"]:
+        scene = tilesplat.load_scene(formats / name)
+        assert scene.size == reference.size and scene.sh_degree == 3, name
+        # Lossy formats, some of which reorder the Gaussians: every mean of the lossless PLY has one
+        # within a centimetre in the file.
+        distances = np.linalg.norm(reference.positions[:, None, :] - scene.positions[None, :, :], axis=2)
+        assert distances.min(axis=1).max() < 0.01, name
+    scene_file = tilesplat.load_scene(REPO / "scenes" / "two_playbots.json")
+    assert scene_file.size == 2 * tilesplat.load_scene(BUNDLED_PLAYBOT).size
+
+
+def test_cameras_from_a_camera_set_and_of_its_own_making():
+    views = tilesplat.load_cameras(REPO / "scenes" / "playbot_lod3" / "playbot_lod3_31000_sh2.json")
+    assert len(views) > 1
+    assert views[0].camera.width > 0 and views[0].name
+    small = views[0].camera.resized(160, 90)
+    assert (small.width, small.height) == (160, 90)
+    look = tilesplat.Camera.look_at([0, 0, -5], [0, 0, 0], [0, -1, 0], 64, 48, 50.0)
+    assert look.position == [0, 0, -5] and look.width == 64
+
+
+@pytest.fixture(scope="module")
+def playbot_renderer():
+    scene = tilesplat.load_scene(BUNDLED_PLAYBOT)
+    renderer = tilesplat.Renderer(validation=True)
+    renderer.set_scene(scene)
+    return scene, renderer
+
+
+def test_render_returns_numpy_images_and_stats(playbot_renderer):
+    scene, renderer = playbot_renderer
+    image = renderer.render(tilesplat.Camera.orbit(scene, 160, 90, azimuth_deg=30))
+    assert image.rgba.shape == (90, 160, 4) and image.rgba.dtype == np.float32
+    assert np.isfinite(image.rgba).all()
+    alpha = image.rgba[..., 3]
+    assert alpha.min() >= 0 and alpha.max() <= 1 and alpha.max() > 0.5
+    assert image.depth.shape == (90, 160) and image.splat_count.dtype == np.uint32
+    stats = renderer.last_frame_stats
+    assert stats["gaussians"] == scene.size and stats["visible"] > 0
+    assert stats["sort_strategy"] == renderer.sort_strategy_for("auto")
+    assert [name for name, _ in stats["passes"]][0] == "projection"
+    no_outputs = renderer.render(tilesplat.Camera.orbit(scene, 32, 18), depth=False, splat_count=False)
+    assert no_outputs.depth is None and no_outputs.splat_count is None
+    assert renderer.validation_messages == 0
+
+
+def test_render_equals_the_cpp_app_to_the_bit(playbot_renderer, render_exe, tmp_path):
+    scene, renderer = playbot_renderer
+    exr = tmp_path / "app.exr"
+    subprocess.run([render_exe, str(BUNDLED_PLAYBOT), "--width", "160", "--height", "90", "--azimuth", "30",
+                    "--mode", "depth16", "-o", str(exr)], check=True, capture_output=True)
+    ours = renderer.render(tilesplat.Camera.orbit(scene, 160, 90, azimuth_deg=30), accuracy="depth16")
+    # Both through the same EXR writer and reader (scene-linear on disk), so equal renders read back equal.
+    ours.write_exr(tmp_path / "ours.exr")
+    from_app, from_module = tilesplat.read_exr(exr), tilesplat.read_exr(tmp_path / "ours.exr")
+    assert np.array_equal(from_module.rgba, from_app.rgba)
+    assert np.array_equal(from_module.depth, from_app.depth)
+    assert np.array_equal(from_module.splat_count, from_app.splat_count)
+    assert np.array_equal(ours.splat_count, from_app.splat_count)
+
+
+def test_a_scene_from_arrays_renders_as_the_loaded_one(playbot_renderer):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 96, 54, azimuth_deg=120)
+    loaded = renderer.render(camera)
+    rebuilt = tilesplat.Scene.from_arrays(scene.positions, scene.log_scales, scene.rotations,
+                                          scene.opacity_logits, scene.sh)
+    other = tilesplat.Renderer()
+    other.set_scene(rebuilt)
+    again = other.render(camera)
+    assert np.array_equal(loaded.rgba, again.rgba)
+    # float64 input is converted, not refused.
+    as_double = tilesplat.Scene.from_arrays(scene.positions.astype(np.float64), scene.log_scales,
+                                            scene.rotations, scene.opacity_logits, scene.sh)
+    assert as_double.size == scene.size
+
+
+def test_settings_are_keyword_arguments(playbot_renderer):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 96, 54)
+    exact = renderer.render(camera, sort="radix")
+    for sort in ["onesweep", "tile-local"]:
+        assert np.array_equal(renderer.render(camera, sort=sort).rgba, exact.rgba), sort
+    mip = renderer.render(camera, antialiasing="mip")
+    assert not np.array_equal(mip.rgba, exact.rgba)
+    stochastic = renderer.render(camera, compositor="stochastic", stochastic_frames=64, seed=3)
+    assert tilesplat.compare_images(stochastic, exact)["psnr_db"] > 20
+    white = renderer.render(camera, background=[1, 1, 1])
+    assert white.rgba[0, 0, :3].min() > 0.5 or exact.rgba[0, 0, 3] > 0.5
+
+
+def test_images_write_exr_and_png(playbot_renderer, tmp_path):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 64, 36)
+    image = renderer.render(camera)
+    image.write_exr(tmp_path / "a.exr", camera=camera)
+    image.write_png(tmp_path / "a.png", exposure_stops=1, tone_map="aces")
+    back = tilesplat.read_exr(tmp_path / "a.exr")
+    # On disk the colours are scene-linear: they come back through the sRGB curve and its inverse.
+    np.testing.assert_allclose(back.rgba, image.rgba, atol=2e-6)
+    assert np.array_equal(back.splat_count, image.splat_count)
+    # Z as tilesplat-render writes it: the depth where splats were blended, far (1e10) where none was.
+    empty = image.splat_count == 0
+    assert empty.any() and not empty.all()
+    assert np.array_equal(back.depth[~empty], image.depth[~empty]) and (back.depth[empty] == 1e10).all()
+    assert (tmp_path / "a.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_errors_are_python_exceptions_with_the_engines_messages(tmp_path):
+    with pytest.raises(FileNotFoundError, match="missing.ply"):
+        tilesplat.load_scene(tmp_path / "missing.ply")
+    truncated = tmp_path / "truncated.ply"
+    truncated.write_bytes(BUNDLED_SH3.read_bytes()[:2000])
+    with pytest.raises(tilesplat.SceneError, match="truncated.ply"):
+        tilesplat.load_scene(truncated)
+    assert issubclass(tilesplat.SceneError, ValueError)
+    good = tilesplat.load_scene(BUNDLED_SH3)
+    with pytest.raises(ValueError, match=r"log_scales must have the shape \(64, 3\), got \(64, 2\)"):
+        tilesplat.Scene.from_arrays(good.positions, good.log_scales[:, :2], good.rotations, good.opacity_logits,
+                                    good.sh)
+    nan_positions = good.positions.copy()
+    nan_positions[5, 1] = np.nan
+    with pytest.raises(ValueError, match="positions holds a non-finite value"):
+        tilesplat.Scene.from_arrays(nan_positions, good.log_scales, good.rotations, good.opacity_logits, good.sh)
+    with pytest.raises(ValueError, match="sh must have 1, 4, 9 or 16 coefficients"):
+        tilesplat.Scene.from_arrays(good.positions, good.log_scales, good.rotations, good.opacity_logits,
+                                    good.sh[:, :5])
+    renderer = tilesplat.Renderer()
+    renderer.set_scene(good)
+    camera = tilesplat.Camera.orbit(good, 32, 32)
+    with pytest.raises(ValueError, match="antialiasing must be one of classic, antialiased, mip, got 'gauss'"):
+        renderer.render(camera, antialiasing="gauss")
+    with pytest.raises(ValueError):
+        renderer.render(camera, accuracy="depth12")
+    with pytest.raises(RuntimeError, match="no Vulkan device matches"):
+        tilesplat.Renderer(device="no-such-device")
+
+
+def test_render_releases_the_gil(playbot_renderer):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 640, 360)
+    renderer.render(camera)  # compile the pipelines first
+    start = time.perf_counter()
+    renderer.render(camera, reuse_lists=False)
+    frame = time.perf_counter() - start
+
+    ticks = []
+    done = threading.Event()
+
+    def tick():
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    ticker = threading.Thread(target=tick)
+    ticker.start()
+    for _ in range(3):
+        renderer.render(camera, reuse_lists=False)
+    done.set()
+    ticker.join()
+    gaps = np.diff(ticks)
+    # With the GIL held through a frame the ticker would stall for a whole frame.
+    assert len(ticks) > 10 and gaps.max() < max(0.5 * frame, 0.02), (frame, gaps.max())
+
+
+def test_camera_paths_orbits_and_host_matrices(tmp_path):
+    scene = tilesplat.load_scene(BUNDLED_SH3)
+    orbit = tilesplat.orbit_cameras(scene, 4, 64, 36, elevation_deg=30)
+    assert len(orbit) == 4 and orbit[0] == tilesplat.Camera.orbit(scene, 64, 36, elevation_deg=30)
+    assert orbit[1] == tilesplat.Camera.orbit(scene, 64, 36, azimuth_deg=90, elevation_deg=30)
+    keys = tmp_path / "fly.json"
+    keys.write_text('{"keyframes": [{"position": [0, -1, 4], "look_at": [0, 0, 0], "fov": 50},'
+                    ' {"position": [3, -1, 2], "look_at": [0, 0, 0], "fov": 40}]}')
+    path = tilesplat.camera_path(keys, 5, 64, 36)
+    assert len(path) == 5 and path[0].position == [0, -1, 4] and path[-1].position == [3, -1, 2]
+    # A Vulkan-convention perspective (y flipped, depth 0..1), 60 degrees vertical, from the origin.
+    f = 1 / np.tan(np.radians(30))
+    near, far = 0.1, 100.0
+    projection = np.zeros((4, 4))
+    projection[0, 0], projection[1, 1] = f * 36 / 64, -f
+    projection[2, 2], projection[2, 3] = far / (near - far), near * far / (near - far)
+    projection[3, 2] = -1
+    camera = tilesplat.Camera.from_matrices(np.eye(4).T.flatten().tolist(), projection.T.flatten().tolist(), 64, 36)
+    assert camera.fx == pytest.approx(18 * f) and camera.fy == pytest.approx(18 * f)
+    assert camera.position == pytest.approx([0, 0, 0])
+    with pytest.raises(ValueError, match="clip must be vulkan or opengl"):
+        tilesplat.Camera.from_matrices(np.eye(4).flatten().tolist(), projection.T.flatten().tolist(), 64, 36, "d3d")

@@ -1,0 +1,53 @@
+"""tilesplat: 3D Gaussian Splatting on Vulkan compute, from Python.
+
+Scenes, cameras and the renderer of the C++ engine, with numpy arrays in and out::
+
+    import tilesplat
+    scene = tilesplat.load_scene("scene.ply")
+    renderer = tilesplat.Renderer()          # the first discrete GPU, else the first device (lavapipe)
+    renderer.set_scene(scene)
+    image = renderer.render(tilesplat.Camera.orbit(scene, 960, 540, azimuth_deg=30))
+    image.rgba                               # (540, 960, 4) float32, premultiplied, linear
+    image.write_exr("frame.exr")
+
+Errors carry the engine's messages: tilesplat.SceneError (a ValueError) for a bad scene file, ValueError
+for a bad argument, FileNotFoundError for a missing file.
+"""
+
+from ._core import (
+    Camera,
+    CameraView,
+    Image,
+    Renderer,
+    Scene,
+    SceneError,
+    __version__,
+    camera_path,
+    compare_images,
+    devices,
+    load_cameras,
+    load_scene,
+    orbit_cameras,
+    read_exr,
+    sort_strategies,
+)
+from .gsplat_compat import rasterization
+
+__all__ = [
+    "Camera",
+    "CameraView",
+    "Image",
+    "Renderer",
+    "Scene",
+    "SceneError",
+    "__version__",
+    "camera_path",
+    "compare_images",
+    "devices",
+    "load_cameras",
+    "load_scene",
+    "orbit_cameras",
+    "rasterization",
+    "read_exr",
+    "sort_strategies",
+]
