@@ -1,0 +1,20 @@
+// What render_reference shares with project_gaussian: the projection of one Gaussian with the lights
+// prepared once per frame, and the checks of the inputs it projects.
+#pragma once
+
+#include <cstddef>
+
+#include "lighting.h"
+#include "tilesplat/reference.h"
+
+namespace tilesplat::reference {
+
+// project_gaussian, the lights already prepared (prepare_lighting, lighting.h).
+ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& camera,
+                          Antialiasing antialiasing, const PreparedLighting& lighting, double near_plane);
+// Throws std::invalid_argument for a near plane that is not finite and positive (as the GPU's plan does).
+void check_near_plane(double near_plane);
+// Throws std::invalid_argument when the scene has normals but not 3 per Gaussian.
+void check_normals(const GaussianScene& scene);
+
+}  // namespace tilesplat::reference
