@@ -48,7 +48,7 @@ struct Frame {
   fs::path png;  // empty: no preview
 };
 
-std::string single_quoted(const std::string& text) { return "'" + text + "'"; }
+using cli::single_quoted;
 
 // What the EXR's renderSettings attribute records: everything that changes the image.
 std::string settings_text(const tilesplat::RenderSettings& settings) {

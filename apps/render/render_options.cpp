@@ -17,9 +17,7 @@ bool renders_sequence(const cli::ArgParser& parser) {
 
 namespace {
 
-std::string single_quoted(const std::string& text) {
-  return "'" + text + "'";
-}
+using cli::single_quoted;
 
 // The flag mistakes of a many-frame run, before anything is loaded.
 void check_sequence_flags(const cli::ArgParser& parser, const RenderOptions& options) {

@@ -128,10 +128,10 @@ def rasterization(means, quats, scales, opacities, colors, viewmats, Ks, width, 
     logits = np.log(clipped / (1 - clipped)).astype(np.float32)
 
     renderer = renderer or _default_renderer()
-    settings = dict(near_plane=float(near_plane), antialiasing=_RASTERIZE_MODES[rasterize_mode],
-                    depth="D" in render_mode, splat_count=False, reuse_lists=False)
     colour_out = render_mode.startswith("RGB")
     depth_out = "D" in render_mode
+    settings = dict(near_plane=float(near_plane), antialiasing=_RASTERIZE_MODES[rasterize_mode],
+                    depth=depth_out, splat_count=False, reuse_lists=False)
     channels = (3 if colour_out else 0) + (1 if depth_out else 0)
     render_colors = np.zeros((cameras, height, width, channels), np.float32)
     render_alphas = np.zeros((cameras, height, width, 1), np.float32)
