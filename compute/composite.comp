@@ -49,6 +49,8 @@ layout(constant_id = 9) const bool HOST_DEPTH_SORTED = false;
 // The tiles' lists are blended in more than one dispatch (see above). Off, the state loads and stores
 // compile away: CPU drivers run both sides of a branch, so even skipped they cost loops over the lanes.
 layout(constant_id = 10) const bool CHUNKED = true;
+// The cap on one splat's alpha (RenderSettings::max_alpha): 0.99 as the 3DGS trainer renders.
+layout(constant_id = 11) const float MAX_ALPHA = 0.99;
 
 // The push constants: CompositePush in shader_io.h.
 
@@ -156,7 +158,7 @@ uint blend_splat(uint entry, vec2 tile_origin, uint local_x, uint local_y0, uint
   for (uint p = first; p < first + count; ++p) {
     float dy = mean_a_b.y - (float(local_y0 + p) + 0.5);
     float power = k0 + dy * (k1 + c_opacity_depth_r.x * dy);
-    float alpha = min(0.99, c_opacity_depth_r.y * exp(power));
+    float alpha = min(MAX_ALPHA, c_opacity_depth_r.y * exp(power));
     bool behind = HOST_DEPTH && !(c_opacity_depth_r.z < host_z[p]);
     bool hit = T[p] > 0.0 && alpha >= ALPHA_MIN && !behind;
     float next_T = T[p] * (1.0 - alpha);

@@ -21,6 +21,7 @@ layout(constant_id = 2) const uint PIXELS_PER_INVOCATION = 1;
 layout(constant_id = 4) const float ALPHA_MIN = 1.0 / 255.0;
 layout(constant_id = 6) const float T_MIN = 1e-4;
 layout(constant_id = 7) const uint WINDOW = 8;  // 2 to 16
+layout(constant_id = 8) const float MAX_ALPHA = 0.99;  // RenderSettings::max_alpha
 
 // The push constants: CompositeResortPush in shader_io.h.
 
@@ -170,7 +171,7 @@ void main() {
         float dy = mean_ab.y - (float(local_y0 + p) + 0.5);
         float power = mean_ab.z * dx * dx + mean_ab.w * dx * dy + c_opacity.x * dy * dy;
         if (power > 0.0) continue;
-        float alpha = min(0.99, c_opacity.y * exp(power));
+        float alpha = min(MAX_ALPHA, c_opacity.y * exp(power));
         if (alpha < ALPHA_MIN) continue;
         vec2 pixel = vec2(px, py0 + p) + 0.5;
         my_done += offer(p, ray_depth(j, pixel), alpha, vec4(s_colour[j].rgb, c_opacity.z));

@@ -33,6 +33,7 @@ layout(constant_id = 1) const bool WRITE_COUNT = true;
 layout(constant_id = 2) const uint PIXELS_PER_INVOCATION = 1;  // 1, 2, 4, 8 or 16
 layout(constant_id = 4) const float ALPHA_MIN = 1.0 / 255.0;   // the alpha cut-off (AccuracyModes)
 layout(constant_id = 5) const float ALPHA_INV = 255.0;         // 1 / ALPHA_MIN, as the tile coverage uses it
+layout(constant_id = 6) const float MAX_ALPHA = 0.99;          // RenderSettings::max_alpha
 
 // The push constants: StochasticCompositePush in shader_io.h.
 
@@ -95,7 +96,7 @@ void test_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
   for (uint p = first; p < first + count; ++p) {
     float dy = mean_a_b.y - (float(local_y0 + p) + 0.5);
     float power = k0 + dy * (k1 + c_opacity.x * dy);
-    float alpha = min(0.99, c_opacity.y * exp(power));
+    float alpha = min(MAX_ALPHA, c_opacity.y * exp(power));
     // u in [0, 1) on a 2^-24 grid: kept with probability alpha (rounded up to that grid).
     float u = float(hash32(pixel_hash[p] ^ splat_hash) >> 8) * (1.0 / 16777216.0);
     bool keep = alpha >= ALPHA_MIN && u < alpha;

@@ -60,10 +60,11 @@ TEST(CliRender, HelpListsEveryFlag) {
   EXPECT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(contains(result.out, "usage: tilesplat-render")) << result.out;
   for (const char* flag :
-       {"-o,", "--output", "--png", "--exposure", "--half", "--no-depth", "--no-count", "--background", "--reference",
-        "--stats", "--cameras", "--view", "--width", "--height", "--azimuth", "--elevation", "--fov", "--distance",
-        "--strict", "--device", "--list-devices", "--sort", "--validation", "--help", "SCENE.ply", "--tone-map",
-        "--antialiasing", "--stochastic"})
+       {"-o,",        "--output",     "--png",          "--exposure",  "--half",       "--no-depth",
+        "--no-count", "--background", "--reference",    "--stats",     "--cameras",    "--view",
+        "--width",    "--height",     "--azimuth",      "--elevation", "--fov",        "--distance",
+        "--strict",   "--device",     "--list-devices", "--sort",      "--validation", "--help",
+        "SCENE.ply",  "--tone-map",   "--antialiasing", "--max-alpha", "--stochastic"})
     EXPECT_TRUE(contains(result.out, flag)) << "--help does not mention " << flag << "\n" << result.out;
   EXPECT_TRUE(result.err.empty()) << result.err;
 }
@@ -356,6 +357,31 @@ TEST(CliRender, AntialiasingFlagSetsTheFootprintFilter) {
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
   EXPECT_TRUE(contains(bad.err, "--antialiasing must be classic, antialiased or mip, got 'gaussian'")) << bad.err;
   EXPECT_FALSE(fs::exists(out / "bad.exr"));
+}
+
+TEST(CliRender, MaxAlphaFlagSetsTheCapAndIsRecorded) {
+  const auto out = fresh_output_dir();
+  auto render = [&](const std::string& cap, const std::string& name) {
+    std::vector<std::string> args = {bundled_playbot().string(), "--width", "96", "--height", "54", "-o",
+                                     (out / name).string()};
+    if (!cap.empty()) args.insert(args.end(), {"--max-alpha", cap});
+    return run_exe(kRenderExe, args);
+  };
+  ASSERT_EQ(render("", "default.exr").exit_code, 0);
+  ASSERT_EQ(render("0.99", "cap99.exr").exit_code, 0);
+  ASSERT_EQ(render("0.999", "gsplat.exr").exit_code, 0);
+  EXPECT_EQ(tilesplat::read_exr(out / "default.exr").rgba, tilesplat::read_exr(out / "cap99.exr").rgba);
+  EXPECT_NE(tilesplat::read_exr(out / "default.exr").rgba, tilesplat::read_exr(out / "gsplat.exr").rgba);
+  EXPECT_TRUE(contains(tilesplat::read_exr_string_attributes(out / "gsplat.exr").at("renderSettings"),
+                       " max_alpha=0.999 "));
+  EXPECT_FALSE(
+      contains(tilesplat::read_exr_string_attributes(out / "default.exr").at("renderSettings"), "max_alpha"));
+  for (const std::string bad : {"1", "0", "-0.5", "nan", "high"}) {
+    const auto result = render(bad, "bad.exr");
+    EXPECT_EQ(result.exit_code, 2) << bad << ": " << result.err;
+    EXPECT_TRUE(contains(result.err, "--max-alpha")) << result.err;
+    EXPECT_FALSE(fs::exists(out / "bad.exr"));
+  }
 }
 
 TEST(CliRender, StochasticFlagConvergesTowardTheSortedImage) {

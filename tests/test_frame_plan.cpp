@@ -232,6 +232,11 @@ TEST(FramePlan, RefusesWhatTheDeviceOrCompositorCannotDo) {
     bad_near.near_plane = near_plane;
     EXPECT_THROW(plan_frame(camera(), bad_near, context()), std::invalid_argument) << near_plane;
   }
+  for (const double max_alpha : {0.0, 1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    RenderSettings bad_cap;
+    bad_cap.max_alpha = max_alpha;
+    EXPECT_THROW(plan_frame(camera(), bad_cap, context()), std::invalid_argument) << max_alpha;
+  }
 }
 
 TEST(FramePlan, EffectsReachTheProjectionVariant) {

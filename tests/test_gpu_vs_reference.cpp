@@ -222,6 +222,66 @@ TEST(GpuRenderer, NearPlaneCullsWhereTheSettingSaysOnTheGpuAndInTheReference) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+TEST(GpuRenderer, MaxAlphaCapsEachSplatOnTheGpuAndInTheReference) {
+  // Nearly opaque splats (opacity 0.9997) side by side, overlapping at two depths: every pixel's alpha
+  // comes from splats capped at max_alpha, 0.99 by default (the 3DGS trainer's) or 0.999 (gsplat's).
+  GaussianScene scene;
+  scene.sh_degree = 0;
+  for (int i = 0; i < 5; ++i) {
+    scene.positions.insert(scene.positions.end(), {0.25f * float(i - 2), 0.0f, 2.0f + 0.1f * float(i % 2)});
+    scene.log_scales.insert(scene.log_scales.end(), {-1.2f, -1.4f, -1.6f});
+    scene.rotations.insert(scene.rotations.end(), {1, 0, 0, 0});
+    scene.opacity_logits.push_back(8.0f);
+    scene.sh.insert(scene.sh.end(), {1.0f, float(i) * 0.3f - 0.6f, -0.5f});
+  }
+  // One wide splat alone: its pixels near the centre would have alpha 0.9996, above either cap.
+  GaussianScene lone;
+  lone.sh_degree = 0;
+  lone.positions = {0, 0, 2};
+  lone.log_scales = {0, 0, 0};
+  lone.rotations = {1, 0, 0, 0};
+  lone.opacity_logits = {12.0f};
+  lone.sh = {0.5f, 0.5f, 0.5f};
+  const auto max_alpha_of = [](const RenderImage& image) {
+    float most = 0;
+    for (size_t i = 3; i < image.rgba.size(); i += 4) most = std::max(most, image.rgba[i]);
+    return most;
+  };
+  const Camera camera = look_at_camera({0, 0, 0}, {0, 0, 1}, {0, -1, 0}, 128, 64, 60);
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(scene);
+  RenderSettings settings;
+  const RenderImage by_default = renderer.render(camera, settings);
+  for (const double max_alpha : {kDefaultMaxAlpha, 0.999, 0.5}) {
+    settings.max_alpha = max_alpha;
+    renderer.set_scene(scene);
+    const RenderImage gpu = renderer.render(camera, settings);
+    const ImageDifference d = compare_images(gpu, render_reference(scene, camera, settings));
+    EXPECT_GE(d.psnr_db, 60.0) << "max_alpha " << max_alpha;
+    float alpha_change = 0;  // the cap changes the image where splats reach it
+    for (size_t i = 3; i < gpu.rgba.size(); i += 4)
+      alpha_change = std::max(alpha_change, std::abs(gpu.rgba[i] - by_default.rgba[i]));
+    EXPECT_GE(alpha_change, max_alpha == kDefaultMaxAlpha ? 0.0f : 0.001f) << max_alpha;
+    EXPECT_LE(alpha_change, max_alpha == kDefaultMaxAlpha ? 0.0f : 1.0f) << max_alpha;
+
+    renderer.set_scene(lone);
+    EXPECT_FLOAT_EQ(max_alpha_of(renderer.render(camera, settings)), float(max_alpha));
+    EXPECT_NEAR(max_alpha_of(render_reference(lone, camera, settings)), max_alpha, 1e-6);
+    RenderSettings resorted = settings;  // the per-pixel re-sort composite caps alike
+    resorted.accuracy.resort_window = 4;
+    EXPECT_FLOAT_EQ(max_alpha_of(renderer.render(camera, resorted)), float(max_alpha));
+  }
+  renderer.set_scene(scene);
+  settings.max_alpha = kDefaultMaxAlpha;
+  EXPECT_EQ(renderer.render(camera, settings).rgba, by_default.rgba);  // the default, to the bit
+  for (const double bad : {0.0, 1.0 / 255.0, 1.0, 1.5, std::nan("")}) {
+    settings.max_alpha = bad;
+    EXPECT_THROW(renderer.render(camera, settings), std::invalid_argument) << bad;
+    EXPECT_THROW(render_reference(scene, camera, settings), std::invalid_argument) << bad;
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 TEST(GpuRenderer, ReportsPassTimingsAndCounts) {
   Renderer& renderer = testing::validated_renderer();
   GaussianScene scene = load_scene(testing::bundled_playbot());

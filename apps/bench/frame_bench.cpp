@@ -405,7 +405,7 @@ int run_frame_bench(const BenchOptions& options) {
             false;  // every measured frame is a whole frame, not a composite on reused lists
         if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
         cli::apply_scene_settings(scene.loaded, settings);
-        if (options.common.antialiasing) settings.antialiasing = *options.common.antialiasing;
+        cli::apply_training_options(options.common, settings);
         Collector collector(sort);
         for (int frame = 0; frame < frames_per_row; ++frame) {
           // Rendering reads the image back, which is part of cpu frame; the first measured image of

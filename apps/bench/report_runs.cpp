@@ -264,7 +264,7 @@ int run_formats_report(const BenchOptions& options) {
   format_options.repeat = options.repeat;
   if (!options.common.sorts.empty()) format_options.settings.sort = options.common.sorts.front();
   if (!options.common.modes.empty()) format_options.settings.accuracy = options.common.modes.front();
-  if (options.common.antialiasing) format_options.settings.antialiasing = *options.common.antialiasing;
+  cli::apply_training_options(options.common, format_options.settings);
 
   const std::vector<fs::path> files(options.common.scenes.begin() + 1, options.common.scenes.end());
   const auto renderer = tilesplat::Renderer::create(cli::renderer_options(options.common));

@@ -228,6 +228,20 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
           }
         throw UsageError("--antialiasing must be classic, antialiased or mip, got " + single_quoted(text));
       });
+  parser.add_value("--max-alpha", "A",
+                   "the cap on one splat's alpha at a pixel the splats were trained with: 0.99 (3DGS, the "
+                   "default) or 0.999 (gsplat)",
+                   [&options](const std::string& text) {
+                     const double cap = parse_double("--max-alpha", text);
+                     if (!(cap > 0 && cap < 1))
+                       throw UsageError("--max-alpha must be between 0 and 1, got " + single_quoted(text));
+                     options.max_alpha = cap;
+                   });
+}
+
+void apply_training_options(const CommonOptions& options, RenderSettings& settings) {
+  if (options.antialiasing) settings.antialiasing = *options.antialiasing;
+  if (options.max_alpha) settings.max_alpha = *options.max_alpha;
 }
 
 void check_common_options(const ArgParser& parser, const CommonOptions& options) {

@@ -33,6 +33,8 @@ struct CommonOptions {
   std::vector<AccuracyModes> modes;
   // --antialiasing: the footprint filter the asset was trained with; unset = the scene file's, else classic.
   std::optional<Antialiasing> antialiasing;
+  // --max-alpha: the cap on a splat's alpha the asset was trained with; unset = kDefaultMaxAlpha.
+  std::optional<double> max_alpha;
 };
 
 inline constexpr int kOrbitDefaultWidth = 1920;
@@ -44,7 +46,7 @@ enum class SceneChoice { kOne, kList };
 
 // Declares SCENE, --cameras, --view, --width, --height, the orbit flags, --strict, --device,
 // --list-devices, --validation, --sort (one name, or a comma list / "all" for kList) and --mode
-// (one accuracy mode combination, or a comma list of them for kList), and --antialiasing.
+// (one accuracy mode combination, or a comma list of them for kList), --antialiasing and --max-alpha.
 void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice,
                         SceneChoice scene_choice = SceneChoice::kOne);
 
@@ -65,6 +67,10 @@ bool parse_and_handle_info_flags(ArgParser& parser, int argc, const char* const*
 void print_devices();
 
 RendererOptions renderer_options(const CommonOptions& options);
+
+// What the flags say of how the splats were trained (--antialiasing, --max-alpha), over `settings`
+// (which hold the scene file's).
+void apply_training_options(const CommonOptions& options, RenderSettings& settings);
 
 // Whether any SCENE of the options is a scene file (.json).
 bool any_scene_file(const CommonOptions& options);

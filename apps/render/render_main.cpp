@@ -55,6 +55,11 @@ std::string settings_text(const tilesplat::RenderSettings& settings) {
   std::string text = "sort=" + settings.sort;
   text += " accuracy=" + tilesplat::to_string(settings.accuracy);
   text += " antialiasing=" + tilesplat::to_string(settings.antialiasing);
+  if (settings.max_alpha != tilesplat::kDefaultMaxAlpha) {
+    char cap[32];
+    std::snprintf(cap, sizeof cap, "%.9g", settings.max_alpha);
+    text += std::string(" max_alpha=") + cap;
+  }
   text += " compositor=" + tilesplat::to_string(settings.compositor);
   if (settings.compositor == tilesplat::Compositor::kStochastic)
     text += " frames=" + std::to_string(settings.stochastic.frames) +
@@ -429,7 +434,7 @@ int run(int argc, char** argv) {
   if (parser.seen("--background") || !loaded.description) settings.background = options.background;
   if (options.no_depth) settings.depth = false;
   if (options.no_count) settings.splat_count = false;
-  if (options.common.antialiasing) settings.antialiasing = *options.common.antialiasing;
+  cli::apply_training_options(options.common, settings);
   if (options.stochastic_frames > 0) {
     settings.compositor = tilesplat::Compositor::kStochastic;
     settings.stochastic.frames = static_cast<uint32_t>(options.stochastic_frames);

@@ -95,7 +95,7 @@ class Viewer {
         view_(options.common.view),
         sorts_(sort_cycle()) {
     cli::apply_scene_settings(loaded, base_settings_);
-    if (options.common.antialiasing) base_settings_.antialiasing = *options.common.antialiasing;
+    cli::apply_training_options(options.common, base_settings_);
     for (const char* mode : kModeCycle) modes_.push_back(tilesplat::parse_accuracy_modes(mode));
     if (!options.common.modes.empty()) mode_ = find_or_append(modes_, options.common.modes.front());
     if (!options.common.sorts.empty()) sort_ = find_or_append(sorts_, options.common.sorts.front());

@@ -159,6 +159,8 @@ struct HostDepth {
 /// The view depth at or below which a Gaussian is culled (RenderSettings::near_plane): the 3DGS
 /// trainer's and its rasterizer's.
 inline constexpr double kDefaultNearPlane = 0.2;
+/// The default RenderSettings::max_alpha: the cap the 3DGS trainer and its rasterizer put on a splat's alpha.
+inline constexpr double kDefaultMaxAlpha = 0.99;
 
 /// Everything that changes how one frame is rendered.
 struct RenderSettings {
@@ -189,6 +191,11 @@ struct RenderSettings {
   /// in the reference alike: kDefaultNearPlane (0.2) as the 3DGS trainer renders, or what a caller's
   /// camera uses (gsplat's rasterization() defaults to 0.01). Finite and positive.
   double near_plane = kDefaultNearPlane;
+  /// The most one splat may cover of a pixel: alpha = min(max_alpha, opacity * G). kDefaultMaxAlpha (0.99)
+  /// as the 3DGS trainer renders; 0.999 as gsplat's rasterizer does (tilesplat.rasterization() sets it).
+  /// An asset renders as it was trained with the cap its trainer used. Above accuracy.alpha_cutoff and
+  /// below 1 (at 1 a splat would end its pixels before blending, the stop being exclusive).
+  double max_alpha = kDefaultMaxAlpha;
 };
 
 }  // namespace tilesplat

@@ -8,6 +8,7 @@
 #include "host_depth.h"
 #include "passes/stochastic_composite_pass.h"
 #include "passes/tile_coverage.h"
+#include "settings_checks.h"
 #include "shader_io.h"
 #include "tilesplat/reference.h"
 
@@ -184,9 +185,8 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
   validate(settings.accuracy);
   validate_compositor(settings);
   validate_host_depth(settings, camera);
-  if (!(std::isfinite(settings.near_plane) && settings.near_plane > 0))
-    throw std::invalid_argument("RenderSettings::near_plane must be a positive, finite view depth, got " +
-                                std::to_string(settings.near_plane));
+  check_near_plane(settings.near_plane);
+  check_max_alpha(settings);
 
   FramePlan plan;
   plan.sort = context.sort;

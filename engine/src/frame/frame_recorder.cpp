@@ -148,14 +148,15 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
 void FrameRecorder::record_composite(Recording& r, FramePass pass) {
   FrameResources& res = r.res;
   const AccuracyModes& modes = r.settings.accuracy;
-  const CompositeInputs inputs{.splats = res.projected.splats,
-                               .tile_lists = res.lists_in_alt ? res.keys.values_alt : res.keys.values,
-                               .ranges = res.ranges,
-                               .out = res.outputs,
-                               .background = r.settings.background,
-                               .write_depth = r.settings.depth,
-                               .write_count = r.settings.splat_count,
-                               .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff}};
+  const CompositeInputs inputs{
+      .splats = res.projected.splats,
+      .tile_lists = res.lists_in_alt ? res.keys.values_alt : res.keys.values,
+      .ranges = res.ranges,
+      .out = res.outputs,
+      .background = r.settings.background,
+      .write_depth = r.settings.depth,
+      .write_count = r.settings.splat_count,
+      .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff, float(r.settings.max_alpha)}};
   const VkDeviceAddress counters = res.counters.address();
   if (pass == FramePass::kStochasticComposite)
     stochastic_composite_.record(r.stream, inputs, {r.settings.stochastic.frames, r.settings.stochastic.seed},

@@ -104,7 +104,8 @@ void CompositePass::record(VkCommandBuffer cmd, const CompositeInputs& in, const
                       {7, variant.host_depth_in ? 1u : 0u},
                       {8, variant.surface_depth_out ? 1u : 0u},
                       {9, variant.exact_depth_order ? 1u : 0u},
-                      {10, variant.chunked ? 1u : 0u}},
+                      {10, variant.chunked ? 1u : 0u},
+                      {11, std::bit_cast<uint32_t>(variant.cutoffs.max_alpha)}},
                      variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }

@@ -6,6 +6,7 @@
 #include <map>
 #include <vector>
 
+#include "tilesplat/render_settings.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
 
@@ -33,10 +34,12 @@ std::vector<VkBufferView> composite_texel_views(const vk::Buffer& splats, const 
                                                 const vk::Buffer& unused);
 uint32_t composite_chunk_splats(const vk::Context& ctx);
 
-// The cut-offs as in AccuracyModes (reference: 1/255 and 1e-4).
+// The cut-offs as in AccuracyModes (reference: 1/255 and 1e-4), and the cap on alpha
+// (RenderSettings::max_alpha).
 struct CompositeCutoffs {
   float alpha = 1.0f / 255.0f;
   float transmittance = 1e-4f;
+  float max_alpha = float(kDefaultMaxAlpha);
   auto operator<=>(const CompositeCutoffs&) const = default;
 };
 

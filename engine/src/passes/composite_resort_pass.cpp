@@ -33,7 +33,8 @@ void CompositeResortPass::record(VkCommandBuffer cmd, const CompositeInputs& in,
                                            {3, kTileSize / pixels_per_invocation_},
                                            {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
                                            {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
-                                           {7, variant.window}}))
+                                           {7, variant.window},
+                                           {8, std::bit_cast<uint32_t>(variant.cutoffs.max_alpha)}}))
              .first;
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);

@@ -46,6 +46,7 @@ class StochasticCompositePass {
     bool write_depth = true;
     bool write_count = true;
     float alpha_cutoff = 1.0f / 255.0f;
+    float max_alpha = float(kDefaultMaxAlpha);
     bool texel_buffers = false;  // the CPU layout (composite_stochastic_texel)
     auto operator<=>(const Variant&) const = default;
   };

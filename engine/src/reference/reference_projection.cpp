@@ -13,6 +13,7 @@
 #include <string>
 
 #include "lighting.h"
+#include "settings_checks.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
@@ -260,13 +261,6 @@ ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& ca
   return out;
 }
 
-// A near plane the reference can cull at (the GPU's plan refuses the same values).
-void check_near_plane(double near_plane) {
-  if (!(std::isfinite(near_plane) && near_plane > 0))
-    throw std::invalid_argument("RenderSettings::near_plane must be a positive, finite view depth, got " +
-                                std::to_string(near_plane));
-}
-
 void check_normals(const GaussianScene& scene) {
   if (scene.has_normals() && scene.normals.size() != 3 * scene.size())
     throw std::invalid_argument("render_reference: scene normals must be empty or 3 per Gaussian");
@@ -277,7 +271,7 @@ void check_normals(const GaussianScene& scene) {
 ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const Camera& camera,
                                    Antialiasing antialiasing, const Lighting& lighting, double near_plane) {
   if (i >= scene.size()) throw std::out_of_range("project_gaussian: index out of range");
-  reference::check_near_plane(near_plane);
+  check_near_plane(near_plane);
   if (lighting.enabled()) reference::check_normals(scene);
   return reference::project(scene, i, camera, antialiasing, prepare_lighting(lighting), near_plane);
 }

@@ -13,7 +13,6 @@ namespace tilesplat::reference {
 ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& camera,
                           Antialiasing antialiasing, const PreparedLighting& lighting, double near_plane);
 // Throws std::invalid_argument for a near plane that is not finite and positive (as the GPU's plan does).
-void check_near_plane(double near_plane);
 // Throws std::invalid_argument when the scene has normals but not 3 per Gaussian.
 void check_normals(const GaussianScene& scene);
 

@@ -16,13 +16,14 @@
 #include "host_depth.h"
 #include "lighting.h"
 #include "reference/reference_projection.h"
+#include "settings_checks.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
 namespace {
 
-// The blending rules the GPU's composite shares (docs/rendering-math.md).
-constexpr double kMaxAlpha = 0.99;
+// The blending rules the GPU's composite shares (docs/rendering-math.md); the cap on alpha is
+// RenderSettings::max_alpha.
 constexpr double kMinAlpha = 1.0 / 255.0;
 constexpr double kMinTransmittance = 1e-4;
 
@@ -77,12 +78,14 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
   validate(camera);
   check_scene(scene);
   validate_host_depth(settings, camera);
-  reference::check_near_plane(settings.near_plane);
+  check_near_plane(settings.near_plane);
+  check_max_alpha(settings);
   // A host's surfaces, as view depths: a splat blends only in front of them (RenderSettings::host).
   const std::vector<float> host_z = settings.host ? host_view_depths(*settings.host) : std::vector<float>{};
   const bool surface_out = settings.host && settings.host->write_depth;
   const double surface_alpha = surface_out ? settings.host->alpha_threshold : 0.0;
   const size_t n = scene.size();
+  const double max_alpha = settings.max_alpha;
 
   const PreparedLighting lighting = prepare_lighting(settings.lighting);  // validates
   if (settings.lighting.enabled()) reference::check_normals(scene);
@@ -172,7 +175,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
               const double power =
                   -0.5 * (splat.conic[0] * dx * dx + splat.conic[2] * dy * dy) - splat.conic[1] * dx * dy;
               if (power > 0) continue;
-              const double alpha = std::min(kMaxAlpha, splat.opacity * std::exp(power));
+              const double alpha = std::min(max_alpha, splat.opacity * std::exp(power));
               if (alpha < kMinAlpha) continue;
               // Behind (or at) the host's opaque surface; compared as the float depths the GPU sorts on.
               if (!host_z.empty() && !(static_cast<float>(splat.depth) < surface_z)) continue;
