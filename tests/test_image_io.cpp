@@ -934,6 +934,28 @@ TEST(PngPreview, ExposureScalesLinearLight) {
   EXPECT_EQ(darker.rgb[2], expected_srgb_byte(0.25));
 }
 
+TEST(PngPreview, PreviewPixelsAreThePngsBytes) {
+  // preview_pixels() gives what write_png_preview() writes, graded or not, without a file.
+  RenderImage image;
+  image.width = 3;
+  image.height = 2;
+  for (int i = 0; i < 6; ++i)
+    image.rgba.insert(image.rgba.end(),
+                      {0.1f * float(i), 0.9f - 0.15f * float(i), 1.5f - 0.3f * float(i), 1.0f});
+  const fs::path path = fresh_dir() / "preview.png";
+  for (const PreviewOptions options :
+       {PreviewOptions{}, PreviewOptions{.exposure_stops = 1.5, .tone_map = ToneMap::kAces}}) {
+    write_png_preview(path, image, options);
+    const std::vector<uint8_t> pixels = preview_pixels(image, options);
+    EXPECT_EQ(pixels, read_png_rgb(path).rgb) << options.exposure_stops;
+    EXPECT_EQ(pixels.size(), 18u);
+  }
+  EXPECT_EQ(preview_pixels(image)[3], 26);  // pixel 1's red, 0.1 as it is: round(25.5)
+  EXPECT_THROW(preview_pixels(image, {.exposure_stops = 21}), std::invalid_argument);
+  image.rgba.pop_back();
+  EXPECT_THROW(preview_pixels(image), std::invalid_argument);
+}
+
 TEST(ToneMap, CurvesFollowTheirFormulasAndStayInRange) {
   // Reinhard: x / (1 + x). ACES (Narkowicz): x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), at most 1.
   for (double x : {0.01, 0.18, 0.5, 1.0, 4.0, 100.0}) {

@@ -173,6 +173,12 @@ struct PreviewOptions {
   ToneMap tone_map = ToneMap::kNone;  ///< the tone curve
 };
 
+/// The bytes of write_png_preview(): 8-bit sRGB R G B per pixel, row after row from the top (3 x width x
+/// height), for showing a frame without a file (a UI texture, a notebook). Throws std::invalid_argument for
+/// an rgba of the wrong size or an exposure out of range.
+TILESPLAT_API std::vector<std::uint8_t> preview_pixels(const RenderImage& image,
+                                                       const PreviewOptions& options = {});
+
 /// An 8-bit sRGB PNG preview of the colour channels (alpha dropped): byte = round(255 * clamp(C, 0, 1)) of
 /// the rendered display value C unless options grade it (ToneMap). Atomic like write_exr. Throws
 /// std::runtime_error naming the file for an empty image or an exposure out of range.

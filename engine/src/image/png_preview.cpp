@@ -27,6 +27,17 @@ std::uint8_t preview_byte(float colour, double scale, ToneMap tone_map) {
   return static_cast<std::uint8_t>(std::lround(std::min(display, 1.0) * 255.0));
 }
 
+// What makes an image or the options unfit for a preview; empty when nothing does.
+std::string preview_problem(const RenderImage& image, const PreviewOptions& options) {
+  const size_t pixels = image.pixels();
+  if (image.rgba.size() != 4 * pixels)
+    return "rgba holds " + std::to_string(image.rgba.size()) + " values, a " + std::to_string(image.width) +
+           "x" + std::to_string(image.height) + " image needs " + std::to_string(4 * pixels);
+  if (!(std::abs(options.exposure_stops) <= 20.0))
+    return "exposure " + std::to_string(options.exposure_stops) + " stops is not a number from -20 to 20";
+  return {};
+}
+
 }  // namespace
 
 std::string to_string(ToneMap tone_map) {
@@ -50,6 +61,18 @@ double apply_tone_map(ToneMap tone_map, double x) {
   return x;
 }
 
+std::vector<std::uint8_t> preview_pixels(const RenderImage& image, const PreviewOptions& options) {
+  if (const std::string problem = preview_problem(image, options); !problem.empty())
+    throw std::invalid_argument("preview_pixels: " + problem);
+  const size_t pixels = image.pixels();
+  const double scale = std::exp2(options.exposure_stops);
+  std::vector<std::uint8_t> rgb(3 * pixels);
+  for (size_t pixel = 0; pixel < pixels; ++pixel)
+    for (size_t c = 0; c < 3; ++c)
+      rgb[3 * pixel + c] = preview_byte(image.rgba[4 * pixel + c], scale, options.tone_map);
+  return rgb;
+}
+
 void write_png_preview(const std::filesystem::path& path, const RenderImage& image, const PreviewOptions& options) {
   const std::string prefix = "cannot write " + path.string() + ": ";
   if (image.width <= 0 || image.height <= 0)
@@ -58,19 +81,9 @@ void write_png_preview(const std::filesystem::path& path, const RenderImage& ima
   // libpng takes the row stride (3 bytes a pixel) as a 32-bit int.
   if (image.width > INT_MAX / 3)
     throw std::runtime_error(prefix + "image width " + std::to_string(image.width) + " is too large for PNG");
-  const size_t pixels = image.pixels();
-  if (image.rgba.size() != 4 * pixels)
-    throw std::runtime_error(prefix + "rgba holds " + std::to_string(image.rgba.size()) + " values, a " +
-                             std::to_string(image.width) + "x" + std::to_string(image.height) +
-                             " image needs " + std::to_string(4 * pixels));
-  if (!(std::abs(options.exposure_stops) <= 20.0))
-    throw std::runtime_error(prefix + "exposure " + std::to_string(options.exposure_stops) +
-                             " stops is not a number from -20 to 20");
-  const double scale = std::exp2(options.exposure_stops);
-
-  std::vector<std::uint8_t> rgb(3 * pixels);
-  for (size_t pixel = 0; pixel < pixels; ++pixel)
-    for (size_t c = 0; c < 3; ++c) rgb[3 * pixel + c] = preview_byte(image.rgba[4 * pixel + c], scale, options.tone_map);
+  if (const std::string problem = preview_problem(image, options); !problem.empty())
+    throw std::runtime_error(prefix + problem);
+  const std::vector<std::uint8_t> rgb = preview_pixels(image, options);
 
   detail::write_file_atomically(path, [&](const std::filesystem::path& temp) {
     png_image png{};
