@@ -4,6 +4,8 @@
 # zlib, zstd, libwebp and libzip are the containers of the compressed splat formats (.spz, .sog).
 # libssl-dev's libcrypto gives the apps SHA-256 (the EXRs' scene checksum, the render manifest).
 # xvfb and xauth give the viewer's tests a display (xvfb-run) on a machine without one.
+# python3-dev and python3-venv build and test the Python package; python3-torch (Debian's CPU build) runs
+# gsplat's PyTorch functions, which python/run_tests.sh holds tilesplat.rasterization() to.
 # doxygen builds the API reference (the docs target and its test); file is what cpack -G DEB asks
 # to find the binaries whose library dependencies it lists.
 # --fuzz adds clang and its compiler-rt (libFuzzer) for tests/fuzz/run.sh; the normal build needs neither.
@@ -54,7 +56,7 @@ pkgs=(
   libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev libcli11-dev
   zlib1g-dev libzstd-dev libwebp-dev libzip-dev libssl-dev
   libgtest-dev googletest
-  python3-dev python3-venv
+  python3-dev python3-venv python3-torch
   xvfb xauth
 )
 case "${1:-}" in

@@ -45,6 +45,14 @@ NumpyArray<T> view_of(std::vector<T>& values, std::initializer_list<size_t> shap
   return NumpyArray<T>(values.data(), shape, owner);
 }
 
+// A numpy array that owns `values` (moved to the heap, freed with the array), with the given shape.
+template <typename T>
+NumpyArray<T> owned_array(std::vector<T>&& values, std::initializer_list<size_t> shape) {
+  auto* owned = new std::vector<T>(std::move(values));
+  nb::capsule owner(owned, [](void* pointer) noexcept { delete static_cast<std::vector<T>*>(pointer); });
+  return NumpyArray<T>(owned->data(), shape, owner);
+}
+
 // A C-contiguous float32 array on the CPU; other dtypes and layouts are converted (copied) on the way in.
 using FloatInput = nb::ndarray<const float, nb::c_contig, nb::device::cpu>;
 
@@ -98,7 +106,8 @@ void check_exists(const std::filesystem::path& path, const char* what) {
 RenderSettings make_settings(const std::string& sort, bool depth, bool splat_count,
                              const std::string& accuracy, const std::string& antialiasing,
                              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
-                             const std::array<float, 3>& background, bool reuse_lists, double near_plane) {
+                             const std::array<float, 3>& background, bool reuse_lists, double near_plane,
+                             double max_alpha) {
   RenderSettings settings;
   settings.sort = sort;
   settings.depth = depth;
@@ -114,6 +123,7 @@ RenderSettings make_settings(const std::string& sort, bool depth, bool splat_cou
   settings.background = background;
   settings.reuse_lists = reuse_lists;
   settings.near_plane = near_plane;
+  settings.max_alpha = max_alpha;
   return settings;
 }
 
@@ -345,9 +355,11 @@ void bind(nb::module_& m) {
       "`frames` cameras along a keyframe file (docs/camera-paths.md), as tilesplat-render --path.");
 
   // --- images
-  nb::class_<RenderImage>(m, "Image",
-                          "A rendered frame: rgba (H, W, 4) premultiplied over the background, depth (H, W) "
-                          "expected view depth, splat_count (H, W) blended splats; numpy views of the image.")
+  nb::class_<RenderImage>(
+      m, "Image",
+      "A rendered frame: rgba (H, W, 4) premultiplied over the background, in the trained "
+      "display values (sRGB-encoded, as the photographs were: docs/colour.md), depth (H, W) "
+      "expected view depth, splat_count (H, W) blended splats; numpy views of the image.")
       .def_ro("width", &RenderImage::width)
       .def_ro("height", &RenderImage::height)
       .def_prop_ro("rgba",
@@ -395,7 +407,20 @@ void bind(nb::module_& m) {
                                             std::array{ToneMap::kNone, ToneMap::kAces, ToneMap::kReinhard});
             write_png_preview(path, image, options);
           },
-          "path"_a, "exposure_stops"_a = 0.0, "tone_map"_a = "none", "Writes an 8-bit sRGB preview.");
+          "path"_a, "exposure_stops"_a = 0.0, "tone_map"_a = "none", "Writes an 8-bit sRGB preview.")
+      .def(
+          "preview",
+          [](const RenderImage& image, double exposure_stops, const std::string& tone_map) {
+            PreviewOptions options;
+            options.exposure_stops = exposure_stops;
+            options.tone_map = parse_choice("tone_map", tone_map,
+                                            std::array{ToneMap::kNone, ToneMap::kAces, ToneMap::kReinhard});
+            return owned_array(preview_pixels(image, options),
+                               {size_t(image.height), size_t(image.width), 3});
+          },
+          "exposure_stops"_a = 0.0, "tone_map"_a = "none",
+          "The PNG preview's pixels, (H, W, 3) uint8 sRGB, for showing the frame (matplotlib's imshow): "
+          "rgba holds display values already, so they are shown as they are unless graded.");
 
   m.def(
       "read_exr",
@@ -453,21 +478,21 @@ void bind(nb::module_& m) {
           [](RendererHandle& self, const Camera& camera, const std::string& sort, bool depth,
              bool splat_count, const std::string& accuracy, const std::string& antialiasing,
              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
-             const std::array<float, 3>& background, bool reuse_lists, double near_plane) {
+             const std::array<float, 3>& background, bool reuse_lists, double near_plane, double max_alpha) {
             const RenderSettings settings =
                 make_settings(sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames,
-                              seed, background, reuse_lists, near_plane);
+                              seed, background, reuse_lists, near_plane, max_alpha);
             nb::gil_scoped_release release;
             return self.renderer->render(camera, settings);
           },
           "camera"_a, "sort"_a = "auto", "depth"_a = true, "splat_count"_a = true, "accuracy"_a = "reference",
           "antialiasing"_a = "classic", "compositor"_a = "sorted", "stochastic_frames"_a = 16, "seed"_a = 1,
           "background"_a = std::array<float, 3>{0, 0, 0}, "reuse_lists"_a = true,
-          "near_plane"_a = kDefaultNearPlane,
+          "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha,
           "Renders the scene from `camera`. Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted' or 'stochastic'; near_plane the view depth at or below which a Gaussian is "
-          "culled.")
+          "culled; max_alpha the cap on one splat's alpha (0.99 as 3DGS trains, 0.999 as gsplat does).")
       .def_prop_ro("last_frame_stats",
                    [](const RendererHandle& self) { return stats_dict(self.renderer->last_frame_stats()); })
       .def_prop_ro("device_info",

@@ -33,3 +33,8 @@ def render_exe():
 def shared_scenes():
     require(SHARED.is_dir(), f"{SHARED} not found (the shared scenes beside the repository)")
     return SHARED
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "gsplat: needs torch and gsplat; python/run_tests.sh runs these in a "
+                                       "virtual environment that has them (pytest -m gsplat)")

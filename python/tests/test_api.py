@@ -144,6 +144,18 @@ def test_images_write_exr_and_png(playbot_renderer, tmp_path):
     assert np.array_equal(back.depth[~empty], image.depth[~empty]) and (back.depth[empty] == 1e10).all()
     assert (tmp_path / "a.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
+    # preview(): the PNG's pixels to show (matplotlib's imshow): the display values as they are, in bytes.
+    preview = image.preview()
+    assert preview.dtype == np.uint8 and preview.shape == (36, 64, 3)
+    expected = np.round(np.clip(image.rgba[..., :3], 0, 1) * 255).astype(np.uint8)
+    assert np.abs(preview.astype(int) - expected).max() <= 1  # float32 against the engine's double rounding
+    graded = image.preview(exposure_stops=1, tone_map="aces")
+    assert graded.shape == preview.shape and not np.array_equal(graded, preview)
+    with pytest.raises(ValueError, match="tone_map must be one of"):
+        image.preview(tone_map="filmic")
+    with pytest.raises(ValueError, match="exposure"):
+        image.preview(exposure_stops=40)
+
 
 def test_errors_are_python_exceptions_with_the_engines_messages(tmp_path):
     with pytest.raises(FileNotFoundError, match="missing.ply"):

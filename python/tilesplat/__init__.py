@@ -7,7 +7,8 @@ Scenes, cameras and the renderer of the C++ engine, with numpy arrays in and out
     renderer = tilesplat.Renderer()          # the first discrete GPU, else the first device (lavapipe)
     renderer.set_scene(scene)
     image = renderer.render(tilesplat.Camera.orbit(scene, 960, 540, azimuth_deg=30))
-    image.rgba                               # (540, 960, 4) float32, premultiplied, linear
+    image.rgba                               # (540, 960, 4) float32, premultiplied display values (sRGB)
+    image.preview()                          # (540, 960, 3) uint8 to show, as the PNG holds it
     image.write_exr("frame.exr")
 
 Errors carry the engine's messages: tilesplat.SceneError (a ValueError) for a bad scene file, ValueError

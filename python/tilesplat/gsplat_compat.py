@@ -3,7 +3,12 @@ Vulkan engine on any device (lavapipe included). Forward only: no gradients.
 
 The inputs are gsplat's activated parameters (scales, opacities in [0, 1]); the engine stores the trainer's
 (log scales, opacity logits), so they are converted on the way in, which costs a float32 rounding of each
-scale and opacity. What the engine does not do raises NotImplementedError naming the argument.
+scale and opacity. Frames are blended with gsplat's rules (alpha capped at 0.999, RenderSettings::max_alpha).
+What the engine does not do raises NotImplementedError naming the argument.
+
+numpy arrays and torch tensors are both taken; torch is never imported unless a tensor is passed. With
+tensors (on any device: they travel through the CPU) the results are tensors on the device of `means`.
+Results of inputs that require gradients carry a backward that raises NotImplementedError.
 """
 
 import numpy as np
@@ -11,6 +16,8 @@ import numpy as np
 from ._core import Camera, Renderer, Scene
 
 _SH_C0 = 0.28209479177387814  # the degree-0 SH basis constant: colour = C0 * dc + 0.5
+_GSPLAT_MAX_ALPHA = 0.999  # gsplat's rasterize_to_pixels caps alpha here (3DGS: 0.99)
+_TILE_SIZE = 16
 _RENDER_MODES = ("RGB", "D", "ED", "RGB+D", "RGB+ED")
 _RASTERIZE_MODES = {"classic": "classic", "antialiased": "antialiased"}
 
@@ -25,9 +32,20 @@ def _default_renderer():
     return _renderer
 
 
+def _is_tensor(value):
+    """Whether `value` is a torch tensor, without importing torch."""
+    return type(value).__module__.split(".")[0] == "torch" and hasattr(value, "detach")
+
+
 def _array(name, value, shape, dtype=np.float32):
-    """`value` as a C-contiguous array of `dtype` with `shape` (None: any size on that axis)."""
-    array = np.ascontiguousarray(np.asarray(value), dtype=dtype)
+    """`value` (array-like or torch tensor) as a C-contiguous array of `dtype` with `shape` (None: any size
+    on that axis)."""
+    if _is_tensor(value):
+        value = value.detach().cpu().numpy()
+    array = np.asarray(value)
+    if array.dtype.kind not in "fiu":
+        raise ValueError(f"{name} must hold real numbers, got dtype {array.dtype}")
+    array = np.ascontiguousarray(array, dtype=dtype)
     if array.ndim != len(shape) or any(want is not None and got != want for got, want in zip(array.shape, shape)):
         expected = "(" + ", ".join("N" if s is None else str(s) for s in shape) + ")"
         raise ValueError(f"{name} must have the shape {expected}, got {tuple(array.shape)}")
@@ -52,6 +70,39 @@ def _camera(viewmat, K, width, height):
     return camera
 
 
+def _as_tensors(means, inputs, outputs):
+    """The results as torch tensors on the device of `means`; when an input requires gradients (and
+    autograd is on), joined to them by a backward that says this is forward only."""
+    import torch
+
+    results = tuple(torch.from_numpy(output).to(means.device) for output in outputs)
+    needing_grad = [t for t in inputs if _is_tensor(t) and t.requires_grad]
+    if needing_grad and torch.is_grad_enabled():
+        results = _forward_only(torch).apply(len(results), *results, *needing_grad)
+    return results
+
+
+_FORWARD_ONLY = None
+
+
+def _forward_only(torch):
+    """An autograd function that passes the results through and refuses a backward pass."""
+    global _FORWARD_ONLY
+    if _FORWARD_ONLY is None:
+        class ForwardOnly(torch.autograd.Function):
+            @staticmethod
+            def forward(ctx, count, *tensors):
+                return tuple(t.clone() for t in tensors[:count])
+
+            @staticmethod
+            def backward(ctx, *grads):
+                raise NotImplementedError("tilesplat.rasterization() is forward only: it has no backward pass "
+                                          "(train with gsplat; render with tilesplat)")
+
+        _FORWARD_ONLY = ForwardOnly
+    return _FORWARD_ONLY
+
+
 def _unsupported(**arguments):
     for name, (value, default) in arguments.items():
         if (value is not None) if default is None else (value != default):
@@ -73,8 +124,13 @@ def rasterization(means, quats, scales, opacities, colors, viewmats, Ks, width, 
 
     Returns (render_colors [C, H, W, X], render_alphas [C, H, W, 1], meta), X = 3 for "RGB", 1 for "D" and
     "ED", 4 for "RGB+D" and "RGB+ED". D is the alpha-weighted depth sum, ED = D / alpha (0 where no splat
-    was blended). meta holds what the engine measures: per camera the visible Gaussians and the GPU time,
-    and the sort strategy that ran.
+    was blended). numpy arrays in give numpy arrays out; torch tensors give tensors on the device of
+    `means` (the type of `means` decides).
+
+    meta holds gsplat's scalar entries (width, height, n_cameras, tile_size, tile_width, tile_height,
+    near_plane, far_plane) and what the engine measures per camera: "visible" Gaussians, "n_isects" (tile
+    intersections, gsplat's name) and "gpu_ms", with the "sort_strategy" that ran. gsplat's per-Gaussian
+    tensors (radii, means2d, conics, ...) stay on the device and are not returned.
 
     Differences from gsplat: without sh_degree, colours below 0 are clamped to 0 (the engine's colour is
     max(C0 * dc + 0.5, 0)); packed, channel_chunk and sparse_grad change nothing here. renderer: a
@@ -91,6 +147,8 @@ def rasterization(means, quats, scales, opacities, colors, viewmats, Ks, width, 
     if rasterize_mode not in _RASTERIZE_MODES:
         raise ValueError(f"rasterize_mode must be classic or antialiased, got {rasterize_mode!r}")
 
+    tensors_in = _is_tensor(means)
+    tensor_inputs = (means, quats, scales, opacities, colors, viewmats, Ks, backgrounds)
     means = _array("means", means, (None, 3))
     n = means.shape[0]
     quats = _array("quats", quats, (n, 4))
@@ -104,8 +162,7 @@ def rasterization(means, quats, scales, opacities, colors, viewmats, Ks, width, 
     if ((opacities < 0) | (opacities > 1)).any():
         raise ValueError("opacities must be in [0, 1]")
     if sh_degree is None:
-        colors = np.asarray(colors)
-        per_camera = colors.ndim == 3
+        per_camera = (colors.dim() if _is_tensor(colors) else np.ndim(colors)) == 3
         colors = _array("colors", colors, (cameras, n, 3) if per_camera else (n, 3))
         sh = ((colors - 0.5) / _SH_C0)[..., None, :]  # degree 0: [.., N, 1, 3]
     else:
@@ -131,12 +188,14 @@ def rasterization(means, quats, scales, opacities, colors, viewmats, Ks, width, 
     colour_out = render_mode.startswith("RGB")
     depth_out = "D" in render_mode
     settings = dict(near_plane=float(near_plane), antialiasing=_RASTERIZE_MODES[rasterize_mode],
-                    depth=depth_out, splat_count=False, reuse_lists=False)
+                    max_alpha=_GSPLAT_MAX_ALPHA, depth=depth_out, splat_count=False, reuse_lists=False)
     channels = (3 if colour_out else 0) + (1 if depth_out else 0)
     render_colors = np.zeros((cameras, height, width, channels), np.float32)
     render_alphas = np.zeros((cameras, height, width, 1), np.float32)
-    meta = {"width": width, "height": height, "n_cameras": cameras, "near_plane": near_plane,
-            "far_plane": far_plane, "visible": [], "gpu_ms": [], "sort_strategy": None}
+    meta = {"width": width, "height": height, "n_cameras": cameras, "tile_size": _TILE_SIZE,
+            "tile_width": -(-width // _TILE_SIZE), "tile_height": -(-height // _TILE_SIZE),
+            "near_plane": near_plane, "far_plane": far_plane, "visible": [], "n_isects": [], "gpu_ms": [],
+            "sort_strategy": None}
 
     uploaded = None
     for c in range(cameras):
@@ -155,6 +214,7 @@ def rasterization(means, quats, scales, opacities, colors, viewmats, Ks, width, 
         image = renderer.render(camera, background=background, **settings)
         stats = renderer.last_frame_stats
         meta["visible"].append(stats["visible"])
+        meta["n_isects"].append(stats["intersections"])
         meta["gpu_ms"].append(stats["gpu_ms"])
         meta["sort_strategy"] = stats["sort_strategy"]
         alpha = image.rgba[..., 3]
@@ -164,4 +224,7 @@ def rasterization(means, quats, scales, opacities, colors, viewmats, Ks, width, 
         if depth_out:
             expected = image.depth
             render_colors[c, ..., -1] = expected if render_mode.endswith("ED") else expected * alpha
+    if tensors_in:
+        render_colors, render_alphas = _as_tensors(tensor_inputs[0], tensor_inputs,
+                                                   (render_colors, render_alphas))
     return render_colors, render_alphas, meta
