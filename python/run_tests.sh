@@ -41,7 +41,7 @@ fi
 "$work/venv-gsplat/bin/python" -m pip install --quiet --no-deps "gsplat==$gsplat_version"
 "$work/venv-gsplat/bin/python" -m pip install --quiet pytest
 TILESPLAT_RENDER_EXE="$build/apps/tilesplat-render" \
-  "$work/venv-gsplat/bin/python" -m pytest -p no:cacheprovider -ra -m gsplat "$root/python/tests"
+  "$work/venv-gsplat/bin/python" -m pytest -p no:cacheprovider -ra -s -m gsplat "$root/python/tests"  # -s: the measures
 echo "python: the example (examples/python/render_orbit.py)"
 "$work/venv/bin/python" "$root/examples/python/render_orbit.py" "$root/scenes/playbot_lod3/playbot_lod3_31000_sh2.ply" \
   "$work/orbit" --frames 8 --width 320 --height 180
