@@ -384,6 +384,50 @@ TEST(CliRender, MaxAlphaFlagSetsTheCapAndIsRecorded) {
   }
 }
 
+TEST(CliRender, LensFlagsRenderDepthOfFieldAndAreRecorded) {
+  const auto out = fresh_output_dir();
+  auto render = [&](std::vector<std::string> extra, const std::string& name) {
+    std::vector<std::string> args = {bundled_playbot().string(), "--width", "96", "--height", "54", "-o",
+                                     (out / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_exe(kRenderExe, args);
+  };
+  ASSERT_EQ(render({}, "pinhole.exr").exit_code, 0);
+  const auto lens = render({"--aperture", "0.2", "--lens-samples", "8"}, "lens.exr");
+  ASSERT_EQ(lens.exit_code, 0) << lens.err;
+  const auto pinhole = tilesplat::read_exr(out / "pinhole.exr");
+  const auto blurred = tilesplat::read_exr(out / "lens.exr");
+  EXPECT_LT(tilesplat::compare_images(blurred, pinhole).psnr_db, 45.0);
+  EXPECT_TRUE(contains(tilesplat::read_exr_string_attributes(out / "lens.exr").at("renderSettings"),
+                       " lens=aperture:0.200000,focus:scene-centre,samples:8"))
+      << tilesplat::read_exr_string_attributes(out / "lens.exr").at("renderSettings");
+  // The float64 reference through the same lens.
+  const auto reference = render({"--aperture", "0.2", "--lens-samples", "8", "--reference"}, "lens_ref.exr");
+  ASSERT_EQ(reference.exit_code, 0) << reference.err;
+  EXPECT_GE(tilesplat::compare_images(tilesplat::read_exr(out / "lens_ref.exr"), blurred).psnr_db, 60.0);
+  // An f-number, focused on a given depth.
+  ASSERT_EQ(
+      render({"--f-stop", "0.05", "--focus-distance", "3", "--lens-samples", "4"}, "fstop.exr").exit_code, 0);
+  EXPECT_TRUE(contains(tilesplat::read_exr_string_attributes(out / "fstop.exr").at("renderSettings"),
+                       " lens=f/0.050:sensor:36.000mm:units-per-metre:1.000000,focus:3.000000,samples:4"));
+
+  const std::vector<std::pair<std::vector<std::string>, std::string>> mistakes = {
+      {{"--aperture", "0"}, "--aperture must be a positive number, got '0'"},
+      {{"--aperture", "nan"}, "--aperture expects a finite number, got 'nan'"},
+      {{"--focus-distance", "2"},
+       "--focus-distance shapes the lens, and neither --aperture nor --f-stop gave one"},
+      {{"--aperture", "0.1", "--f-stop", "2"}, "--aperture and --f-stop both give the aperture"},
+      {{"--aperture", "0.1", "--sensor-width", "24"}, "--sensor-width applies to --f-stop only"},
+      {{"--aperture", "0.1", "--lens-samples", "0"}, "--lens-samples"},
+  };
+  for (const auto& [flags, message] : mistakes) {
+    const auto result = render(flags, "bad.exr");
+    EXPECT_EQ(result.exit_code, 2) << flags.front() << ": " << result.err;
+    EXPECT_TRUE(contains(result.err, message)) << result.err;
+    EXPECT_FALSE(fs::exists(out / "bad.exr"));
+  }
+}
+
 TEST(CliRender, StochasticFlagConvergesTowardTheSortedImage) {
   const auto out = fresh_output_dir();
   auto render = [&](std::vector<std::string> extra, const std::string& name) {

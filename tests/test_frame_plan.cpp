@@ -237,6 +237,12 @@ TEST(FramePlan, RefusesWhatTheDeviceOrCompositorCannotDo) {
     bad_cap.max_alpha = max_alpha;
     EXPECT_THROW(plan_frame(camera(), bad_cap, context()), std::invalid_argument) << max_alpha;
   }
+  // A lens is averaged above the plan (Renderer::render): one frame's plan takes none, nor a bad one.
+  for (const double aperture : {0.1, -0.1}) {
+    RenderSettings with_lens;
+    with_lens.lens.aperture_diameter = aperture;
+    EXPECT_THROW(plan_frame(camera(), with_lens, context()), std::invalid_argument) << aperture;
+  }
 }
 
 TEST(FramePlan, EffectsReachTheProjectionVariant) {

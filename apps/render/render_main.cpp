@@ -51,7 +51,7 @@ struct Frame {
 using cli::single_quoted;
 
 // What the EXR's renderSettings attribute records: everything that changes the image.
-std::string settings_text(const tilesplat::RenderSettings& settings) {
+std::string settings_text(const tilesplat::RenderSettings& settings, const LensFlags& lens) {
   std::string text = "sort=" + settings.sort;
   text += " accuracy=" + tilesplat::to_string(settings.accuracy);
   text += " antialiasing=" + tilesplat::to_string(settings.antialiasing);
@@ -73,6 +73,7 @@ std::string settings_text(const tilesplat::RenderSettings& settings) {
     if (c > 0) text += ',';
     text.append(digits, end);
   }
+  if (lens.enabled()) text += " lens=" + lens_text(lens);
   return text;
 }
 
@@ -253,13 +254,21 @@ struct FrameWriter {
 // Renders one camera with the GPU renderer or the float64 reference; `gpu_ms` gets the frame's time.
 class FrameRenderer {
  public:
-  FrameRenderer(const RenderOptions& options, const tilesplat::GaussianScene& scene) : scene_(scene) {
+  FrameRenderer(const RenderOptions& options, const tilesplat::GaussianScene& scene)
+      : scene_(scene), lens_(options.lens) {
+    if (lens_.enabled()) {
+      const tilesplat::Bounds bounds = tilesplat::compute_bounds(scene);
+      scene_centre_ = {bounds.center[0], bounds.center[1], bounds.center[2]};
+    }
     if (options.reference) return;
     renderer_ = tilesplat::Renderer::create(cli::renderer_options(options.common));
     renderer_->set_scene(scene);
   }
 
-  tilesplat::RenderImage render(const tilesplat::Camera& camera, const tilesplat::RenderSettings& settings) {
+  tilesplat::RenderImage render(const tilesplat::Camera& camera,
+                                const tilesplat::RenderSettings& base_settings) {
+    tilesplat::RenderSettings settings = base_settings;
+    settings.lens = lens_for_frame(lens_, camera, scene_centre_);  // the focus follows the frame's camera
     tilesplat::RenderImage image;
     if (renderer_) {
       image = renderer_->render(camera, settings);
@@ -292,6 +301,8 @@ class FrameRenderer {
 
  private:
   const tilesplat::GaussianScene& scene_;
+  LensFlags lens_;
+  std::array<double, 3> scene_centre_ = {0, 0, 0};  // where the lens focuses unless --focus-distance says
   std::unique_ptr<tilesplat::Renderer> renderer_;
   double gpu_ms_ = 0, cpu_ms_ = 0;
 };
@@ -456,11 +467,12 @@ int run(int argc, char** argv) {
   writer.exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
   writer.exr.attributes["scene"] = loaded.path.string();
   writer.exr.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
-  writer.exr.attributes["renderSettings"] = settings_text(settings);
+  writer.exr.attributes["renderSettings"] = settings_text(settings, options.lens);
 
   if (sequence) {
     // Everything besides the camera that makes two runs' files differ, for the manifest.
-    std::string settings_line = settings_text(settings) + " exr=" + (options.half ? "half" : "float") + "," +
+    std::string settings_line = settings_text(settings, options.lens) +
+                                " exr=" + (options.half ? "half" : "float") + "," +
                                 tilesplat::to_string(options.compression) + "," +
                                 tilesplat::to_string(options.exr_colour) + (writer.exr.alpha ? ",A" : "") +
                                 (settings.depth ? ",Z" : "") + (settings.splat_count ? ",splats" : "");

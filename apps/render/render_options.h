@@ -8,6 +8,7 @@
 
 #include "cli.h"
 #include "tilesplat/image.h"
+#include "tilesplat/lens.h"
 #include "tilesplat/renderer.h"
 
 namespace tilesplat::render_app {
@@ -23,6 +24,28 @@ inline constexpr const char* kDescription =
     "(out/manifest.jsonl) and in shards (--shard). A scene file's background and outputs "
     "apply unless --background, --no-depth or --no-count say otherwise.";
 
+// Depth of field from the command line: an aperture (a diameter, or an f-number through the sensor's
+// width and the scene's scale), focused at a view depth or, unless --focus-distance says, at the scene's
+// centre as each frame's camera sees it.
+struct LensFlags {
+  std::optional<double> aperture;        // --aperture D, world units
+  std::optional<double> f_stop;          // --f-stop N
+  std::optional<double> focus_distance;  // --focus-distance Z
+  double sensor_width_mm = 36.0;         // --sensor-width MM
+  double units_per_metre = 1.0;          // --units-per-metre U
+  int samples = 32;                      // --lens-samples N
+  bool enabled() const { return aperture.has_value() || f_stop.has_value(); }
+};
+
+// The lens of one frame: the flags' aperture and focus for `camera`, the focus on `scene_centre` unless
+// --focus-distance was given. Off (the pinhole) without --aperture or --f-stop. Throws UsageError for a
+// scene centre behind the camera when it would be the focus.
+ThinLens lens_for_frame(const LensFlags& flags, const Camera& camera,
+                        const std::array<double, 3>& scene_centre);
+// "aperture:D,focus:Z,samples:N" (f/N for an f-number, focus:scene-centre by default), for the EXR's
+// renderSettings; empty when off.
+std::string lens_text(const LensFlags& flags);
+
 struct RenderOptions {
   tilesplat::cli::CommonOptions common;
   std::string output;
@@ -36,6 +59,7 @@ struct RenderOptions {
   bool no_count = false;
   bool reference = false;
   int stochastic_frames = 0;  // --stochastic N: the sort-free compositor averaging N frames; 0 = sorted
+  LensFlags lens;
   bool stats = false;
   // Many frames in one run.
   std::string views;      // --views: a selection of the camera set's views

@@ -9,16 +9,17 @@
 // keys, for far fewer key bits times keys: on playbot_lod0 at 1080p, 4 digit passes over 0.5M
 // Gaussians plus 2 over 1.5M pairs instead of 6 over 1.5M.
 // Data flows one way; the only host read-back is the counters (and the image) after the fence.
-#include "renderer_impl.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 
+#include "frame/lens_frames.h"
 #include "host_depth.h"
 #include "passes/frame_counters.h"
+#include "renderer_impl.h"
+#include "settings_checks.h"
 
 namespace tilesplat {
 
@@ -172,6 +173,23 @@ void Renderer::set_scene(const GaussianScene& scene) {
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
   Impl& r = *impl_;
   const auto start = std::chrono::steady_clock::now();
+  if (settings.lens.enabled()) {
+    // Depth of field: the pinhole frames of the lens samples, averaged (frame/lens_frames.h).
+    check_lens(settings, camera);
+    RenderSettings pinhole = settings;
+    pinhole.lens = {};
+    FrameStats frame;
+    frame.samples = 0;
+    RenderImage image = render_lens_frames(camera, settings, [&](const Camera& sample_camera) {
+      RenderImage sample = render(sample_camera, pinhole);
+      add_sample_stats(frame, r.stats);
+      return sample;
+    });
+    r.stats = frame;
+    r.stats.cpu_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return image;
+  }
   r.render_frame(camera, settings);
   RenderImage image;
   image.width = camera.width;

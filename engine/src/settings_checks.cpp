@@ -20,4 +20,21 @@ void check_max_alpha(const RenderSettings& settings) {
                                 std::to_string(settings.max_alpha));
 }
 
+void check_lens(const RenderSettings& settings, const Camera& camera) {
+  validate(settings.lens);
+  validate(camera);
+  if (settings.host)
+    throw std::invalid_argument(
+        "RenderSettings::lens: depth of field cannot be combined with a host's depth "
+        "(RenderSettings::host)");
+}
+
+void check_no_lens(const RenderSettings& settings) {
+  validate(settings.lens);  // an aperture below 0 or NaN is not "off"
+  if (settings.lens.enabled())
+    throw std::invalid_argument(
+        "RenderSettings::lens: depth of field is rendered by Renderer::render() and "
+        "render_reference(), not by render_to_image or a frame submitted without waiting");
+}
+
 }  // namespace tilesplat

@@ -10,5 +10,10 @@ namespace tilesplat {
 void check_near_plane(double near_plane);
 // RenderSettings::max_alpha: finite, above accuracy.alpha_cutoff and below 1. Throws std::invalid_argument.
 void check_max_alpha(const RenderSettings& settings);
+// RenderSettings::lens, where a frame through it can be made (Renderer::render, render_reference): a valid
+// lens (validate(ThinLens)), a valid camera, and no host depth. Throws std::invalid_argument.
+void check_lens(const RenderSettings& settings, const Camera& camera);
+// A single pinhole frame (the frame plan, render_to_image): RenderSettings::lens must be valid and off.
+void check_no_lens(const RenderSettings& settings);
 
 }  // namespace tilesplat

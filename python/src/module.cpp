@@ -23,6 +23,7 @@
 #include "tilesplat/camera_path.h"
 #include "tilesplat/camera_sets.h"
 #include "tilesplat/image.h"
+#include "tilesplat/lens.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
@@ -107,7 +108,7 @@ RenderSettings make_settings(const std::string& sort, bool depth, bool splat_cou
                              const std::string& accuracy, const std::string& antialiasing,
                              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
                              const std::array<float, 3>& background, bool reuse_lists, double near_plane,
-                             double max_alpha) {
+                             double max_alpha, const std::optional<ThinLens>& lens) {
   RenderSettings settings;
   settings.sort = sort;
   settings.depth = depth;
@@ -124,6 +125,7 @@ RenderSettings make_settings(const std::string& sort, bool depth, bool splat_cou
   settings.reuse_lists = reuse_lists;
   settings.near_plane = near_plane;
   settings.max_alpha = max_alpha;
+  if (lens) settings.lens = *lens;
   return settings;
 }
 
@@ -143,6 +145,7 @@ nb::dict stats_dict(const FrameStats& stats) {
   out["submissions"] = stats.submissions;
   out["device_bytes"] = stats.device_bytes;
   out["reused_sorted_lists"] = stats.reused_sorted_lists;
+  out["samples"] = stats.samples;
   return out;
 }
 
@@ -354,6 +357,35 @@ void bind(nb::module_& m) {
       "path"_a, "frames"_a, "width"_a = 1920, "height"_a = 1080,
       "`frames` cameras along a keyframe file (docs/camera-paths.md), as tilesplat-render --path.");
 
+  // --- the thin lens (depth of field)
+  nb::class_<ThinLens>(m, "ThinLens",
+                       "A thin lens for depth of field: aperture_diameter (world units; 0 = a pinhole), "
+                       "focus_distance (the view depth in focus) and samples (pinhole frames averaged).")
+      .def(
+          "__init__",
+          [](ThinLens* lens, double aperture_diameter, double focus_distance, int samples) {
+            new (lens) ThinLens{aperture_diameter, focus_distance, samples};
+            validate(*lens);
+          },
+          "aperture_diameter"_a = 0.0, "focus_distance"_a = 1.0, "samples"_a = 32)
+      .def_rw("aperture_diameter", &ThinLens::aperture_diameter)
+      .def_rw("focus_distance", &ThinLens::focus_distance)
+      .def_rw("samples", &ThinLens::samples)
+      .def("__repr__", [](const ThinLens& lens) {
+        return "ThinLens(aperture_diameter=" + std::to_string(lens.aperture_diameter) +
+               ", focus_distance=" + std::to_string(lens.focus_distance) +
+               ", samples=" + std::to_string(lens.samples) + ")";
+      });
+  m.def("lens_samples", &lens_samples, "count"_a,
+        "The lens positions of `count` samples on the unit disk (Vogel's golden-angle spiral), as (x, y) "
+        "pairs.");
+  m.def("lens_sample_camera", &lens_sample_camera, "camera"_a, "lens"_a, "sample"_a,
+        "The pinhole camera of one lens position: moved on the aperture, its principal point shifted so that "
+        "the focus plane stays put.");
+  m.def("aperture_for_f_stop", &aperture_for_f_stop, "camera"_a, "f_stop"_a, "sensor_width_mm"_a = 36.0,
+        "world_units_per_metre"_a = 1.0,
+        "The aperture diameter of an f-number: the focal length over f_stop.");
+
   // --- images
   nb::class_<RenderImage>(
       m, "Image",
@@ -478,21 +510,23 @@ void bind(nb::module_& m) {
           [](RendererHandle& self, const Camera& camera, const std::string& sort, bool depth,
              bool splat_count, const std::string& accuracy, const std::string& antialiasing,
              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
-             const std::array<float, 3>& background, bool reuse_lists, double near_plane, double max_alpha) {
+             const std::array<float, 3>& background, bool reuse_lists, double near_plane, double max_alpha,
+             const std::optional<ThinLens>& lens) {
             const RenderSettings settings =
                 make_settings(sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames,
-                              seed, background, reuse_lists, near_plane, max_alpha);
+                              seed, background, reuse_lists, near_plane, max_alpha, lens);
             nb::gil_scoped_release release;
             return self.renderer->render(camera, settings);
           },
           "camera"_a, "sort"_a = "auto", "depth"_a = true, "splat_count"_a = true, "accuracy"_a = "reference",
           "antialiasing"_a = "classic", "compositor"_a = "sorted", "stochastic_frames"_a = 16, "seed"_a = 1,
           "background"_a = std::array<float, 3>{0, 0, 0}, "reuse_lists"_a = true,
-          "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha,
+          "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
           "Renders the scene from `camera`. Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted' or 'stochastic'; near_plane the view depth at or below which a Gaussian is "
-          "culled; max_alpha the cap on one splat's alpha (0.99 as 3DGS trains, 0.999 as gsplat does).")
+          "culled; max_alpha the cap on one splat's alpha (0.99 as 3DGS trains, 0.999 as gsplat does); lens "
+          "a ThinLens for depth of field (the mean of its samples' pinhole frames in linear light).")
       .def_prop_ro("last_frame_stats",
                    [](const RendererHandle& self) { return stats_dict(self.renderer->last_frame_stats()); })
       .def_prop_ro("device_info",

@@ -236,3 +236,30 @@ def test_camera_paths_orbits_and_host_matrices(tmp_path):
     assert camera.position == pytest.approx([0, 0, 0])
     with pytest.raises(ValueError, match="clip must be vulkan or opengl"):
         tilesplat.Camera.from_matrices(np.eye(4).flatten().tolist(), projection.T.flatten().tolist(), 64, 36, "d3d")
+
+
+def test_depth_of_field_through_a_thin_lens(playbot_renderer):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 96, 54, azimuth_deg=30)
+    pinhole = renderer.render(camera)
+    assert np.array_equal(renderer.render(camera, lens=tilesplat.ThinLens()).rgba, pinhole.rgba)  # off: the pinhole
+    lens = tilesplat.ThinLens(aperture_diameter=0.2, focus_distance=2.0, samples=4)
+    blurred = renderer.render(camera, lens=lens)
+    assert renderer.last_frame_stats["samples"] == 4
+    assert tilesplat.compare_images(blurred, pinhole)["psnr_db"] < 45
+    # The definition: the mean in linear light of the samples' pinhole frames.
+    samples = tilesplat.lens_samples(4)
+    assert len(samples) == 4 and all(x * x + y * y <= 1 for x, y in samples)
+    frames = [renderer.render(tilesplat.lens_sample_camera(camera, lens, s)).rgba for s in samples]
+    decode = lambda c: np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)  # noqa: E731
+    encode = lambda l: np.where(l <= 0.0031308, l * 12.92, 1.055 * l ** (1 / 2.4) - 0.055)  # noqa: E731
+    linear = [np.concatenate([f[..., 3:] * decode(np.where(f[..., 3:] > 0, f[..., :3] / np.maximum(f[..., 3:], 1e-30),
+                                                                  f[..., :3])), f[..., 3:]], -1)
+              for f in frames]
+    mean = np.mean(linear, axis=0)
+    alpha = mean[..., 3:]
+    expected = np.where(alpha > 0, alpha * encode(mean[..., :3] / np.maximum(alpha, 1e-30)), encode(mean[..., :3]))
+    np.testing.assert_allclose(blurred.rgba[..., :3], expected, atol=2e-5)
+    assert tilesplat.aperture_for_f_stop(camera, 2.0) > 0
+    with pytest.raises(ValueError, match="focus_distance"):
+        tilesplat.ThinLens(aperture_diameter=0.1, focus_distance=0)

@@ -13,6 +13,7 @@
 
 #include "tilesplat/camera.h"
 #include "tilesplat/export.h"
+#include "tilesplat/lens.h"
 
 namespace tilesplat {
 
@@ -196,6 +197,10 @@ struct RenderSettings {
   /// An asset renders as it was trained with the cap its trainer used. Above accuracy.alpha_cutoff and
   /// below 1 (at 1 a splat would end its pixels before blending, the stop being exclusive).
   double max_alpha = kDefaultMaxAlpha;
+  /// Depth of field: a thin lens (tilesplat/lens.h). Its default, an aperture of 0, is the pinhole camera:
+  /// nothing is averaged and the frame is the one it always was. Renderer::render and render_reference
+  /// take it; render_to_image and the frames submitted without waiting refuse it, as does host depth.
+  ThinLens lens;
 };
 
 }  // namespace tilesplat

@@ -187,6 +187,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
   validate_host_depth(settings, camera);
   check_near_plane(settings.near_plane);
   check_max_alpha(settings);
+  check_no_lens(settings);
 
   FramePlan plan;
   plan.sort = context.sort;

@@ -1,0 +1,90 @@
+#include "frame/lens_frames.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace tilesplat {
+
+void LinearFrameMean::add(const RenderImage& frame) {
+  if (frames_ == 0) {
+    width_ = frame.width;
+    height_ = frame.height;
+    depth_ = !frame.depth.empty();
+    count_ = !frame.splat_count.empty();
+    linear_rgba_.assign(frame.rgba.size(), 0.0);
+    alpha_depth_.assign(depth_ ? frame.depth.size() : 0, 0.0);
+    counts_.assign(count_ ? frame.splat_count.size() : 0, 0.0);
+  } else if (frame.width != width_ || frame.height != height_ || frame.rgba.size() != linear_rgba_.size() ||
+             frame.depth.empty() == depth_ || frame.splat_count.empty() == count_) {
+    throw std::logic_error("LinearFrameMean: the frames differ in size or outputs");
+  }
+  const std::vector<float> linear =
+      convert_colours(frame.rgba, ColourEncoding::kSrgbDisplay, ColourEncoding::kSceneLinear, over_background_);
+  for (size_t i = 0; i < linear.size(); ++i) linear_rgba_[i] += linear[i];
+  for (size_t p = 0; p < alpha_depth_.size(); ++p) alpha_depth_[p] += double(frame.rgba[4 * p + 3]) * frame.depth[p];
+  for (size_t p = 0; p < counts_.size(); ++p) counts_[p] += frame.splat_count[p];
+  ++frames_;
+}
+
+RenderImage LinearFrameMean::mean() const {
+  if (frames_ == 0) throw std::logic_error("LinearFrameMean: no frames");
+  RenderImage image;
+  image.width = width_;
+  image.height = height_;
+  std::vector<float> linear(linear_rgba_.size());
+  for (size_t i = 0; i < linear.size(); ++i) linear[i] = static_cast<float>(linear_rgba_[i] / frames_);
+  image.rgba = convert_colours(linear, ColourEncoding::kSceneLinear, ColourEncoding::kSrgbDisplay, over_background_);
+  if (depth_) {
+    image.depth.resize(alpha_depth_.size());
+    for (size_t p = 0; p < alpha_depth_.size(); ++p) {
+      const double alpha_sum = linear_rgba_[4 * p + 3];
+      image.depth[p] = alpha_sum > 0 ? static_cast<float>(alpha_depth_[p] / alpha_sum) : 0.0f;
+    }
+  }
+  if (count_) {
+    image.splat_count.resize(counts_.size());
+    for (size_t p = 0; p < counts_.size(); ++p)
+      image.splat_count[p] = static_cast<uint32_t>(std::lround(counts_[p] / frames_));
+  }
+  return image;
+}
+
+RenderImage render_lens_frames(const Camera& camera, const RenderSettings& settings,
+                               const std::function<RenderImage(const Camera&)>& render_pinhole) {
+  const ThinLens& lens = settings.lens;
+  validate(lens);
+  LinearFrameMean mean(settings.background != std::array<float, 3>{0, 0, 0});
+  for (const auto& sample : lens_samples(lens.samples)) mean.add(render_pinhole(lens_sample_camera(camera, lens, sample)));
+  return mean.mean();
+}
+
+void add_sample_stats(FrameStats& frame, const FrameStats& sample) {
+  if (frame.samples == 0) {
+    frame = sample;
+    frame.samples = 1;
+    return;
+  }
+  for (const PassTiming& pass : sample.passes) {
+    auto it = std::find_if(frame.passes.begin(), frame.passes.end(),
+                           [&](const PassTiming& p) { return p.name == pass.name; });
+    if (it == frame.passes.end())
+      frame.passes.push_back(pass);
+    else
+      it->gpu_ms += pass.gpu_ms;
+  }
+  frame.gpu_ms += sample.gpu_ms;
+  frame.visible = std::max(frame.visible, sample.visible);
+  frame.intersections = std::max(frame.intersections, sample.intersections);
+  frame.sort_bits = std::max(frame.sort_bits, sample.sort_bits);
+  frame.retries += sample.retries;
+  frame.submissions += sample.submissions;
+  frame.sort_fallbacks += sample.sort_fallbacks;
+  frame.device_bytes = std::max(frame.device_bytes, sample.device_bytes);
+  frame.uploaded_bytes += sample.uploaded_bytes;
+  frame.reused_sorted_lists = frame.reused_sorted_lists && sample.reused_sorted_lists;
+  frame.complete = frame.complete && sample.complete;
+  ++frame.samples;
+}
+
+}  // namespace tilesplat

@@ -1,0 +1,236 @@
+// Depth of field (RenderSettings::lens, tilesplat/lens.h): the sample pattern, the camera of each sample,
+// the frame as the linear mean of the samples' pinhole frames on the GPU and in the float64 reference, and
+// off being the pinhole frame to the bit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+#include "test_support.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/image.h"
+#include "tilesplat/lens.h"
+#include "tilesplat/reference.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+
+using namespace tilesplat;
+
+namespace {
+
+// Where a camera-space point of `camera` lands on its image.
+std::array<double, 2> project(const Camera& camera, const std::array<double, 3>& world) {
+  const auto p = camera.to_camera(world);
+  return {camera.fx * p[0] / p[2] + camera.cx, camera.fy * p[1] / p[2] + camera.cy};
+}
+
+// The mean of frames in linear light, written out as the definition says (tilesplat/lens.h); `opaque`
+// for frames over a background.
+RenderImage linear_mean(const std::vector<RenderImage>& frames, bool opaque = false) {
+  std::vector<double> sum(frames.front().rgba.size(), 0.0);
+  for (const RenderImage& frame : frames) {
+    const std::vector<float> linear =
+        convert_colours(frame.rgba, ColourEncoding::kSrgbDisplay, ColourEncoding::kSceneLinear, opaque);
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += linear[i];
+  }
+  std::vector<float> mean(sum.size());
+  for (size_t i = 0; i < sum.size(); ++i) mean[i] = float(sum[i] / double(frames.size()));
+  RenderImage image = frames.front();
+  image.rgba = convert_colours(mean, ColourEncoding::kSceneLinear, ColourEncoding::kSrgbDisplay, opaque);
+  return image;
+}
+
+float max_abs_difference(const std::vector<float>& a, const std::vector<float>& b) {
+  float most = 0;
+  for (size_t i = 0; i < a.size(); ++i) most = std::max(most, std::abs(a[i] - b[i]));
+  return most;
+}
+
+}  // namespace
+
+TEST(LensSamples, AreVogelsSpiralOnTheUnitDisk) {
+  for (const int count : {1, 2, 7, 32, 1024}) {
+    const auto samples = lens_samples(count);
+    ASSERT_EQ(samples.size(), size_t(count));
+    double sum_x = 0, sum_y = 0, sum_r2 = 0;
+    for (int i = 0; i < count; ++i) {
+      const auto [x, y] = samples[size_t(i)];
+      const double r = std::hypot(x, y);
+      EXPECT_NEAR(r, std::sqrt((i + 0.5) / count), 1e-12);
+      EXPECT_LE(r, 1.0);
+      if (r > 1e-9) {
+        const double golden = std::numbers::pi * (3 - std::sqrt(5.0));
+        EXPECT_NEAR(std::remainder(std::atan2(y, x) - i * golden, 2 * std::numbers::pi), 0.0, 1e-9) << i;
+      }
+      sum_x += x, sum_y += y, sum_r2 += r * r;
+    }
+    EXPECT_NEAR(sum_r2 / count, 0.5, 1e-12);  // each sample stands for an equal area
+    if (count >= 32) {
+      EXPECT_LT(std::hypot(sum_x, sum_y) / count, 0.03) << count;  // centred
+    }
+  }
+  EXPECT_EQ(lens_samples(32), lens_samples(32));
+  for (const int bad : {0, -1, kMaxLensSamples + 1}) EXPECT_THROW(lens_samples(bad), std::invalid_argument) << bad;
+}
+
+TEST(LensSampleCamera, KeepsTheFocusPlaneWhereThePinholeSeesIt) {
+  const Camera camera = look_at_camera({1, -0.5, -4}, {0, 0, 0}, {0, -1, 0}, 320, 240, 50);
+  const ThinLens lens{.aperture_diameter = 0.2, .focus_distance = 3.0, .samples = 16};
+  // Points at view depth 3 (in focus) and 6 (behind it), across the image.
+  const auto at_depth = [&](double x, double y, double z) {
+    std::array<double, 3> world = camera.position;  // position + R^T (x, y, z)
+    for (int k = 0; k < 3; ++k)
+      world[k] += x * camera.rotation[k] + y * camera.rotation[3 + k] + z * camera.rotation[6 + k];
+    return world;
+  };
+  double behind_moved = 0;
+  for (const auto& sample : lens_samples(lens.samples)) {
+    const Camera moved = lens_sample_camera(camera, lens, sample);
+    EXPECT_EQ(moved.rotation, camera.rotation);
+    const double shift = std::hypot(moved.position[0] - camera.position[0], moved.position[1] - camera.position[1],
+                                    moved.position[2] - camera.position[2]);
+    EXPECT_NEAR(shift, 0.1 * std::hypot(sample[0], sample[1]), 1e-12);
+    for (const auto& [x, y] : {std::array{0.0, 0.0}, std::array{0.9, -0.4}, std::array{-1.2, 0.7}}) {
+      const auto pinhole = project(camera, at_depth(x, y, 3.0));
+      const auto through = project(moved, at_depth(x, y, 3.0));
+      EXPECT_NEAR(through[0], pinhole[0], 1e-9);
+      EXPECT_NEAR(through[1], pinhole[1], 1e-9);
+      const auto far_pinhole = project(camera, at_depth(x, y, 6.0));
+      const auto far_through = project(moved, at_depth(x, y, 6.0));
+      behind_moved = std::max(behind_moved, std::hypot(far_through[0] - far_pinhole[0], far_through[1] - far_pinhole[1]));
+    }
+  }
+  // The circle of confusion of depth 6 focused at 3: aperture * fx * |1/6 - 1/3| / 2 at the rim.
+  EXPECT_NEAR(behind_moved, 0.2 * camera.fx * (1.0 / 3 - 1.0 / 6) / 2, 0.2 * camera.fx / 12 * 0.05);
+  EXPECT_EQ(lens_sample_camera(camera, ThinLens{}, {0.5, 0.5}), camera);  // no aperture: the pinhole
+  EXPECT_THROW(lens_sample_camera(camera, {.aperture_diameter = 0.1, .focus_distance = 0}, {0, 0}),
+               std::invalid_argument);
+}
+
+TEST(ApertureForFStop, IsTheFocalLengthOverTheFNumber) {
+  // 1920 px wide, fx 1920: a 36 mm sensor makes it a 36 mm lens; at f/2 the aperture is 18 mm.
+  Camera camera;
+  camera.width = 1920, camera.height = 1080, camera.fx = camera.fy = 1920, camera.cx = 960, camera.cy = 540;
+  EXPECT_NEAR(aperture_for_f_stop(camera, 2.0), 0.018, 1e-12);
+  EXPECT_NEAR(aperture_for_f_stop(camera, 2.0, 36.0, 100.0), 1.8, 1e-12);  // a scene in centimetres
+  for (const double bad : {0.0, -1.0, std::nan("")}) {
+    EXPECT_THROW(aperture_for_f_stop(camera, bad), std::invalid_argument) << bad;
+    EXPECT_THROW(aperture_for_f_stop(camera, 2.0, bad), std::invalid_argument) << bad;
+  }
+}
+
+class DepthOfField : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    scene_ = load_scene(tilesplat::testing::bundled_playbot());
+    camera_ = orbit_camera(scene_, 128, 72, {.azimuth_deg = 30});
+    renderer_ = &tilesplat::testing::validated_renderer();
+    renderer_->set_scene(scene_);
+    const Bounds bounds = compute_bounds(scene_);
+    const auto p = camera_.to_camera({bounds.center[0], bounds.center[1], bounds.center[2]});
+    focus_ = p[2];  // the view depth of the scene's centre
+  }
+  GaussianScene scene_;
+  Camera camera_;
+  Renderer* renderer_ = nullptr;
+  double focus_ = 1;
+};
+
+TEST_F(DepthOfField, OffIsThePinholeFrameToTheBit) {
+  const RenderImage pinhole = renderer_->render(camera_);
+  RenderSettings settings;
+  settings.lens = {.aperture_diameter = 0, .focus_distance = 2.5, .samples = 8};
+  const RenderImage off = renderer_->render(camera_, settings);
+  EXPECT_EQ(off.rgba, pinhole.rgba);
+  EXPECT_EQ(off.depth, pinhole.depth);
+  EXPECT_EQ(off.splat_count, pinhole.splat_count);
+  EXPECT_EQ(renderer_->last_frame_stats().samples, 1);
+  EXPECT_EQ(render_reference(scene_, camera_, settings).rgba, render_reference(scene_, camera_).rgba);
+}
+
+TEST_F(DepthOfField, IsTheLinearMeanOfTheSamplesPinholeFrames) {
+  RenderSettings settings;
+  settings.lens = {.aperture_diameter = 0.05 * focus_, .focus_distance = focus_, .samples = 6};
+  const RenderImage through_lens = renderer_->render(camera_, settings);
+  const FrameStats stats = renderer_->last_frame_stats();
+  EXPECT_EQ(stats.samples, 6);
+  EXPECT_EQ(stats.passes.front().name, "projection");
+
+  std::vector<RenderImage> frames;
+  double gpu_ms = 0;
+  for (const auto& sample : lens_samples(6)) {
+    frames.push_back(renderer_->render(lens_sample_camera(camera_, settings.lens, sample)));
+    gpu_ms += renderer_->last_frame_stats().gpu_ms;
+  }
+  const RenderImage mean = linear_mean(frames);
+  EXPECT_LE(max_abs_difference(through_lens.rgba, mean.rgba), 1e-6f);
+  EXPECT_GT(stats.gpu_ms, 0.5 * gpu_ms);  // the samples' times, summed
+  // Depth: the alpha-weighted mean of the samples' depths.
+  const size_t pixel = size_t(36) * 128 + 64;
+  double alpha_depth = 0, alpha = 0;
+  for (const RenderImage& frame : frames) {
+    alpha_depth += double(frame.rgba[4 * pixel + 3]) * frame.depth[pixel];
+    alpha += frame.rgba[4 * pixel + 3];
+  }
+  ASSERT_GT(alpha, 0.0);
+  EXPECT_NEAR(through_lens.depth[pixel], alpha_depth / alpha, 1e-5 * focus_);
+  EXPECT_NE(through_lens.rgba, frames.front().rgba);
+
+  // The reference makes it the same way from its own pinhole frames.
+  const RenderImage reference = render_reference(scene_, camera_, settings);
+  const ImageDifference d = compare_images(through_lens, reference);
+  std::printf("[ measure  ] depth of field, 6 samples, against the float64 reference: PSNR %.1f dB, max abs %.2e\n",
+              d.psnr_db, d.max_abs);
+  EXPECT_GE(d.psnr_db, 60.0);
+  EXPECT_EQ(renderer_->validation_messages(), 0u);
+}
+
+TEST_F(DepthOfField, OverABackgroundTheColoursAreAveragedAsOpaque) {
+  // Over white, a pixel's colour holds the background (C = c + T), so it is not premultiplied by its
+  // alpha: decoding C / A would blow it up where alpha is small. Each is converted as an opaque colour.
+  RenderSettings settings;
+  settings.background = {1, 1, 1};
+  settings.lens = {.aperture_diameter = 0.1 * focus_, .focus_distance = focus_, .samples = 4};
+  const RenderImage through_lens = renderer_->render(camera_, settings);
+  RenderSettings pinhole = settings;
+  pinhole.lens = {};
+  std::vector<RenderImage> frames;
+  for (const auto& sample : lens_samples(4))
+    frames.push_back(renderer_->render(lens_sample_camera(camera_, settings.lens, sample), pinhole));
+  EXPECT_LE(max_abs_difference(through_lens.rgba, linear_mean(frames, /*opaque=*/true).rgba), 1e-6f);
+  float brightest = 0;
+  for (size_t i = 0; i < through_lens.rgba.size(); ++i)
+    if (i % 4 != 3) brightest = std::max(brightest, through_lens.rgba[i]);
+  EXPECT_LE(brightest, 1.0f + 1e-5f);  // white is the brightest there is
+  EXPECT_GE(compare_images(through_lens, render_reference(scene_, camera_, settings)).psnr_db, 60.0);
+}
+
+TEST_F(DepthOfField, BlursWhatIsOutOfFocusMore) {
+  const RenderImage pinhole = renderer_->render(camera_);
+  RenderSettings settings;
+  settings.lens = {.aperture_diameter = 0.08 * focus_, .focus_distance = focus_, .samples = 16};
+  const double in_focus = compare_images(renderer_->render(camera_, settings), pinhole).psnr_db;
+  settings.lens.focus_distance = 4 * focus_;  // focused far behind the scene
+  const double out_of_focus = compare_images(renderer_->render(camera_, settings), pinhole).psnr_db;
+  std::printf("[ measure  ] against the pinhole frame: focused on the scene %.1f dB, behind it %.1f dB\n", in_focus,
+              out_of_focus);
+  EXPECT_GT(in_focus, out_of_focus + 3.0);
+}
+
+TEST_F(DepthOfField, BadLensesAreRefused) {
+  RenderSettings settings;
+  for (const ThinLens bad : {ThinLens{.aperture_diameter = -0.1}, ThinLens{.aperture_diameter = std::nan("")},
+                             ThinLens{.aperture_diameter = 0.1, .focus_distance = 0},
+                             ThinLens{.aperture_diameter = 0.1, .focus_distance = -2},
+                             ThinLens{.aperture_diameter = 0.1, .focus_distance = 1, .samples = 0},
+                             ThinLens{.aperture_diameter = 0.1, .focus_distance = 1, .samples = kMaxLensSamples + 1}}) {
+    settings.lens = bad;
+    EXPECT_THROW(renderer_->render(camera_, settings), std::invalid_argument);
+    EXPECT_THROW(render_reference(scene_, camera_, settings), std::invalid_argument);
+  }
+  settings.lens = {.aperture_diameter = 0.1, .focus_distance = 1, .samples = 4};
+  settings.host = HostDepth{};
+  EXPECT_THROW(renderer_->render(camera_, settings), std::invalid_argument);
+}
