@@ -15,7 +15,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "frame/lens_frames.h"
+#include "frame/averaged_frames.h"
 #include "host_depth.h"
 #include "passes/frame_counters.h"
 #include "renderer_impl.h"
@@ -173,15 +173,13 @@ void Renderer::set_scene(const GaussianScene& scene) {
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
   Impl& r = *impl_;
   const auto start = std::chrono::steady_clock::now();
-  if (settings.lens.enabled()) {
-    // Depth of field: the pinhole frames of the lens samples, averaged (frame/lens_frames.h).
-    check_lens(settings, camera);
-    RenderSettings pinhole = settings;
-    pinhole.lens = {};
+  // A frame averaged from sample frames (frame/averaged_frames.h), each rendered here with
+  // `sample_settings`; its statistics are the samples' summed.
+  const auto averaged = [&](const RenderSettings& sample_settings, auto average) {
     FrameStats frame;
     frame.samples = 0;
-    RenderImage image = render_lens_frames(camera, settings, [&](const Camera& sample_camera) {
-      RenderImage sample = render(sample_camera, pinhole);
+    RenderImage image = average(camera, settings, [&](const Camera& sample_camera) {
+      RenderImage sample = render(sample_camera, sample_settings);
       add_sample_stats(frame, r.stats);
       return sample;
     });
@@ -189,6 +187,19 @@ RenderImage Renderer::render(const Camera& camera, const RenderSettings& setting
     r.stats.cpu_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return image;
+  };
+  if (settings.shutter
+          .enabled()) {  // motion blur: the frames at the shutter's times (each may be a lens frame)
+    check_shutter(settings, camera);
+    RenderSettings still = settings;
+    still.shutter = {};
+    return averaged(still, render_shutter_frames);
+  }
+  if (settings.lens.enabled()) {  // depth of field: the pinhole frames of the lens samples
+    check_lens(settings, camera);
+    RenderSettings pinhole = settings;
+    pinhole.lens = {};
+    return averaged(pinhole, render_lens_frames);
   }
   r.render_frame(camera, settings);
   RenderImage image;

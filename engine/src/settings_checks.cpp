@@ -29,11 +29,31 @@ void check_lens(const RenderSettings& settings, const Camera& camera) {
         "(RenderSettings::host)");
 }
 
-void check_no_lens(const RenderSettings& settings) {
+void check_shutter(const RenderSettings& settings, const Camera& camera) {
+  validate(settings.shutter);
+  validate(camera);
+  const Camera& end = *settings.shutter.end_camera;
+  if (end.width != camera.width || end.height != camera.height)
+    throw std::invalid_argument("RenderSettings::shutter: the end camera is " + std::to_string(end.width) +
+                                "x" + std::to_string(end.height) + ", the camera " +
+                                std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                                ": a camera moves, it does not change size");
+  if (settings.host)
+    throw std::invalid_argument(
+        "RenderSettings::shutter: motion blur cannot be combined with a host's depth "
+        "(RenderSettings::host)");
+}
+
+void check_single_frame(const RenderSettings& settings) {
   validate(settings.lens);  // an aperture below 0 or NaN is not "off"
+  validate(settings.shutter);
   if (settings.lens.enabled())
     throw std::invalid_argument(
         "RenderSettings::lens: depth of field is rendered by Renderer::render() and "
+        "render_reference(), not by render_to_image or a frame submitted without waiting");
+  if (settings.shutter.enabled())
+    throw std::invalid_argument(
+        "RenderSettings::shutter: motion blur is rendered by Renderer::render() and "
         "render_reference(), not by render_to_image or a frame submitted without waiting");
 }
 

@@ -13,7 +13,11 @@ void check_max_alpha(const RenderSettings& settings);
 // RenderSettings::lens, where a frame through it can be made (Renderer::render, render_reference): a valid
 // lens (validate(ThinLens)), a valid camera, and no host depth. Throws std::invalid_argument.
 void check_lens(const RenderSettings& settings, const Camera& camera);
-// A single pinhole frame (the frame plan, render_to_image): RenderSettings::lens must be valid and off.
-void check_no_lens(const RenderSettings& settings);
+// RenderSettings::shutter, where a frame through it can be made: a valid shutter (validate(Shutter)), an
+// end camera of the camera's size, and no host depth. Throws std::invalid_argument.
+void check_shutter(const RenderSettings& settings, const Camera& camera);
+// A single pinhole frame (the frame plan, render_to_image): RenderSettings::lens and shutter must be valid
+// and off.
+void check_single_frame(const RenderSettings& settings);
 
 }  // namespace tilesplat

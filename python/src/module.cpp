@@ -28,6 +28,7 @@
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
+#include "tilesplat/shutter.h"
 #include "tilesplat/version.h"
 
 namespace nb = nanobind;
@@ -108,7 +109,8 @@ RenderSettings make_settings(const std::string& sort, bool depth, bool splat_cou
                              const std::string& accuracy, const std::string& antialiasing,
                              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
                              const std::array<float, 3>& background, bool reuse_lists, double near_plane,
-                             double max_alpha, const std::optional<ThinLens>& lens) {
+                             double max_alpha, const std::optional<ThinLens>& lens,
+                             const std::optional<Shutter>& shutter) {
   RenderSettings settings;
   settings.sort = sort;
   settings.depth = depth;
@@ -126,6 +128,7 @@ RenderSettings make_settings(const std::string& sort, bool depth, bool splat_cou
   settings.near_plane = near_plane;
   settings.max_alpha = max_alpha;
   if (lens) settings.lens = *lens;
+  if (shutter) settings.shutter = *shutter;
   return settings;
 }
 
@@ -145,7 +148,7 @@ nb::dict stats_dict(const FrameStats& stats) {
   out["submissions"] = stats.submissions;
   out["device_bytes"] = stats.device_bytes;
   out["reused_sorted_lists"] = stats.reused_sorted_lists;
-  out["samples"] = stats.samples;
+  out["samples"] = stats.samples;  // frames averaged (lens, shutter)
   return out;
 }
 
@@ -386,6 +389,27 @@ void bind(nb::module_& m) {
         "world_units_per_metre"_a = 1.0,
         "The aperture diameter of an f-number: the focal length over f_stop.");
 
+  // --- the shutter (motion blur)
+  nb::class_<Shutter>(m, "Shutter",
+                      "A shutter open from `open` to `close` (times in [0, 1]) while the camera moves to "
+                      "end_camera (at time 1); samples frames averaged.")
+      .def(
+          "__init__",
+          [](Shutter* shutter, double open, double close, int samples, std::optional<Camera> end_camera) {
+            new (shutter) Shutter{open, close, samples, std::move(end_camera)};
+            validate(*shutter);
+          },
+          "open"_a = 0.0, "close"_a = 0.0, "samples"_a = 16, "end_camera"_a = nb::none())
+      .def_rw("open", &Shutter::open)
+      .def_rw("close", &Shutter::close)
+      .def_rw("samples", &Shutter::samples)
+      .def_rw("end_camera", &Shutter::end_camera);
+  m.def("shutter_times", &shutter_times, "open"_a, "close"_a, "count"_a,
+        "The times of `count` samples of a shutter: the middles of equal slices of [open, close].");
+  m.def("camera_between", &camera_between, "start"_a, "end"_a, "t"_a,
+        "The camera at time t between start (0) and end (1): position and intrinsics blended, rotation "
+        "slerped.");
+
   // --- images
   nb::class_<RenderImage>(
       m, "Image",
@@ -511,10 +535,10 @@ void bind(nb::module_& m) {
              bool splat_count, const std::string& accuracy, const std::string& antialiasing,
              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
              const std::array<float, 3>& background, bool reuse_lists, double near_plane, double max_alpha,
-             const std::optional<ThinLens>& lens) {
+             const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter) {
             const RenderSettings settings =
                 make_settings(sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames,
-                              seed, background, reuse_lists, near_plane, max_alpha, lens);
+                              seed, background, reuse_lists, near_plane, max_alpha, lens, shutter);
             nb::gil_scoped_release release;
             return self.renderer->render(camera, settings);
           },
@@ -522,11 +546,14 @@ void bind(nb::module_& m) {
           "antialiasing"_a = "classic", "compositor"_a = "sorted", "stochastic_frames"_a = 16, "seed"_a = 1,
           "background"_a = std::array<float, 3>{0, 0, 0}, "reuse_lists"_a = true,
           "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
+          "shutter"_a = nb::none(),
           "Renders the scene from `camera`. Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted' or 'stochastic'; near_plane the view depth at or below which a Gaussian is "
           "culled; max_alpha the cap on one splat's alpha (0.99 as 3DGS trains, 0.999 as gsplat does); lens "
-          "a ThinLens for depth of field (the mean of its samples' pinhole frames in linear light).")
+          "a ThinLens for depth of field (the mean of its samples' pinhole frames in linear light); shutter "
+          "a "
+          "Shutter for motion blur (the mean of the frames at its times).")
       .def_prop_ro("last_frame_stats",
                    [](const RendererHandle& self) { return stats_dict(self.renderer->last_frame_stats()); })
       .def_prop_ro("device_info",

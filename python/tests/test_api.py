@@ -263,3 +263,22 @@ def test_depth_of_field_through_a_thin_lens(playbot_renderer):
     assert tilesplat.aperture_for_f_stop(camera, 2.0) > 0
     with pytest.raises(ValueError, match="focus_distance"):
         tilesplat.ThinLens(aperture_diameter=0.1, focus_distance=0)
+
+
+def test_motion_blur_through_a_shutter(playbot_renderer):
+    scene, renderer = playbot_renderer
+    start = tilesplat.Camera.orbit(scene, 96, 54, azimuth_deg=30)
+    end = tilesplat.Camera.orbit(scene, 96, 54, azimuth_deg=45)
+    still = renderer.render(start)
+    closed = tilesplat.Shutter(open=0.5, close=0.5, samples=4, end_camera=end)
+    assert np.array_equal(renderer.render(start, shutter=closed).rgba, still.rgba)
+    shutter = tilesplat.Shutter(open=0.0, close=1.0, samples=4, end_camera=end)
+    blurred = renderer.render(start, shutter=shutter)
+    assert renderer.last_frame_stats["samples"] == 4
+    assert tilesplat.shutter_times(0.0, 1.0, 4) == [0.125, 0.375, 0.625, 0.875]
+    frames = [renderer.render(tilesplat.camera_between(start, end, t)) for t in tilesplat.shutter_times(0, 1, 4)]
+    # Alpha is the plain mean of the frames' alphas (colours are averaged in linear light).
+    np.testing.assert_allclose(blurred.rgba[..., 3], np.mean([f.rgba[..., 3] for f in frames], axis=0), atol=1e-6)
+    assert tilesplat.compare_images(blurred, still)["psnr_db"] < 40
+    with pytest.raises(ValueError, match="0 <= open <= close <= 1"):
+        tilesplat.Shutter(open=0.6, close=0.2, end_camera=end)

@@ -22,9 +22,11 @@ from ._core import (
     Renderer,
     Scene,
     SceneError,
+    Shutter,
     ThinLens,
     __version__,
     aperture_for_f_stop,
+    camera_between,
     camera_path,
     compare_images,
     devices,
@@ -34,6 +36,7 @@ from ._core import (
     load_scene,
     orbit_cameras,
     read_exr,
+    shutter_times,
     sort_strategies,
 )
 from .gsplat_compat import rasterization
@@ -45,9 +48,11 @@ __all__ = [
     "Renderer",
     "Scene",
     "SceneError",
+    "Shutter",
     "ThinLens",
     "__version__",
     "aperture_for_f_stop",
+    "camera_between",
     "camera_path",
     "compare_images",
     "devices",
@@ -58,5 +63,6 @@ __all__ = [
     "orbit_cameras",
     "rasterization",
     "read_exr",
+    "shutter_times",
     "sort_strategies",
 ]

@@ -14,6 +14,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/export.h"
 #include "tilesplat/lens.h"
+#include "tilesplat/shutter.h"
 
 namespace tilesplat {
 
@@ -201,6 +202,9 @@ struct RenderSettings {
   /// nothing is averaged and the frame is the one it always was. Renderer::render and render_reference
   /// take it; render_to_image and the frames submitted without waiting refuse it, as does host depth.
   ThinLens lens;
+  /// Motion blur: a shutter open over camera motion (tilesplat/shutter.h). Off by default (closed, no end
+  /// camera). Taken and refused where the lens is; with both, every time sample is a lens frame.
+  Shutter shutter;
 };
 
 }  // namespace tilesplat

@@ -72,8 +72,9 @@ struct FrameStats {
   /// more (tile, Gaussian) pairs or composite chunks than the buffers held: it was drawn without those
   /// that did not fit, and the buffers grew for the next frame. Frames that wait re-render instead.
   bool complete = true;
-  /// Pinhole frames averaged into this one: 1, or RenderSettings::lens.samples through a lens. Over
-  /// several, gpu_ms and passes are the sums, visible and intersections the largest of any sample.
+  /// Pinhole frames averaged into this one: 1, or the lens's samples times the shutter's
+  /// (RenderSettings::lens, shutter). Over several, gpu_ms and passes are the sums, visible and
+  /// intersections the largest of any sample.
   int samples = 1;
 };
 

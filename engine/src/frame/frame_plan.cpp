@@ -187,7 +187,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
   validate_host_depth(settings, camera);
   check_near_plane(settings.near_plane);
   check_max_alpha(settings);
-  check_no_lens(settings);
+  check_single_frame(settings);
 
   FramePlan plan;
   plan.sort = context.sort;

@@ -13,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-#include "frame/lens_frames.h"
+#include "frame/averaged_frames.h"
 #include "host_depth.h"
 #include "lighting.h"
 #include "reference/reference_projection.h"
@@ -76,6 +76,15 @@ struct Splat {
 
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
                              const RenderSettings& settings) {
+  if (settings.shutter.enabled()) {
+    // Motion blur: the reference's frames at the shutter's times, averaged as the GPU's are.
+    check_shutter(settings, camera);
+    RenderSettings still = settings;
+    still.shutter = {};
+    return render_shutter_frames(camera, settings, [&](const Camera& sample_camera) {
+      return render_reference(scene, sample_camera, still);
+    });
+  }
   if (settings.lens.enabled()) {
     // Depth of field: the reference's pinhole frames of the lens samples, averaged as the GPU's are.
     check_lens(settings, camera);
@@ -90,7 +99,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
   validate_host_depth(settings, camera);
   check_near_plane(settings.near_plane);
   check_max_alpha(settings);
-  check_no_lens(settings);
+  check_single_frame(settings);
   // A host's surfaces, as view depths: a splat blends only in front of them (RenderSettings::host).
   const std::vector<float> host_z = settings.host ? host_view_depths(*settings.host) : std::vector<float>{};
   const bool surface_out = settings.host && settings.host->write_depth;

@@ -1,6 +1,7 @@
-// A frame through a thin lens (RenderSettings::lens): the mean, in linear light, of the pinhole frames
-// of its samples. The GPU renderer and the float64 reference both make it this way, each rendering the
-// pinhole frames its own way, so that they are held to one definition.
+// Frames averaged from samples: through a thin lens (RenderSettings::lens), the mean in linear light of
+// the pinhole frames of its lens samples; through an open shutter over camera motion
+// (RenderSettings::shutter), of the frames at its times. The GPU renderer and the float64 reference both
+// make them this way, each rendering the sample frames its own way, so that they are held to one definition.
 #pragma once
 
 #include <functional>
@@ -10,6 +11,7 @@
 #include "tilesplat/lens.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/renderer.h"
+#include "tilesplat/shutter.h"
 
 namespace tilesplat {
 
@@ -39,9 +41,16 @@ class LinearFrameMean {
 RenderImage render_lens_frames(const Camera& camera, const RenderSettings& settings,
                                const std::function<RenderImage(const Camera&)>& render_pinhole);
 
+// The frame of `camera` through the shutter of `settings` (enabled): the linear mean over
+// settings.background of render_frame(camera_between(camera, end_camera, t)) over shutter_times(...), in
+// order.
+RenderImage render_shutter_frames(const Camera& camera, const RenderSettings& settings,
+                                  const std::function<RenderImage(const Camera&)>& render_frame);
+
 // Adds a sample frame's statistics to those of the frame it is part of: GPU times summed (pass by pass),
-// the largest visible and intersection counts, retries and submissions summed; samples counts the frames
-// (frame.samples == 0: `sample` is the first, and becomes the frame's).
+// the largest visible and intersection counts, retries and submissions summed; samples summed (a sample
+// that was itself averaged brings its own count). frame.samples == 0: `sample` is the first, and becomes
+// the frame's.
 void add_sample_stats(FrameStats& frame, const FrameStats& sample);
 
 }  // namespace tilesplat

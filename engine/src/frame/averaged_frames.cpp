@@ -1,4 +1,4 @@
-#include "frame/lens_frames.h"
+#include "frame/averaged_frames.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,10 +19,11 @@ void LinearFrameMean::add(const RenderImage& frame) {
              frame.depth.empty() == depth_ || frame.splat_count.empty() == count_) {
     throw std::logic_error("LinearFrameMean: the frames differ in size or outputs");
   }
-  const std::vector<float> linear =
-      convert_colours(frame.rgba, ColourEncoding::kSrgbDisplay, ColourEncoding::kSceneLinear, over_background_);
+  const std::vector<float> linear = convert_colours(frame.rgba, ColourEncoding::kSrgbDisplay,
+                                                    ColourEncoding::kSceneLinear, over_background_);
   for (size_t i = 0; i < linear.size(); ++i) linear_rgba_[i] += linear[i];
-  for (size_t p = 0; p < alpha_depth_.size(); ++p) alpha_depth_[p] += double(frame.rgba[4 * p + 3]) * frame.depth[p];
+  for (size_t p = 0; p < alpha_depth_.size(); ++p)
+    alpha_depth_[p] += double(frame.rgba[4 * p + 3]) * frame.depth[p];
   for (size_t p = 0; p < counts_.size(); ++p) counts_[p] += frame.splat_count[p];
   ++frames_;
 }
@@ -34,7 +35,8 @@ RenderImage LinearFrameMean::mean() const {
   image.height = height_;
   std::vector<float> linear(linear_rgba_.size());
   for (size_t i = 0; i < linear.size(); ++i) linear[i] = static_cast<float>(linear_rgba_[i] / frames_);
-  image.rgba = convert_colours(linear, ColourEncoding::kSceneLinear, ColourEncoding::kSrgbDisplay, over_background_);
+  image.rgba =
+      convert_colours(linear, ColourEncoding::kSceneLinear, ColourEncoding::kSrgbDisplay, over_background_);
   if (depth_) {
     image.depth.resize(alpha_depth_.size());
     for (size_t p = 0; p < alpha_depth_.size(); ++p) {
@@ -55,14 +57,24 @@ RenderImage render_lens_frames(const Camera& camera, const RenderSettings& setti
   const ThinLens& lens = settings.lens;
   validate(lens);
   LinearFrameMean mean(settings.background != std::array<float, 3>{0, 0, 0});
-  for (const auto& sample : lens_samples(lens.samples)) mean.add(render_pinhole(lens_sample_camera(camera, lens, sample)));
+  for (const auto& sample : lens_samples(lens.samples))
+    mean.add(render_pinhole(lens_sample_camera(camera, lens, sample)));
+  return mean.mean();
+}
+
+RenderImage render_shutter_frames(const Camera& camera, const RenderSettings& settings,
+                                  const std::function<RenderImage(const Camera&)>& render_frame) {
+  const Shutter& shutter = settings.shutter;
+  validate(shutter);
+  LinearFrameMean mean(settings.background != std::array<float, 3>{0, 0, 0});
+  for (const double t : shutter_times(shutter.open, shutter.close, shutter.samples))
+    mean.add(render_frame(camera_between(camera, *shutter.end_camera, t)));
   return mean.mean();
 }
 
 void add_sample_stats(FrameStats& frame, const FrameStats& sample) {
   if (frame.samples == 0) {
     frame = sample;
-    frame.samples = 1;
     return;
   }
   for (const PassTiming& pass : sample.passes) {
@@ -84,7 +96,7 @@ void add_sample_stats(FrameStats& frame, const FrameStats& sample) {
   frame.uploaded_bytes += sample.uploaded_bytes;
   frame.reused_sorted_lists = frame.reused_sorted_lists && sample.reused_sorted_lists;
   frame.complete = frame.complete && sample.complete;
-  ++frame.samples;
+  frame.samples += sample.samples;
 }
 
 }  // namespace tilesplat

@@ -1,6 +1,6 @@
-// Depth of field (RenderSettings::lens, tilesplat/lens.h): the sample pattern, the camera of each sample,
-// the frame as the linear mean of the samples' pinhole frames on the GPU and in the float64 reference, and
-// off being the pinhole frame to the bit.
+// Depth of field (RenderSettings::lens, tilesplat/lens.h) and motion blur (RenderSettings::shutter,
+// tilesplat/shutter.h): the sample patterns, the camera of each sample, the frame as the linear mean of the
+// samples' frames on the GPU and in the float64 reference, and off being the pinhole frame to the bit.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,6 +15,7 @@
 #include "tilesplat/reference.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/shutter.h"
 
 using namespace tilesplat;
 
@@ -72,7 +73,8 @@ TEST(LensSamples, AreVogelsSpiralOnTheUnitDisk) {
     }
   }
   EXPECT_EQ(lens_samples(32), lens_samples(32));
-  for (const int bad : {0, -1, kMaxLensSamples + 1}) EXPECT_THROW(lens_samples(bad), std::invalid_argument) << bad;
+  for (const int bad : {0, -1, kMaxLensSamples + 1})
+    EXPECT_THROW(lens_samples(bad), std::invalid_argument) << bad;
 }
 
 TEST(LensSampleCamera, KeepsTheFocusPlaneWhereThePinholeSeesIt) {
@@ -89,8 +91,9 @@ TEST(LensSampleCamera, KeepsTheFocusPlaneWhereThePinholeSeesIt) {
   for (const auto& sample : lens_samples(lens.samples)) {
     const Camera moved = lens_sample_camera(camera, lens, sample);
     EXPECT_EQ(moved.rotation, camera.rotation);
-    const double shift = std::hypot(moved.position[0] - camera.position[0], moved.position[1] - camera.position[1],
-                                    moved.position[2] - camera.position[2]);
+    const double shift =
+        std::hypot(moved.position[0] - camera.position[0], moved.position[1] - camera.position[1],
+                   moved.position[2] - camera.position[2]);
     EXPECT_NEAR(shift, 0.1 * std::hypot(sample[0], sample[1]), 1e-12);
     for (const auto& [x, y] : {std::array{0.0, 0.0}, std::array{0.9, -0.4}, std::array{-1.2, 0.7}}) {
       const auto pinhole = project(camera, at_depth(x, y, 3.0));
@@ -99,7 +102,8 @@ TEST(LensSampleCamera, KeepsTheFocusPlaneWhereThePinholeSeesIt) {
       EXPECT_NEAR(through[1], pinhole[1], 1e-9);
       const auto far_pinhole = project(camera, at_depth(x, y, 6.0));
       const auto far_through = project(moved, at_depth(x, y, 6.0));
-      behind_moved = std::max(behind_moved, std::hypot(far_through[0] - far_pinhole[0], far_through[1] - far_pinhole[1]));
+      behind_moved = std::max(behind_moved,
+                              std::hypot(far_through[0] - far_pinhole[0], far_through[1] - far_pinhole[1]));
     }
   }
   // The circle of confusion of depth 6 focused at 3: aperture * fx * |1/6 - 1/3| / 2 at the rim.
@@ -121,7 +125,7 @@ TEST(ApertureForFStop, IsTheFocalLengthOverTheFNumber) {
   }
 }
 
-class DepthOfField : public ::testing::Test {
+class AveragedFrames : public ::testing::Test {
  protected:
   void SetUp() override {
     scene_ = load_scene(tilesplat::testing::bundled_playbot());
@@ -138,7 +142,7 @@ class DepthOfField : public ::testing::Test {
   double focus_ = 1;
 };
 
-TEST_F(DepthOfField, OffIsThePinholeFrameToTheBit) {
+TEST_F(AveragedFrames, OffIsThePinholeFrameToTheBit) {
   const RenderImage pinhole = renderer_->render(camera_);
   RenderSettings settings;
   settings.lens = {.aperture_diameter = 0, .focus_distance = 2.5, .samples = 8};
@@ -150,7 +154,7 @@ TEST_F(DepthOfField, OffIsThePinholeFrameToTheBit) {
   EXPECT_EQ(render_reference(scene_, camera_, settings).rgba, render_reference(scene_, camera_).rgba);
 }
 
-TEST_F(DepthOfField, IsTheLinearMeanOfTheSamplesPinholeFrames) {
+TEST_F(AveragedFrames, IsTheLinearMeanOfTheSamplesPinholeFrames) {
   RenderSettings settings;
   settings.lens = {.aperture_diameter = 0.05 * focus_, .focus_distance = focus_, .samples = 6};
   const RenderImage through_lens = renderer_->render(camera_, settings);
@@ -181,13 +185,14 @@ TEST_F(DepthOfField, IsTheLinearMeanOfTheSamplesPinholeFrames) {
   // The reference makes it the same way from its own pinhole frames.
   const RenderImage reference = render_reference(scene_, camera_, settings);
   const ImageDifference d = compare_images(through_lens, reference);
-  std::printf("[ measure  ] depth of field, 6 samples, against the float64 reference: PSNR %.1f dB, max abs %.2e\n",
-              d.psnr_db, d.max_abs);
+  std::printf(
+      "[ measure  ] depth of field, 6 samples, against the float64 reference: PSNR %.1f dB, max abs %.2e\n",
+      d.psnr_db, d.max_abs);
   EXPECT_GE(d.psnr_db, 60.0);
   EXPECT_EQ(renderer_->validation_messages(), 0u);
 }
 
-TEST_F(DepthOfField, OverABackgroundTheColoursAreAveragedAsOpaque) {
+TEST_F(AveragedFrames, OverABackgroundTheColoursAreAveragedAsOpaque) {
   // Over white, a pixel's colour holds the background (C = c + T), so it is not premultiplied by its
   // alpha: decoding C / A would blow it up where alpha is small. Each is converted as an opaque colour.
   RenderSettings settings;
@@ -207,25 +212,26 @@ TEST_F(DepthOfField, OverABackgroundTheColoursAreAveragedAsOpaque) {
   EXPECT_GE(compare_images(through_lens, render_reference(scene_, camera_, settings)).psnr_db, 60.0);
 }
 
-TEST_F(DepthOfField, BlursWhatIsOutOfFocusMore) {
+TEST_F(AveragedFrames, BlursWhatIsOutOfFocusMore) {
   const RenderImage pinhole = renderer_->render(camera_);
   RenderSettings settings;
   settings.lens = {.aperture_diameter = 0.08 * focus_, .focus_distance = focus_, .samples = 16};
   const double in_focus = compare_images(renderer_->render(camera_, settings), pinhole).psnr_db;
   settings.lens.focus_distance = 4 * focus_;  // focused far behind the scene
   const double out_of_focus = compare_images(renderer_->render(camera_, settings), pinhole).psnr_db;
-  std::printf("[ measure  ] against the pinhole frame: focused on the scene %.1f dB, behind it %.1f dB\n", in_focus,
-              out_of_focus);
+  std::printf("[ measure  ] against the pinhole frame: focused on the scene %.1f dB, behind it %.1f dB\n",
+              in_focus, out_of_focus);
   EXPECT_GT(in_focus, out_of_focus + 3.0);
 }
 
-TEST_F(DepthOfField, BadLensesAreRefused) {
+TEST_F(AveragedFrames, BadLensesAreRefused) {
   RenderSettings settings;
-  for (const ThinLens bad : {ThinLens{.aperture_diameter = -0.1}, ThinLens{.aperture_diameter = std::nan("")},
-                             ThinLens{.aperture_diameter = 0.1, .focus_distance = 0},
-                             ThinLens{.aperture_diameter = 0.1, .focus_distance = -2},
-                             ThinLens{.aperture_diameter = 0.1, .focus_distance = 1, .samples = 0},
-                             ThinLens{.aperture_diameter = 0.1, .focus_distance = 1, .samples = kMaxLensSamples + 1}}) {
+  for (const ThinLens bad :
+       {ThinLens{.aperture_diameter = -0.1}, ThinLens{.aperture_diameter = std::nan("")},
+        ThinLens{.aperture_diameter = 0.1, .focus_distance = 0},
+        ThinLens{.aperture_diameter = 0.1, .focus_distance = -2},
+        ThinLens{.aperture_diameter = 0.1, .focus_distance = 1, .samples = 0},
+        ThinLens{.aperture_diameter = 0.1, .focus_distance = 1, .samples = kMaxLensSamples + 1}}) {
     settings.lens = bad;
     EXPECT_THROW(renderer_->render(camera_, settings), std::invalid_argument);
     EXPECT_THROW(render_reference(scene_, camera_, settings), std::invalid_argument);
@@ -233,4 +239,78 @@ TEST_F(DepthOfField, BadLensesAreRefused) {
   settings.lens = {.aperture_diameter = 0.1, .focus_distance = 1, .samples = 4};
   settings.host = HostDepth{};
   EXPECT_THROW(renderer_->render(camera_, settings), std::invalid_argument);
+}
+
+TEST(ShutterTimes, AreTheMiddlesOfEqualSlices) {
+  EXPECT_EQ(shutter_times(0, 1, 4), (std::vector<double>{0.125, 0.375, 0.625, 0.875}));
+  EXPECT_EQ(shutter_times(0.25, 0.25, 2), (std::vector<double>{0.25, 0.25}));
+  const auto times = shutter_times(0.2, 0.7, 5);
+  for (int i = 0; i < 5; ++i) EXPECT_NEAR(times[size_t(i)], 0.2 + (i + 0.5) * 0.1, 1e-15);
+  EXPECT_THROW(shutter_times(0.5, 0.4, 4), std::invalid_argument);
+  EXPECT_THROW(shutter_times(-0.1, 0.4, 4), std::invalid_argument);
+  EXPECT_THROW(shutter_times(0, 1.5, 4), std::invalid_argument);
+  EXPECT_THROW(shutter_times(0, std::nan(""), 4), std::invalid_argument);
+  EXPECT_THROW(shutter_times(0, 1, 0), std::invalid_argument);
+}
+
+TEST(CameraBetween, BlendsPositionAndIntrinsicsAndSlerpsTheRotation) {
+  const Camera start = look_at_camera({0, 0, -4}, {0, 0, 0}, {0, -1, 0}, 64, 48, 50);
+  const Camera end = look_at_camera({4, 0, 0}, {0, 0, 0}, {0, -1, 0}, 64, 48, 40);  // a quarter turn round
+  EXPECT_EQ(camera_between(start, end, 0), start);
+  const Camera middle = camera_between(start, end, 0.5);
+  EXPECT_NEAR(middle.position[0], 2, 1e-12);
+  EXPECT_NEAR(middle.position[2], -2, 1e-12);
+  EXPECT_NEAR(middle.fy, 0.5 * (start.fy + end.fy), 1e-9);
+  // Half of the quarter turn: the view axis (the rotation's third row) at 45 degrees between the two.
+  const std::array<double, 3> axis = {middle.rotation[6], middle.rotation[7], middle.rotation[8]};
+  EXPECT_NEAR(axis[0], -std::sqrt(0.5), 1e-9);
+  EXPECT_NEAR(axis[2], std::sqrt(0.5), 1e-9);
+  const Camera at_end = camera_between(start, end, 1);
+  for (int k = 0; k < 9; ++k) EXPECT_NEAR(at_end.rotation[size_t(k)], end.rotation[size_t(k)], 1e-12);
+  EXPECT_THROW(camera_between(start, resize_camera(end, 32, 24), 0.5), std::invalid_argument);
+  EXPECT_THROW(camera_between(start, end, 1.5), std::invalid_argument);
+}
+
+TEST_F(AveragedFrames, MotionBlurIsTheLinearMeanOfTheFramesAtTheShutterTimes) {
+  RenderSettings settings;
+  const Camera end = orbit_camera(scene_, 128, 72, {.azimuth_deg = 40});
+  // Off: a closed shutter, or an open one over a camera that does not move, is the frame it always was.
+  const RenderImage still = renderer_->render(camera_);
+  settings.shutter = {.open = 0.3, .close = 0.3, .samples = 8, .end_camera = end};
+  EXPECT_EQ(renderer_->render(camera_, settings).rgba, still.rgba);
+  settings.shutter = {.open = 0, .close = 1, .samples = 8, .end_camera = std::nullopt};
+  EXPECT_EQ(renderer_->render(camera_, settings).rgba, still.rgba);
+  EXPECT_EQ(renderer_->last_frame_stats().samples, 1);
+
+  settings.shutter = {.open = 0, .close = 0.5, .samples = 5, .end_camera = end};
+  const RenderImage blurred = renderer_->render(camera_, settings);
+  EXPECT_EQ(renderer_->last_frame_stats().samples, 5);
+  std::vector<RenderImage> frames;
+  for (const double t : shutter_times(0, 0.5, 5))
+    frames.push_back(renderer_->render(camera_between(camera_, end, t)));
+  EXPECT_LE(max_abs_difference(blurred.rgba, linear_mean(frames).rgba), 1e-6f);
+  EXPECT_LT(compare_images(blurred, still).psnr_db, 40.0);
+  const ImageDifference d = compare_images(blurred, render_reference(scene_, camera_, settings));
+  std::printf("[ measure  ] motion blur, 5 samples, against the float64 reference: PSNR %.1f dB\n",
+              d.psnr_db);
+  EXPECT_GE(d.psnr_db, 60.0);
+
+  // With a lens too, every time sample is a lens frame: 5 x 3 pinhole frames.
+  settings.lens = {.aperture_diameter = 0.05 * focus_, .focus_distance = focus_, .samples = 3};
+  const RenderImage both = renderer_->render(camera_, settings);
+  EXPECT_EQ(renderer_->last_frame_stats().samples, 15);
+  std::vector<RenderImage> lens_frames;
+  RenderSettings lens_only;
+  lens_only.lens = settings.lens;
+  for (const double t : shutter_times(0, 0.5, 5))
+    lens_frames.push_back(renderer_->render(camera_between(camera_, end, t), lens_only));
+  EXPECT_LE(max_abs_difference(both.rgba, linear_mean(lens_frames).rgba), 2e-6f);
+
+  settings.lens = {};
+  settings.shutter.end_camera = resize_camera(end, 64, 36);
+  EXPECT_THROW(renderer_->render(camera_, settings), std::invalid_argument);
+  settings.shutter = {.open = 0.6, .close = 0.5, .samples = 5, .end_camera = end};
+  EXPECT_THROW(renderer_->render(camera_, settings), std::invalid_argument);
+  EXPECT_THROW(render_reference(scene_, camera_, settings), std::invalid_argument);
+  EXPECT_EQ(renderer_->validation_messages(), 0u);
 }

@@ -1,0 +1,47 @@
+/// @file
+/// Motion blur from a moving camera: a shutter open over part of the frame's time, the frame the mean of
+/// pinhole frames at the shutter's times (docs/effects.md, "Motion blur").
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "tilesplat/camera.h"
+#include "tilesplat/export.h"
+
+namespace tilesplat {
+
+/// A shutter over camera motion. The frame's time runs from 0, where the camera is the one rendered, to 1,
+/// where it is `end_camera`; between them camera_between() moves it. The shutter is open from `open` to
+/// `close`, and the frame is the mean, in linear light (as a ThinLens frame's: tilesplat/lens.h), of
+/// `samples` pinhole frames at shutter_times(open, close, samples). Off (the frame it always was) unless the
+/// shutter opens for a while (close > open) over a camera that moves (end_camera set).
+struct Shutter {
+  double open = 0;                   ///< when the shutter opens, in [0, 1]
+  double close = 0;                  ///< when it closes, in [open, 1]
+  int samples = 16;                  ///< times averaged, 1 to kMaxShutterSamples
+  std::optional<Camera> end_camera;  ///< the camera at time 1: the same size as the rendered one
+  /// Whether the shutter blurs anything: open for a while over a camera that moves.
+  bool enabled() const { return close > open && end_camera.has_value(); }
+  /// Member-wise equality.
+  bool operator==(const Shutter&) const = default;
+};
+
+/// The most time samples a frame may average.
+inline constexpr int kMaxShutterSamples = 4096;
+
+/// The times of `count` samples of a shutter open from `open` to `close`: the middles of `count` equal
+/// slices, open + (i + 0.5) (close - open) / count. Throws std::invalid_argument for a count outside
+/// 1..kMaxShutterSamples or times outside 0 <= open <= close <= 1.
+TILESPLAT_API std::vector<double> shutter_times(double open, double close, int count);
+
+/// The camera at time `t` in [0, 1] between `start` (0) and `end` (1): the position and the intrinsics
+/// blended linearly, the rotation by the shortest-arc slerp. Throws std::invalid_argument for cameras of
+/// different sizes or t outside [0, 1].
+TILESPLAT_API Camera camera_between(const Camera& start, const Camera& end, double t);
+
+/// Throws std::invalid_argument naming the field for times outside 0 <= open <= close <= 1 (or not finite),
+/// a sample count outside 1..kMaxShutterSamples, or an end camera validate(Camera) refuses.
+TILESPLAT_API void validate(const Shutter& shutter);
+
+}  // namespace tilesplat

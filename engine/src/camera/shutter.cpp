@@ -1,0 +1,58 @@
+// The shutter: its sample times and the camera between the frame's start and end.
+#include "tilesplat/shutter.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "camera/rotation_interpolation.h"
+
+namespace tilesplat {
+namespace {
+
+void check_times(double open, double close) {
+  if (!(std::isfinite(open) && std::isfinite(close) && 0 <= open && open <= close && close <= 1))
+    throw std::invalid_argument("shutter: open and close must be times with 0 <= open <= close <= 1, got " +
+                                std::to_string(open) + " and " + std::to_string(close));
+}
+
+}  // namespace
+
+void validate(const Shutter& shutter) {
+  check_times(shutter.open, shutter.close);
+  if (shutter.samples < 1 || shutter.samples > kMaxShutterSamples)
+    throw std::invalid_argument("shutter: samples must be 1 to " + std::to_string(kMaxShutterSamples) +
+                                ", got " + std::to_string(shutter.samples));
+  if (shutter.end_camera) validate(*shutter.end_camera);
+}
+
+std::vector<double> shutter_times(double open, double close, int count) {
+  check_times(open, close);
+  if (count < 1 || count > kMaxShutterSamples)
+    throw std::invalid_argument("shutter_times: count must be 1 to " + std::to_string(kMaxShutterSamples) +
+                                ", got " + std::to_string(count));
+  std::vector<double> times(static_cast<size_t>(count));
+  for (int i = 0; i < count; ++i) times[static_cast<size_t>(i)] = open + (i + 0.5) * (close - open) / count;
+  return times;
+}
+
+Camera camera_between(const Camera& start, const Camera& end, double t) {
+  if (start.width != end.width || start.height != end.height)
+    throw std::invalid_argument("camera_between: the cameras differ in size (" + std::to_string(start.width) +
+                                "x" + std::to_string(start.height) + " and " + std::to_string(end.width) +
+                                "x" + std::to_string(end.height) + ")");
+  if (!(t >= 0 && t <= 1))
+    throw std::invalid_argument("camera_between: t must be in [0, 1], got " + std::to_string(t));
+  const auto blend = [t](double a, double b) { return a + (b - a) * t; };
+  Camera camera = start;
+  camera.fx = blend(start.fx, end.fx);
+  camera.fy = blend(start.fy, end.fy);
+  camera.cx = blend(start.cx, end.cx);
+  camera.cy = blend(start.cy, end.cy);
+  for (size_t k = 0; k < 3; ++k) camera.position[k] = blend(start.position[k], end.position[k]);
+  if (t > 0)
+    camera.rotation = matrix_of(slerp(quaternion_of(start.rotation), quaternion_of(end.rotation), t));
+  return camera;
+}
+
+}  // namespace tilesplat
