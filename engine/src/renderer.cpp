@@ -19,7 +19,6 @@
 #include "host_depth.h"
 #include "passes/frame_counters.h"
 #include "renderer_impl.h"
-#include "settings_checks.h"
 
 namespace tilesplat {
 
@@ -173,33 +172,21 @@ void Renderer::set_scene(const GaussianScene& scene) {
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
   Impl& r = *impl_;
   const auto start = std::chrono::steady_clock::now();
-  // A frame averaged from sample frames (frame/averaged_frames.h), each rendered here with
-  // `sample_settings`; its statistics are the samples' summed.
-  const auto averaged = [&](const RenderSettings& sample_settings, auto average) {
+  if (averages_samples(settings)) {
+    // Depth of field, motion blur: sample frames averaged (frame/averaged_frames.h), rendered here; the
+    // frame's statistics are the samples' summed.
     FrameStats frame;
     frame.samples = 0;
-    RenderImage image = average(camera, settings, [&](const Camera& sample_camera) {
-      RenderImage sample = render(sample_camera, sample_settings);
-      add_sample_stats(frame, r.stats);
-      return sample;
-    });
+    RenderImage image = render_averaged(
+        camera, settings, [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
+          RenderImage sample = render(sample_camera, sample_settings);
+          add_sample_stats(frame, r.stats);
+          return sample;
+        });
     r.stats = frame;
     r.stats.cpu_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return image;
-  };
-  if (settings.shutter
-          .enabled()) {  // motion blur: the frames at the shutter's times (each may be a lens frame)
-    check_shutter(settings, camera);
-    RenderSettings still = settings;
-    still.shutter = {};
-    return averaged(still, render_shutter_frames);
-  }
-  if (settings.lens.enabled()) {  // depth of field: the pinhole frames of the lens samples
-    check_lens(settings, camera);
-    RenderSettings pinhole = settings;
-    pinhole.lens = {};
-    return averaged(pinhole, render_lens_frames);
   }
   r.render_frame(camera, settings);
   RenderImage image;

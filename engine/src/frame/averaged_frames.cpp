@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "settings_checks.h"
+
 namespace tilesplat {
 
 void LinearFrameMean::add(const RenderImage& frame) {
@@ -52,23 +54,27 @@ RenderImage LinearFrameMean::mean() const {
   return image;
 }
 
-RenderImage render_lens_frames(const Camera& camera, const RenderSettings& settings,
-                               const std::function<RenderImage(const Camera&)>& render_pinhole) {
-  const ThinLens& lens = settings.lens;
-  validate(lens);
-  LinearFrameMean mean(settings.background != std::array<float, 3>{0, 0, 0});
-  for (const auto& sample : lens_samples(lens.samples))
-    mean.add(render_pinhole(lens_sample_camera(camera, lens, sample)));
-  return mean.mean();
+bool averages_samples(const RenderSettings& settings) {
+  return settings.shutter.enabled() || settings.lens.enabled();
 }
 
-RenderImage render_shutter_frames(const Camera& camera, const RenderSettings& settings,
-                                  const std::function<RenderImage(const Camera&)>& render_frame) {
-  const Shutter& shutter = settings.shutter;
-  validate(shutter);
+RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
+                            const SampleRenderer& render_sample) {
   LinearFrameMean mean(settings.background != std::array<float, 3>{0, 0, 0});
-  for (const double t : shutter_times(shutter.open, shutter.close, shutter.samples))
-    mean.add(render_frame(camera_between(camera, *shutter.end_camera, t)));
+  RenderSettings sample_settings = settings;
+  if (settings.shutter.enabled()) {
+    check_shutter(settings, camera);
+    const Shutter& shutter = settings.shutter;
+    sample_settings.shutter = {};
+    for (const double t : shutter_times(shutter.open, shutter.close, shutter.samples))
+      mean.add(render_sample(camera_between(camera, *shutter.end_camera, t), sample_settings));
+  } else {
+    check_lens(settings, camera);
+    const ThinLens& lens = settings.lens;
+    sample_settings.lens = {};
+    for (const auto& sample : lens_samples(lens.samples))
+      mean.add(render_sample(lens_sample_camera(camera, lens, sample), sample_settings));
+  }
   return mean.mean();
 }
 

@@ -36,16 +36,20 @@ class LinearFrameMean {
   std::vector<double> counts_;
 };
 
-// The frame of `camera` through the lens of `settings` (enabled): the linear mean (LinearFrameMean, over
-// settings.background) of render_pinhole(lens_sample_camera(...)) over lens_samples(lens.samples), in order.
-RenderImage render_lens_frames(const Camera& camera, const RenderSettings& settings,
-                               const std::function<RenderImage(const Camera&)>& render_pinhole);
+// Whether `settings` ask for a frame averaged from sample frames: an enabled shutter or lens.
+bool averages_samples(const RenderSettings& settings);
 
-// The frame of `camera` through the shutter of `settings` (enabled): the linear mean over
-// settings.background of render_frame(camera_between(camera, end_camera, t)) over shutter_times(...), in
-// order.
-RenderImage render_shutter_frames(const Camera& camera, const RenderSettings& settings,
-                                  const std::function<RenderImage(const Camera&)>& render_frame);
+// Renders one sample frame: a camera and the settings without the effect being averaged.
+using SampleRenderer = std::function<RenderImage(const Camera&, const RenderSettings&)>;
+
+// The averaged frame of `camera` (averages_samples(settings)), checked first (check_shutter, check_lens).
+// With an enabled shutter: the linear mean (LinearFrameMean, over settings.background) of
+// render_sample(camera_between(camera, end_camera, t), settings without the shutter) over shutter_times(...);
+// those settings may still hold a lens, which render_sample averages in turn. Otherwise, through the lens:
+// the mean of render_sample(lens_sample_camera(camera, lens, s), settings without the lens) over
+// lens_samples(lens.samples). Samples are rendered in that order.
+RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
+                            const SampleRenderer& render_sample);
 
 // Adds a sample frame's statistics to those of the frame it is part of: GPU times summed (pass by pass),
 // the largest visible and intersection counts, retries and submissions summed; samples summed (a sample

@@ -76,23 +76,12 @@ struct Splat {
 
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
                              const RenderSettings& settings) {
-  if (settings.shutter.enabled()) {
-    // Motion blur: the reference's frames at the shutter's times, averaged as the GPU's are.
-    check_shutter(settings, camera);
-    RenderSettings still = settings;
-    still.shutter = {};
-    return render_shutter_frames(camera, settings, [&](const Camera& sample_camera) {
-      return render_reference(scene, sample_camera, still);
-    });
-  }
-  if (settings.lens.enabled()) {
-    // Depth of field: the reference's pinhole frames of the lens samples, averaged as the GPU's are.
-    check_lens(settings, camera);
-    RenderSettings pinhole = settings;
-    pinhole.lens = {};
-    return render_lens_frames(camera, settings, [&](const Camera& sample_camera) {
-      return render_reference(scene, sample_camera, pinhole);
-    });
+  if (averages_samples(settings)) {
+    // Depth of field, motion blur: the reference's own sample frames, averaged as the GPU's are.
+    return render_averaged(camera, settings,
+                           [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
+                             return render_reference(scene, sample_camera, sample_settings);
+                           });
   }
   validate(camera);
   check_scene(scene);
