@@ -50,29 +50,27 @@ struct Frame {
 
 using cli::single_quoted;
 
+// The shortest text that reads back as exactly `value` (std::to_chars).
+template <typename Number>
+std::string shortest_exact(Number value) {
+  char digits[32];
+  return std::string(digits, std::to_chars(digits, digits + sizeof(digits), value).ptr);
+}
+
 // What the EXR's renderSettings attribute records: everything that changes the image.
 std::string settings_text(const tilesplat::RenderSettings& settings, const LensFlags& lens) {
   std::string text = "sort=" + settings.sort;
   text += " accuracy=" + tilesplat::to_string(settings.accuracy);
   text += " antialiasing=" + tilesplat::to_string(settings.antialiasing);
-  if (settings.max_alpha != tilesplat::kDefaultMaxAlpha) {
-    char cap[32];
-    std::snprintf(cap, sizeof cap, "%.9g", settings.max_alpha);
-    text += std::string(" max_alpha=") + cap;
-  }
+  if (settings.max_alpha != tilesplat::kDefaultMaxAlpha)
+    text += " max_alpha=" + shortest_exact(settings.max_alpha);
   text += " compositor=" + tilesplat::to_string(settings.compositor);
   if (settings.compositor == tilesplat::Compositor::kStochastic)
     text += " frames=" + std::to_string(settings.stochastic.frames) +
             " seed=" + std::to_string(settings.stochastic.seed);
   text += " lights=" + std::to_string(settings.lighting.lights.size());
   text += " background=";
-  for (size_t c = 0; c < 3; ++c) {
-    char digits[32];
-    const auto end =
-        std::to_chars(digits, digits + sizeof(digits), settings.background[c]).ptr;  // shortest exact
-    if (c > 0) text += ',';
-    text.append(digits, end);
-  }
+  for (size_t c = 0; c < 3; ++c) text += (c > 0 ? "," : "") + shortest_exact(settings.background[c]);
   if (lens.enabled()) text += " lens=" + lens_text(lens);
   return text;
 }
