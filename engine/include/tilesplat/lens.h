@@ -45,7 +45,8 @@ TILESPLAT_API std::vector<std::array<double, 2>> lens_samples(int count);
 /// by (fx x, fy y) * aperture_diameter / (2 focus_distance) pixels the same way, so that every point at view
 /// depth focus_distance projects where it does in `camera`. Throws std::invalid_argument for a lens
 /// validate(ThinLens) refuses.
-TILESPLAT_API Camera lens_sample_camera(const Camera& camera, const ThinLens& lens, const std::array<double, 2>& sample);
+TILESPLAT_API Camera lens_sample_camera(const Camera& camera, const ThinLens& lens,
+                                        const std::array<double, 2>& sample);
 
 /// The aperture diameter (world units) of an f-number: the focal length over f_stop. The focal length in
 /// millimetres is fx * sensor_width_mm / width (a full-frame sensor is 36 mm wide); `world_units_per_metre`

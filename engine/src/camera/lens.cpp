@@ -9,7 +9,9 @@
 namespace tilesplat {
 namespace {
 
-bool positive_finite(double value) { return std::isfinite(value) && value > 0; }
+bool positive_finite(double value) {
+  return std::isfinite(value) && value > 0;
+}
 
 }  // namespace
 
@@ -56,10 +58,13 @@ Camera lens_sample_camera(const Camera& camera, const ThinLens& lens, const std:
   return moved;
 }
 
-double aperture_for_f_stop(const Camera& camera, double f_stop, double sensor_width_mm, double world_units_per_metre) {
-  if (!positive_finite(f_stop)) throw std::invalid_argument("f-stop must be positive and finite, got " + std::to_string(f_stop));
+double aperture_for_f_stop(const Camera& camera, double f_stop, double sensor_width_mm,
+                           double world_units_per_metre) {
+  if (!positive_finite(f_stop))
+    throw std::invalid_argument("f-stop must be positive and finite, got " + std::to_string(f_stop));
   if (!positive_finite(sensor_width_mm))
-    throw std::invalid_argument("sensor width must be positive and finite, got " + std::to_string(sensor_width_mm));
+    throw std::invalid_argument("sensor width must be positive and finite, got " +
+                                std::to_string(sensor_width_mm));
   if (!positive_finite(world_units_per_metre))
     throw std::invalid_argument("world units per metre must be positive and finite, got " +
                                 std::to_string(world_units_per_metre));
