@@ -19,6 +19,7 @@
 #define real2 vec2
 #define real3 vec3
 #define real4 vec4
+#define realmat2 mat2
 #define realmat3 mat3
 #define to_real(bits) float(packDouble2x32(bits))
 #else
@@ -26,6 +27,7 @@
 #define real2 dvec2
 #define real3 dvec3
 #define real4 dvec4
+#define realmat2 dmat2
 #define realmat3 dmat3
 #endif
 
@@ -52,6 +54,10 @@ layout(constant_id = 10) const bool COMPENSATE_OPACITY = false;
 // splat uses its shortest axis. The lights are data, not constants: changing them rebuilds nothing.
 layout(constant_id = 11) const bool LIGHTING = false;
 layout(constant_id = 12) const bool FILE_NORMALS = false;
+// The camera model (tilesplat::CameraModel): 0 pinhole, 1 OpenCV, 2 fisheye, 3 orthographic. The
+// pinhole's code is the only code of the default pipeline.
+layout(constant_id = 13) const uint CAMERA_MODEL = 0;
+const uint MODEL_PINHOLE = 0, MODEL_OPENCV = 1, MODEL_FISHEYE = 2, MODEL_ORTHOGRAPHIC = 3;
 
 // CameraParams and LightParams, the blocks the host writes for this pass, are in shader_io.h.
 
@@ -210,6 +216,123 @@ void write_ray_depth(uint i, real3 mu, realmat3 S) {
   pc.ray_depth.v[RAY_DEPTH_VEC4S * i + 2] = vec4(float(Q[2][2]), float(mu.z), 0.0, 0.0);
 }
 
+#ifdef TS_FP32_PROJECTION
+real atan2_real(real y, real x) { return atan(y, x); }
+#else
+// atan(a) for a in [0, 1] in double (GLSL's atan is float32 only): two argument reductions,
+// atan(a) = pi/6 + atan((sqrt3 a - 1) / (sqrt3 + a)) above tan(pi/12) and atan(a) = 2 atan(a / (1 +
+// sqrt(1 + a^2))), leave |a| < 0.14, where 11 terms of the series are below double rounding.
+real atan_unit(real a) {
+  const real SQRT3 = 1.7320508075688772LF, TAN_PI_12 = 0.2679491924311227LF;
+  real offset = 0.0;
+  if (a > TAN_PI_12) {
+    a = (SQRT3 * a - 1.0) / (SQRT3 + a);
+    offset = 0.5235987755982988LF;  // pi / 6
+  }
+  a = a / (1.0 + sqrt(1.0 + a * a));
+  real a2 = a * a;
+  real series = 0.0;
+  for (int k = 10; k >= 0; --k) series = series * a2 + real((k % 2 == 0 ? 1.0 : -1.0) / double(2 * k + 1));
+  return offset + 2.0 * a * series;
+}
+// atan2(y, x) for y >= 0 (an angle from the optical axis: y a radius, x the depth), in [0, pi].
+real atan2_real(real y, real x) {
+  const real PI = 3.141592653589793LF;
+  if (x == 0.0) return y > 0.0 ? 0.5 * PI : 0.0;
+  real ratio = y / abs(x);
+  real angle = ratio <= 1.0 ? atan_unit(ratio) : 0.5 * PI - atan_unit(abs(x) / y);
+  return x > 0.0 ? angle : PI - angle;
+}
+#endif
+
+// OpenCV's distortion of the normalized point p (camera_models.cpp, distort): the distorted point and
+// its 2x2 Jacobian (column-major, d[c][r] = d distorted_r / d p_c).
+real2 distort(real2 p, out realmat2 d) {
+  real k[8];
+  for (uint i = 0; i < 8; ++i) k[i] = to_real(camera_word(CAMERA_DISTORTION + i));
+  real p1 = k[2], p2 = k[3];
+  real x = p.x, y = p.y;
+  real r2 = x * x + y * y;
+  real num = 1.0 + r2 * (k[0] + r2 * (k[1] + r2 * k[4]));
+  real den = 1.0 + r2 * (k[5] + r2 * (k[6] + r2 * k[7]));
+  real dnum = k[0] + r2 * (2.0 * k[1] + r2 * 3.0 * k[4]);
+  real dden = k[5] + r2 * (2.0 * k[6] + r2 * 3.0 * k[7]);
+  real radial = num / den;
+  real slope = (dnum * den - num * dden) / (den * den);
+  real cross_term = 2.0 * x * y * slope + 2.0 * p1 * x + 2.0 * p2 * y;
+  d = realmat2(radial + 2.0 * x * x * slope + 2.0 * p1 * y + 6.0 * p2 * x, cross_term,  //
+               cross_term, radial + 2.0 * y * y * slope + 6.0 * p1 * y + 2.0 * p2 * x);
+  return real2(x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x),
+               y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y);
+}
+
+// A splat centre t through the camera models other than the pinhole (camera_models.cpp,
+// project_centre, in the same operations): its pixel, the rows of d pixel / d t, and the depth it
+// sorts by. False: not drawn.
+bool project_centre(real3 t, out real2 mean, out real3 j0, out real3 j1, out real depth) {
+  real fx = to_real(camera_word(CAMERA_FOCAL)), fy = to_real(camera_word(CAMERA_FOCAL + 1));
+  real cx = to_real(camera_word(CAMERA_FOCAL + 2)), cy = to_real(camera_word(CAMERA_FOCAL + 3));
+  real near_plane = to_real(camera_word(CAMERA_CLIP + 2));
+  real reach = to_real(camera_word(CAMERA_CLIP + 3));
+  real x = t.x, y = t.y, z = t.z;
+  mean = real2(0.0);
+  j0 = real3(0.0);
+  j1 = real3(0.0);
+  depth = z;
+  if (CAMERA_MODEL == MODEL_OPENCV) {
+    if (!(z > near_plane)) return false;
+    real xn = x / z, yn = y / z;
+    if (!(xn * xn + yn * yn < reach * reach)) return false;
+    realmat2 unused;
+    real2 centre = distort(real2(xn, yn), unused);
+    mean = real2(fx * centre.x + cx, fy * centre.y + cy);
+    real limit_x = to_real(camera_word(CAMERA_CLIP)), limit_y = to_real(camera_word(CAMERA_CLIP + 1));
+    real xc = clamp(xn, -limit_x, limit_x), yc = clamp(yn, -limit_y, limit_y);
+    realmat2 d;
+    distort(real2(xc, yc), d);
+    // d[c][r]: d00 = d[0][0], d01 = d[1][0], d10 = d[0][1], d11 = d[1][1].
+    if (!(d[0][0] * d[1][1] - d[1][0] * d[0][1] > 0.0)) return false;
+    real inv_z = 1.0 / z;
+    j0 = real3(fx * d[0][0] * inv_z, fx * d[1][0] * inv_z, -fx * (d[0][0] * xc + d[1][0] * yc) * inv_z);
+    j1 = real3(fy * d[0][1] * inv_z, fy * d[1][1] * inv_z, -fy * (d[0][1] * xc + d[1][1] * yc) * inv_z);
+    return true;
+  }
+  if (CAMERA_MODEL == MODEL_FISHEYE) {
+    real r2 = x * x + y * y;
+    real rho2 = r2 + z * z;
+    real rho = sqrt(rho2);
+    if (!(rho > near_plane)) return false;
+    real r = sqrt(r2);
+    real theta = atan2_real(r, z);
+    if (!(theta < reach)) return false;
+    real k1 = to_real(camera_word(CAMERA_DISTORTION)), k2 = to_real(camera_word(CAMERA_DISTORTION + 1));
+    real k3 = to_real(camera_word(CAMERA_DISTORTION + 2)), k4 = to_real(camera_word(CAMERA_DISTORTION + 3));
+    real t2 = theta * theta;
+    real theta_d = theta * (1.0 + t2 * (k1 + t2 * (k2 + t2 * (k3 + t2 * k4))));
+    real slope = 1.0 + t2 * (3.0 * k1 + t2 * (5.0 * k2 + t2 * (7.0 * k3 + t2 * 9.0 * k4)));
+    real s, h;
+    if (r2 > 0.0) {
+      s = theta_d / r;
+      h = (slope * z / rho2 - s) / r2;
+    } else {
+      s = 1.0 / z;
+      h = (2.0 * k1 - 2.0 / 3.0) / (z * z * z);
+    }
+    mean = real2(fx * s * x + cx, fy * s * y + cy);
+    real along = slope / rho2;
+    j0 = real3(fx * (s + x * x * h), fx * x * y * h, -fx * x * along);
+    j1 = real3(fy * x * y * h, fy * (s + y * y * h), -fy * y * along);
+    depth = rho;
+    return true;
+  }
+  // MODEL_ORTHOGRAPHIC
+  if (!(z > near_plane)) return false;
+  mean = real2(fx * x + cx, fy * y + cy);
+  j0 = real3(fx, 0.0, 0.0);
+  j1 = real3(0.0, fy, 0.0);
+  return true;
+}
+
 // Returns the tiles touched (0 = culled) and fills the splat record.
 uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   real3 world = real3(position_of(i));
@@ -218,7 +341,11 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) W[c][r] = to_real(camera_word(CAMERA_ROTATION + 3 * r + c));
   real3 t = W * rel;
-  if (!(t.z > to_real(camera_word(CAMERA_CLIP + 2))) || !is_finite(t.x) || !is_finite(t.y) || !is_finite(t.z)) return 0;
+  if (CAMERA_MODEL == MODEL_PINHOLE) {
+    if (!(t.z > to_real(camera_word(CAMERA_CLIP + 2))) || !is_finite(t.x) || !is_finite(t.y) || !is_finite(t.z)) return 0;
+  } else if (!is_finite(t.x) || !is_finite(t.y) || !is_finite(t.z)) {
+    return 0;
+  }
 
   // The 3D shape: R S from the log scales and quaternion (reference), or the covariance itself,
   // precomputed on the host and stored in 16 bits (COV_HALF, as web viewers do).
@@ -235,16 +362,24 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
     RS = rotation_of(i) * realmat3(s.x, 0, 0, 0, s.y, 0, 0, 0, s.z);
   }
 
-  real fx = to_real(camera_word(CAMERA_FOCAL)), fy = to_real(camera_word(CAMERA_FOCAL + 1));
-  real cx = to_real(camera_word(CAMERA_FOCAL + 2)), cy = to_real(camera_word(CAMERA_FOCAL + 3));
-  real inv_z = 1.0 / t.z;
-  real limit_x = to_real(camera_word(CAMERA_CLIP)), limit_y = to_real(camera_word(CAMERA_CLIP + 1));
-  real tx = clamp(t.x * inv_z, -limit_x, limit_x) * t.z;
-  real ty = clamp(t.y * inv_z, -limit_y, limit_y) * t.z;
   // The 2x3 Jacobian's rows, applied to the world-to-camera rotation and then to R S:
   // cov2d = (J W R S)(J W R S)^T, never forming the 3D covariance (better conditioned).
-  real3 j0 = real3(fx * inv_z, 0.0, -fx * tx * inv_z * inv_z);
-  real3 j1 = real3(0.0, fy * inv_z, -fy * ty * inv_z * inv_z);
+  real3 j0, j1;
+  real2 mean;
+  real depth = t.z;  // what the splat sorts by and depth images average: z, a fisheye's distance
+  if (CAMERA_MODEL == MODEL_PINHOLE) {
+    real fx = to_real(camera_word(CAMERA_FOCAL)), fy = to_real(camera_word(CAMERA_FOCAL + 1));
+    real cx = to_real(camera_word(CAMERA_FOCAL + 2)), cy = to_real(camera_word(CAMERA_FOCAL + 3));
+    real inv_z = 1.0 / t.z;
+    real limit_x = to_real(camera_word(CAMERA_CLIP)), limit_y = to_real(camera_word(CAMERA_CLIP + 1));
+    real tx = clamp(t.x * inv_z, -limit_x, limit_x) * t.z;
+    real ty = clamp(t.y * inv_z, -limit_y, limit_y) * t.z;
+    j0 = real3(fx * inv_z, 0.0, -fx * tx * inv_z * inv_z);
+    j1 = real3(0.0, fy * inv_z, -fy * ty * inv_z * inv_z);
+    mean = real2(fx * t.x * inv_z + cx, fy * t.y * inv_z + cy);
+  } else if (!project_centre(t, mean, j0, j1, depth)) {
+    return 0;
+  }
   real a, b, c, det;
   real det_unfiltered;  // of the 2D covariance before the low-pass filter
   const real d = real(DILATION_TENTHS) / 10.0;  // the double nearest 0.3 or 0.1, as the reference's
@@ -270,7 +405,6 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
     det_unfiltered = dot(uxv, uxv);
     det = det_unfiltered + d * (dot(u, u) + dot(v, v)) + d * d;
   }
-  real2 mean = real2(fx * t.x * inv_z + cx, fy * t.y * inv_z + cy);
   // The composite works in float32 relative to the mean, so the mean must be a finite float.
   if (!(det > 0.0) || !is_finite(a) || !is_finite(b) || !is_finite(c) || !is_finite(det) ||
       !(abs(mean.x) <= real(FLT_MAX)) || !(abs(mean.y) <= real(FLT_MAX)))
@@ -310,7 +444,8 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   }
   if (touched == 0) return 0;
 
-  vec3 dir = vec3(normalize(rel));
+  // The SH are seen along the ray from the camera; an orthographic camera's rays are all its axis.
+  vec3 dir = CAMERA_MODEL == MODEL_ORTHOGRAPHIC ? vec3(W[0][2], W[1][2], W[2][2]) : vec3(normalize(rel));
   vec3 colour = eval_sh(SH_DEGREE, pc.sh, i, dir) + 0.5;
   if (any(isnan(colour)) || any(isinf(colour))) return 0;  // NaN or Inf coefficients: culled
   colour = max(colour, vec3(0.0));
@@ -322,7 +457,7 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   }
   // The mean is stored as float hi + lo so that (pixel - mean) in the composite stays accurate.
   vec2 mean_lo = vec2(mean - real2(mean_hi));
-  record[0] = vec4(mean_hi, float(t.z), opacity);
+  record[0] = vec4(mean_hi, float(depth), opacity);
   record[1] = vec4(vec3(c / det, -b / det, a / det), mean_lo.x);
   record[2] = vec4(colour, mean_lo.y);
   record[3] = cov_det;

@@ -195,13 +195,16 @@ TS_BUFFER(CameraParams) {
   TS_F64 rotation[9];         // world-to-camera rotation, row-major
   TS_F64 centre[3];           // camera centre (world)
   TS_F64 focal_principal[4];  // fx, fy, cx, cy
-  // 1.3 tan(fov_x/2), 1.3 tan(fov_y/2), the near plane, unused: the reference compares in double, and
-  // a float 0.2 would cull a splat on the plane that the reference keeps.
+  // The Jacobian's clamp of x/z and y/z (1.3 tan(fov_x/2), 1.3 tan(fov_y/2) for the pinhole), the near
+  // plane, the model's reach (camera_models::ModelLimits): the reference compares in double, and a
+  // float 0.2 would cull a splat on the plane that the reference keeps.
   TS_F64 clip[4];
   uvec4 grid;  // tiles x, tiles y, width, height
+  TS_F64 distortion[8];  // Camera::distortion (CAMERA_MODEL other than the pinhole)
 };
 // The same as uvec2 words (projection.comp's camera_word): where each field starts.
-TS_CONST uint CAMERA_ROTATION = 0, CAMERA_CENTRE = 9, CAMERA_FOCAL = 12, CAMERA_CLIP = 16, CAMERA_GRID = 20;
+TS_CONST uint CAMERA_ROTATION = 0, CAMERA_CENTRE = 9, CAMERA_FOCAL = 12, CAMERA_CLIP = 16, CAMERA_GRID = 20,
+              CAMERA_DISTORTION = 22;
 
 // The frame's lights, written by the host (ProjectionPass::set_lighting) in float64 from the same
 // prepared values as the reference's (engine/src/lighting.h).
@@ -519,7 +522,8 @@ TS_PUSH_INSTANCE;
 // What the C++ compiler can check of the layouts: the blocks' sizes (std430 lays the members out as
 // C++ does here: scalars, 8-byte addresses and doubles, 16-byte vec4) and the 128 bytes of push
 // constants that every Vulkan device accepts (maxPushConstantsSize).
-static_assert(sizeof(CameraParams) == 176 && CAMERA_GRID * sizeof(uvec2) == 160);
+static_assert(sizeof(CameraParams) == 240 && CAMERA_GRID * sizeof(uvec2) == 160 &&
+              CAMERA_DISTORTION * sizeof(uvec2) == 176);
 static_assert(sizeof(LightRecord) == 56 && sizeof(LightParams) == 40);
 static_assert(sizeof(CompositePush) <= 128 && sizeof(CompositeResortPush) <= 128 &&
               sizeof(StochasticCompositePush) <= 128 && sizeof(PackShHalfPush) <= 128 &&

@@ -141,15 +141,69 @@ TEST(CameraSets, ColmapBinaryAndTextModelsReadAsTheSameCameras) {
   }
 }
 
-TEST(CameraSets, ColmapDistortionTruncationAndMissingCamerasAreErrors) {
+TEST(CameraSets, ColmapLensModelsAreReadIntoTheirParameters) {
+  const auto views = reference_views();
+  const fs::path out = fresh_output_dir();
+  write_colmap(views, out / "models", false);
+  using tilesplat::CameraModel;
+  struct Case {
+    const char* line;
+    CameraModel model;
+    std::array<double, 4> intrinsics;  // fx fy cx cy
+    std::array<double, 8> distortion;
+  };
+  const Case cases[] = {
+      {"SIMPLE_RADIAL 640 480 500 320 240 0.01", CameraModel::kOpenCV, {500, 500, 320, 240}, {0.01}},
+      {"RADIAL 640 480 500 320 240 0.01 -0.002", CameraModel::kOpenCV, {500, 500, 320, 240}, {0.01, -0.002}},
+      {"OPENCV 640 480 500 510 320 240 0.01 -0.002 0.0003 -0.0004",
+       CameraModel::kOpenCV,
+       {500, 510, 320, 240},
+       {0.01, -0.002, 0.0003, -0.0004}},
+      {"FULL_OPENCV 640 480 500 510 320 240 0.01 -0.002 0.0003 -0.0004 0.001 0.02 0.003 0.0004",
+       CameraModel::kOpenCV,
+       {500, 510, 320, 240},
+       {0.01, -0.002, 0.0003, -0.0004, 0.001, 0.02, 0.003, 0.0004}},
+      {"OPENCV_FISHEYE 640 480 300 310 320 240 0.05 -0.01 0.002 -0.0003",
+       CameraModel::kFisheye,
+       {300, 310, 320, 240},
+       {0.05, -0.01, 0.002, -0.0003}},
+      {"SIMPLE_RADIAL_FISHEYE 640 480 300 320 240 0.05", CameraModel::kFisheye, {300, 300, 320, 240}, {0.05}},
+      {"RADIAL_FISHEYE 640 480 300 320 240 0.05 -0.01",
+       CameraModel::kFisheye,
+       {300, 300, 320, 240},
+       {0.05, -0.01}},
+      {"PINHOLE 640 480 500 510 320 240", CameraModel::kPinhole, {500, 510, 320, 240}, {}},
+  };
+  for (const Case& c : cases) {
+    {
+      std::ofstream cameras(out / "models" / "cameras.txt");
+      for (size_t id = 1; id <= views.size(); ++id) cameras << id << " " << c.line << "\n";
+    }
+    const auto loaded = tilesplat::load_colmap_cameras(out / "models");
+    ASSERT_EQ(loaded.size(), views.size()) << c.line;
+    const tilesplat::Camera& camera = loaded.front().camera;
+    EXPECT_EQ(camera.model, c.model) << c.line;
+    EXPECT_EQ((std::array<double, 4>{camera.fx, camera.fy, camera.cx, camera.cy}), c.intrinsics) << c.line;
+    EXPECT_EQ(camera.distortion, c.distortion) << c.line;
+    for (size_t k = 0; k < 9; ++k) EXPECT_NEAR(camera.rotation[k], views.front().camera.rotation[k], 1e-12);
+  }
+  // The models the renderer does not have are refused by name.
+  for (const char* line :
+       {"FOV 640 480 500 510 320 240 0.9", "THIN_PRISM_FISHEYE 640 480 500 510 320 240 0 0 0 0 0 0 0 0"}) {
+    std::ofstream(out / "models" / "cameras.txt") << "1 " << line << "\n";
+    const std::string error =
+        tilesplat::testing::error_of([&] { tilesplat::load_colmap_cameras(out / "models"); });
+    EXPECT_NE(error.find(std::string("uses the ") + std::string(line).substr(0, std::string(line).find(' ')) +
+                         " model, which the renderer does not have"),
+              std::string::npos)
+        << error;
+  }
+}
+
+TEST(CameraSets, ColmapTruncationAndMissingCamerasAreErrors) {
   const auto views = reference_views();
   const fs::path out = fresh_output_dir();
   write_colmap(views, out / "radial", false);
-  std::ofstream(out / "radial" / "cameras.txt") << "1 SIMPLE_RADIAL 640 480 500 320 240 0.01\n";
-  EXPECT_NE(tilesplat::testing::error_of([&] {
-              tilesplat::load_colmap_cameras(out / "radial");
-            }).find("uses the SIMPLE_RADIAL model, whose lens distortion the renderer cannot honour"),
-            std::string::npos);
   std::ofstream(out / "radial" / "cameras.txt") << "7 PINHOLE 640 480 500 500 320 240\n";
   EXPECT_NE(tilesplat::testing::error_of([&] {
               tilesplat::load_colmap_cameras(out / "radial");
@@ -226,15 +280,26 @@ TEST(CameraSets, TransformsJsonReadsAsTheSameCameras) {
   // Looking down -z in OpenGL is looking down +z in the engine's frame: the camera at z = 4 sees the origin.
   EXPECT_NEAR(ngp[0].camera.to_camera({0, 0, 0})[2], 4, 1e-12);
 
-  std::ofstream(out / "distorted.json") << transforms_json(views, "\"k1\": 0.05, ");
+  // Distortion without a model is OPENCV's (instant-ngp's files); nerfstudio's fisheye is Kannala-Brandt.
+  std::ofstream(out / "distorted.json")
+      << transforms_json(views, "\"k1\": 0.05, \"p2\": 0.001, \"k3\": 0.002, ");
+  const auto distorted = tilesplat::load_camera_set(out / "distorted.json");
+  EXPECT_EQ(distorted[0].camera.model, tilesplat::CameraModel::kOpenCV);
+  EXPECT_EQ(distorted[0].camera.distortion, (std::array<double, 8>{0.05, 0, 0, 0.001, 0.002, 0, 0, 0}));
+  std::ofstream(out / "fisheye.json")
+      << transforms_json(views, "\"camera_model\": \"OPENCV_FISHEYE\", \"k1\": 0.1, \"k4\": -0.01, ");
+  const auto fisheye = tilesplat::load_camera_set(out / "fisheye.json");
+  EXPECT_EQ(fisheye[0].camera.model, tilesplat::CameraModel::kFisheye);
+  EXPECT_EQ(fisheye[0].camera.distortion, (std::array<double, 8>{0.1, 0, 0, -0.01, 0, 0, 0, 0}));
+  std::ofstream(out / "k4.json") << transforms_json(views, "\"camera_model\": \"OPENCV\", \"k4\": 0.01, ");
   EXPECT_NE(tilesplat::testing::error_of([&] {
-              tilesplat::load_camera_set(out / "distorted.json");
-            }).find("frame 0: distortion coefficient k1 is not zero"),
+              tilesplat::load_camera_set(out / "k4.json");
+            }).find("frame 0: k4 of an OPENCV camera is nerfstudio's r^8 term"),
             std::string::npos);
-  std::ofstream(out / "fisheye.json") << transforms_json(views, "\"camera_model\": \"OPENCV_FISHEYE\", ");
+  std::ofstream(out / "panorama.json") << transforms_json(views, "\"camera_model\": \"EQUIRECTANGULAR\", ");
   EXPECT_NE(tilesplat::testing::error_of([&] {
-              tilesplat::load_camera_set(out / "fisheye.json");
-            }).find("OPENCV_FISHEYE"),
+              tilesplat::load_camera_set(out / "panorama.json");
+            }).find("camera_model EQUIRECTANGULAR is not one the renderer draws"),
             std::string::npos);
   std::ofstream(out / "sizeless.json")
       << R"({"fl_x": 500, "frames": [{"transform_matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]})";

@@ -553,6 +553,13 @@ TEST(ExrIo, CameraRoundTripsExactlyAndInOpenExrsConventions) {
   ASSERT_TRUE(back.has_value());
   EXPECT_EQ(*back, camera);  // every double to the bit
 
+  // A lens model and its coefficients too.
+  camera.model = CameraModel::kOpenCV;
+  camera.distortion = {-0.1234567890123, 0.0301, 1e-4, -2.5e-4, 0.002, 0.01, -0.003, 1.0 / 3.0};
+  options.camera = camera;
+  write_exr(dir / "opencv.exr", make_image(64, 48, true, true), options);
+  EXPECT_EQ(read_exr_camera(dir / "opencv.exr"), camera);
+
   // No camera given: none recorded. A missing file: an error naming it.
   write_exr(dir / "none.exr", make_image(4, 3, false, false));
   EXPECT_FALSE(read_exr_camera(dir / "none.exr").has_value());

@@ -76,6 +76,11 @@ std::string camera_pose_text(const Camera& camera) {
   for (const double value : {camera.fx, camera.fy, camera.cx, camera.cy}) add(value);
   for (const double value : camera.rotation) add(value);
   for (const double value : camera.position) add(value);
+  if (camera.model != CameraModel::kPinhole) {  // a pinhole's line stays as it always was
+    text += ' ';
+    text += camera_model_name(camera.model);
+    for (const double value : camera.distortion) add(value);
+  }
   return text;
 }
 

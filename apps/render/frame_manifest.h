@@ -36,7 +36,8 @@ struct ManifestEntry {
 
 std::string to_json_line(const ManifestEntry& entry);  // one line, no newline
 
-// fx fy cx cy, the rotation's 9 and the position's 3 values, each as its shortest exact decimal.
+// fx fy cx cy, the rotation's 9 and the position's 3 values, each as its shortest exact decimal; then,
+// for a model other than the pinhole, its name and its 8 coefficients.
 std::string camera_pose_text(const Camera& camera);
 
 // "manifest.jsonl" for a run in one shard, "manifest.shard-I-of-N.jsonl" for a shard.

@@ -434,6 +434,7 @@ int run(int argc, char** argv) {
     frames.push_back({0, loaded.view_index.value_or(0), loaded.camera, loaded.camera_description,
                       loaded.view_index, loaded.view_name, options.output, options.png});
   }
+  for (Frame& frame : frames) frame.camera = camera_for_frame(options.camera_model, frame.camera);
 
   tilesplat::RenderSettings settings;
   if (!options.common.sorts.empty()) settings.sort = options.common.sorts.front();

@@ -169,6 +169,21 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                    [&options, positive](const std::string& text) {
                      options.lens.units_per_metre = positive("--units-per-metre", text);
                    });
+  parser.section("camera model (every frame's camera, its pose and size kept, through another lens)");
+  parser.add_value(
+      "--fisheye", "DEG",
+      "an equidistant fisheye whose field of view spans DEG degrees across the image's shorter "
+      "side (up to 360: a circular fisheye, past 180 it sees behind)",
+      [&options](const std::string& text) {
+        const double degrees = cli::parse_double("--fisheye", text);
+        if (!(degrees > 0 && degrees <= 360))
+          throw cli::UsageError("--fisheye must be in (0, 360] degrees, got " + single_quoted(text));
+        options.camera_model.fisheye_fov_deg = degrees;
+      });
+  parser.add_value("--orthographic", "H", "an orthographic view H world units tall (parallel rays)",
+                   [&options, positive](const std::string& text) {
+                     options.camera_model.view_height = positive("--orthographic", text);
+                   });
   parser.add_switch("--stats",
                     "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
                     "intersections, retries",
@@ -230,6 +245,11 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
                              {"--png", options.png}});
   if (options.reference && parser.seen("--stochastic"))
     throw cli::UsageError("--stochastic is a GPU compositor; the --reference renderer blends sorted lists");
+  if (options.camera_model.fisheye_fov_deg && options.camera_model.view_height)
+    throw cli::UsageError("--fisheye and --orthographic are two camera models: one of them");
+  if (options.camera_model.enabled() && options.lens.enabled())
+    throw cli::UsageError("depth of field (--aperture, --f-stop) needs a pinhole camera, not " +
+                          std::string(options.camera_model.fisheye_fov_deg ? "--fisheye" : "--orthographic"));
   if (options.lens.aperture && options.lens.f_stop)
     throw cli::UsageError("--aperture and --f-stop both give the aperture: one of them");
   if (!options.lens.enabled())
@@ -254,6 +274,12 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
             ": the frame number belongs in the file name, not the folder (the folder holds the "
             "manifest)");
     }
+}
+
+Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera) {
+  if (flags.fisheye_fov_deg) return fisheye_camera(camera, *flags.fisheye_fov_deg);
+  if (flags.view_height) return orthographic_camera(camera, *flags.view_height);
+  return camera;
 }
 
 ThinLens lens_for_frame(const LensFlags& flags, const Camera& camera,

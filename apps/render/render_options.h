@@ -46,6 +46,16 @@ ThinLens lens_for_frame(const LensFlags& flags, const Camera& camera,
 // renderSettings; empty when off.
 std::string lens_text(const LensFlags& flags);
 
+// --fisheye and --orthographic: every frame's camera (its pose, size and principal point) through
+// another model. Off: the cameras as given, whatever model they have.
+struct CameraModelFlags {
+  std::optional<double> fisheye_fov_deg;  // --fisheye DEG: equidistant, DEG across the shorter side
+  std::optional<double> view_height;      // --orthographic H: H world units tall
+  bool enabled() const { return fisheye_fov_deg.has_value() || view_height.has_value(); }
+};
+// The frame's camera through the flags' model (fisheye_camera, orthographic_camera), or as it is.
+Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera);
+
 struct RenderOptions {
   tilesplat::cli::CommonOptions common;
   std::string output;
@@ -60,6 +70,7 @@ struct RenderOptions {
   bool reference = false;
   int stochastic_frames = 0;  // --stochastic N: the sort-free compositor averaging N frames; 0 = sorted
   LensFlags lens;
+  CameraModelFlags camera_model;
   bool stats = false;
   // Many frames in one run.
   std::string views;      // --views: a selection of the camera set's views

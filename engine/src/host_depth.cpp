@@ -16,6 +16,9 @@ void validate_host_depth(const RenderSettings& settings, const Camera& camera) {
   if (settings.accuracy.resort_window > 0)
     fail("per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
          ") does not depth-test against a host's surfaces: render without it");
+  if (camera.model != CameraModel::kPinhole)
+    fail(std::string("a host's depth buffer is a pinhole projection's; the camera is ") +
+         camera_model_name(camera.model));
   if (!std::isfinite(host.convention.a) || !std::isfinite(host.convention.b) || host.convention.b == 0)
     fail("the depth convention must have finite a and b, b not 0 (DepthConvention::from_projection)");
   if (!(host.alpha_threshold > 0.0f && host.alpha_threshold <= 1.0f))

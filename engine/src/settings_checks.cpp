@@ -23,6 +23,12 @@ void check_max_alpha(const RenderSettings& settings) {
 void check_lens(const RenderSettings& settings, const Camera& camera) {
   validate(settings.lens);
   validate(camera);
+  // The thin lens shears a pinhole's frustum (lens_sample_camera moves the principal point); the other
+  // models have no such shear written yet.
+  if (settings.lens.enabled() && camera.model != CameraModel::kPinhole)
+    throw std::invalid_argument(
+        std::string("RenderSettings::lens: depth of field needs a pinhole camera, not ") +
+        camera_model_name(camera.model));
   if (settings.host)
     throw std::invalid_argument(
         "RenderSettings::lens: depth of field cannot be combined with a host's depth "
@@ -33,6 +39,10 @@ void check_shutter(const RenderSettings& settings, const Camera& camera) {
   validate(settings.shutter);
   validate(camera);
   const Camera& end = *settings.shutter.end_camera;
+  if (end.model != camera.model || end.distortion != camera.distortion)
+    throw std::invalid_argument(
+        "RenderSettings::shutter: the end camera's model or coefficients differ from the camera's: a camera "
+        "moves, its lens stays");
   if (end.width != camera.width || end.height != camera.height)
     throw std::invalid_argument("RenderSettings::shutter: the end camera is " + std::to_string(end.width) +
                                 "x" + std::to_string(end.height) + ", the camera " +
@@ -42,6 +52,13 @@ void check_shutter(const RenderSettings& settings, const Camera& camera) {
     throw std::invalid_argument(
         "RenderSettings::shutter: motion blur cannot be combined with a host's depth "
         "(RenderSettings::host)");
+}
+
+void check_camera_model(const RenderSettings& settings, const Camera& camera) {
+  if (camera.model != CameraModel::kPinhole && settings.accuracy.resort_window > 0)
+    throw std::invalid_argument("per-pixel re-sorting (resort" +
+                                std::to_string(settings.accuracy.resort_window) +
+                                ") needs a pinhole camera, not " + camera_model_name(camera.model));
 }
 
 void check_single_frame(const RenderSettings& settings) {

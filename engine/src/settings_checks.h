@@ -16,6 +16,9 @@ void check_lens(const RenderSettings& settings, const Camera& camera);
 // RenderSettings::shutter, where a frame through it can be made: a valid shutter (validate(Shutter)), an
 // end camera of the camera's size, and no host depth. Throws std::invalid_argument.
 void check_shutter(const RenderSettings& settings, const Camera& camera);
+// What a camera model rules out: the per-pixel re-sorting (its rays are the pinhole's) needs
+// CameraModel::kPinhole. Throws std::invalid_argument.
+void check_camera_model(const RenderSettings& settings, const Camera& camera);
 // A single pinhole frame (the frame plan, render_to_image): RenderSettings::lens and shutter must be valid
 // and off.
 void check_single_frame(const RenderSettings& settings);

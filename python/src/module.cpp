@@ -278,6 +278,19 @@ void bind(nb::module_& m) {
       .def_rw("cy", &Camera::cy)
       .def_rw("rotation", &Camera::rotation, "world to camera, row-major 3x3 as 9 numbers")
       .def_rw("position", &Camera::position, "the camera centre in world space")
+      .def_prop_rw(
+          "model", [](const Camera& c) { return std::string(camera_model_name(c.model)); },
+          [](Camera& c, const std::string& name) { c.model = parse_camera_model(name); },
+          "'pinhole', 'opencv', 'fisheye' or 'orthographic' (docs/cameras.md)")
+      .def_rw("distortion", &Camera::distortion,
+              "the model's 8 coefficients: opencv k1 k2 p1 p2 k3 k4 k5 k6, fisheye k1 k2 k3 k4 0 0 0 0")
+      .def(
+          "fisheye", [](const Camera& c, double fov_deg) { return fisheye_camera(c, fov_deg); }, "fov_deg"_a,
+          "The equidistant fisheye with this pose and size, fov_deg (up to 360) across the shorter side.")
+      .def(
+          "orthographic",
+          [](const Camera& c, double view_height) { return orthographic_camera(c, view_height); },
+          "view_height"_a, "The orthographic camera with this pose and size, view_height world units tall.")
       .def(
           "resized", [](const Camera& c, int width, int height) { return resize_camera(c, width, height); },
           "width"_a, "height"_a, "The same view at another size (the field of view kept).")

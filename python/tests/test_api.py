@@ -282,3 +282,26 @@ def test_motion_blur_through_a_shutter(playbot_renderer):
     assert tilesplat.compare_images(blurred, still)["psnr_db"] < 40
     with pytest.raises(ValueError, match="0 <= open <= close <= 1"):
         tilesplat.Shutter(open=0.6, close=0.2, end_camera=end)
+
+
+def test_camera_models(playbot_renderer):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 96, 64, azimuth_deg=30)
+    assert camera.model == "pinhole" and list(camera.distortion) == [0.0] * 8
+    fisheye = camera.fisheye(200)
+    assert fisheye.model == "fisheye" and fisheye.position == camera.position
+    wide = renderer.render(fisheye)
+    assert tilesplat.compare_images(wide, renderer.render(camera))["psnr_db"] < 30  # another image
+    distorted = tilesplat.Camera.orbit(scene, 96, 64, azimuth_deg=30)
+    distorted.model = "opencv"
+    distorted.distortion = [-0.1, 0.02, 0, 0, 0, 0, 0, 0]
+    assert 20 < tilesplat.compare_images(renderer.render(distorted), renderer.render(camera))["psnr_db"] < 60
+    orthographic = camera.orthographic(3.0)
+    assert orthographic.model == "orthographic" and orthographic.fy == pytest.approx(64 / 3.0)
+    assert renderer.render(orthographic).rgba[..., 3].max() > 0.5
+    with pytest.raises(ValueError, match="unknown camera model 'equirect'"):
+        camera.model = "equirect"
+    bad = camera.fisheye(180)
+    bad.distortion = [0, 0, 0, 0, 0.1, 0, 0, 0]
+    with pytest.raises(RuntimeError, match="the fisheye camera has 4 distortion coefficients"):
+        renderer.render(bad)

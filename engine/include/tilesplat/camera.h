@@ -1,5 +1,6 @@
 /// @file
-/// Pinhole cameras in the original trainer's convention (OpenCV axes: x right, y down, z forward).
+/// Cameras in the original trainer's convention (OpenCV axes: x right, y down, z forward): the pinhole,
+/// and the lens models real datasets come with (OpenCV distortion, fisheye) and orthographic views.
 #pragma once
 
 #include <array>
@@ -35,7 +36,35 @@ struct ClipSpace {
   static ClipSpace opengl() { return {Y::kUp, Depth::kMinusOneToOne}; }
 };
 
-/// A pinhole camera: an image size, intrinsics in pixels and a pose. Camera space has OpenCV axes
+/// How a camera-space point t = (x, y, z) becomes a pixel (Camera::model). Every model keeps the
+/// intrinsics' meaning: (cx, cy) is where the optical axis meets the image, fx and fy scale to pixels.
+/// A splat goes through a non-linear model by the local Jacobian of the model at its centre (the first
+/// order of EWA splatting, as gsplat's fisheye and OpenCV cameras): exact for the mean, an approximation
+/// for the shape that grows with the splat's angular size (docs/cameras.md measures it).
+enum class CameraModel {
+  /// u = fx x / z + cx, v = fy y / z + cy: the trainer's camera and the default.
+  kPinhole,
+  /// The pinhole with OpenCV's radial-tangential distortion of (x / z, y / z), Camera::distortion =
+  /// k1 k2 p1 p2 k3 k4 k5 k6 (OpenCV's order; the rational k4..k6 are 0 for COLMAP's OPENCV). Points
+  /// beyond the radius where the radial distortion folds back are not drawn.
+  kOpenCV,
+  /// Kannala-Brandt, as OpenCV's fisheye module and COLMAP's OPENCV_FISHEYE: theta = the angle from the
+  /// optical axis, theta_d = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8), and the pixel
+  /// lies at radius theta_d (in units of fx, fy) along the point's direction. Zero coefficients are the
+  /// equidistant fisheye. Fields of view past 180 degrees: points behind the camera are drawn while
+  /// theta_d grows with theta. Camera::distortion = k1 k2 k3 k4 0 0 0 0.
+  kFisheye,
+  /// u = fx x + cx, v = fy y + cy: parallel rays along the camera's z; fx and fy in pixels per world unit.
+  kOrthographic,
+};
+
+/// The model's name as files and flags spell it: "pinhole", "opencv", "fisheye", "orthographic".
+TILESPLAT_API const char* camera_model_name(CameraModel model);
+/// The model named so (camera_model_name's names); throws std::invalid_argument naming the known ones.
+TILESPLAT_API CameraModel parse_camera_model(const std::string& name);
+
+/// A camera: an image size, intrinsics in pixels, a pose, and the model that maps the two (pinhole
+/// unless Camera::model says otherwise). Camera space has OpenCV axes
 /// (x right, y down, z forward, the convention of the original trainer and COLMAP); pixel (i, j)
 /// has its centre at (i + 0.5, j + 0.5), row 0 at the top. A plain value, safe to copy between
 /// threads.
@@ -50,6 +79,9 @@ struct TILESPLAT_API Camera {
   /// the camera's x, y and z axes in world space.
   std::array<double, 9> rotation = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   std::array<double, 3> position = {0, 0, 0};  ///< the camera centre in world space
+  CameraModel model = CameraModel::kPinhole;   ///< how camera space maps to pixels
+  /// The model's coefficients (CameraModel says which); all 0 for the pinhole and the orthographic camera.
+  std::array<double, 8> distortion = {0, 0, 0, 0, 0, 0, 0, 0};
 
   /// A world-space point in camera space: rotation * (world - position).
   std::array<double, 3> to_camera(const std::array<double, 3>& world) const;
@@ -105,8 +137,10 @@ struct TILESPLAT_API DepthConvention {
 };
 
 /// Throws std::invalid_argument ("invalid camera: ...", saying what) for a camera no renderer can use:
-/// a size that is not positive, focal lengths that are not positive and finite, or a non-finite
-/// principal point, rotation or position. Both renderers call it; device limits are checked on top.
+/// a size that is not positive, focal lengths that are not positive and finite, a non-finite
+/// principal point, rotation, position or coefficient, or coefficients the model does not have (any
+/// for the pinhole and the orthographic camera, k5..k8 for the fisheye). Both renderers call it;
+/// device limits are checked on top.
 TILESPLAT_API void validate(const Camera& camera);
 
 /// One entry of the trainer's cameras.json.
@@ -142,6 +176,16 @@ TILESPLAT_API Camera orbit_camera(const GaussianScene& scene, int width, int hei
 /// other way in its view. Orbiting is a pivot at the scene; pivot = camera.position turns it in place.
 TILESPLAT_API Camera turn_camera(const Camera& camera, const std::array<double, 3>& pivot,
                                  const std::array<double, 3>& axis, double radians);
+
+/// The equidistant fisheye (CameraModel::kFisheye, zero coefficients) with `camera`'s pose, size and
+/// principal point whose `field_of_view_deg` (up to 360) spans the image's shorter side: a circular
+/// fisheye inscribed in the frame. Throws std::invalid_argument for a field of view outside (0, 360].
+TILESPLAT_API Camera fisheye_camera(const Camera& camera, double field_of_view_deg);
+
+/// The orthographic camera (CameraModel::kOrthographic) with `camera`'s pose, size and principal point
+/// whose image is `view_height` world units tall (square pixels). Throws std::invalid_argument for a
+/// height that is not positive and finite.
+TILESPLAT_API Camera orthographic_camera(const Camera& camera, double view_height);
 
 /// A camera at `eye` looking at `target`; `up` is the world up direction (the camera's -y).
 TILESPLAT_API Camera look_at_camera(const std::array<double, 3>& eye, const std::array<double, 3>& target,

@@ -139,8 +139,10 @@ TILESPLAT_API StoredExr read_exr_as_stored(const std::filesystem::path& path);
 /// The camera write_exr() recorded in an EXR (ExrWriteOptions::camera), rebuilt exactly from its
 /// double-precision attributes (`tilesplatRotation` M33d = Camera::rotation, `tilesplatPosition` V3d,
 /// `tilesplatFocalLength` V2d = (fx, fy), `tilesplatPrincipalPoint` V2d = (cx, cy), in pixels; the size is
-/// the data window's); std::nullopt when the file has none. The standard attributes written beside them
-/// follow OpenEXR's conventions, which differ from Camera's:
+/// the data window's; for a model other than the pinhole `tilesplatCameraModel`, its name, and
+/// `tilesplatDistortion`, its 8 coefficients as shortest round-trip decimals); std::nullopt when the file
+/// has none. `worldToNDC` is written for the pinhole only (the other models' pixels are no matrix). The
+/// standard attributes written beside them follow OpenEXR's conventions, which differ from Camera's:
 /// - `worldToCamera` maps world points (row vectors, p * M, as Imath multiplies) into OpenEXR's camera space:
 ///   x right, **y up**, z forward (left-handed, as RenderMan); tilesplat's camera space is y down, so the
 ///   second axis is negated.

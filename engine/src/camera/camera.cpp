@@ -1,4 +1,5 @@
-// Pinhole camera helpers: world-to-camera transform, resizing, look-at and orbit framing.
+// Camera helpers: the models' names and checks, world-to-camera transform, resizing, look-at and orbit
+// framing.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -38,6 +39,28 @@ Vec3 rotated(const Vec3& v, const Vec3& axis, double angle) {
 
 }  // namespace
 
+const char* camera_model_name(CameraModel model) {
+  switch (model) {
+    case CameraModel::kPinhole:
+      return "pinhole";
+    case CameraModel::kOpenCV:
+      return "opencv";
+    case CameraModel::kFisheye:
+      return "fisheye";
+    case CameraModel::kOrthographic:
+      return "orthographic";
+  }
+  return "unknown";
+}
+
+CameraModel parse_camera_model(const std::string& name) {
+  for (CameraModel model :
+       {CameraModel::kPinhole, CameraModel::kOpenCV, CameraModel::kFisheye, CameraModel::kOrthographic})
+    if (name == camera_model_name(model)) return model;
+  throw std::invalid_argument("unknown camera model '" + name +
+                              "' (known: pinhole, opencv, fisheye, orthographic)");
+}
+
 void validate(const Camera& camera) {
   auto fail = [](const std::string& why) { throw std::invalid_argument("invalid camera: " + why); };
   if (camera.width <= 0 || camera.height <= 0)
@@ -48,6 +71,43 @@ void validate(const Camera& camera) {
   auto finite = [](double v) { return std::isfinite(v); };
   if (!std::all_of(camera.rotation.begin(), camera.rotation.end(), finite)) fail("non-finite rotation");
   if (!std::all_of(camera.position.begin(), camera.position.end(), finite)) fail("non-finite position");
+  const int coefficients = camera.model == CameraModel::kOpenCV    ? 8
+                           : camera.model == CameraModel::kFisheye ? 4
+                                                                   : 0;
+  if (camera.model != CameraModel::kPinhole && camera.model != CameraModel::kOpenCV &&
+      camera.model != CameraModel::kFisheye && camera.model != CameraModel::kOrthographic)
+    fail("unknown camera model " + std::to_string(int(camera.model)));
+  for (size_t k = 0; k < camera.distortion.size(); ++k) {
+    if (!std::isfinite(camera.distortion[k])) fail("non-finite distortion coefficient " + std::to_string(k));
+    if (int(k) >= coefficients && camera.distortion[k] != 0)
+      fail(std::string("the ") + camera_model_name(camera.model) + " camera has " +
+           std::to_string(coefficients) + " distortion coefficients, but coefficient " + std::to_string(k) +
+           " is " + std::to_string(camera.distortion[k]));
+  }
+}
+
+Camera fisheye_camera(const Camera& camera, double field_of_view_deg) {
+  if (!(field_of_view_deg > 0 && field_of_view_deg <= 360))
+    throw std::invalid_argument("fisheye_camera: the field of view must be in (0, 360] degrees, got " +
+                                std::to_string(field_of_view_deg));
+  Camera fisheye = camera;
+  fisheye.model = CameraModel::kFisheye;
+  fisheye.distortion = {};
+  // Equidistant: the pixel radius is f theta, and theta = fov / 2 lands on the shorter side's edge.
+  fisheye.fx = fisheye.fy =
+      0.5 * std::min(camera.width, camera.height) / degrees_to_radians(0.5 * field_of_view_deg);
+  return fisheye;
+}
+
+Camera orthographic_camera(const Camera& camera, double view_height) {
+  if (!(std::isfinite(view_height) && view_height > 0))
+    throw std::invalid_argument("orthographic_camera: the view height must be positive and finite, got " +
+                                std::to_string(view_height));
+  Camera orthographic = camera;
+  orthographic.model = CameraModel::kOrthographic;
+  orthographic.distortion = {};
+  orthographic.fx = orthographic.fy = camera.height / view_height;
+  return orthographic;
 }
 
 std::array<double, 3> Camera::to_camera(const std::array<double, 3>& world) const {

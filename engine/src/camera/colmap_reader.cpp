@@ -218,6 +218,50 @@ std::vector<ColmapImage> read_images_txt(const fs::path& path) {
   return images;
 }
 
+// The camera's intrinsics and model from COLMAP's parameters (colmap/sensor/models.h): the pinholes, the
+// OpenCV family (SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV: CameraModel::kOpenCV) and the fisheyes whose
+// angle mapping is Kannala-Brandt's (OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE, RADIAL_FISHEYE:
+// CameraModel::kFisheye). FOV and THIN_PRISM_FISHEYE are refused by name.
+void set_intrinsics(Camera& camera, const ColmapCamera& source, const std::string& camera_where,
+                    const fs::path& cameras_file) {
+  const std::string& model = source.model;
+  const auto& p = source.params;
+  auto number = [&](size_t index, const char* what) { return finite(p[index], cameras_file.string(), what); };
+  // SIMPLE_* and RADIAL* have one focal length and no fy: their parameters start f cx cy.
+  const bool one_focal = model == "SIMPLE_PINHOLE" || model == "SIMPLE_RADIAL" || model == "RADIAL" ||
+                         model == "SIMPLE_RADIAL_FISHEYE" || model == "RADIAL_FISHEYE";
+  if (model == "FOV" || model == "THIN_PRISM_FISHEYE")
+    throw SceneError(
+        camera_where + " uses the " + model +
+        " model, which the renderer does not have (it has PINHOLE, SIMPLE_PINHOLE, SIMPLE_RADIAL, "
+        "RADIAL, OPENCV, FULL_OPENCV, OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE and RADIAL_FISHEYE): "
+        "undistort the model to PINHOLE first (colmap image_undistorter)");
+  camera.fx = number(0, "a focal length");
+  camera.fy = one_focal ? camera.fx : number(1, "a focal length");
+  const size_t centre = one_focal ? 1 : 2;
+  camera.cx = number(centre, "a principal point");
+  camera.cy = number(centre + 1, "a principal point");
+  if (!(camera.fx > 0 && camera.fy > 0)) throw SceneError(camera_where + ": focal lengths must be positive");
+  const size_t first = centre + 2;  // the first distortion parameter
+  auto coefficient = [&](size_t index) { return number(index, "a distortion coefficient"); };
+  auto& k = camera.distortion;
+  if (model == "SIMPLE_RADIAL" || model == "RADIAL" || model == "OPENCV" || model == "FULL_OPENCV") {
+    camera.model = CameraModel::kOpenCV;
+    k[0] = coefficient(first);                                    // k1
+    if (model != "SIMPLE_RADIAL") k[1] = coefficient(first + 1);  // k2
+    if (model == "OPENCV" || model == "FULL_OPENCV")
+      for (size_t i = 2; i < p.size() - first; ++i) k[i] = coefficient(first + i);  // p1 p2 (k3 k4 k5 k6)
+  } else if (model == "OPENCV_FISHEYE" || model == "SIMPLE_RADIAL_FISHEYE" || model == "RADIAL_FISHEYE") {
+    camera.model = CameraModel::kFisheye;
+    for (size_t i = 0; i < p.size() - first; ++i) k[i] = coefficient(first + i);  // k1 (k2 (k3 k4))
+  }
+  try {
+    validate(camera);
+  } catch (const std::invalid_argument& error) {
+    throw SceneError(camera_where + ": " + error.what());
+  }
+}
+
 CameraView to_view(const ColmapImage& image, const std::map<int, ColmapCamera>& cameras,
                    const fs::path& images_file, const fs::path& cameras_file) {
   const std::string where =
@@ -228,10 +272,6 @@ CameraView to_view(const ColmapImage& image, const std::map<int, ColmapCamera>& 
                      cameras_file.filename().string());
   const ColmapCamera& source = found->second;
   const std::string camera_where = cameras_file.string() + ": camera " + std::to_string(image.camera_id);
-  if (source.model != "PINHOLE" && source.model != "SIMPLE_PINHOLE")
-    throw SceneError(camera_where + " uses the " + source.model +
-                     " model, whose lens distortion the renderer cannot honour: undistort the model to "
-                     "PINHOLE first (colmap image_undistorter)");
   if (source.width < 1 || source.height < 1 || source.width > (1u << 20) || source.height > (1u << 20))
     throw SceneError(camera_where + ": image size " + std::to_string(source.width) + "x" +
                      std::to_string(source.height) + " is impossible");
@@ -242,14 +282,7 @@ CameraView to_view(const ColmapImage& image, const std::map<int, ColmapCamera>& 
   Camera& camera = view.camera;
   camera.width = static_cast<int>(source.width);
   camera.height = static_cast<int>(source.height);
-  const auto& p = source.params;
-  const bool simple = source.model == "SIMPLE_PINHOLE";
-  camera.fx = finite(p[0], cameras_file.string(), "a focal length");
-  camera.fy = simple ? camera.fx : finite(p[1], cameras_file.string(), "a focal length");
-  camera.cx = finite(p[simple ? 1 : 2], cameras_file.string(), "a principal point");
-  camera.cy = finite(p[simple ? 2 : 3], cameras_file.string(), "a principal point");
-  if (!(camera.fx > 0 && camera.fy > 0)) throw SceneError(camera_where + ": focal lengths must be positive");
-
+  set_intrinsics(camera, source, camera_where, cameras_file);
   std::array<double, 4> q = image.q;
   const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   if (!std::isfinite(norm) || !(norm > 1e-6))

@@ -53,18 +53,48 @@ int image_dimension(const FrameFields& fields, const char* name) {
   return static_cast<int>(*value);
 }
 
+// nerfstudio's camera models: PINHOLE; OPENCV (k1 k2 k3 p1 p2, and the pinhole's default when the
+// file names no model) as CameraModel::kOpenCV; OPENCV_FISHEYE (k1..k4) as kFisheye. nerfstudio's k4 of
+// OPENCV is a radial r^8 term, which OpenCV's model (a rational k4) does not have: refused unless 0.
+void set_model(Camera& camera, const FrameFields& fields) {
+  const std::string model = fields.text("camera_model").value_or("OPENCV");
+  auto coefficient = [&](const char* name) { return fields.number(name).value_or(0.0); };
+  if (model == "OPENCV_FISHEYE") {
+    camera.model = CameraModel::kFisheye;
+    camera.distortion = {
+        coefficient("k1"), coefficient("k2"), coefficient("k3"), coefficient("k4"), 0, 0, 0, 0};
+    if (coefficient("p1") != 0 || coefficient("p2") != 0)
+      fields.fail("OPENCV_FISHEYE has no tangential distortion, but p1 or p2 is not zero");
+  } else if (model == "OPENCV" || model == "PINHOLE") {
+    if (coefficient("k4") != 0)
+      fields.fail(
+          "k4 of an OPENCV camera is nerfstudio's r^8 term, which the renderer's OpenCV model does "
+          "not have: undistort the images, or give k4 = 0");
+    camera.distortion = {coefficient("k1"),
+                         coefficient("k2"),
+                         coefficient("p1"),
+                         coefficient("p2"),
+                         coefficient("k3"),
+                         0,
+                         0,
+                         0};
+    if (model == "PINHOLE" && camera.distortion != std::array<double, 8>{})
+      fields.fail("camera_model PINHOLE has distortion coefficients: say OPENCV, or give none");
+    const bool distorted = camera.distortion != std::array<double, 8>{};
+    camera.model = distorted ? CameraModel::kOpenCV : CameraModel::kPinhole;
+  } else {
+    fields.fail("camera_model " + model +
+                " is not one the renderer draws (PINHOLE, OPENCV, OPENCV_FISHEYE): undistort the images to "
+                "PINHOLE first");
+  }
+  for (const double k : camera.distortion)
+    if (!std::isfinite(k)) fields.fail("the distortion coefficients must be finite");
+}
+
 CameraView read_frame(const json& top, const json& frame, size_t index, const std::string& file) {
   const std::string where = file + ": frame " + std::to_string(index);
   if (!frame.is_object()) throw SceneError(where + ": must be an object");
   const FrameFields fields(top, frame, where);
-
-  if (const auto model = fields.text("camera_model"); model && *model != "OPENCV" && *model != "PINHOLE")
-    fields.fail("camera_model " + *model + " is not a pinhole camera, which is all the renderer draws");
-  for (const char* coefficient : {"k1", "k2", "k3", "k4", "p1", "p2"})
-    if (const auto value = fields.number(coefficient); value && *value != 0)
-      fields.fail(
-          std::string("distortion coefficient ") + coefficient +
-          " is not zero, and the renderer cannot honour lens distortion (undistort the images first)");
 
   CameraView view;
   view.id = static_cast<int>(index);
@@ -88,6 +118,7 @@ CameraView read_frame(const json& top, const json& frame, size_t index, const st
   if (!(camera.fx > 0 && camera.fy > 0)) fields.fail("focal lengths must be positive");
   camera.cx = fields.number("cx").value_or(camera.width / 2.0);
   camera.cy = fields.number("cy").value_or(camera.height / 2.0);
+  set_model(camera, fields);
 
   const json* matrix = frame.contains("transform_matrix") ? &frame["transform_matrix"] : nullptr;
   if (matrix == nullptr || !matrix->is_array() || matrix->size() < 3)

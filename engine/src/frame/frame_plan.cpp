@@ -161,9 +161,11 @@ std::string choose_sort_strategy(const std::string& requested, const DeviceCaps&
   return device.vendor_id == kVendorNvidia ? "onesweep" : "radix";
 }
 
-ProjectionVariant projection_variant(const RenderSettings& settings, const SceneShape& scene) {
+ProjectionVariant projection_variant(const RenderSettings& settings, const SceneShape& scene,
+                                     CameraModel camera_model) {
   const AccuracyModes& modes = settings.accuracy;
   ProjectionVariant v;
+  v.camera_model = uint32_t(camera_model);
   v.dilation_tenths = settings.antialiasing == Antialiasing::kMip ? 1 : 3;
   v.compensate_opacity = settings.antialiasing != Antialiasing::kClassic;
   v.stored_sh_degree = scene.sh_degree;
@@ -188,6 +190,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
   check_near_plane(settings.near_plane);
   check_max_alpha(settings);
   check_single_frame(settings);
+  check_camera_model(settings, camera);
 
   FramePlan plan;
   plan.sort = context.sort;
@@ -196,7 +199,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
                 settings.antialiasing,    settings.lighting,
                 settings.compositor,      settings.near_plane};
   plan.build_lists = !(settings.reuse_lists && context.lists && *context.lists == plan.lists);
-  plan.projection = projection_variant(settings, context.scene);
+  plan.projection = projection_variant(settings, context.scene, camera.model);
   plan.tiles = tile_grid(camera);
   plan.compositor = settings.compositor;
   plan.depth_key_bits = uint32_t(settings.accuracy.depth_key_bits);

@@ -156,6 +156,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
 FramePlan composite_only(FramePlan plan);
 
 // The projection a frame's accuracy modes and effects call for, on a scene of this shape.
-ProjectionVariant projection_variant(const RenderSettings& settings, const SceneShape& scene);
+ProjectionVariant projection_variant(const RenderSettings& settings, const SceneShape& scene,
+                                     CameraModel camera_model = CameraModel::kPinhole);
 
 }  // namespace tilesplat

@@ -18,7 +18,9 @@
 #include <array>
 #include <climits>
 #include <cstdint>
+#include <cstdio>
 #include <exception>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -114,7 +116,8 @@ void add_camera_attributes(Imf::Header& header, const Camera& camera) {
                                   camera.cx / w, camera.cy / h, 0, 1, 0, 0, 1, 0);
   const Imath::M44d world_to_ndc = world_to_camera * camera_to_ndc;
   Imf::addWorldToCamera(header, Imath::M44f(world_to_camera));
-  Imf::addWorldToNDC(header, Imath::M44f(world_to_ndc));
+  // worldToNDC is a pinhole's matrix: other models' pixels are not a matrix of the point.
+  if (camera.model == CameraModel::kPinhole) Imf::addWorldToNDC(header, Imath::M44f(world_to_ndc));
 
   Imath::M33d rotation;
   for (int r = 0; r < 3; ++r)
@@ -124,6 +127,38 @@ void add_camera_attributes(Imf::Header& header, const Camera& camera) {
                 Imf::V3dAttribute(Imath::V3d(camera.position[0], camera.position[1], camera.position[2])));
   header.insert("tilesplatFocalLength", Imf::V2dAttribute(Imath::V2d(camera.fx, camera.fy)));
   header.insert("tilesplatPrincipalPoint", Imf::V2dAttribute(Imath::V2d(camera.cx, camera.cy)));
+  if (camera.model != CameraModel::kPinhole) {  // a pinhole's header stays as it always was
+    header.insert("tilesplatCameraModel", Imf::StringAttribute(camera_model_name(camera.model)));
+    std::string coefficients;
+    for (const double k : camera.distortion) {
+      char text[32];
+      std::snprintf(text, sizeof(text), "%.17g", k);
+      if (!coefficients.empty()) coefficients += ' ';
+      coefficients += text;
+    }
+    header.insert("tilesplatDistortion", Imf::StringAttribute(coefficients));
+  }
+}
+
+// tilesplatCameraModel and tilesplatDistortion (add_camera_attributes) into `camera`; absent: the pinhole.
+void read_camera_model(const Imf::Header& header, Camera& camera) {
+  const auto* model = header.findTypedAttribute<Imf::StringAttribute>("tilesplatCameraModel");
+  const auto* distortion = header.findTypedAttribute<Imf::StringAttribute>("tilesplatDistortion");
+  if (model == nullptr && distortion == nullptr) return;
+  if (model == nullptr || distortion == nullptr)
+    throw std::runtime_error(
+        "tilesplatCameraModel and tilesplatDistortion come together, and one is missing");
+  try {
+    camera.model = parse_camera_model(model->value());
+  } catch (const std::invalid_argument& error) {
+    throw std::runtime_error(std::string("tilesplatCameraModel: ") + error.what());
+  }
+  std::istringstream words(distortion->value());
+  for (double& k : camera.distortion)
+    if (!(words >> k))
+      throw std::runtime_error("tilesplatDistortion must hold 8 numbers, got '" + distortion->value() + "'");
+  std::string extra;
+  if (words >> extra) throw std::runtime_error("tilesplatDistortion holds more than 8 numbers");
 }
 
 Imf::Compression openexr_compression(ExrCompression compression) {
@@ -365,6 +400,7 @@ std::optional<Camera> read_exr_camera(const std::filesystem::path& path) {
     camera.fy = focal->value().y;
     camera.cx = principal->value().x;
     camera.cy = principal->value().y;
+    read_camera_model(header, camera);
     try {
       validate(camera);
     } catch (const std::invalid_argument& error) {

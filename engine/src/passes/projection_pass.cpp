@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstring>
 
+#include "camera/camera_models.h"
 #include "lighting.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/reference.h"
@@ -31,6 +32,11 @@ using shader_io::ProjectionPush;
 using PackShPush = shader_io::PackShHalfPush;
 using PackCovariancePush = shader_io::PackCovarianceHalfPush;
 
+// The words projection.comp reads the camera block by (camera_word) must be where C++ writes its fields.
+static_assert(offsetof(CameraParams, clip) == shader_io::CAMERA_CLIP * 8);
+static_assert(offsetof(CameraParams, grid) == shader_io::CAMERA_GRID * 8);
+static_assert(offsetof(CameraParams, distortion) == shader_io::CAMERA_DISTORTION * 8);
+
 }  // namespace
 
 ProjectionPass::ProjectionPass(vk::Context& ctx)
@@ -48,9 +54,12 @@ void ProjectionPass::set_camera(const Camera& camera, double near_plane) {
   p.focal_principal[1] = camera.fy;
   p.focal_principal[2] = camera.cx;
   p.focal_principal[3] = camera.cy;
-  p.clip[0] = 1.3 * camera.tan_half_fov_x();
-  p.clip[1] = 1.3 * camera.tan_half_fov_y();
+  const camera_models::ModelLimits limits = camera_models::model_limits(camera);
+  p.clip[0] = limits.clamp_x;
+  p.clip[1] = limits.clamp_y;
   p.clip[2] = near_plane;
+  p.clip[3] = limits.reach;
+  std::copy(camera.distortion.begin(), camera.distortion.end(), p.distortion);
   p.grid = {uint32_t((camera.width + kTileSize - 1) / kTileSize),
             uint32_t((camera.height + kTileSize - 1) / kTileSize), uint32_t(camera.width),
             uint32_t(camera.height)};
@@ -88,14 +97,20 @@ const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant&
   auto it = pipelines_.find(std::make_pair(v, texel));
   if (it == pipelines_.end()) {
     const uint32_t stored_coeffs = uint32_t((v.stored_sh_degree + 1) * (v.stored_sh_degree + 1));
-    const std::vector<vk::SpecConstant> spec = {
-        {0, uint32_t(v.sh_degree)},         {1, stored_coeffs},
-        {2, v.sh_half},                     {3, v.covariance_half},
-        {4, v.opacity_extent},              {5, v.square_tiles},
-        {6, std::bit_cast<uint32_t>(v.alpha_inv)}, {7, v.depth_key_bits},
-        {8, v.ray_depth},                   {9, v.dilation_tenths},
-        {10, v.compensate_opacity},         {11, v.lighting},
-        {12, v.file_normals}};
+    const std::vector<vk::SpecConstant> spec = {{0, uint32_t(v.sh_degree)},
+                                                {1, stored_coeffs},
+                                                {2, v.sh_half},
+                                                {3, v.covariance_half},
+                                                {4, v.opacity_extent},
+                                                {5, v.square_tiles},
+                                                {6, std::bit_cast<uint32_t>(v.alpha_inv)},
+                                                {7, v.depth_key_bits},
+                                                {8, v.ray_depth},
+                                                {9, v.dilation_tenths},
+                                                {10, v.compensate_opacity},
+                                                {11, v.lighting},
+                                                {12, v.file_normals},
+                                                {13, v.camera_model}};
     const char* shader = texel                            ? "projection_texel"
                          : ctx_.features().shader_float64 ? "projection"
                                                           : "projection_fp32";

@@ -46,6 +46,7 @@ struct ProjectionVariant {
   bool compensate_opacity = false;
   bool lighting = false;      // relighting on (the lights themselves are data: ProjectionPass::set_lighting)
   bool file_normals = false;  // lit, with the scene's normal buffer (else every splat's shortest axis)
+  uint32_t camera_model = 0;  // tilesplat::CameraModel: the pinhole's code alone unless another is asked for
   auto operator<=>(const ProjectionVariant&) const = default;
 };
 

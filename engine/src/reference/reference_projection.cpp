@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "camera/camera_models.h"
 #include "lighting.h"
 #include "settings_checks.h"
 #include "tilesplat/reference.h"
@@ -26,7 +27,6 @@ constexpr double kShC2[5] = {1.0925484305920792, -1.0925484305920792, 0.31539156
 constexpr double kShC3[7] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658, 0.3731763325901154,
                              -0.4570457994644658, 1.445305721320277, -0.5900435899266435};
 
-constexpr double kFrustumClampFactor = 1.3;  // x/z, y/z clamp before the Jacobian, in units of tan(fov/2)
 // The low-pass filter added to every 2D covariance, per antialiasing mode.
 double low_pass_dilation(Antialiasing mode) {
   return mode == Antialiasing::kMip ? 0.1 : 0.3;
@@ -160,14 +160,19 @@ std::array<double, 3> eval_sh(int degree, const float* coeffs, const std::array<
 namespace reference {
 
 ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& camera,
-                          Antialiasing antialiasing, const PreparedLighting& lighting, double near_plane) {
+                          const camera_models::ModelLimits& limits, Antialiasing antialiasing,
+                          const PreparedLighting& lighting, double near_plane) {
   ProjectedGaussian out;
   const std::array<double, 3> mean = {scene.positions[3 * i], scene.positions[3 * i + 1],
                                       scene.positions[3 * i + 2]};
   const std::array<double, 3> t = camera.to_camera(mean);
   out.depth = t[2];
-  // Written as a negated comparison so that a NaN depth is culled too.
-  if (!(t[2] > near_plane) || !all_finite({t[0], t[1], t[2]})) return out;
+  if (camera.model == CameraModel::kPinhole) {
+    // Written as a negated comparison so that a NaN depth is culled too.
+    if (!(t[2] > near_plane) || !all_finite({t[0], t[1], t[2]})) return out;
+  } else if (!all_finite({t[0], t[1], t[2]})) {
+    return out;
+  }
 
   // Scales are float32 values: a log scale whose exp overflows a float is an infinite scale (the GPU
   // evaluates exp in float32), and an infinite scale has no usable covariance.
@@ -175,20 +180,39 @@ ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& ca
     if (!(std::exp(double(scene.log_scales[3 * i + size_t(axis)])) <= kFloatMax)) return out;
   const std::array<double, 9> sigma = covariance3d(&scene.log_scales[3 * i], &scene.rotations[4 * i]);
 
-  // The Jacobian is evaluated at a point clamped to 1.3x the field of view so that splats far
-  // outside the frame do not get absurdly stretched footprints; the mean itself is not clamped.
-  const double limit_x = kFrustumClampFactor * camera.tan_half_fov_x();
-  const double limit_y = kFrustumClampFactor * camera.tan_half_fov_y();
-  const double tz = t[2];
-  const double tx = std::clamp(t[0] / tz, -limit_x, limit_x) * tz;
-  const double ty = std::clamp(t[1] / tz, -limit_y, limit_y) * tz;
-  const double j00 = camera.fx / tz, j02 = -camera.fx * tx / (tz * tz);
-  const double j11 = camera.fy / tz, j12 = -camera.fy * ty / (tz * tz);
-
-  // T = J W (2x3).
+  // T = J W (2x3), J the projection's Jacobian at the centre.
   const auto& w = camera.rotation;
-  const double t0[3] = {j00 * w[0] + j02 * w[6], j00 * w[1] + j02 * w[7], j00 * w[2] + j02 * w[8]};
-  const double t1[3] = {j11 * w[3] + j12 * w[6], j11 * w[4] + j12 * w[7], j11 * w[5] + j12 * w[8]};
+  double t0[3], t1[3];
+  if (camera.model == CameraModel::kPinhole) {
+    // The Jacobian is evaluated at a point clamped to 1.3x the field of view so that splats far
+    // outside the frame do not get absurdly stretched footprints; the mean itself is not clamped.
+    const double limit_x = limits.clamp_x;
+    const double limit_y = limits.clamp_y;
+    const double tz = t[2];
+    const double tx = std::clamp(t[0] / tz, -limit_x, limit_x) * tz;
+    const double ty = std::clamp(t[1] / tz, -limit_y, limit_y) * tz;
+    const double j00 = camera.fx / tz, j02 = -camera.fx * tx / (tz * tz);
+    const double j11 = camera.fy / tz, j12 = -camera.fy * ty / (tz * tz);
+    for (size_t k = 0; k < 3; ++k) {
+      t0[k] = j00 * w[k] + j02 * w[6 + k];
+      t1[k] = j11 * w[3 + k] + j12 * w[6 + k];
+    }
+    out.mean[0] = camera.fx * t[0] / tz + camera.cx;
+    out.mean[1] = camera.fy * t[1] / tz + camera.cy;
+  } else {  // the other models' centre and Jacobian (camera_models.cpp)
+    const camera_models::CentreProjection centre =
+        camera_models::project_centre(camera, limits, t, near_plane);
+    out.depth = centre.depth;
+    if (!centre.visible) return out;
+    const auto& ju = centre.jacobian_u;
+    const auto& jv = centre.jacobian_v;
+    for (size_t k = 0; k < 3; ++k) {
+      t0[k] = ju[0] * w[k] + ju[1] * w[3 + k] + ju[2] * w[6 + k];
+      t1[k] = jv[0] * w[k] + jv[1] * w[3 + k] + jv[2] * w[6 + k];
+    }
+    out.mean[0] = centre.pixel[0];
+    out.mean[1] = centre.pixel[1];
+  }
   double sigma_t0[3], sigma_t1[3];
   for (size_t r = 0; r < 3; ++r) {
     sigma_t0[r] = sigma[r * 3] * t0[0] + sigma[r * 3 + 1] * t0[1] + sigma[r * 3 + 2] * t0[2];
@@ -203,8 +227,6 @@ ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& ca
   out.cov2d[0] = a;
   out.cov2d[1] = b;
   out.cov2d[2] = c;
-  out.mean[0] = camera.fx * t[0] / tz + camera.cx;
-  out.mean[1] = camera.fy * t[1] / tz + camera.cy;
 
   const double det = a * c - b * b;
   // The composite works in float32 relative to the mean: a mean beyond the float range is culled.
@@ -238,8 +260,10 @@ ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& ca
   // The filtered footprint is larger than the splat; these modes keep its integral (its energy).
   if (antialiasing != Antialiasing::kClassic)
     out.opacity *= std::sqrt(std::max(2.5e-5, std::max(0.0, a0 * c0 - b * b) / det));
+  // The SH are seen along the ray from the camera; an orthographic camera's rays are all its axis.
   std::array<double, 3> dir = {mean[0] - camera.position[0], mean[1] - camera.position[1],
                                mean[2] - camera.position[2]};
+  if (camera.model == CameraModel::kOrthographic) dir = {w[6], w[7], w[8]};
   const double dir_length = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
   if (dir_length > 0)
     for (double& d : dir) d /= dir_length;
@@ -273,7 +297,9 @@ ProjectedGaussian project_gaussian(const GaussianScene& scene, size_t i, const C
   if (i >= scene.size()) throw std::out_of_range("project_gaussian: index out of range");
   check_near_plane(near_plane);
   if (lighting.enabled()) reference::check_normals(scene);
-  return reference::project(scene, i, camera, antialiasing, prepare_lighting(lighting), near_plane);
+  validate(camera);
+  return reference::project(scene, i, camera, camera_models::model_limits(camera), antialiasing,
+                            prepare_lighting(lighting), near_plane);
 }
 
 }  // namespace tilesplat

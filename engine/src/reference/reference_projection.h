@@ -4,14 +4,17 @@
 
 #include <cstddef>
 
+#include "camera/camera_models.h"
 #include "lighting.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat::reference {
 
-// project_gaussian, the lights already prepared (prepare_lighting, lighting.h).
+// project_gaussian, the camera's limits (camera_models::model_limits) and the lights (prepare_lighting,
+// lighting.h) already prepared once for the frame.
 ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& camera,
-                          Antialiasing antialiasing, const PreparedLighting& lighting, double near_plane);
+                          const camera_models::ModelLimits& limits, Antialiasing antialiasing,
+                          const PreparedLighting& lighting, double near_plane);
 // Throws std::invalid_argument for a near plane that is not finite and positive (as the GPU's plan does).
 // Throws std::invalid_argument when the scene has normals but not 3 per Gaussian.
 void check_normals(const GaussianScene& scene);

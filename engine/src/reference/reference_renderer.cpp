@@ -89,6 +89,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
   check_near_plane(settings.near_plane);
   check_max_alpha(settings);
   check_single_frame(settings);
+  check_camera_model(settings, camera);
   // A host's surfaces, as view depths: a splat blends only in front of them (RenderSettings::host).
   const std::vector<float> host_z = settings.host ? host_view_depths(*settings.host) : std::vector<float>{};
   const bool surface_out = settings.host && settings.host->write_depth;
@@ -98,12 +99,13 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
 
   const PreparedLighting lighting = prepare_lighting(settings.lighting);  // validates
   if (settings.lighting.enabled()) reference::check_normals(scene);
+  const camera_models::ModelLimits limits = camera_models::model_limits(camera);
 
   std::vector<ProjectedGaussian> projected(n);
   parallel_chunks(n, 4096, [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i)
       projected[i] =
-          reference::project(scene, i, camera, settings.antialiasing, lighting, settings.near_plane);
+          reference::project(scene, i, camera, limits, settings.antialiasing, lighting, settings.near_plane);
   });
 
   // Front to back by the float32 depth the GPU sorts on, ties by Gaussian index.

@@ -41,8 +41,9 @@ constexpr auto kTopKeys = std::to_array<std::string_view>({"$schema", "version",
                                                       "background", "effects", "outputs"});
 constexpr auto kModelKeys = std::to_array<std::string_view>({"path", "translation", "rotation_deg",
                                                         "quaternion", "scale", "z_up"});
-constexpr auto kCameraKeys = std::to_array<std::string_view>({"name", "width", "height", "fx", "fy",
-                                                          "cx", "cy", "position", "rotation", "look_at"});
+constexpr auto kCameraKeys =
+    std::to_array<std::string_view>({"name", "width", "height", "fx", "fy", "cx", "cy", "position",
+                                     "rotation", "look_at", "model", "distortion", "view_height"});
 constexpr auto kLookAtKeys = std::to_array<std::string_view>({"eye", "target", "up", "fov_deg"});
 constexpr auto kEffectKeys = std::to_array<std::string_view>({"sh_degree", "view_dependent", "antialiasing",
                                                          "lights", "ambient", "exposure", "tone_map"});
@@ -145,7 +146,10 @@ std::array<double, 9> read_camera_rotation(const Reader& reader, const Node& nod
   return m;
 }
 
-Camera read_look_at(const Reader& reader, const Node& node, int width, int height) {
+// A look_at camera (a pinhole). A fisheye's field of view (`fisheye_fov`, set for model "fisheye") may
+// reach 360 degrees; the pinhole returned then has a 50-degree one, for fisheye_camera() to replace.
+Camera read_look_at(const Reader& reader, const Node& node, int width, int height,
+                    double* fisheye_fov = nullptr) {
   reader.expect_object(node, kLookAtKeys);
   const auto eye = reader.numbers<3>(reader.required_child(node, "eye", "the camera centre [x, y, z]"),
                                      -kMaxCoordinate, kMaxCoordinate);
@@ -155,7 +159,14 @@ Camera read_look_at(const Reader& reader, const Node& node, int width, int heigh
   const auto up_node = reader.optional_child(node, "up");
   if (up_node) up = reader.nonzero_vector(*up_node);
   double fov = kDefaultFovDeg;
-  if (const auto fov_node = reader.optional_child(node, "fov_deg")) {
+  if (fisheye_fov != nullptr) {
+    *fisheye_fov = kDefaultFovDeg;
+    if (const auto fov_node = reader.optional_child(node, "fov_deg")) {
+      *fisheye_fov = reader.number(*fov_node, 0, 360);
+      if (!(*fisheye_fov > 0))
+        reader.fail(fov_node->path, "a fisheye's field of view must be above 0 and at most 360 degrees");
+    }
+  } else if (const auto fov_node = reader.optional_child(node, "fov_deg")) {
     fov = reader.number(*fov_node, 0, 180);
     if (!(fov > 0 && fov < 180))
       reader.fail(fov_node->path, "must be strictly between 0 and 180 degrees, got " + format_number(fov));
@@ -190,6 +201,48 @@ Camera read_pinhole(const Reader& reader, const Node& node, int width, int heigh
   return camera;
 }
 
+// "model": the camera's model (CameraModel); pinhole when absent.
+CameraModel read_model_name(const Reader& reader, const Node& node) {
+  const auto model_node = reader.optional_child(node, "model");
+  if (!model_node) return CameraModel::kPinhole;
+  return parse_camera_model(std::string(reader.choice(
+      *model_node, std::to_array<std::string_view>({"pinhole", "opencv", "fisheye", "orthographic"}))));
+}
+
+// "distortion" and "view_height" of a camera of `model`: its coefficients in OpenCV's order (k1 k2 p1 p2
+// k3 k4 k5 k6; a fisheye's k1..k4; missing ones are 0), and an orthographic look_at camera's height in
+// world units. `fisheye_fov`: a look_at fisheye's field of view across the shorter side.
+void read_model(const Reader& reader, const Node& node, CameraModel model, bool look_at, double fisheye_fov,
+                Camera& camera) {
+  const auto distortion = reader.optional_child(node, "distortion");
+  const auto view_height = reader.optional_child(node, "view_height");
+  const size_t coefficients = model == CameraModel::kOpenCV ? 8 : model == CameraModel::kFisheye ? 4 : 0;
+  if (look_at && model == CameraModel::kOpenCV)
+    reader.fail(node.path,
+                "an OpenCV camera's distortion is in units of its focal length: give fx and fy "
+                "instead of 'look_at'");
+  if (view_height && !(look_at && model == CameraModel::kOrthographic))
+    reader.fail(view_height->path,
+                "belongs to an orthographic camera with 'look_at' (with fx and fy, an "
+                "orthographic camera's scale is in pixels per world unit)");
+  if (look_at && model == CameraModel::kOrthographic && !view_height)
+    reader.fail(node.path,
+                "an orthographic 'look_at' camera needs 'view_height' (its height in world units)");
+  if (look_at && model == CameraModel::kFisheye) camera = fisheye_camera(camera, fisheye_fov);
+  if (look_at && model == CameraModel::kOrthographic)
+    camera = orthographic_camera(camera, reader.positive(*view_height, kMaxCoordinate));
+  camera.model = model;
+  if (distortion) {
+    const json& values = reader.array(*distortion, "the distortion coefficients");
+    if (values.size() > coefficients)
+      reader.fail(distortion->path, "the " + std::string(camera_model_name(model)) + " camera has " +
+                                        std::to_string(coefficients) + " distortion coefficients, got " +
+                                        std::to_string(values.size()));
+    for (size_t i = 0; i < values.size(); ++i)
+      camera.distortion[i] = reader.number(Node{values[i], element_path(distortion->path, i)}, -1e6, 1e6);
+  }
+}
+
 CameraView read_camera(const Reader& reader, const Node& node, size_t index) {
   reader.expect_object(node, kCameraKeys);
   CameraView view;
@@ -198,14 +251,19 @@ CameraView read_camera(const Reader& reader, const Node& node, size_t index) {
   const int width = reader.integer(reader.required_child(node, "width", "the image width in pixels"), 1, kMaxImageSide);
   const int height =
       reader.integer(reader.required_child(node, "height", "the image height in pixels"), 1, kMaxImageSide);
-  if (const auto look_at = reader.optional_child(node, "look_at")) {
+  const auto look_at = reader.optional_child(node, "look_at");
+  const CameraModel model = read_model_name(reader, node);
+  double fisheye_fov = kDefaultFovDeg;
+  if (look_at) {
     for (const char* key : {"fx", "fy", "cx", "cy", "position", "rotation"})
       if (const auto conflict = reader.optional_child(node, key))
         reader.fail(conflict->path, "not allowed with 'look_at', which sets the pose and the focal length");
-    view.camera = read_look_at(reader, *look_at, width, height);
+    view.camera = read_look_at(reader, *look_at, width, height,
+                               model == CameraModel::kFisheye ? &fisheye_fov : nullptr);
   } else {
     view.camera = read_pinhole(reader, node, width, height);
   }
+  read_model(reader, node, model, look_at.has_value(), fisheye_fov, view.camera);
   return view;
 }
 

@@ -1,0 +1,58 @@
+// The camera models' math (tilesplat::CameraModel) in float64, written once on the host: the reference
+// projects every splat centre with it, and the GPU's projection (compute/projection.comp,
+// project_centre) mirrors it operation for operation with the limits the host derives here.
+#pragma once
+
+#include <array>
+
+#include "tilesplat/camera.h"
+
+namespace tilesplat::camera_models {
+
+// Where a model stops drawing and where its Jacobian is evaluated at most: derived once per camera,
+// given to the GPU in CameraParams::clip.
+struct ModelLimits {
+  // Pinhole and OpenCV: the Jacobian is evaluated at (x / z, y / z) clamped to these, 1.3 times the
+  // image's extent in undistorted coordinates (the trainer's rule, which keeps splats far outside the
+  // frame from getting absurd footprints).
+  double clamp_x = 0;
+  double clamp_y = 0;
+  // OpenCV: the undistorted radius sqrt((x/z)^2 + (y/z)^2) from which the radial distortion folds back
+  // (d(r radial(r)) / dr <= 0); fisheye: the angle from the axis from which theta_d stops growing, at
+  // most pi. Centres at or beyond it are not drawn. Infinite where nothing folds.
+  double reach = 0;
+};
+ModelLimits model_limits(const Camera& camera);
+
+// A splat centre t (camera space) through the camera's model.
+struct CentreProjection {
+  bool visible = false;                // false: culled (behind the near plane, beyond the reach, ...)
+  std::array<double, 2> pixel{};       // where the centre lands
+  std::array<double, 3> jacobian_u{};  // d pixel.x / d t
+  std::array<double, 3> jacobian_v{};  // d pixel.y / d t
+  double depth = 0;                    // what splats sort by and depth images hold: z, or the distance
+};
+// For every model but the pinhole, whose projection the reference keeps written out in its own words.
+CentreProjection project_centre(const Camera& camera, const ModelLimits& limits,
+                                const std::array<double, 3>& t, double near_plane);
+
+// OpenCV's distortion of the normalized point (x, y) = (X / Z, Y / Z), and its 2x2 Jacobian (row-major).
+struct Distorted {
+  std::array<double, 2> point{};
+  std::array<double, 4> jacobian{};
+};
+Distorted distort(const std::array<double, 8>& k, double x, double y);
+
+// The fisheye's theta_d(theta) and its derivative.
+std::array<double, 2> fisheye_theta_d(const std::array<double, 8>& k, double theta);
+
+// The pixel of a camera-space point, for any model (the mean of project_centre, and the pinhole's
+// fx x / z + cx); visible = false where the model draws nothing.
+CentreProjection project_point(const Camera& camera, const std::array<double, 3>& t);
+
+// The camera-space unit ray through image point (u, v) (pixel coordinates, centres at +0.5), for any
+// model; nullopt-like false where no ray maps there (outside a fisheye's reach, past OpenCV's fold).
+// Used by tests and by tools that resample one model's image into another's.
+bool pixel_ray(const Camera& camera, double u, double v, std::array<double, 3>& ray);
+
+}  // namespace tilesplat::camera_models
