@@ -54,10 +54,14 @@ layout(constant_id = 10) const bool COMPENSATE_OPACITY = false;
 // splat uses its shortest axis. The lights are data, not constants: changing them rebuilds nothing.
 layout(constant_id = 11) const bool LIGHTING = false;
 layout(constant_id = 12) const bool FILE_NORMALS = false;
-// The camera model (tilesplat::CameraModel): 0 pinhole, 1 OpenCV, 2 fisheye, 3 orthographic. The
-// pinhole's code is the only code of the default pipeline.
+// The camera model (tilesplat::CameraModel): 0 pinhole, 1 OpenCV, 2 fisheye, 3 orthographic, 4
+// equirectangular. The pinhole's code is the only code of the default pipeline.
 layout(constant_id = 13) const uint CAMERA_MODEL = 0;
-const uint MODEL_PINHOLE = 0, MODEL_OPENCV = 1, MODEL_FISHEYE = 2, MODEL_ORTHOGRAPHIC = 3;
+const uint MODEL_PINHOLE = 0, MODEL_OPENCV = 1, MODEL_FISHEYE = 2, MODEL_ORTHOGRAPHIC = 3, MODEL_EQUIRECTANGULAR = 4;
+// Records per Gaussian (camera_models::seam_copies): the equirectangular camera draws a splat a second
+// time a period to the side, so that one across the +-180 degree seam shows on both edges. Gaussian i's
+// records are i and count + i.
+const uint SEAM_COPIES = CAMERA_MODEL == MODEL_EQUIRECTANGULAR ? 2u : 1u;
 
 // CameraParams and LightParams, the blocks the host writes for this pass, are in shader_io.h.
 
@@ -235,13 +239,19 @@ real atan_unit(real a) {
   for (int k = 10; k >= 0; --k) series = series * a2 + real((k % 2 == 0 ? 1.0 : -1.0) / double(2 * k + 1));
   return offset + 2.0 * a * series;
 }
-// atan2(y, x) for y >= 0 (an angle from the optical axis: y a radius, x the depth), in [0, pi].
+// atan2(y, x) in [-pi, pi], as C's (atan2(0, x) = 0 for x >= 0; the sign of a zero y is not kept).
 real atan2_real(real y, real x) {
   const real PI = 3.141592653589793LF;
-  if (x == 0.0) return y > 0.0 ? 0.5 * PI : 0.0;
-  real ratio = y / abs(x);
-  real angle = ratio <= 1.0 ? atan_unit(ratio) : 0.5 * PI - atan_unit(abs(x) / y);
-  return x > 0.0 ? angle : PI - angle;
+  real ay = abs(y);
+  real angle;
+  if (x == 0.0) {
+    angle = ay > 0.0 ? 0.5 * PI : 0.0;
+  } else {
+    real ratio = ay / abs(x);
+    angle = ratio <= 1.0 ? atan_unit(ratio) : 0.5 * PI - atan_unit(abs(x) / ay);
+    if (x < 0.0) angle = PI - angle;
+  }
+  return y < 0.0 ? -angle : angle;
 }
 #endif
 
@@ -268,8 +278,8 @@ real2 distort(real2 p, out realmat2 d) {
 
 // A splat centre t through the camera models other than the pinhole (camera_models.cpp,
 // project_centre, in the same operations): its pixel, the rows of d pixel / d t, and the depth it
-// sorts by. False: not drawn.
-bool project_centre(real3 t, out real2 mean, out real3 j0, out real3 j1, out real depth) {
+// sorts by. `seam_copy` 1: the equirectangular camera's second record. False: not drawn.
+bool project_centre(real3 t, uint seam_copy, out real2 mean, out real3 j0, out real3 j1, out real depth) {
   real fx = to_real(camera_word(CAMERA_FOCAL)), fy = to_real(camera_word(CAMERA_FOCAL + 1));
   real cx = to_real(camera_word(CAMERA_FOCAL + 2)), cy = to_real(camera_word(CAMERA_FOCAL + 3));
   real near_plane = to_real(camera_word(CAMERA_CLIP + 2));
@@ -325,6 +335,22 @@ bool project_centre(real3 t, out real2 mean, out real3 j0, out real3 j1, out rea
     depth = rho;
     return true;
   }
+  if (CAMERA_MODEL == MODEL_EQUIRECTANGULAR) {
+    real q2 = x * x + z * z;
+    real rho2 = q2 + y * y;
+    real rho = sqrt(rho2);
+    if (!(rho > near_plane) || !(q2 > 0.0)) return false;
+    real q = sqrt(q2);
+    const real TWO_PI = real(6.283185307179586LF);
+    real longitude = atan2_real(x, z);
+    if (seam_copy == 1) longitude += longitude < 0.0 ? TWO_PI : -TWO_PI;
+    mean = real2(fx * longitude + cx, fy * atan2_real(y, q) + cy);
+    j0 = real3(fx * z / q2, 0.0, -fx * x / q2);
+    real across = fy / (q * rho2);
+    j1 = real3(-across * x * y, fy * q / rho2, -across * y * z);
+    depth = rho;
+    return true;
+  }
   // MODEL_ORTHOGRAPHIC
   if (!(z > near_plane)) return false;
   mean = real2(fx * x + cx, fy * y + cy);
@@ -333,8 +359,8 @@ bool project_centre(real3 t, out real2 mean, out real3 j0, out real3 j1, out rea
   return true;
 }
 
-// Returns the tiles touched (0 = culled) and fills the splat record.
-uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
+// Returns the tiles touched (0 = culled) and fills the splat record of Gaussian i's copy `seam_copy`.
+uint project(uint i, uint seam_copy, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
   real3 world = real3(position_of(i));
   real3 rel = world - real3(to_real(camera_word(CAMERA_CENTRE)), to_real(camera_word(CAMERA_CENTRE + 1)), to_real(camera_word(CAMERA_CENTRE + 2)));
   realmat3 W;  // column-major: W[c][r] = rotation[r][c]
@@ -377,7 +403,7 @@ uint project(uint i, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
     j0 = real3(fx * inv_z, 0.0, -fx * tx * inv_z * inv_z);
     j1 = real3(0.0, fy * inv_z, -fy * ty * inv_z * inv_z);
     mean = real2(fx * t.x * inv_z + cx, fy * t.y * inv_z + cy);
-  } else if (!project_centre(t, mean, j0, j1, depth)) {
+  } else if (!project_centre(t, seam_copy, mean, j0, j1, depth)) {
     return 0;
   }
   real a, b, c, det;
@@ -482,21 +508,23 @@ void count_pairs(uint touched) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  uint j = gl_GlobalInvocationID.x;  // the record: Gaussian i's copy seam_copy
   uint touched = 0;
   uint depth_near = 0xffffffffu, depth_far = 0u;
-  if (i < pc.count) {
+  if (j < pc.count * SEAM_COPIES) {
+    uint seam_copy = j < pc.count ? 0u : 1u;
+    uint i = j - seam_copy * pc.count;
     vec4 record[SPLAT_VEC4S];
     uvec2 rect;
-    touched = project(i, record, rect);
-    write_projected(i, record, rect, touched > 0);
-    write_tile_count(i, touched);
+    touched = project(i, seam_copy, record, rect);
+    write_projected(j, record, rect, touched > 0);
+    write_tile_count(j, touched);
     // View depth > near > 0, so its IEEE bits order like unsigned integers; their top 24 bits too.
     // 16-bit keys are made by depth_quantize.comp once the visible range is known: here the float
     // bits. Culled Gaussians touch no tile; they sort last only to keep the visible ones together.
     uint depth_bits = floatBitsToUint(record[0].z);
     uint key = DEPTH_KEY_BITS == 24 ? depth_bits >> 8 : depth_bits;
-    write_depth_pair(i, touched > 0 ? key : (DEPTH_KEY_BITS == 24 ? 0xffffffu : 0xffffffffu));
+    write_depth_pair(j, touched > 0 ? key : (DEPTH_KEY_BITS == 24 ? 0xffffffu : 0xffffffffu));
     depth_near = touched > 0 ? depth_bits : 0xffffffffu;
     depth_far = touched > 0 ? depth_bits : 0u;
   }

@@ -126,8 +126,13 @@ class CameraModels : public ::testing::Test {
 }  // namespace
 
 TEST_F(CameraModels, EachMatchesTheFloat64Reference) {
+  Camera inside = pinhole_;  // a panorama from the scene's centre, 2:1
+  inside.width = 256;
+  inside.height = 128;
+  const Bounds bounds = compute_bounds(scene_);
+  inside.position = {bounds.center[0], bounds.center[1] - 0.3, bounds.center[2]};
   const Camera cameras[] = {opencv_camera(pinhole_), fisheye_camera(pinhole_, 190),
-                            orthographic_camera(pinhole_, 3.0)};
+                            orthographic_camera(pinhole_, 3.0), equirectangular_camera(inside)};
   for (const Camera& camera : cameras) {
     const RenderImage gpu = renderer_->render(camera);
     const RenderImage reference = render_reference(scene_, camera);
@@ -289,6 +294,95 @@ TEST_F(CameraModels, OrthographicIsTheLimitOfAFarTelephoto) {
   const RenderImage reference = render_reference(scene_, inside);
   tilesplat::testing::expect_matches_reference(all_around, reference, 2e-3, "fisheye 360 from inside");
   EXPECT_EQ(renderer_->validation_messages(), 0u);
+}
+
+TEST(CameraModelResampling, AnEquirectangularCentreIsThePinholeImageResampled) {
+  const GaussianScene blobs = separated_blobs(600, 0.08);
+  Renderer& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(blobs);
+  const Camera panorama = equirectangular_camera(tilesplat::testing::axis_camera(512, 256, 100));
+  const Camera pinhole = tilesplat::testing::axis_camera(600, 600, 2 * panorama.fx);  // +-57 degrees
+  const RenderImage wide = renderer.render(panorama);
+  const RenderImage narrow = renderer.render(pinhole);
+  int compared = 0;
+  auto within_45 = [](const Camera& camera) {
+    return [camera](double u, double v, std::array<double, 3>& ray) {
+      const double longitude = (u - camera.cx) / camera.fx, latitude = (v - camera.cy) / camera.fy;
+      if (std::abs(longitude) > std::numbers::pi / 4 || std::abs(latitude) > std::numbers::pi / 4)
+        return false;
+      ray = {std::cos(latitude) * std::sin(longitude), std::sin(latitude),
+             std::cos(latitude) * std::cos(longitude)};
+      return true;
+    };
+  };
+  const double psnr = resampled_psnr(wide, narrow, pinhole, within_45(panorama), &compared);
+  std::printf(
+      "[ measure  ] equirectangular within 45 deg of its axis against the pinhole resampled, %d pixels: "
+      "PSNR %.1f dB\n",
+      compared, psnr);
+  EXPECT_GT(compared, 8000);
+  EXPECT_GE(psnr, 35.0);
+  Camera wrong = panorama;  // a panorama read with the latitude's scale off by 5%
+  wrong.fy *= 1.05;
+  const double wrong_psnr = resampled_psnr(wide, narrow, pinhole, within_45(wrong), &compared);
+  std::printf("[ measure  ] the same read with a latitude scale 5%% off: PSNR %.1f dB\n", wrong_psnr);
+  EXPECT_LT(wrong_psnr, psnr - 6.0);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(CameraModelSeam, ASplatBehindAPanoramaShowsOnBothEdges) {
+  GaussianScene scene;
+  scene.positions = {0.3f, 0, -5};  // a little off straight behind: its centre just inside the right edge
+  scene.log_scales = {std::log(0.4f), std::log(0.4f), std::log(0.4f)};
+  scene.rotations = {1, 0, 0, 0};
+  scene.opacity_logits = {4};
+  scene.sh = {1, 1, 1};
+  const Camera panorama = equirectangular_camera(tilesplat::testing::axis_camera(256, 128, 100));
+  Renderer& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(scene);
+  const RenderImage image = renderer.render(panorama);
+  const size_t row = 64;
+  const float left = image.rgba[4 * (row * 256 + 0) + 3], right = image.rgba[4 * (row * 256 + 255) + 3];
+  EXPECT_GT(left, 0.3f);  // the splat is cut by neither edge: both hold it
+  EXPECT_GT(right, 0.3f);
+  // Across the seam the image is what the panorama turned half a turn shows in its middle: column
+  // 128 + k there is column k here (mod 256).
+  Camera turned = panorama;
+  turned.rotation = {-1, 0, 0, 0, 1, 0, 0, 0, -1};
+  const RenderImage middle = renderer.render(turned);
+  for (int k = -12; k < 12; ++k) {
+    const size_t here = row * 256 + size_t((k + 256) % 256), there = row * 256 + size_t(128 + k);
+    for (int c = 0; c < 4; ++c)
+      EXPECT_NEAR(image.rgba[4 * here + c], middle.rgba[4 * there + c], 1e-4) << "column offset " << k;
+  }
+  tilesplat::testing::expect_matches_reference(image, render_reference(scene, panorama), 2e-3, "seam");
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+TEST(CameraModelChecks, ProjectAndRayDirectionAreInverses) {
+  Camera base = look_at_camera({0.3, -1.2, -4.0}, {0.1, 0.2, 0.3}, {0, -1, 0}, 640, 480, 60.0);
+  Camera opencv = base;
+  opencv.model = CameraModel::kOpenCV;
+  opencv.distortion = {-0.2, 0.05, 0.001, -0.002, 0, 0, 0, 0};
+  for (const Camera& camera : {base, opencv, fisheye_camera(base, 250), equirectangular_camera(base)}) {
+    for (const auto& [u, v] : {std::pair{320.0, 240.0}, {100.5, 120.25}, {600.0, 400.0}}) {
+      const auto ray = camera.ray_direction(u, v);
+      ASSERT_TRUE(ray.has_value()) << camera_model_name(camera.model);
+      const std::array<double, 3> point = {camera.position[0] + 3 * (*ray)[0],
+                                           camera.position[1] + 3 * (*ray)[1],
+                                           camera.position[2] + 3 * (*ray)[2]};
+      const auto pixel = camera.project(point);
+      ASSERT_TRUE(pixel.has_value()) << camera_model_name(camera.model);
+      EXPECT_NEAR((*pixel)[0], u, 1e-6) << camera_model_name(camera.model);
+      EXPECT_NEAR((*pixel)[1], v, 1e-6) << camera_model_name(camera.model);
+    }
+  }
+  EXPECT_FALSE(base.project({0.3, -1.2, -10.0}).has_value());              // behind the pinhole
+  EXPECT_FALSE(fisheye_camera(base, 250).ray_direction(0, 0).has_value());  // 208 degrees off the axis
+  const Camera orthographic = orthographic_camera(base, 2.0);
+  const auto axis = orthographic.ray_direction(0, 0);
+  ASSERT_TRUE(axis.has_value());
+  for (size_t k = 0; k < 3; ++k) EXPECT_NEAR((*axis)[k], base.rotation[6 + k], 1e-15);
 }
 
 TEST(CameraModelChecks, BadCoefficientsAndUnsupportedCombinationsAreClearErrors) {

@@ -297,9 +297,12 @@ TEST(CameraSets, TransformsJsonReadsAsTheSameCameras) {
             }).find("frame 0: k4 of an OPENCV camera is nerfstudio's r^8 term"),
             std::string::npos);
   std::ofstream(out / "panorama.json") << transforms_json(views, "\"camera_model\": \"EQUIRECTANGULAR\", ");
+  const auto panorama = tilesplat::load_camera_set(out / "panorama.json");
+  EXPECT_EQ(panorama[0].camera, tilesplat::equirectangular_camera(panorama[0].camera));
+  std::ofstream(out / "fov.json") << transforms_json(views, "\"camera_model\": \"FOV\", ");
   EXPECT_NE(tilesplat::testing::error_of([&] {
-              tilesplat::load_camera_set(out / "panorama.json");
-            }).find("camera_model EQUIRECTANGULAR is not one the renderer draws"),
+              tilesplat::load_camera_set(out / "fov.json");
+            }).find("camera_model FOV is not one the renderer draws"),
             std::string::npos);
   std::ofstream(out / "sizeless.json")
       << R"({"fl_x": 500, "frames": [{"transform_matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]})";

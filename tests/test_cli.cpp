@@ -320,9 +320,26 @@ TEST(CliBench, EffectsTableMeasuresEachEffectBesideItsNeverHadItRow) {
       run_exe(kBenchExe, {bundled_sh3().string(), "--effects", "--width", "64", "--height", "36", "--warmup", "1",
                           "--repeat", "1", "--sort", "radix", "--markdown", md.string(), "--csv", csv.string()});
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  for (const char* row : {"base (all off, SH3)", "sh0 ", "sh1 ", "sh2 ", "sh0 [stored SH0]", "lights: 1 directional + 1 point",
-                          "lights off [no normals]", "antialiased", "mip", "+depth", "+splat count",
-                          "stochastic, 1 frame", "stochastic_composite", "tile_binning"})
+  for (const char* row : {"base (all off, SH3)",
+                          "sh0 ",
+                          "sh1 ",
+                          "sh2 ",
+                          "sh0 [stored SH0]",
+                          "lights: 1 directional + 1 point",
+                          "lights off [no normals]",
+                          "antialiased",
+                          "mip",
+                          "+depth",
+                          "+splat count",
+                          "stochastic, 1 frame",
+                          "stochastic_composite",
+                          "tile_binning",
+                          "camera: opencv",
+                          "camera: fisheye, 180 degrees",
+                          "camera: orthographic",
+                          "camera: equirectangular",
+                          "depth of field, 8 lens samples",
+                          "motion blur, 8 time samples"})
     EXPECT_TRUE(contains(result.out, row)) << row << "\n" << result.out;
   // Every row is a whole frame: the projection and both sorts are measured, never skipped.
   for (const char* pass : {"projection", "depth_sort", "tile_sort", "composite"})

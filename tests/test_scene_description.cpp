@@ -488,10 +488,11 @@ TEST(SceneDescription, CamerasHaveModels) {
       {"width": 64, "height": 48, "model": "fisheye", "distortion": [0.05],
        "look_at": {"eye": [0, 0, -3], "target": [0, 0, 0], "fov_deg": 270}},
       {"width": 64, "height": 48, "model": "orthographic", "view_height": 2.5,
-       "look_at": {"eye": [0, 0, -3], "target": [0, 0, 0]}}]})",
+       "look_at": {"eye": [0, 0, -3], "target": [0, 0, 0]}},
+      {"width": 64, "height": 32, "model": "equirectangular", "look_at": {"eye": [0, 0, -3], "target": [0, 0, 0]}}]})",
                                        "$PLY", bundled_sh3().string());
   const SceneDescription d = load_scene_description(write_text(dir / "models.json", text));
-  ASSERT_EQ(d.cameras.size(), 3u);
+  ASSERT_EQ(d.cameras.size(), 4u);
   EXPECT_EQ(d.cameras[0].camera.model, CameraModel::kOpenCV);
   EXPECT_EQ(d.cameras[0].camera.distortion, (std::array<double, 8>{-0.1, 0.02, 0.001, 0, 0, 0, 0, 0}));
   EXPECT_EQ(d.cameras[0].camera.fy, 52);
@@ -500,6 +501,7 @@ TEST(SceneDescription, CamerasHaveModels) {
   EXPECT_NEAR(d.cameras[1].camera.fx, 24 / (135 * std::numbers::pi / 180), 1e-12);  // 270 degrees over 48 px
   EXPECT_EQ(d.cameras[2].camera.model, CameraModel::kOrthographic);
   EXPECT_NEAR(d.cameras[2].camera.fy, 48 / 2.5, 1e-12);
+  EXPECT_EQ(d.cameras[3].camera, equirectangular_camera(d.cameras[3].camera));
 }
 
 TEST(SceneDescription, MalformedJsonGivesLineAndColumn) {

@@ -7,7 +7,9 @@
 #include <numbers>
 
 #include "cli.h"
+#include "tilesplat/lens.h"
 #include "tilesplat/scene_description.h"
+#include "tilesplat/shutter.h"
 
 namespace tilesplat::effects {
 
@@ -157,6 +159,42 @@ std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& bas
     add("host depth in + out (a plane through the scene)", SceneVariant::kScene, [](RenderSettings&) {});
     rows.back().host_plane = true;
   }
+
+  // The camera models, each of the view's pose and size; the per-pixel re-sorting is the pinhole's.
+  if (base.accuracy.resort_window == 0) {
+    const Bounds bounds = compute_bounds(scene);
+    const std::array<double, 3> centre = {bounds.center[0], bounds.center[1], bounds.center[2]};
+    auto camera_row = [&](const std::string& name, std::function<Camera(const Camera&)> camera) {
+      add(name, SceneVariant::kScene, [](RenderSettings&) {});
+      rows.back().camera = std::move(camera);
+    };
+    camera_row("camera: opencv (k1 -0.1, k2 0.02, p1 0.001, p2 -0.001)", [](const Camera& view) {
+      Camera camera = view;
+      camera.model = CameraModel::kOpenCV;
+      camera.distortion = {-0.1, 0.02, 0.001, -0.001, 0, 0, 0, 0};
+      return camera;
+    });
+    camera_row("camera: fisheye, 180 degrees", [](const Camera& view) { return fisheye_camera(view, 180); });
+    camera_row("camera: orthographic, the view's framing", [centre](const Camera& view) {
+      // As tall as the pinhole's view is at the scene's centre.
+      return orthographic_camera(view, 2 * view.to_camera(centre)[2] * view.tan_half_fov_y());
+    });
+    camera_row("camera: equirectangular, 360x180 in the view's size",
+               [](const Camera& view) { return equirectangular_camera(view); });
+    // The averaged frames: 8 samples each, so about 8 frames' time.
+    add("depth of field, 8 lens samples", SceneVariant::kScene, [](RenderSettings&) {});
+    rows.back().for_view = [centre](RenderSettings& settings, const Camera& view) {
+      const double focus = view.to_camera(centre)[2];
+      settings.lens = {.aperture_diameter = 0.05 * focus, .focus_distance = focus, .samples = 8};
+    };
+    add("motion blur, 8 time samples (5 degrees of orbit)", SceneVariant::kScene, [](RenderSettings&) {});
+    rows.back().for_view = [centre](RenderSettings& settings, const Camera& view) {
+      settings.shutter = {.open = 0,
+                          .close = 1,
+                          .samples = 8,
+                          .end_camera = turn_camera(view, centre, {0, -1, 0}, 5 * std::numbers::pi / 180)};
+    };
+  }
   return rows;
 }
 
@@ -199,7 +237,9 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
       settings.reuse_lists = false;  // whole frames: consecutive rows often share the camera and lists
       for (size_t v = 0; v < options.views.size(); ++v) {
         if (rows[r].host_plane) settings.host = HostDepth{bench_depth_convention(), planes[v], true, 0.5f};
-        renderer.render(options.views[v], settings);
+        const Camera view = rows[r].camera ? rows[r].camera(options.views[v]) : options.views[v];
+        if (rows[r].for_view) rows[r].for_view(settings, view);
+        renderer.render(view, settings);
         const FrameStats& stats = renderer.last_frame_stats();
         if (frame == 0 && v == 0) rows[r].device_bytes = stats.device_bytes;
         if (frame >= options.warmup) {

@@ -4,7 +4,9 @@
 // One scene, rendered at the chosen views with one effect changed at a time from a base that has
 // every effect off (the scene's SH degree, classic antialiasing, no lights, colour and alpha only):
 // SH degree 0..3 (a scene below SH3 padded with zero bands for the sh3 row), relighting, the
-// antialiasing modes, the depth and splat-count outputs, and the stochastic compositor. Two rows
+// antialiasing modes, the depth and splat-count outputs, the stochastic compositor, the camera
+// models (each view through OpenCV distortion, a fisheye, an orthographic and an equirectangular
+// camera of its size), and the averaged frames (a thin lens, a shutter). Two rows
 // render a scene that never had the effect (its SH stored at degree 0; its normals removed) next to
 // the row that turns the effect off, so the table shows "off" and "never" side by side. The frames
 // of all rows are interleaved (row after row, repeat after repeat) so that a CPU driver's drifting
@@ -40,6 +42,10 @@ struct Row {
   // Depth-test against a host's plane through the scene (plane_through_scene) and write depth out;
   // settings.host is filled per view.
   bool host_plane = false;
+  // The row's frame of a view: its camera (another model of the view, say) and what its settings need
+  // of the view (a lens focused on the scene's centre, a shutter's end camera). Empty: the view as is.
+  std::function<Camera(const Camera&)> camera;
+  std::function<void(RenderSettings&, const Camera&)> for_view;
   // Measured: medians over the repeats, then over the views.
   double frame_ms = 0;
   std::vector<PassTiming> passes;

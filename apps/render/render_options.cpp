@@ -184,6 +184,10 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                    [&options, positive](const std::string& text) {
                      options.camera_model.view_height = positive("--orthographic", text);
                    });
+  parser.add_switch(
+      "--equirectangular",
+      "the 360x180 panorama around the camera (give a 2:1 size, e.g. --width 2048 --height 1024)",
+      &options.camera_model.equirectangular);
   parser.add_switch("--stats",
                     "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
                     "intersections, retries",
@@ -245,11 +249,13 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
                              {"--png", options.png}});
   if (options.reference && parser.seen("--stochastic"))
     throw cli::UsageError("--stochastic is a GPU compositor; the --reference renderer blends sorted lists");
-  if (options.camera_model.fisheye_fov_deg && options.camera_model.view_height)
-    throw cli::UsageError("--fisheye and --orthographic are two camera models: one of them");
+  if (options.camera_model.given() > 1)
+    throw cli::UsageError("--fisheye, --orthographic and --equirectangular are camera models: one of them");
   if (options.camera_model.enabled() && options.lens.enabled())
     throw cli::UsageError("depth of field (--aperture, --f-stop) needs a pinhole camera, not " +
-                          std::string(options.camera_model.fisheye_fov_deg ? "--fisheye" : "--orthographic"));
+                          std::string(options.camera_model.fisheye_fov_deg ? "--fisheye"
+                                      : options.camera_model.view_height   ? "--orthographic"
+                                                                           : "--equirectangular"));
   if (options.lens.aperture && options.lens.f_stop)
     throw cli::UsageError("--aperture and --f-stop both give the aperture: one of them");
   if (!options.lens.enabled())
@@ -279,6 +285,7 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
 Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera) {
   if (flags.fisheye_fov_deg) return fisheye_camera(camera, *flags.fisheye_fov_deg);
   if (flags.view_height) return orthographic_camera(camera, *flags.view_height);
+  if (flags.equirectangular) return equirectangular_camera(camera);
   return camera;
 }
 

@@ -46,12 +46,14 @@ ThinLens lens_for_frame(const LensFlags& flags, const Camera& camera,
 // renderSettings; empty when off.
 std::string lens_text(const LensFlags& flags);
 
-// --fisheye and --orthographic: every frame's camera (its pose, size and principal point) through
-// another model. Off: the cameras as given, whatever model they have.
+// --fisheye, --orthographic and --equirectangular: every frame's camera (its pose, size and principal point)
+// through another model. Off: the cameras as given, whatever model they have.
 struct CameraModelFlags {
   std::optional<double> fisheye_fov_deg;  // --fisheye DEG: equidistant, DEG across the shorter side
   std::optional<double> view_height;      // --orthographic H: H world units tall
-  bool enabled() const { return fisheye_fov_deg.has_value() || view_height.has_value(); }
+  bool equirectangular = false;           // --equirectangular: the 360x180 panorama
+  int given() const { return fisheye_fov_deg.has_value() + view_height.has_value() + equirectangular; }
+  bool enabled() const { return given() > 0; }
 };
 // The frame's camera through the flags' model (fisheye_camera, orthographic_camera), or as it is.
 Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera);

@@ -281,7 +281,7 @@ void bind(nb::module_& m) {
       .def_prop_rw(
           "model", [](const Camera& c) { return std::string(camera_model_name(c.model)); },
           [](Camera& c, const std::string& name) { c.model = parse_camera_model(name); },
-          "'pinhole', 'opencv', 'fisheye' or 'orthographic' (docs/cameras.md)")
+          "'pinhole', 'opencv', 'fisheye', 'orthographic' or 'equirectangular' (docs/cameras.md)")
       .def_rw("distortion", &Camera::distortion,
               "the model's 8 coefficients: opencv k1 k2 p1 p2 k3 k4 k5 k6, fisheye k1 k2 k3 k4 0 0 0 0")
       .def(

@@ -299,6 +299,9 @@ def test_camera_models(playbot_renderer):
     orthographic = camera.orthographic(3.0)
     assert orthographic.model == "orthographic" and orthographic.fy == pytest.approx(64 / 3.0)
     assert renderer.render(orthographic).rgba[..., 3].max() > 0.5
+    panorama = tilesplat.Camera.orbit(scene, 128, 64, azimuth_deg=30).equirectangular()
+    assert panorama.model == "equirectangular" and panorama.fx == pytest.approx(128 / (2 * np.pi))
+    assert renderer.render(panorama).rgba[..., 3].max() > 0.5
     with pytest.raises(ValueError, match="unknown camera model 'equirect'"):
         camera.model = "equirect"
     bad = camera.fisheye(180)

@@ -64,6 +64,13 @@ constexpr const char* kValidImagesTxt = "7 1 0 0 0 0 0 4 1 a.png\n\n";
 
 void check_camera(const tilesplat::Camera& camera) {
   tilesplat::validate(camera);  // throws std::invalid_argument, which libFuzzer reports
+  // The lens's limits (a scan for where its mapping folds, undistorting the image's border) end for any
+  // coefficients; a point in front of the camera projects to finite numbers or not at all, and the ray
+  // through the image's centre is a unit vector or none.
+  if (const auto pixel = camera.project({0.1, -0.05, 2.0}))
+    FUZZ_CHECK(std::isfinite((*pixel)[0]) && std::isfinite((*pixel)[1]));
+  if (const auto ray = camera.ray_direction(camera.cx, camera.cy))
+    FUZZ_CHECK(std::fabs(std::hypot((*ray)[0], (*ray)[1], (*ray)[2]) - 1) < 1e-6);
   const auto& r = camera.rotation;
   for (size_t i = 0; i < 3; ++i) {
     const double norm = r[i * 3] * r[i * 3] + r[i * 3 + 1] * r[i * 3 + 1] + r[i * 3 + 2] * r[i * 3 + 2];

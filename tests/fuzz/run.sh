@@ -53,6 +53,19 @@ seed spz "$scenes/train_3pts.spz" "$scenes/formats/playcanvas_test_64_sh3.v3.spz
 seed sog "$scenes/formats/playcanvas_test_64_sh3.sog"
 seed compressed_ply "$scenes/playcanvas_test_64.compressed.ply" "$scenes/formats/playcanvas_test_64_sh3.compressed.ply"
 seed gltf "$scenes/formats/playcanvas_test_64_sh3.glb"
+# The camera readers (fuzz_cameras.cpp: the first byte picks the reader) from a COLMAP camera of each lens
+# family and a transforms.json of each nerfstudio model.
+mkdir -p "$build/seeds/cameras"
+n=0
+for line in "1 OPENCV 64 48 50 50 32 24 -0.1 0.02 0.001 -0.001" "1 SIMPLE_RADIAL_FISHEYE 64 48 30 32 24 0.05" \
+  "1 FULL_OPENCV 64 48 50 50 32 24 -0.1 0.02 0.001 -0.001 0.002 0.01 -0.003 0.0005" \
+  "1 OPENCV_FISHEYE 64 48 30 30 32 24 0.05 -0.01 0.002 -0.0003"; do
+  printf '\002%s\n' "$line" >"$build/seeds/cameras/colmap_$((n += 1))"
+done
+for model in '"OPENCV", "k1": -0.1, "p1": 0.001' '"OPENCV_FISHEYE", "k1": 0.05, "k4": -0.001' '"EQUIRECTANGULAR"'; do
+  printf '\004"camera_model": %s, "fl_x": 50, "w": 64, "h": 48, "frames": [{"transform_matrix": %s}]}' "$model" \
+    '[[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 4], [0, 0, 0, 1]]' >"$build/seeds/cameras/transforms_$((n += 1))"
+done
 
 # libFuzzer's timeout is wall-clock: a process the machine stops or starves for a while reports
 # one on whatever input it was running. Such a "timeout" that replays in time is not a finding.

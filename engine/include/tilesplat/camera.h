@@ -5,6 +5,7 @@
 
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,9 +57,15 @@ enum class CameraModel {
   kFisheye,
   /// u = fx x + cx, v = fy y + cy: parallel rays along the camera's z; fx and fy in pixels per world unit.
   kOrthographic,
+  /// Longitude and latitude: u = cx + fx atan2(x, z), v = cy + fy atan2(y, sqrt(x^2 + z^2)), the 360x180
+  /// panorama when fx = width / (2 pi), fy = height / pi and (cx, cy) is the image centre
+  /// (equirectangular_camera). Longitude 0 is the camera's forward axis, latitude grows downward (y). A
+  /// splat across the +-180 degree seam is drawn on both edges; the poles themselves are not drawn.
+  kEquirectangular,
 };
 
-/// The model's name as files and flags spell it: "pinhole", "opencv", "fisheye", "orthographic".
+/// The model's name as files and flags spell it: "pinhole", "opencv", "fisheye", "orthographic",
+/// "equirectangular".
 TILESPLAT_API const char* camera_model_name(CameraModel model);
 /// The model named so (camera_model_name's names); throws std::invalid_argument naming the known ones.
 TILESPLAT_API CameraModel parse_camera_model(const std::string& name);
@@ -85,6 +92,14 @@ struct TILESPLAT_API Camera {
 
   /// A world-space point in camera space: rotation * (world - position).
   std::array<double, 3> to_camera(const std::array<double, 3>& world) const;
+  /// Where a world-space point lands on the image through the camera's model, in pixel coordinates
+  /// (pixel (i, j) spans [i, i + 1) x [j, j + 1)); std::nullopt where the model draws nothing there (behind
+  /// a pinhole, past a lens's fold, at a panorama's poles).
+  std::optional<std::array<double, 2>> project(const std::array<double, 3>& world) const;
+  /// The world-space unit direction of the ray through pixel coordinates (u, v), the inverse of project();
+  /// std::nullopt where no ray lands there (past 180 degrees off a fisheye's axis, past a lens's fold). An
+  /// orthographic camera's rays all have its forward axis.
+  std::optional<std::array<double, 3>> ray_direction(double u, double v) const;
   /// tan(horizontal fov / 2) = width / (2 fx).
   double tan_half_fov_x() const { return width / (2.0 * fx); }
   /// tan(vertical fov / 2) = height / (2 fy).
@@ -186,6 +201,11 @@ TILESPLAT_API Camera fisheye_camera(const Camera& camera, double field_of_view_d
 /// whose image is `view_height` world units tall (square pixels). Throws std::invalid_argument for a
 /// height that is not positive and finite.
 TILESPLAT_API Camera orthographic_camera(const Camera& camera, double view_height);
+
+/// The 360x180 equirectangular panorama (CameraModel::kEquirectangular) with `camera`'s pose and size:
+/// fx = width / (2 pi), fy = height / pi, the principal point at the image centre. A 2:1 image has square
+/// pixels at the equator.
+TILESPLAT_API Camera equirectangular_camera(const Camera& camera);
 
 /// A camera at `eye` looking at `target`; `up` is the world up direction (the camera's -y).
 TILESPLAT_API Camera look_at_camera(const std::array<double, 3>& eye, const std::array<double, 3>& target,

@@ -1,5 +1,7 @@
 // Camera helpers: the models' names and checks, world-to-camera transform, resizing, look-at and orbit
 // framing.
+#include "tilesplat/camera.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,7 +9,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "tilesplat/camera.h"
+#include "camera/camera_models.h"
 #include "tilesplat/scene.h"
 
 namespace tilesplat {
@@ -49,16 +51,18 @@ const char* camera_model_name(CameraModel model) {
       return "fisheye";
     case CameraModel::kOrthographic:
       return "orthographic";
+    case CameraModel::kEquirectangular:
+      return "equirectangular";
   }
   return "unknown";
 }
 
 CameraModel parse_camera_model(const std::string& name) {
-  for (CameraModel model :
-       {CameraModel::kPinhole, CameraModel::kOpenCV, CameraModel::kFisheye, CameraModel::kOrthographic})
+  for (CameraModel model : {CameraModel::kPinhole, CameraModel::kOpenCV, CameraModel::kFisheye,
+                            CameraModel::kOrthographic, CameraModel::kEquirectangular})
     if (name == camera_model_name(model)) return model;
   throw std::invalid_argument("unknown camera model '" + name +
-                              "' (known: pinhole, opencv, fisheye, orthographic)");
+                              "' (known: pinhole, opencv, fisheye, orthographic, equirectangular)");
 }
 
 void validate(const Camera& camera) {
@@ -75,7 +79,8 @@ void validate(const Camera& camera) {
                            : camera.model == CameraModel::kFisheye ? 4
                                                                    : 0;
   if (camera.model != CameraModel::kPinhole && camera.model != CameraModel::kOpenCV &&
-      camera.model != CameraModel::kFisheye && camera.model != CameraModel::kOrthographic)
+      camera.model != CameraModel::kFisheye && camera.model != CameraModel::kOrthographic &&
+      camera.model != CameraModel::kEquirectangular)
     fail("unknown camera model " + std::to_string(int(camera.model)));
   for (size_t k = 0; k < camera.distortion.size(); ++k) {
     if (!std::isfinite(camera.distortion[k])) fail("non-finite distortion coefficient " + std::to_string(k));
@@ -97,6 +102,17 @@ Camera fisheye_camera(const Camera& camera, double field_of_view_deg) {
   fisheye.fx = fisheye.fy =
       0.5 * std::min(camera.width, camera.height) / degrees_to_radians(0.5 * field_of_view_deg);
   return fisheye;
+}
+
+Camera equirectangular_camera(const Camera& camera) {
+  Camera panorama = camera;
+  panorama.model = CameraModel::kEquirectangular;
+  panorama.distortion = {};
+  panorama.fx = camera.width / (2 * std::numbers::pi);
+  panorama.fy = camera.height / std::numbers::pi;
+  panorama.cx = camera.width / 2.0;
+  panorama.cy = camera.height / 2.0;
+  return panorama;
 }
 
 Camera orthographic_camera(const Camera& camera, double view_height) {
@@ -121,6 +137,23 @@ std::array<double, 3> Camera::to_camera(const std::array<double, 3>& world) cons
     camera_space[row] = w[0] * world[0] + w[1] * world[1] + w[2] * world[2] + translation;
   }
   return camera_space;
+}
+
+std::optional<std::array<double, 2>> Camera::project(const std::array<double, 3>& world) const {
+  const camera_models::CentreProjection centre = camera_models::project_point(*this, to_camera(world));
+  if (!centre.visible || !std::isfinite(centre.pixel[0]) || !std::isfinite(centre.pixel[1]))
+    return std::nullopt;
+  return centre.pixel;
+}
+
+std::optional<std::array<double, 3>> Camera::ray_direction(double u, double v) const {
+  Vec3 ray{};
+  if (!camera_models::pixel_ray(*this, u, v, ray)) return std::nullopt;
+  // Camera to world: the rotation's transpose (its rows are the camera's axes in world space).
+  Vec3 world{};
+  for (size_t k = 0; k < 3; ++k)
+    world[k] = rotation[k] * ray[0] + rotation[3 + k] * ray[1] + rotation[6 + k] * ray[2];
+  return world;
 }
 
 Camera resize_camera(const Camera& camera, int width, int height) {

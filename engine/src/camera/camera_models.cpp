@@ -160,13 +160,14 @@ ModelLimits model_limits(const Camera& camera) {
       limits.reach = fisheye_fold(camera.distortion);
       break;
     case CameraModel::kOrthographic:
+    case CameraModel::kEquirectangular:
       break;
   }
   return limits;
 }
 
 CentreProjection project_centre(const Camera& camera, const ModelLimits& limits,
-                                const std::array<double, 3>& t, double near_plane) {
+                                const std::array<double, 3>& t, double near_plane, uint32_t seam_copy) {
   CentreProjection out;
   const double x = t[0], y = t[1], z = t[2];
   const double fx = camera.fx, fy = camera.fy;
@@ -231,6 +232,23 @@ CentreProjection project_centre(const Camera& camera, const ModelLimits& limits,
       out.jacobian_v = {0, fy, 0};
       out.depth = z;
       break;
+    case CameraModel::kEquirectangular: {
+      // Longitude atan2(x, z) and latitude atan2(y, q), q = sqrt(x^2 + z^2): at the poles (q = 0) the
+      // longitude is undefined and the splat is not drawn.
+      const double q2 = x * x + z * z;
+      const double rho2 = q2 + y * y;
+      const double rho = std::sqrt(rho2);
+      if (!(rho > near_plane) || !(q2 > 0)) return out;
+      const double q = std::sqrt(q2);
+      double longitude = std::atan2(x, z);
+      if (seam_copy == 1) longitude += longitude < 0 ? 2 * std::numbers::pi : -2 * std::numbers::pi;
+      out.pixel = {fx * longitude + camera.cx, fy * std::atan2(y, q) + camera.cy};
+      out.jacobian_u = {fx * z / q2, 0, -fx * x / q2};
+      const double across = fy / (q * rho2);
+      out.jacobian_v = {-across * x * y, fy * q / rho2, -across * y * z};
+      out.depth = rho;
+      break;
+    }
   }
   out.visible = true;
   return out;
@@ -263,6 +281,14 @@ bool pixel_ray(const Camera& camera, double u, double v, std::array<double, 3>& 
     case CameraModel::kOrthographic:
       ray = {0, 0, 1};
       return true;
+    case CameraModel::kEquirectangular: {
+      const double longitude = xd, latitude = yd;
+      if (!(std::abs(latitude) < std::numbers::pi / 2)) return false;
+      x = std::cos(latitude) * std::sin(longitude);
+      y = std::sin(latitude);
+      z = std::cos(latitude) * std::cos(longitude);
+      break;
+    }
   }
   const double length = std::sqrt(x * x + y * y + z * z);
   ray = {x / length, y / length, z / length};

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 
 #include "tilesplat/camera.h"
 
@@ -32,9 +33,17 @@ struct CentreProjection {
   std::array<double, 3> jacobian_v{};  // d pixel.y / d t
   double depth = 0;                    // what splats sort by and depth images hold: z, or the distance
 };
+// How many records each Gaussian projects to: 2 for the equirectangular camera, whose splats across the
+// +-180 degree seam are drawn again one period (2 pi fx) to the other side; 1 for the others.
+inline uint32_t seam_copies(const Camera& camera) {
+  return camera.model == CameraModel::kEquirectangular ? 2 : 1;
+}
+
 // For every model but the pinhole, whose projection the reference keeps written out in its own words.
+// `seam_copy` 1: the equirectangular camera's second copy, its pixel a period (2 pi fx) to the side of the
+// image nearer it.
 CentreProjection project_centre(const Camera& camera, const ModelLimits& limits,
-                                const std::array<double, 3>& t, double near_plane);
+                                const std::array<double, 3>& t, double near_plane, uint32_t seam_copy = 0);
 
 // OpenCV's distortion of the normalized point (x, y) = (X / Z, Y / Z), and its 2x2 Jacobian (row-major).
 struct Distorted {

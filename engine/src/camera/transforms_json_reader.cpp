@@ -54,7 +54,8 @@ int image_dimension(const FrameFields& fields, const char* name) {
 }
 
 // nerfstudio's camera models: PINHOLE; OPENCV (k1 k2 k3 p1 p2, and the pinhole's default when the
-// file names no model) as CameraModel::kOpenCV; OPENCV_FISHEYE (k1..k4) as kFisheye. nerfstudio's k4 of
+// file names no model) as CameraModel::kOpenCV; OPENCV_FISHEYE (k1..k4) as kFisheye; EQUIRECTANGULAR
+// (the focal lengths unused) as kEquirectangular. nerfstudio's k4 of
 // OPENCV is a radial r^8 term, which OpenCV's model (a rational k4) does not have: refused unless 0.
 void set_model(Camera& camera, const FrameFields& fields) {
   const std::string model = fields.text("camera_model").value_or("OPENCV");
@@ -82,10 +83,13 @@ void set_model(Camera& camera, const FrameFields& fields) {
       fields.fail("camera_model PINHOLE has distortion coefficients: say OPENCV, or give none");
     const bool distorted = camera.distortion != std::array<double, 8>{};
     camera.model = distorted ? CameraModel::kOpenCV : CameraModel::kPinhole;
+  } else if (model == "EQUIRECTANGULAR") {
+    camera = equirectangular_camera(camera);  // nerfstudio's panoramas span 360x180 degrees of the image
   } else {
-    fields.fail("camera_model " + model +
-                " is not one the renderer draws (PINHOLE, OPENCV, OPENCV_FISHEYE): undistort the images to "
-                "PINHOLE first");
+    fields.fail(
+        "camera_model " + model +
+        " is not one the renderer draws (PINHOLE, OPENCV, OPENCV_FISHEYE, EQUIRECTANGULAR): undistort the "
+        "images to PINHOLE first");
   }
   for (const double k : camera.distortion)
     if (!std::isfinite(k)) fields.fail("the distortion coefficients must be finite");

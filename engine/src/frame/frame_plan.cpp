@@ -200,6 +200,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
                 settings.compositor,      settings.near_plane};
   plan.build_lists = !(settings.reuse_lists && context.lists && *context.lists == plan.lists);
   plan.projection = projection_variant(settings, context.scene, camera.model);
+  plan.splat_records = context.scene.count * plan.projection.seam_copies();
   plan.tiles = tile_grid(camera);
   plan.compositor = settings.compositor;
   plan.depth_key_bits = uint32_t(settings.accuracy.depth_key_bits);

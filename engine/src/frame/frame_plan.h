@@ -114,6 +114,7 @@ struct FramePlan {
   bool build_lists = true;  // false: the composite alone, on the lists the previous frame left
   SortTraits sort;          // the strategy that runs ("auto" resolved)
   ProjectionVariant projection;
+  uint32_t splat_records = 0;  // projected records: the scene's count times projection.seam_copies()
   TileGrid tiles;
   // Keys: the per-Gaussian depth key's bits (AccuracyModes::depth_key_bits); whether the pairs are
   // 64-bit (tile, depth) keys, for a strategy that sorts those itself; and the bits the frame's sorts

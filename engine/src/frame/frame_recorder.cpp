@@ -41,7 +41,7 @@ void FrameRecorder::prepare(const FramePlan& plan, FrameResources& resources, So
   resources.prepare_frame(plan, needs_state);
   if (!plan.build_lists) return;
   projection_.prepare(resources.scene, plan.projection);
-  sorter.reserve(std::max(resources.scene.count, resources.keys.capacity));
+  sorter.reserve(std::max(plan.splat_records, resources.keys.capacity));
 }
 
 struct FrameRecorder::Recording {
@@ -68,7 +68,7 @@ void FrameRecorder::record(vk::CommandStream& stream, const FramePlan& plan, con
 void FrameRecorder::record_pass(Recording& r, FramePass pass) {
   FrameResources& res = r.res;
   const FramePlan& plan = r.plan;
-  const uint32_t n = res.scene.count;
+  const uint32_t n = plan.splat_records;  // projected records: the Gaussians, or their seam copies too
   VkCommandBuffer cmd = r.stream.cmd();  // a host sort flushes the stream: each pass takes the current one
   switch (pass) {
     case FramePass::kHostDepthIn:

@@ -69,15 +69,25 @@ void FrameResources::upload_scene(const GaussianScene& source) {
   s.count = uint32_t(n);
   s.sh_degree = source.sh_degree;
 
+  projected = ProjectedBuffers();  // the previous scene's, released before this one's are made
+  ensure_projected_records(uint32_t(n));
+  ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)), /*wide=*/false);
+}
+
+// The projection's per-record buffers for at least `records` records (ProjectedBuffers): the scene's
+// count, twice it for the equirectangular camera's seam copies.
+void FrameResources::ensure_projected_records(uint32_t records) {
   ProjectedBuffers& p = projected;
+  if (p.records >= records && p.splats) return;
+  const size_t n = records;
   p.splats = vk::Buffer(ctx_, n * kSplatRecordBytes, vk::MemoryUse::Device, "projected splats");
   p.rects = make_buffer<uint64_t>(ctx_, n, "tile rects");
   p.tile_counts = make_buffer<uint32_t>(ctx_, n, "tile counts");
   p.depth_offsets = make_buffer<uint32_t>(ctx_, n, "tile offsets (depth order)");
   p.offsets = make_buffer<uint32_t>(ctx_, n, "tile offsets");
   p.big_splats = make_buffer<uint32_t>(ctx_, n, "big splats");
-  p.depth_order = KeyBuffers::allocate(ctx_, uint32_t(n), 32, "depth");
-  ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)), /*wide=*/false);
+  p.depth_order = KeyBuffers::allocate(ctx_, records, 32, "depth");
+  p.records = records;
 }
 
 // The host's buffers (RenderSettings::host): the host's surfaces as view depths (+inf where it drew
@@ -133,6 +143,7 @@ void FrameResources::prepare_frame(const FramePlan& plan, bool needs_composite_s
   else if (!needs_composite_state && composite_state.size() > 0)
     composite_state = vk::Buffer();  // 32 bytes a pixel that a one-dispatch composite does not use
   if (!plan.build_lists) return;
+  ensure_projected_records(plan.splat_records);
   const VkDeviceSize ray_depth_bytes = VkDeviceSize(scene.count) * kRayDepthBytes;
   if (plan.projection.ray_depth && projected.ray_depth.size() < ray_depth_bytes)
     projected.ray_depth = vk::Buffer(ctx_, std::max<VkDeviceSize>(kRayDepthBytes, ray_depth_bytes),

@@ -71,6 +71,7 @@ class FrameResources {
 
  private:
   void ensure_key_capacity(uint32_t capacity, bool wide);
+  void ensure_projected_records(uint32_t records);
   vk::Context& ctx_;
 };
 

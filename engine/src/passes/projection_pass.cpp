@@ -187,7 +187,7 @@ void ProjectionPass::record(VkCommandBuffer cmd, const SceneBuffers& scene, Proj
   const auto& pipeline = pipeline_for(variant, !views.empty());
   pipeline.bind(cmd, push);
   if (!views.empty()) pipeline.push_texel_views(cmd, views);
-  pipeline.dispatch(cmd, vk::div_ceil(scene.count, 256));
+  pipeline.dispatch(cmd, vk::div_ceil(scene.count * variant.seam_copies(), 256));
 }
 
 }  // namespace tilesplat

@@ -8,6 +8,7 @@
 
 #include "passes/key_buffers.h"
 #include "shader_io.h"
+#include "tilesplat/camera.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
 
@@ -47,14 +48,18 @@ struct ProjectionVariant {
   bool lighting = false;      // relighting on (the lights themselves are data: ProjectionPass::set_lighting)
   bool file_normals = false;  // lit, with the scene's normal buffer (else every splat's shortest axis)
   uint32_t camera_model = 0;  // tilesplat::CameraModel: the pinhole's code alone unless another is asked for
+  // Records per Gaussian (camera_models::seam_copies): Gaussian i's are i and scene count + i.
+  uint32_t seam_copies() const { return camera_model == uint32_t(CameraModel::kEquirectangular) ? 2 : 1; }
   auto operator<=>(const ProjectionVariant&) const = default;
 };
 
 // Bytes of one projected splat record (SPLAT_VEC4S vec4, compute/shader_io.h).
 constexpr uint32_t kSplatRecordBytes = shader_io::SPLAT_VEC4S * 16;
 
-// Per-Gaussian outputs of the projection, inputs of the later passes.
+// Per-record outputs of the projection, inputs of the later passes: one record per Gaussian, two for
+// the equirectangular camera (ProjectionVariant::seam_copies).
 struct ProjectedBuffers {
+  uint32_t records = 0;    // what the buffers hold
   vk::Buffer splats;       // kSplatRecordBytes per Gaussian
   vk::Buffer rects;        // uvec2 per Gaussian: packed tile rect
   vk::Buffer tile_counts;  // uint per Gaussian: tiles touched, 0 = culled

@@ -161,7 +161,7 @@ namespace reference {
 
 ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& camera,
                           const camera_models::ModelLimits& limits, Antialiasing antialiasing,
-                          const PreparedLighting& lighting, double near_plane) {
+                          const PreparedLighting& lighting, double near_plane, uint32_t seam_copy) {
   ProjectedGaussian out;
   const std::array<double, 3> mean = {scene.positions[3 * i], scene.positions[3 * i + 1],
                                       scene.positions[3 * i + 2]};
@@ -201,7 +201,7 @@ ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& ca
     out.mean[1] = camera.fy * t[1] / tz + camera.cy;
   } else {  // the other models' centre and Jacobian (camera_models.cpp)
     const camera_models::CentreProjection centre =
-        camera_models::project_centre(camera, limits, t, near_plane);
+        camera_models::project_centre(camera, limits, t, near_plane, seam_copy);
     out.depth = centre.depth;
     if (!centre.visible) return out;
     const auto& ju = centre.jacobian_u;

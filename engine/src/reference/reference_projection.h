@@ -11,10 +11,11 @@
 namespace tilesplat::reference {
 
 // project_gaussian, the camera's limits (camera_models::model_limits) and the lights (prepare_lighting,
-// lighting.h) already prepared once for the frame.
+// lighting.h) already prepared once for the frame. `seam_copy` 1: the equirectangular camera's second
+// copy of the splat (camera_models::seam_copies).
 ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& camera,
                           const camera_models::ModelLimits& limits, Antialiasing antialiasing,
-                          const PreparedLighting& lighting, double near_plane);
+                          const PreparedLighting& lighting, double near_plane, uint32_t seam_copy = 0);
 // Throws std::invalid_argument for a near plane that is not finite and positive (as the GPU's plan does).
 // Throws std::invalid_argument when the scene has normals but not 3 per Gaussian.
 void check_normals(const GaussianScene& scene);

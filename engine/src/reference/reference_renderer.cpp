@@ -101,16 +101,19 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
   if (settings.lighting.enabled()) reference::check_normals(scene);
   const camera_models::ModelLimits limits = camera_models::model_limits(camera);
 
-  std::vector<ProjectedGaussian> projected(n);
-  parallel_chunks(n, 4096, [&](size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i)
-      projected[i] =
-          reference::project(scene, i, camera, limits, settings.antialiasing, lighting, settings.near_plane);
+  // One record per Gaussian, two for the equirectangular camera (its seam copies, records n..2n - 1).
+  const size_t records = n * camera_models::seam_copies(camera);
+  std::vector<ProjectedGaussian> projected(records);
+  parallel_chunks(records, 4096, [&](size_t begin, size_t end) {
+    for (size_t r = begin; r < end; ++r)
+      projected[r] =
+          reference::project(scene, r % std::max<size_t>(n, 1), camera, limits, settings.antialiasing,
+                             lighting, settings.near_plane, uint32_t(r / std::max<size_t>(n, 1)));
   });
 
-  // Front to back by the float32 depth the GPU sorts on, ties by Gaussian index.
+  // Front to back by the float32 depth the GPU sorts on, ties by record index.
   std::vector<uint32_t> order;
-  for (size_t i = 0; i < n; ++i)
+  for (size_t i = 0; i < records; ++i)
     if (projected[i].visible) order.push_back(static_cast<uint32_t>(i));
   std::stable_sort(order.begin(), order.end(), [&](uint32_t lhs, uint32_t rhs) {
     return static_cast<float>(projected[lhs].depth) < static_cast<float>(projected[rhs].depth);

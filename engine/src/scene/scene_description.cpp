@@ -206,12 +206,14 @@ CameraModel read_model_name(const Reader& reader, const Node& node) {
   const auto model_node = reader.optional_child(node, "model");
   if (!model_node) return CameraModel::kPinhole;
   return parse_camera_model(std::string(reader.choice(
-      *model_node, std::to_array<std::string_view>({"pinhole", "opencv", "fisheye", "orthographic"}))));
+      *model_node,
+      std::to_array<std::string_view>({"pinhole", "opencv", "fisheye", "orthographic", "equirectangular"}))));
 }
 
 // "distortion" and "view_height" of a camera of `model`: its coefficients in OpenCV's order (k1 k2 p1 p2
 // k3 k4 k5 k6; a fisheye's k1..k4; missing ones are 0), and an orthographic look_at camera's height in
-// world units. `fisheye_fov`: a look_at fisheye's field of view across the shorter side.
+// world units. `fisheye_fov`: a look_at fisheye's field of view across the shorter side. A look_at
+// equirectangular camera spans 360x180 degrees of its image (equirectangular_camera).
 void read_model(const Reader& reader, const Node& node, CameraModel model, bool look_at, double fisheye_fov,
                 Camera& camera) {
   const auto distortion = reader.optional_child(node, "distortion");
@@ -229,6 +231,7 @@ void read_model(const Reader& reader, const Node& node, CameraModel model, bool 
     reader.fail(node.path,
                 "an orthographic 'look_at' camera needs 'view_height' (its height in world units)");
   if (look_at && model == CameraModel::kFisheye) camera = fisheye_camera(camera, fisheye_fov);
+  if (look_at && model == CameraModel::kEquirectangular) camera = equirectangular_camera(camera);
   if (look_at && model == CameraModel::kOrthographic)
     camera = orthographic_camera(camera, reader.positive(*view_height, kMaxCoordinate));
   camera.model = model;
