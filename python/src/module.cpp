@@ -292,6 +292,9 @@ void bind(nb::module_& m) {
           [](const Camera& c, double view_height) { return orthographic_camera(c, view_height); },
           "view_height"_a, "The orthographic camera with this pose and size, view_height world units tall.")
       .def(
+          "equirectangular", [](const Camera& c) { return equirectangular_camera(c); },
+          "The 360x180 panorama with this pose and size (give it a 2:1 size).")
+      .def(
           "resized", [](const Camera& c, int width, int height) { return resize_camera(c, width, height); },
           "width"_a, "height"_a, "The same view at another size (the field of view kept).")
       .def_static(
