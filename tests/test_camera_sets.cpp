@@ -18,6 +18,8 @@
 #include "tilesplat/camera_path.h"
 #include "tilesplat/camera_sets.h"
 #include "tilesplat/image.h"
+#include "tilesplat/reference.h"
+#include "tilesplat/renderer.h"
 
 namespace {
 
@@ -174,6 +176,8 @@ TEST(CameraSets, ColmapLensModelsAreReadIntoTheirParameters) {
        {0.05, -0.01}},
       {"PINHOLE 640 480 500 510 320 240", CameraModel::kPinhole, {500, 510, 320, 240}, {}},
   };
+  const tilesplat::GaussianScene playbot = tilesplat::load_scene(tilesplat::testing::bundled_playbot());
+  tilesplat::Renderer& renderer = tilesplat::testing::validated_renderer();
   for (const Case& c : cases) {
     {
       std::ofstream cameras(out / "models" / "cameras.txt");
@@ -186,7 +190,17 @@ TEST(CameraSets, ColmapLensModelsAreReadIntoTheirParameters) {
     EXPECT_EQ((std::array<double, 4>{camera.fx, camera.fy, camera.cx, camera.cy}), c.intrinsics) << c.line;
     EXPECT_EQ(camera.distortion, c.distortion) << c.line;
     for (size_t k = 0; k < 9; ++k) EXPECT_NEAR(camera.rotation[k], views.front().camera.rotation[k], 1e-12);
+    // The camera read renders the bundled playbot through its lens on the GPU as the float64 reference does.
+    const tilesplat::Camera small = tilesplat::resize_camera(camera, 160, 120);
+    renderer.set_scene(playbot);
+    const tilesplat::RenderImage gpu = renderer.render(small);
+    const tilesplat::ImageDifference d =
+        tilesplat::compare_images(gpu, tilesplat::render_reference(playbot, small));
+    EXPECT_GE(d.psnr_db, 60.0) << c.line;
+    EXPECT_GT(*std::max_element(gpu.rgba.begin(), gpu.rgba.end()), 0.2f)
+        << c.line << ": the scene is in view";
   }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
   // The models the renderer does not have are refused by name.
   for (const char* line :
        {"FOV 640 480 500 510 320 240 0.9", "THIN_PRISM_FISHEYE 640 480 500 510 320 240 0 0 0 0 0 0 0 0"}) {

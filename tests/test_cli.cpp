@@ -18,6 +18,7 @@
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene_description.h"
+#include "tilesplat/shutter.h"
 #include "tilesplat/version.h"
 
 namespace {
@@ -335,6 +336,9 @@ TEST(CliBench, EffectsTableMeasuresEachEffectBesideItsNeverHadItRow) {
                           "stochastic_composite",
                           "tile_binning",
                           "camera: opencv",
+                          "camera: opencv, all coefficients 0 (off)",
+                          "depth of field, aperture 0 (off)",
+                          "motion blur, shutter closed (off)",
                           "camera: fisheye, 180 degrees",
                           "camera: orthographic",
                           "camera: equirectangular",
@@ -443,6 +447,68 @@ TEST(CliRender, LensFlagsRenderDepthOfFieldAndAreRecorded) {
     EXPECT_TRUE(contains(result.err, message)) << result.err;
     EXPECT_FALSE(fs::exists(out / "bad.exr"));
   }
+}
+
+TEST(CliRender, ShutterFlagBlursEachFrameOverTheMotionToTheNext) {
+  const auto out = fresh_output_dir();
+  auto orbit = [&](std::vector<std::string> extra, const std::string& folder) {
+    fs::create_directories(out / folder);
+    std::vector<std::string> args = {bundled_playbot().string(),
+                                     "--orbit",
+                                     "3",
+                                     "--width",
+                                     "96",
+                                     "--height",
+                                     "54",
+                                     "--quiet",
+                                     "-o",
+                                     (out / folder / "%04d.exr").string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_exe(kRenderExe, args);
+  };
+  ASSERT_EQ(orbit({}, "still").exit_code, 0);
+  const auto blurred = orbit({"--shutter", "180", "--shutter-samples", "4"}, "blurred");
+  ASSERT_EQ(blurred.exit_code, 0) << blurred.err;
+  const fs::path frame0 = out / "blurred" / "0000.exr";
+  EXPECT_TRUE(contains(tilesplat::read_exr_string_attributes(frame0).at("renderSettings"),
+                       " shutter=180deg:samples:4"));
+  EXPECT_LT(
+      tilesplat::compare_images(tilesplat::read_exr(frame0), tilesplat::read_exr(out / "still" / "0000.exr"))
+          .psnr_db,
+      40.0);
+  // Frame 0 is the library's shutter open half the way to frame 1 (an orbit's last frame blurs toward its
+  // first).
+  const tilesplat::Camera start = *tilesplat::read_exr_camera(out / "still" / "0000.exr");
+  const tilesplat::Camera next = *tilesplat::read_exr_camera(out / "still" / "0001.exr");
+  tilesplat::RenderSettings settings;
+  settings.shutter = {.open = 0, .close = 0.5, .samples = 4, .end_camera = next};
+  tilesplat::Renderer& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(tilesplat::load_scene(bundled_playbot()));
+  EXPECT_GE(tilesplat::compare_images(tilesplat::read_exr(frame0), renderer.render(start, settings)).psnr_db,
+            60.0);
+  EXPECT_LT(tilesplat::compare_images(tilesplat::read_exr(out / "blurred" / "0002.exr"),
+                                      tilesplat::read_exr(out / "still" / "0002.exr"))
+                .psnr_db,
+            40.0);
+
+  const std::vector<std::pair<std::vector<std::string>, std::string>> mistakes = {
+      {{"--shutter", "0"}, "--shutter must be in (0, 360] degrees, got '0'"},
+      {{"--shutter", "400"}, "--shutter must be in (0, 360] degrees"},
+      {{"--shutter-samples", "4"}, "--shutter-samples shapes the shutter, and no --shutter gave one"},
+  };
+  for (const auto& [flags, message] : mistakes) {
+    const auto result = orbit(flags, "bad");
+    EXPECT_EQ(result.exit_code, 2) << flags.front() << ": " << result.err;
+    EXPECT_TRUE(contains(result.err, message)) << result.err;
+    EXPECT_FALSE(fs::exists(out / "bad" / "0000.exr"));
+  }
+  const auto single =
+      run_exe(kRenderExe, {bundled_playbot().string(), "--shutter", "180", "-o", (out / "one.exr").string()});
+  EXPECT_EQ(single.exit_code, 2);
+  EXPECT_TRUE(contains(single.err,
+                       "--shutter blurs the camera's motion from one frame to the next: it needs --orbit "
+                       "or --path"))
+      << single.err;
 }
 
 TEST(CliRender, StochasticFlagConvergesTowardTheSortedImage) {

@@ -174,6 +174,11 @@ std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& bas
       camera.distortion = {-0.1, 0.02, 0.001, -0.001, 0, 0, 0, 0};
       return camera;
     });
+    camera_row("camera: opencv, all coefficients 0 (off)", [](const Camera& view) {
+      Camera camera = view;
+      camera.model = CameraModel::kOpenCV;
+      return camera;
+    });
     camera_row("camera: fisheye, 180 degrees", [](const Camera& view) { return fisheye_camera(view, 180); });
     camera_row("camera: orthographic, the view's framing", [centre](const Camera& view) {
       // As tall as the pinhole's view is at the scene's centre.
@@ -181,7 +186,17 @@ std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& bas
     });
     camera_row("camera: equirectangular, 360x180 in the view's size",
                [](const Camera& view) { return equirectangular_camera(view); });
-    // The averaged frames: 8 samples each, so about 8 frames' time.
+    // The averaged frames: 8 samples each, so about 8 frames' time; off (no aperture, a closed shutter)
+    // the base frame.
+    add("depth of field, aperture 0 (off)", SceneVariant::kScene,
+        [](RenderSettings& s) { s.lens = {.aperture_diameter = 0, .focus_distance = 1, .samples = 8}; });
+    add("motion blur, shutter closed (off)", SceneVariant::kScene, [](RenderSettings&) {});
+    rows.back().for_view = [centre](RenderSettings& settings, const Camera& view) {
+      settings.shutter = {.open = 0.5,
+                          .close = 0.5,
+                          .samples = 8,
+                          .end_camera = turn_camera(view, centre, {0, -1, 0}, 5 * std::numbers::pi / 180)};
+    };
     add("depth of field, 8 lens samples", SceneVariant::kScene, [](RenderSettings&) {});
     rows.back().for_view = [centre](RenderSettings& settings, const Camera& view) {
       const double focus = view.to_camera(centre)[2];

@@ -46,6 +46,9 @@ struct Frame {
   std::string view_name;
   fs::path exr;
   fs::path png;  // empty: no preview
+  // The camera one frame later, for --shutter: an orbit's next frame (the first after the last), a path's
+  // (none after its last); none for the views of a camera set, which do not move from one to the next.
+  std::optional<tilesplat::Camera> next_camera;
 };
 
 using cli::single_quoted;
@@ -58,7 +61,8 @@ std::string shortest_exact(Number value) {
 }
 
 // What the EXR's renderSettings attribute records: everything that changes the image.
-std::string settings_text(const tilesplat::RenderSettings& settings, const LensFlags& lens) {
+std::string settings_text(const tilesplat::RenderSettings& settings, const LensFlags& lens,
+                          const ShutterFlags& shutter) {
   std::string text = "sort=" + settings.sort;
   text += " accuracy=" + tilesplat::to_string(settings.accuracy);
   text += " antialiasing=" + tilesplat::to_string(settings.antialiasing);
@@ -72,6 +76,7 @@ std::string settings_text(const tilesplat::RenderSettings& settings, const LensF
   text += " background=";
   for (size_t c = 0; c < 3; ++c) text += (c > 0 ? "," : "") + shortest_exact(settings.background[c]);
   if (lens.enabled()) text += " lens=" + lens_text(lens);
+  if (shutter.enabled()) text += " shutter=" + shutter_text(shutter);
   return text;
 }
 
@@ -157,7 +162,10 @@ std::vector<Frame> plan_sequence(const cli::ArgParser& parser, const RenderOptio
       cameras = tilesplat::sample_camera_path(path, options.path_frames, size.width, size.height);
       what = "path " + fs::path(options.path_file).filename().string();
     }
-    for (size_t f = 0; f < cameras.size(); ++f)
+    const bool orbit = parser.seen("--orbit");
+    for (size_t f = 0; f < cameras.size(); ++f) {
+      std::optional<tilesplat::Camera> next;
+      if (f + 1 < cameras.size() || orbit) next = cameras[(f + 1) % cameras.size()];
       frames.push_back({static_cast<int>(f),
                         static_cast<int>(f),
                         cameras[f],
@@ -165,7 +173,9 @@ std::vector<Frame> plan_sequence(const cli::ArgParser& parser, const RenderOptio
                         {},
                         {},
                         {},
-                        {}});
+                        {},
+                        next});
+    }
   }
 
   for (const auto& [flag, pattern] : {std::pair{"-o", options.output}, std::pair{"--png", options.png}})
@@ -357,7 +367,9 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
     cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()), progress_style(options.quiet));
     std::future<void> writing;
     for (const Frame* frame : to_render) {
-      tilesplat::RenderImage image = renderer.render(frame->camera, settings);
+      tilesplat::RenderSettings frame_settings = settings;
+      frame_settings.shutter = shutter_for_frame(options.shutter, frame->next_camera);
+      tilesplat::RenderImage image = renderer.render(frame->camera, frame_settings);
       cli::ManifestEntry entry = manifest_entry(*frame, frame_count, folder, settings_line);
       entry.gpu_ms = renderer.gpu() ? renderer.gpu_ms() : renderer.cpu_ms();
       gpu_ms.push_back(entry.gpu_ms);
@@ -434,7 +446,10 @@ int run(int argc, char** argv) {
     frames.push_back({0, loaded.view_index.value_or(0), loaded.camera, loaded.camera_description,
                       loaded.view_index, loaded.view_name, options.output, options.png});
   }
-  for (Frame& frame : frames) frame.camera = camera_for_frame(options.camera_model, frame.camera);
+  for (Frame& frame : frames) {
+    frame.camera = camera_for_frame(options.camera_model, frame.camera);
+    if (frame.next_camera) frame.next_camera = camera_for_frame(options.camera_model, *frame.next_camera);
+  }
 
   tilesplat::RenderSettings settings;
   if (!options.common.sorts.empty()) settings.sort = options.common.sorts.front();
@@ -466,11 +481,11 @@ int run(int argc, char** argv) {
   writer.exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
   writer.exr.attributes["scene"] = loaded.path.string();
   writer.exr.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
-  writer.exr.attributes["renderSettings"] = settings_text(settings, options.lens);
+  writer.exr.attributes["renderSettings"] = settings_text(settings, options.lens, options.shutter);
 
   if (sequence) {
     // Everything besides the camera that makes two runs' files differ, for the manifest.
-    std::string settings_line = settings_text(settings, options.lens) +
+    std::string settings_line = settings_text(settings, options.lens, options.shutter) +
                                 " exr=" + (options.half ? "half" : "float") + "," +
                                 tilesplat::to_string(options.compression) + "," +
                                 tilesplat::to_string(options.exr_colour) + (writer.exr.alpha ? ",A" : "") +

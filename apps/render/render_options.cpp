@@ -1,5 +1,6 @@
 #include "render_options.h"
 
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <utility>
@@ -169,6 +170,20 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                    [&options, positive](const std::string& text) {
                      options.lens.units_per_metre = positive("--units-per-metre", text);
                    });
+  parser.section("motion blur (with --orbit or --path: the mean of frames over each frame's motion)");
+  parser.add_value(
+      "--shutter", "DEG",
+      "the shutter angle: open from each frame's time for DEG/360 of the way to the next frame "
+      "(180: half of it, as a film camera; up to 360)",
+      [&options](const std::string& text) {
+        const double degrees = cli::parse_double("--shutter", text);
+        if (!(degrees > 0 && degrees <= 360))
+          throw cli::UsageError("--shutter must be in (0, 360] degrees, got " + single_quoted(text));
+        options.shutter.angle_deg = degrees;
+      });
+  parser.add_int("--shutter-samples", "N", "times averaged over the open shutter (1 to 4096, default 16)",
+                 &options.shutter.samples, 1, kMaxShutterSamples);
+
   parser.section("camera model (every frame's camera, its pose and size kept, through another lens)");
   parser.add_value(
       "--fisheye", "DEG",
@@ -256,6 +271,12 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
                           std::string(options.camera_model.fisheye_fov_deg ? "--fisheye"
                                       : options.camera_model.view_height   ? "--orthographic"
                                                                            : "--equirectangular"));
+  if (parser.seen("--shutter-samples") && !options.shutter.enabled())
+    throw cli::UsageError("--shutter-samples shapes the shutter, and no --shutter gave one");
+  if (options.shutter.enabled() && !parser.seen("--orbit") && !parser.seen("--path"))
+    throw cli::UsageError(
+        "--shutter blurs the camera's motion from one frame to the next: it needs --orbit or "
+        "--path");
   if (options.lens.aperture && options.lens.f_stop)
     throw cli::UsageError("--aperture and --f-stop both give the aperture: one of them");
   if (!options.lens.enabled())
@@ -280,6 +301,18 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
             ": the frame number belongs in the file name, not the folder (the folder holds the "
             "manifest)");
     }
+}
+
+Shutter shutter_for_frame(const ShutterFlags& flags, const std::optional<Camera>& next) {
+  if (!flags.enabled() || !next) return {};
+  return {.open = 0, .close = *flags.angle_deg / 360.0, .samples = flags.samples, .end_camera = next};
+}
+
+std::string shutter_text(const ShutterFlags& flags) {
+  if (!flags.enabled()) return {};
+  char angle[32];
+  const auto end = std::to_chars(angle, angle + sizeof angle, *flags.angle_deg).ptr;  // shortest exact
+  return std::string(angle, end) + "deg:samples:" + std::to_string(flags.samples);
 }
 
 Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera) {

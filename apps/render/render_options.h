@@ -10,6 +10,7 @@
 #include "tilesplat/image.h"
 #include "tilesplat/lens.h"
 #include "tilesplat/renderer.h"
+#include "tilesplat/shutter.h"
 
 namespace tilesplat::render_app {
 
@@ -58,6 +59,20 @@ struct CameraModelFlags {
 // The frame's camera through the flags' model (fisheye_camera, orthographic_camera), or as it is.
 Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera);
 
+// --shutter and --shutter-samples: motion blur over a sequence's camera motion. The shutter opens at a
+// frame's time and stays open for DEG/360 of the interval to the next frame (a film camera's shutter
+// angle: 180 is half the interval).
+struct ShutterFlags {
+  std::optional<double> angle_deg;  // --shutter DEG, in (0, 360]
+  int samples = 16;                 // --shutter-samples N
+  bool enabled() const { return angle_deg.has_value(); }
+};
+// The shutter of a frame whose next frame's camera is `next`: off without --shutter, and for the last
+// frame of a path (which has no next frame: it holds still).
+Shutter shutter_for_frame(const ShutterFlags& flags, const std::optional<Camera>& next);
+// "180deg:samples:16" for the EXR's renderSettings; empty when off.
+std::string shutter_text(const ShutterFlags& flags);
+
 struct RenderOptions {
   tilesplat::cli::CommonOptions common;
   std::string output;
@@ -73,6 +88,7 @@ struct RenderOptions {
   int stochastic_frames = 0;  // --stochastic N: the sort-free compositor averaging N frames; 0 = sorted
   LensFlags lens;
   CameraModelFlags camera_model;
+  ShutterFlags shutter;
   bool stats = false;
   // Many frames in one run.
   std::string views;      // --views: a selection of the camera set's views

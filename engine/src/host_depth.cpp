@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "camera/camera_models.h"
+
 namespace tilesplat {
 
 void validate_host_depth(const RenderSettings& settings, const Camera& camera) {
@@ -16,7 +18,7 @@ void validate_host_depth(const RenderSettings& settings, const Camera& camera) {
   if (settings.accuracy.resort_window > 0)
     fail("per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
          ") does not depth-test against a host's surfaces: render without it");
-  if (camera.model != CameraModel::kPinhole)
+  if (camera_models::drawn_model(camera) != CameraModel::kPinhole)
     fail(std::string("a host's depth buffer is a pinhole projection's; the camera is ") +
          camera_model_name(camera.model));
   if (!std::isfinite(host.convention.a) || !std::isfinite(host.convention.b) || host.convention.b == 0)

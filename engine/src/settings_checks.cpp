@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "camera/camera_models.h"
+
 namespace tilesplat {
 
 void check_near_plane(double near_plane) {
@@ -25,7 +27,7 @@ void check_lens(const RenderSettings& settings, const Camera& camera) {
   validate(camera);
   // The thin lens shears a pinhole's frustum (lens_sample_camera moves the principal point); the other
   // models have no such shear written yet.
-  if (settings.lens.enabled() && camera.model != CameraModel::kPinhole)
+  if (settings.lens.enabled() && camera_models::drawn_model(camera) != CameraModel::kPinhole)
     throw std::invalid_argument(
         std::string("RenderSettings::lens: depth of field needs a pinhole camera, not ") +
         camera_model_name(camera.model));
@@ -55,7 +57,7 @@ void check_shutter(const RenderSettings& settings, const Camera& camera) {
 }
 
 void check_camera_model(const RenderSettings& settings, const Camera& camera) {
-  if (camera.model != CameraModel::kPinhole && settings.accuracy.resort_window > 0)
+  if (camera_models::drawn_model(camera) != CameraModel::kPinhole && settings.accuracy.resort_window > 0)
     throw std::invalid_argument("per-pixel re-sorting (resort" +
                                 std::to_string(settings.accuracy.resort_window) +
                                 ") needs a pinhole camera, not " + camera_model_name(camera.model));

@@ -126,7 +126,7 @@ ModelLimits model_limits(const Camera& camera) {
   // The image's extent from the principal point, in normalized (distorted) coordinates.
   const double left = camera.cx / camera.fx, right = (camera.width - camera.cx) / camera.fx;
   const double top = camera.cy / camera.fy, bottom = (camera.height - camera.cy) / camera.fy;
-  switch (camera.model) {
+  switch (drawn_model(camera)) {
     case CameraModel::kPinhole:
       limits.clamp_x = kFrustumClampFactor * camera.tan_half_fov_x();
       limits.clamp_y = kFrustumClampFactor * camera.tan_half_fov_y();

@@ -33,6 +33,14 @@ struct CentreProjection {
   std::array<double, 3> jacobian_v{};  // d pixel.y / d t
   double depth = 0;                    // what splats sort by and depth images hold: z, or the distance
 };
+// The model a camera is drawn with: its own, except that an OpenCV camera whose coefficients are all 0 is
+// the pinhole (and drawn by the pinhole's code, so that it renders the pinhole's frame to the bit).
+inline CameraModel drawn_model(const Camera& camera) {
+  if (camera.model == CameraModel::kOpenCV && camera.distortion == std::array<double, 8>{})
+    return CameraModel::kPinhole;
+  return camera.model;
+}
+
 // How many records each Gaussian projects to: 2 for the equirectangular camera, whose splats across the
 // +-180 degree seam are drawn again one period (2 pi fx) to the other side; 1 for the others.
 inline uint32_t seam_copies(const Camera& camera) {

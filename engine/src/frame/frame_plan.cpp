@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "camera/camera_models.h"
 #include "host_depth.h"
 #include "passes/stochastic_composite_pass.h"
 #include "passes/tile_coverage.h"
@@ -199,7 +200,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
                 settings.antialiasing,    settings.lighting,
                 settings.compositor,      settings.near_plane};
   plan.build_lists = !(settings.reuse_lists && context.lists && *context.lists == plan.lists);
-  plan.projection = projection_variant(settings, context.scene, camera.model);
+  plan.projection = projection_variant(settings, context.scene, camera_models::drawn_model(camera));
   plan.splat_records = context.scene.count * plan.projection.seam_copies();
   plan.tiles = tile_grid(camera);
   plan.compositor = settings.compositor;

@@ -167,7 +167,8 @@ ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& ca
                                       scene.positions[3 * i + 2]};
   const std::array<double, 3> t = camera.to_camera(mean);
   out.depth = t[2];
-  if (camera.model == CameraModel::kPinhole) {
+  const bool pinhole = camera_models::drawn_model(camera) == CameraModel::kPinhole;
+  if (pinhole) {
     // Written as a negated comparison so that a NaN depth is culled too.
     if (!(t[2] > near_plane) || !all_finite({t[0], t[1], t[2]})) return out;
   } else if (!all_finite({t[0], t[1], t[2]})) {
@@ -183,7 +184,7 @@ ProjectedGaussian project(const GaussianScene& scene, size_t i, const Camera& ca
   // T = J W (2x3), J the projection's Jacobian at the centre.
   const auto& w = camera.rotation;
   double t0[3], t1[3];
-  if (camera.model == CameraModel::kPinhole) {
+  if (pinhole) {
     // The Jacobian is evaluated at a point clamped to 1.3x the field of view so that splats far
     // outside the frame do not get absurdly stretched footprints; the mean itself is not clamped.
     const double limit_x = limits.clamp_x;
