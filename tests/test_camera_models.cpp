@@ -333,6 +333,73 @@ TEST(CameraModelResampling, AnEquirectangularCentreIsThePinholeImageResampled) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// The check on a real scene: each model rendered at twice the pinhole's scale, resampled through its
+// own mapping (Camera::project) into the pinhole's pixels away from the borders, against the pinhole's
+// render. What remains is the resampling's blur, the first-order footprint, and the order of overlapping
+// splats (the fisheye and the panorama sort by distance, the pinhole by z).
+TEST_F(CameraModels, OnTheBundledPlaybotEachModelResamplesToThePinhole) {
+  // The pinhole supersampled 2x2: each pixel the mean of its four quarter-pixel samples' pixels.
+  const Camera pinhole = orbit_camera(scene_, 160, 120, {.azimuth_deg = 30, .vertical_fov_deg = 50});
+  const Camera fine = resize_camera(pinhole, 320, 240);
+  const RenderImage fine_image = renderer_->render(fine);
+  const double scale = 2 * pinhole.fy;  // the models' pixels per radian at their centre: the fine pinhole's
+  struct Case {
+    std::string name;
+    Camera camera;
+  };
+  std::vector<Case> cases;
+  for (const double fov : {120.0, 180.0, 240.0}) {
+    Camera square = pinhole;
+    square.width = square.height = int(std::ceil(scale * fov * std::numbers::pi / 180));
+    square.cx = square.cy = square.width / 2.0;
+    cases.push_back({"fisheye " + std::to_string(int(fov)), fisheye_camera(square, fov)});
+  }
+  Camera wide = pinhole;  // OpenCV at the fine pinhole's scale over 1.4 times its field
+  wide.width = int(2.8 * pinhole.width);
+  wide.height = int(2.8 * pinhole.height);
+  wide.fx = wide.fy = scale;
+  wide.cx = wide.width / 2.0;
+  wide.cy = wide.height / 2.0;
+  cases.push_back({"opencv", opencv_camera(wide)});
+  Camera panorama = pinhole;
+  panorama.width = int(std::ceil(2 * std::numbers::pi * scale));
+  panorama.height = panorama.width / 2;
+  cases.push_back({"equirectangular", equirectangular_camera(panorama)});
+
+  for (const Case& c : cases) {
+    const RenderImage image = renderer_->render(c.camera);
+    double squared = 0;
+    int compared = 0;
+    for (int y = 8; y < pinhole.height - 8; ++y)
+      for (int x = 8; x < pinhole.width - 8; ++x) {
+        double model[4] = {0, 0, 0, 0}, expected[4] = {0, 0, 0, 0};
+        bool inside = true;
+        for (int sub = 0; sub < 4 && inside; ++sub) {
+          const double u = x + 0.25 + 0.5 * (sub % 2), v = y + 0.25 + 0.5 * (sub / 2);
+          const auto ray = pinhole.ray_direction(u, v);
+          const auto at = c.camera.project({pinhole.position[0] + (*ray)[0], pinhole.position[1] + (*ray)[1],
+                                            pinhole.position[2] + (*ray)[2]});
+          float sampled[4];
+          inside = at && sample_rgba(image, (*at)[0], (*at)[1], sampled);
+          const size_t fine_pixel = size_t(2 * y + sub / 2) * size_t(fine.width) + size_t(2 * x + sub % 2);
+          for (int ch = 0; ch < 4 && inside; ++ch) {
+            model[ch] += 0.25 * sampled[ch];
+            expected[ch] += 0.25 * fine_image.rgba[4 * fine_pixel + size_t(ch)];
+          }
+        }
+        if (!inside) continue;
+        for (int ch = 0; ch < 4; ++ch) squared += (model[ch] - expected[ch]) * (model[ch] - expected[ch]);
+        ++compared;
+      }
+    const double psnr = 10 * std::log10(1.0 / (squared / (4.0 * std::max(compared, 1))));
+    std::printf("[ measure  ] playbot, %s (%dx%d) resampled into the pinhole's %d pixels: PSNR %.1f dB\n",
+                c.name.c_str(), c.camera.width, c.camera.height, compared, psnr);
+    EXPECT_EQ(compared, (pinhole.width - 16) * (pinhole.height - 16)) << c.name;
+    EXPECT_GE(psnr, 30.0) << c.name;
+  }
+  EXPECT_EQ(renderer_->validation_messages(), 0u);
+}
+
 TEST(CameraModelSeam, ASplatBehindAPanoramaShowsOnBothEdges) {
   GaussianScene scene;
   scene.positions = {0.3f, 0, -5};  // a little off straight behind: its centre just inside the right edge

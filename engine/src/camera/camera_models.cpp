@@ -98,6 +98,26 @@ double fisheye_theta_for(const std::array<double, 8>& k, double reach, double ra
   return 0.5 * (lo + hi);
 }
 
+// model_limits of the camera last asked about on this thread: project_point and pixel_ray are called per
+// pixel with one camera, and the fold's scan costs tens of thousands of evaluations.
+const ModelLimits& cached_limits(const Camera& camera) {
+  struct Entry {
+    bool valid = false;
+    CameraModel model = CameraModel::kPinhole;
+    std::array<double, 8> distortion{};
+    std::array<double, 4> intrinsics{};
+    std::array<int, 2> size{};
+    ModelLimits limits;
+  };
+  thread_local Entry entry;
+  const std::array<double, 4> intrinsics = {camera.fx, camera.fy, camera.cx, camera.cy};
+  const std::array<int, 2> size = {camera.width, camera.height};
+  if (!entry.valid || entry.model != camera.model || entry.distortion != camera.distortion ||
+      entry.intrinsics != intrinsics || entry.size != size)
+    entry = {true, camera.model, camera.distortion, intrinsics, size, model_limits(camera)};
+  return entry.limits;
+}
+
 }  // namespace
 
 Distorted distort(const std::array<double, 8>& k, double x, double y) {
@@ -255,7 +275,7 @@ CentreProjection project_centre(const Camera& camera, const ModelLimits& limits,
 }
 
 CentreProjection project_point(const Camera& camera, const std::array<double, 3>& t) {
-  return project_centre(camera, model_limits(camera), t, 0.0);
+  return project_centre(camera, cached_limits(camera), t, 0.0);
 }
 
 bool pixel_ray(const Camera& camera, double u, double v, std::array<double, 3>& ray) {
@@ -265,11 +285,11 @@ bool pixel_ray(const Camera& camera, double u, double v, std::array<double, 3>& 
     case CameraModel::kPinhole:
       break;
     case CameraModel::kOpenCV:
-      if (!undistort(camera.distortion, model_limits(camera).reach, xd, yd, x, y)) return false;
+      if (!undistort(camera.distortion, cached_limits(camera).reach, xd, yd, x, y)) return false;
       break;
     case CameraModel::kFisheye: {
       const double radius = std::hypot(xd, yd);
-      const double reach = model_limits(camera).reach;
+      const double reach = cached_limits(camera).reach;
       if (!(radius < fisheye_theta_d(camera.distortion, reach)[0])) return false;
       const double theta = fisheye_theta_for(camera.distortion, reach, radius);
       const double across = radius > 0 ? std::sin(theta) / radius : 0;
