@@ -449,6 +449,46 @@ TEST(CliRender, LensFlagsRenderDepthOfFieldAndAreRecorded) {
   }
 }
 
+TEST(CliRender, SceneFileLensRendersDepthOfFieldUnlessTheFlagsGiveOne) {
+  const auto out = fresh_output_dir();
+  const std::string camera =
+      R"("width": 96, "height": 54, "look_at": {"eye": [0, -1.2, 3.2], "target": [0, -0.35, 0]})";
+  auto scene_file = [&](const std::string& name, const std::string& extra) {
+    std::ofstream(out / name) << R"({"models": [{"path": ")" << bundled_playbot().generic_string()
+                              << R"("}], "cameras": [{)" << camera << extra << "}]}";
+    return (out / name).string();
+  };
+  const std::string sharp = scene_file("sharp.json", "");
+  const std::string lens = scene_file("lens.json", R"(, "lens": {"aperture": 0.6, "samples": 8})");
+  ASSERT_EQ(run_exe(kRenderExe, {sharp, "-o", (out / "sharp.exr").string()}).exit_code, 0);
+  const auto blurred = run_exe(kRenderExe, {lens, "-o", (out / "lens.exr").string()});
+  ASSERT_EQ(blurred.exit_code, 0) << blurred.err;
+  EXPECT_LT(
+      tilesplat::compare_images(tilesplat::read_exr(out / "lens.exr"), tilesplat::read_exr(out / "sharp.exr"))
+          .psnr_db,
+      40.0);
+  const std::string recorded = tilesplat::read_exr_string_attributes(out / "lens.exr").at("renderSettings");
+  EXPECT_TRUE(contains(recorded, " lens=aperture:0.6,focus:")) << recorded;  // the target's distance
+  EXPECT_TRUE(contains(recorded, ",samples:8")) << recorded;
+  // The same as the library through the scene file's lens.
+  const tilesplat::SceneDescription description = tilesplat::load_scene_description(lens);
+  tilesplat::RenderSettings settings;
+  settings.lens = description.lenses.front();
+  tilesplat::Renderer& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(tilesplat::load_described_scene(description));
+  EXPECT_GE(tilesplat::compare_images(tilesplat::read_exr(out / "lens.exr"),
+                                      renderer.render(description.cameras.front().camera, settings))
+                .psnr_db,
+            60.0);
+  // --aperture replaces the scene file's lens.
+  ASSERT_EQ(run_exe(kRenderExe,
+                    {lens, "--aperture", "0.05", "--lens-samples", "4", "-o", (out / "flag.exr").string()})
+                .exit_code,
+            0);
+  EXPECT_TRUE(contains(tilesplat::read_exr_string_attributes(out / "flag.exr").at("renderSettings"),
+                       " lens=aperture:0.050000,focus:scene-centre,samples:4"));
+}
+
 TEST(CliRender, ShutterFlagBlursEachFrameOverTheMotionToTheNext) {
   const auto out = fresh_output_dir();
   auto orbit = [&](std::vector<std::string> extra, const std::string& folder) {

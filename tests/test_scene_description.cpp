@@ -504,6 +504,58 @@ TEST(SceneDescription, CamerasHaveModels) {
   EXPECT_EQ(d.cameras[3].camera, equirectangular_camera(d.cameras[3].camera));
 }
 
+TEST(SceneDescription, CamerasHaveLenses) {
+  const fs::path dir = temp_dir();
+  const std::string text = replace_all(R"({"models": [{"path": "$PLY"}], "cameras": [
+      {"width": 64, "height": 48, "fx": 50, "fy": 50, "position": [0, 0, -3],
+       "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "lens": {"aperture": 0.1, "focus_distance": 2.5}},
+      {"width": 64, "height": 48, "look_at": {"eye": [0, 0, -4], "target": [0, 0, 0], "fov_deg": 40},
+       "lens": {"f_stop": 2, "sensor_width_mm": 24, "units_per_metre": 10, "samples": 12}},
+      {"width": 64, "height": 48, "look_at": {"eye": [0, 0, -4], "target": [0, 0, 0]}}]})",
+                                       "$PLY", bundled_sh3().string());
+  const SceneDescription d = load_scene_description(write_text(dir / "lenses.json", text));
+  ASSERT_EQ(d.lenses.size(), 3u);
+  EXPECT_EQ(d.lenses[0].aperture_diameter, 0.1);
+  EXPECT_EQ(d.lenses[0].focus_distance, 2.5);
+  EXPECT_EQ(d.lenses[0].samples, ThinLens{}.samples);
+  // f/2 on a 24 mm sensor, the scene in decimetres: the focal length over 2, in scene units.
+  EXPECT_DOUBLE_EQ(d.lenses[1].aperture_diameter, aperture_for_f_stop(d.cameras[1].camera, 2, 24, 10));
+  EXPECT_DOUBLE_EQ(d.lenses[1].focus_distance, 4.0);  // a look_at camera focuses on its target
+  EXPECT_EQ(d.lenses[1].samples, 12);
+  EXPECT_FALSE(d.lenses[2].enabled());
+
+  const std::string camera =
+      R"("width": 64, "height": 48, "look_at": {"eye": [0, 0, -4], "target": [0, 0, 0]})";
+  const std::vector<std::pair<std::string, std::string>> mistakes = {
+      {R"("lens": {"aperture": 0.1, "f_stop": 2})",
+       "'aperture' (a diameter in scene units) or 'f_stop', one of them"},
+      {R"("lens": {"focus_distance": 2})", "or 'f_stop', one of them"},
+      {R"("lens": {"aperture": 0.1, "sensor_width_mm": 24})", "applies to 'f_stop' only"},
+      {R"("lens": {"aperture": -1})", "cameras[0].lens.aperture"},
+      {R"("lens": {"aperture": 0.1, "samples": 0})", "cameras[0].lens.samples"},
+      {R"("lens": {"aperture": 0.1, "focal": 3})", "unknown key"},
+      {R"("model": "fisheye", "lens": {"aperture": 0.1})",
+       "depth of field needs a pinhole camera, not fisheye"},
+  };
+  for (const auto& [lens, phrase] : mistakes) {
+    const std::string bad =
+        replace_all(R"({"models": [{"path": "$PLY"}], "cameras": [{)" + camera + ", " + lens + "}]}", "$PLY",
+                    bundled_sh3().string());
+    const std::string message =
+        tilesplat::testing::error_of([&] { load_scene_description(write_text(dir / "bad.json", bad)); });
+    EXPECT_NE(message.find(phrase), std::string::npos) << lens << ": " << message;
+  }
+  const std::string no_focus =
+      replace_all(R"({"models": [{"path": "$PLY"}], "cameras": [{"width": 64, "height": 48,
+      "fx": 50, "fy": 50, "position": [0, 0, -3], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+      "lens": {"aperture": 0.1}}]})",
+                  "$PLY", bundled_sh3().string());
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              load_scene_description(write_text(dir / "no_focus.json", no_focus));
+            }).find("cameras[0].lens: missing 'focus_distance'"),
+            std::string::npos);
+}
+
 TEST(SceneDescription, MalformedJsonGivesLineAndColumn) {
   const fs::path dir = temp_dir();
   auto message_of = [&](const std::string& text) {

@@ -81,6 +81,7 @@ SceneViews scene_views(const LoadedScene& loaded) {
   if (!loaded.description) return out;
   out.views = loaded.description->cameras;
   out.file = loaded.description->cameras_file.empty() ? loaded.path : loaded.description->cameras_file;
+  out.lenses = loaded.description->lenses;
   return out;
 }
 
@@ -188,6 +189,7 @@ LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view
     named = view_camera(cameras.views, options.view, cameras.file, options.width, options.height);
     loaded.view_index = options.view;
     loaded.view_name = cameras.views[size_t(options.view)].name;  // in range: view_camera checked it
+    if (!cameras.lenses.empty()) loaded.lens = cameras.lenses[size_t(options.view)];
   } else {
     if (options.view_given)
       throw UsageError(

@@ -11,6 +11,7 @@
 #include "arg_parser.h"
 #include "common_options.h"
 #include "tilesplat/camera.h"
+#include "tilesplat/lens.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
@@ -28,6 +29,7 @@ struct LoadedScene {
   std::string camera_description;  // "view 0 of cams.json" or "orbit azimuth 0 elevation 20 fov 50"
   std::optional<int> view_index;   // the view's index in its cameras, when the camera is a view
   std::string view_name;           // its img_name (may be empty); empty for the orbit camera
+  ThinLens lens;                   // the scene file's lens for that view (SceneDescription::lenses); off else
   double load_ms = 0;
 };
 
@@ -46,6 +48,7 @@ LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std:
 struct SceneViews {
   std::vector<CameraView> views;
   std::filesystem::path file;
+  std::vector<ThinLens> lenses;  // the scene file's, one per view; empty for --cameras and cameras.json
 };
 SceneViews scene_views(const LoadedScene& loaded);
 // The views a run picks from: those of --cameras (loaded) when given, else the scene file's own.

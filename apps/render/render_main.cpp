@@ -1,6 +1,7 @@
 // tilesplat-render: renders a view of a scene to an EXR (and optionally a PNG preview), or many
 // frames in one process (the views of a camera set, an orbit, a keyframed path) with a manifest
 // that makes the run resumable and lets shards of it run as separate processes.
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <chrono>
@@ -49,6 +50,7 @@ struct Frame {
   // The camera one frame later, for --shutter: an orbit's next frame (the first after the last), a path's
   // (none after its last); none for the views of a camera set, which do not move from one to the next.
   std::optional<tilesplat::Camera> next_camera;
+  tilesplat::ThinLens lens;  // the scene file's lens for this view (off unless it has one)
 };
 
 using cli::single_quoted;
@@ -75,7 +77,12 @@ std::string settings_text(const tilesplat::RenderSettings& settings, const LensF
   text += " lights=" + std::to_string(settings.lighting.lights.size());
   text += " background=";
   for (size_t c = 0; c < 3; ++c) text += (c > 0 ? "," : "") + shortest_exact(settings.background[c]);
-  if (lens.enabled()) text += " lens=" + lens_text(lens);
+  if (lens.enabled())
+    text += " lens=" + lens_text(lens);
+  else if (settings.lens.enabled())  // a scene file's lens for the view
+    text += " lens=aperture:" + shortest_exact(settings.lens.aperture_diameter) +
+            ",focus:" + shortest_exact(settings.lens.focus_distance) +
+            ",samples:" + std::to_string(settings.lens.samples);
   if (shutter.enabled()) text += " shutter=" + shutter_text(shutter);
   return text;
 }
@@ -139,7 +146,9 @@ std::vector<Frame> plan_sequence(const cli::ArgParser& parser, const RenderOptio
                         view,
                         views[size_t(view)].name,
                         {},
-                        {}});
+                        {},
+                        {},
+                        cameras.lenses.empty() ? tilesplat::ThinLens{} : cameras.lenses[size_t(view)]});
     }
   } else {
     const cli::ImageSize size = cli::orbit_image_size(common.width, common.height);
@@ -276,7 +285,8 @@ class FrameRenderer {
   tilesplat::RenderImage render(const tilesplat::Camera& camera,
                                 const tilesplat::RenderSettings& base_settings) {
     tilesplat::RenderSettings settings = base_settings;
-    settings.lens = lens_for_frame(lens_, camera, scene_centre_);  // the focus follows the frame's camera
+    // The flags' lens, its focus following the frame's camera, over the scene file's lens for the view.
+    if (lens_.enabled()) settings.lens = lens_for_frame(lens_, camera, scene_centre_);
     tilesplat::RenderImage image;
     if (renderer_) {
       image = renderer_->render(camera, settings);
@@ -369,6 +379,7 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
     for (const Frame* frame : to_render) {
       tilesplat::RenderSettings frame_settings = settings;
       frame_settings.shutter = shutter_for_frame(options.shutter, frame->next_camera);
+      frame_settings.lens = frame->lens;
       tilesplat::RenderImage image = renderer.render(frame->camera, frame_settings);
       cli::ManifestEntry entry = manifest_entry(*frame, frame_count, folder, settings_line);
       entry.gpu_ms = renderer.gpu() ? renderer.gpu_ms() : renderer.cpu_ms();
@@ -443,8 +454,16 @@ int run(int argc, char** argv) {
   if (sequence) {
     frames = plan_sequence(parser, options, loaded);
   } else {
-    frames.push_back({0, loaded.view_index.value_or(0), loaded.camera, loaded.camera_description,
-                      loaded.view_index, loaded.view_name, options.output, options.png});
+    frames.push_back({0,
+                      loaded.view_index.value_or(0),
+                      loaded.camera,
+                      loaded.camera_description,
+                      loaded.view_index,
+                      loaded.view_name,
+                      options.output,
+                      options.png,
+                      {},
+                      loaded.lens});
   }
   for (Frame& frame : frames) {
     frame.camera = camera_for_frame(options.camera_model, frame.camera);
@@ -481,11 +500,16 @@ int run(int argc, char** argv) {
   writer.exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
   writer.exr.attributes["scene"] = loaded.path.string();
   writer.exr.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
+  // A scene file's lens: the view's own for one frame; for many, each frame's view has its own.
+  if (!sequence) settings.lens = frames.front().lens;
   writer.exr.attributes["renderSettings"] = settings_text(settings, options.lens, options.shutter);
+  if (sequence && !options.lens.enabled() &&
+      std::any_of(frames.begin(), frames.end(), [](const Frame& f) { return f.lens.enabled(); }))
+    writer.exr.attributes["renderSettings"] += " lens=the scene file's, per view";
 
   if (sequence) {
     // Everything besides the camera that makes two runs' files differ, for the manifest.
-    std::string settings_line = settings_text(settings, options.lens, options.shutter) +
+    std::string settings_line = writer.exr.attributes["renderSettings"] +
                                 " exr=" + (options.half ? "half" : "float") + "," +
                                 tilesplat::to_string(options.compression) + "," +
                                 tilesplat::to_string(options.exr_colour) + (writer.exr.alpha ? ",A" : "") +

@@ -14,6 +14,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/export.h"
 #include "tilesplat/image.h"
+#include "tilesplat/lens.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/scene.h"
 
@@ -132,6 +133,9 @@ struct SceneDescription {
   std::filesystem::path file;          ///< the description itself (names it in error messages)
   std::vector<SceneModel> models;      ///< the splat files, in order (load_described_scene() merges them)
   std::vector<CameraView> cameras;     ///< empty when the file has none
+  /// The lens each camera looks through (a camera's "lens": depth of field, tilesplat/lens.h): one per
+  /// camera, off (aperture 0) where a camera has none; empty when the cameras come from a cameras.json.
+  std::vector<ThinLens> lenses;
   std::filesystem::path cameras_file;  ///< resolved cameras.json when "cameras" names one, else empty
   std::array<float, 3> background = {0, 0, 0};  ///< RGB behind the splats, display values like theirs
   SceneEffects effects;                         ///< what to simulate; each off unless the file asks

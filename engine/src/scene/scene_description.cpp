@@ -43,7 +43,9 @@ constexpr auto kModelKeys = std::to_array<std::string_view>({"path", "translatio
                                                         "quaternion", "scale", "z_up"});
 constexpr auto kCameraKeys =
     std::to_array<std::string_view>({"name", "width", "height", "fx", "fy", "cx", "cy", "position",
-                                     "rotation", "look_at", "model", "distortion", "view_height"});
+                                     "rotation", "look_at", "model", "distortion", "view_height", "lens"});
+constexpr auto kLensKeys = std::to_array<std::string_view>(
+    {"aperture", "f_stop", "sensor_width_mm", "units_per_metre", "focus_distance", "samples"});
 constexpr auto kLookAtKeys = std::to_array<std::string_view>({"eye", "target", "up", "fov_deg"});
 constexpr auto kEffectKeys = std::to_array<std::string_view>({"sh_degree", "view_dependent", "antialiasing",
                                                          "lights", "ambient", "exposure", "tone_map"});
@@ -246,7 +248,49 @@ void read_model(const Reader& reader, const Node& node, CameraModel model, bool 
   }
 }
 
-CameraView read_camera(const Reader& reader, const Node& node, size_t index) {
+// A camera's "lens": the aperture as a diameter in scene units or as an f-number (with the sensor's width
+// in millimetres and the scene's units per metre, aperture_for_f_stop), the focus distance (default: a
+// look_at camera's distance to its target) and the samples.
+ThinLens read_lens(const Reader& reader, const Node& node, const Camera& camera,
+                   std::optional<double> target_distance) {
+  reader.expect_object(node, kLensKeys);
+  const auto aperture = reader.optional_child(node, "aperture");
+  const auto f_stop = reader.optional_child(node, "f_stop");
+  if (aperture.has_value() == f_stop.has_value())
+    reader.fail(node.path,
+                "give the aperture as 'aperture' (a diameter in scene units) or 'f_stop', one of them");
+  for (const char* key : {"sensor_width_mm", "units_per_metre"})
+    if (const auto child = reader.optional_child(node, key); child && !f_stop)
+      reader.fail(child->path, "applies to 'f_stop' only");
+  ThinLens lens;
+  if (aperture) {
+    lens.aperture_diameter = reader.positive(*aperture, kMaxCoordinate);
+  } else {
+    const double sensor = reader.optional_child(node, "sensor_width_mm")
+                              ? reader.positive(*reader.optional_child(node, "sensor_width_mm"), 1e4)
+                              : 36.0;
+    const double units = reader.optional_child(node, "units_per_metre")
+                             ? reader.positive(*reader.optional_child(node, "units_per_metre"), 1e9)
+                             : 1.0;
+    lens.aperture_diameter = aperture_for_f_stop(camera, reader.positive(*f_stop, 1e6), sensor, units);
+  }
+  if (const auto focus = reader.optional_child(node, "focus_distance"))
+    lens.focus_distance = reader.positive(*focus, kMaxCoordinate);
+  else if (target_distance)
+    lens.focus_distance = *target_distance;
+  else
+    reader.fail(node.path,
+                "missing 'focus_distance' (the view depth in focus; a 'look_at' camera focuses on its "
+                "target)");
+  if (const auto samples = reader.optional_child(node, "samples"))
+    lens.samples = reader.integer(*samples, 1, kMaxLensSamples);
+  if (camera.model != CameraModel::kPinhole)
+    reader.fail(node.path,
+                "depth of field needs a pinhole camera, not " + std::string(camera_model_name(camera.model)));
+  return lens;
+}
+
+CameraView read_camera(const Reader& reader, const Node& node, size_t index, ThinLens& lens) {
   reader.expect_object(node, kCameraKeys);
   CameraView view;
   view.id = static_cast<int>(index);
@@ -267,6 +311,17 @@ CameraView read_camera(const Reader& reader, const Node& node, size_t index) {
     view.camera = read_pinhole(reader, node, width, height);
   }
   read_model(reader, node, model, look_at.has_value(), fisheye_fov, view.camera);
+  if (const auto lens_node = reader.optional_child(node, "lens")) {
+    std::optional<double> target_distance;
+    if (look_at) {
+      const auto eye =
+          reader.numbers<3>(reader.required_child(*look_at, "eye", ""), -kMaxCoordinate, kMaxCoordinate);
+      const auto target =
+          reader.numbers<3>(reader.required_child(*look_at, "target", ""), -kMaxCoordinate, kMaxCoordinate);
+      target_distance = std::hypot(target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]);
+    }
+    lens = read_lens(reader, *lens_node, view.camera, target_distance);
+  }
   return view;
 }
 
@@ -282,8 +337,9 @@ void read_cameras(const Reader& reader, const Node& node, SceneDescription& out)
   }
   const json& list = reader.array(node, "a cameras.json path or a list of cameras");
   if (list.empty()) reader.fail(node.path, "must list at least one camera (leave 'cameras' out for none)");
+  out.lenses.resize(list.size());
   for (size_t i = 0; i < list.size(); ++i)
-    out.cameras.push_back(read_camera(reader, Node{list[i], element_path(node.path, i)}, i));
+    out.cameras.push_back(read_camera(reader, Node{list[i], element_path(node.path, i)}, i, out.lenses[i]));
 }
 
 // --- effects and outputs
