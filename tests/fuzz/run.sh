@@ -14,7 +14,7 @@ cd "$(dirname "$0")/../.."
 seconds="${1:-60}"
 build="${FUZZ_BUILD_DIR:-build-fuzz}"
 scenes="${TILESPLAT_SHARED_SCENES:-$(cd .. && pwd)/shared/scenes}"
-readers=(ply splat spz sog compressed_ply gltf cameras)
+readers=(ply splat spz sog compressed_ply gltf cameras scene_file)
 fuzz_flags=(-timeout=10 -rss_limit_mb=2048)
 max_len() {  # a SOG zip or a GLB of 64 Gaussians with SH3 is about 20 kB; the rest fit in 16 kB
   case "$1" in sog | gltf) echo 65536 ;; *) echo 16384 ;; esac
