@@ -530,11 +530,30 @@ TEST(CliRender, ShutterFlagBlursEachFrameOverTheMotionToTheNext) {
                                       tilesplat::read_exr(out / "still" / "0002.exr"))
                 .psnr_db,
             40.0);
+  // A rolling shutter: the same times, read out top to bottom in 4 bands instead of averaged.
+  const auto rolled =
+      orbit({"--shutter", "180", "--shutter-samples", "4", "--rolling-shutter", "top-to-bottom"}, "rolled");
+  ASSERT_EQ(rolled.exit_code, 0) << rolled.err;
+  EXPECT_TRUE(
+      contains(tilesplat::read_exr_string_attributes(out / "rolled" / "0000.exr").at("renderSettings"),
+               " shutter=180deg:samples:4:rolling:top-to-bottom"));
+  settings.shutter.scan = tilesplat::ShutterScan::kTopToBottom;
+  EXPECT_GE(tilesplat::compare_images(tilesplat::read_exr(out / "rolled" / "0000.exr"),
+                                      renderer.render(start, settings))
+                .psnr_db,
+            60.0);
+  EXPECT_LT(
+      tilesplat::compare_images(tilesplat::read_exr(out / "rolled" / "0000.exr"), tilesplat::read_exr(frame0))
+          .psnr_db,
+      45.0);
 
   const std::vector<std::pair<std::vector<std::string>, std::string>> mistakes = {
       {{"--shutter", "0"}, "--shutter must be in (0, 360] degrees, got '0'"},
       {{"--shutter", "400"}, "--shutter must be in (0, 360] degrees"},
       {{"--shutter-samples", "4"}, "--shutter-samples shapes the shutter, and no --shutter gave one"},
+      {{"--rolling-shutter", "top-to-bottom"},
+       "--rolling-shutter shapes the shutter, and no --shutter gave one"},
+      {{"--shutter", "180", "--rolling-shutter", "diagonal"}, "--rolling-shutter must be top-to-bottom"},
   };
   for (const auto& [flags, message] : mistakes) {
     const auto result = orbit(flags, "bad");

@@ -181,8 +181,26 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
           throw cli::UsageError("--shutter must be in (0, 360] degrees, got " + single_quoted(text));
         options.shutter.angle_deg = degrees;
       });
-  parser.add_int("--shutter-samples", "N", "times averaged over the open shutter (1 to 4096, default 16)",
+  parser.add_int("--shutter-samples", "N",
+                 "times averaged over the open shutter, or a rolling shutter's bands (1 to 4096, default 16)",
                  &options.shutter.samples, 1, kMaxShutterSamples);
+  parser.add_value("--rolling-shutter", "SCAN",
+                   "read the image out in --shutter-samples bands, each exposed at its time instead of "
+                   "averaged: top-to-bottom, bottom-to-top, left-to-right or right-to-left",
+                   [&options](const std::string& text) {
+                     try {
+                       options.shutter.scan = parse_shutter_scan(text);
+                     } catch (const std::invalid_argument&) {
+                       throw cli::UsageError(
+                           "--rolling-shutter must be top-to-bottom, bottom-to-top, "
+                           "left-to-right or right-to-left, got " +
+                           single_quoted(text));
+                     }
+                     if (options.shutter.scan == ShutterScan::kGlobal)
+                       throw cli::UsageError(
+                           "--rolling-shutter takes a direction; a global shutter is --shutter "
+                           "alone");
+                   });
 
   parser.section("camera model (every frame's camera, its pose and size kept, through another lens)");
   parser.add_value(
@@ -271,8 +289,9 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
                           std::string(options.camera_model.fisheye_fov_deg ? "--fisheye"
                                       : options.camera_model.view_height   ? "--orthographic"
                                                                            : "--equirectangular"));
-  if (parser.seen("--shutter-samples") && !options.shutter.enabled())
-    throw cli::UsageError("--shutter-samples shapes the shutter, and no --shutter gave one");
+  for (const char* shutter_flag : {"--shutter-samples", "--rolling-shutter"})
+    if (parser.seen(shutter_flag) && !options.shutter.enabled())
+      throw cli::UsageError(std::string(shutter_flag) + " shapes the shutter, and no --shutter gave one");
   if (options.shutter.enabled() && !parser.seen("--orbit") && !parser.seen("--path"))
     throw cli::UsageError(
         "--shutter blurs the camera's motion from one frame to the next: it needs --orbit or "
@@ -305,14 +324,20 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
 
 Shutter shutter_for_frame(const ShutterFlags& flags, const std::optional<Camera>& next) {
   if (!flags.enabled() || !next) return {};
-  return {.open = 0, .close = *flags.angle_deg / 360.0, .samples = flags.samples, .end_camera = next};
+  return {.open = 0,
+          .close = *flags.angle_deg / 360.0,
+          .samples = flags.samples,
+          .end_camera = next,
+          .scan = flags.scan};
 }
 
 std::string shutter_text(const ShutterFlags& flags) {
   if (!flags.enabled()) return {};
   char angle[32];
   const auto end = std::to_chars(angle, angle + sizeof angle, *flags.angle_deg).ptr;  // shortest exact
-  return std::string(angle, end) + "deg:samples:" + std::to_string(flags.samples);
+  std::string text = std::string(angle, end) + "deg:samples:" + std::to_string(flags.samples);
+  if (flags.scan != ShutterScan::kGlobal) text += std::string(":rolling:") + shutter_scan_name(flags.scan);
+  return text;
 }
 
 Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera) {

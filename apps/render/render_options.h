@@ -65,6 +65,7 @@ Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera);
 struct ShutterFlags {
   std::optional<double> angle_deg;  // --shutter DEG, in (0, 360]
   int samples = 16;                 // --shutter-samples N
+  ShutterScan scan = ShutterScan::kGlobal;  // --rolling-shutter DIRECTION
   bool enabled() const { return angle_deg.has_value(); }
 };
 // The shutter of a frame whose next frame's camera is `next`: off without --shutter, and for the last

@@ -411,15 +411,21 @@ void bind(nb::module_& m) {
                       "end_camera (at time 1); samples frames averaged.")
       .def(
           "__init__",
-          [](Shutter* shutter, double open, double close, int samples, std::optional<Camera> end_camera) {
-            new (shutter) Shutter{open, close, samples, std::move(end_camera)};
+          [](Shutter* shutter, double open, double close, int samples, std::optional<Camera> end_camera,
+             const std::string& scan) {
+            new (shutter) Shutter{open, close, samples, std::move(end_camera), parse_shutter_scan(scan)};
             validate(*shutter);
           },
-          "open"_a = 0.0, "close"_a = 0.0, "samples"_a = 16, "end_camera"_a = nb::none())
+          "open"_a = 0.0, "close"_a = 0.0, "samples"_a = 16, "end_camera"_a = nb::none(), "scan"_a = "global")
       .def_rw("open", &Shutter::open)
       .def_rw("close", &Shutter::close)
       .def_rw("samples", &Shutter::samples)
-      .def_rw("end_camera", &Shutter::end_camera);
+      .def_rw("end_camera", &Shutter::end_camera)
+      .def_prop_rw(
+          "scan", [](const Shutter& s) { return std::string(shutter_scan_name(s.scan)); },
+          [](Shutter& s, const std::string& name) { s.scan = parse_shutter_scan(name); },
+          "'global' (the mean over the open interval) or a rolling shutter's 'top-to-bottom', "
+          "'bottom-to-top', 'left-to-right', 'right-to-left' (samples bands, each at its time)");
   m.def("shutter_times", &shutter_times, "open"_a, "close"_a, "count"_a,
         "The times of `count` samples of a shutter: the middles of equal slices of [open, close].");
   m.def("camera_between", &camera_between, "start"_a, "end"_a, "t"_a,

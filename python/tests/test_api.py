@@ -282,6 +282,16 @@ def test_motion_blur_through_a_shutter(playbot_renderer):
     assert tilesplat.compare_images(blurred, still)["psnr_db"] < 40
     with pytest.raises(ValueError, match="0 <= open <= close <= 1"):
         tilesplat.Shutter(open=0.6, close=0.2, end_camera=end)
+    # A rolling shutter: the top half from the first time's frame, the bottom half from the second's.
+    rolling = tilesplat.Shutter(open=0.0, close=1.0, samples=2, end_camera=end, scan="top-to-bottom")
+    assert rolling.scan == "top-to-bottom"
+    rolled = renderer.render(start, shutter=rolling)
+    halves = [renderer.render(tilesplat.camera_between(start, end, t)) for t in (0.25, 0.75)]
+    rows = rolled.rgba.shape[0]
+    assert np.array_equal(rolled.rgba[: rows // 2], halves[0].rgba[: rows // 2])
+    assert np.array_equal(rolled.rgba[rows // 2 :], halves[1].rgba[rows // 2 :])
+    with pytest.raises(ValueError, match="unknown shutter scan 'diagonal'"):
+        tilesplat.Shutter(scan="diagonal")
 
 
 def test_camera_models(playbot_renderer):

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "tilesplat/camera.h"
@@ -16,11 +17,29 @@ namespace tilesplat {
 /// `close`, and the frame is the mean, in linear light (as a ThinLens frame's: tilesplat/lens.h), of
 /// `samples` pinhole frames at shutter_times(open, close, samples). Off (the frame it always was) unless the
 /// shutter opens for a while (close > open) over a camera that moves (end_camera set).
+/// How a shutter exposes the image: all of it over the open interval (global), or a band at a time.
+/// A rolling shutter reads the image out in `samples` bands of rows (or columns) in the scan's direction,
+/// band k (counted from where the scan starts) exposed at shutter_times(open, close, samples)[k]; each
+/// band's pixels are those of the frame at its time (no blur within a band). The bands split the rows
+/// (columns) as evenly as integers allow; a scan of more bands than rows (columns) has one per row.
+enum class ShutterScan {
+  kGlobal,       ///< every pixel sees the whole open interval: the frame is the mean over its times
+  kTopToBottom,  ///< rows, the top one first (most CMOS sensors)
+  kBottomToTop,  ///< rows, the bottom one first
+  kLeftToRight,  ///< columns, the leftmost first (a sensor mounted on its side)
+  kRightToLeft,  ///< columns, the rightmost first
+};
+/// "global", "top-to-bottom", "bottom-to-top", "left-to-right", "right-to-left".
+TILESPLAT_API const char* shutter_scan_name(ShutterScan scan);
+/// The scan named so (shutter_scan_name's names); throws std::invalid_argument naming the known ones.
+TILESPLAT_API ShutterScan parse_shutter_scan(const std::string& name);
+
 struct Shutter {
   double open = 0;                   ///< when the shutter opens, in [0, 1]
   double close = 0;                  ///< when it closes, in [open, 1]
-  int samples = 16;                  ///< times averaged, 1 to kMaxShutterSamples
+  int samples = 16;  ///< times averaged, or a rolling shutter's bands: 1 to kMaxShutterSamples
   std::optional<Camera> end_camera;  ///< the camera at time 1: the same size as the rendered one
+  ShutterScan scan = ShutterScan::kGlobal;  ///< global, or a rolling shutter's direction
   /// Whether the shutter blurs anything: open for a while over a camera that moves.
   bool enabled() const { return close > open && end_camera.has_value(); }
   /// Member-wise equality.

@@ -18,12 +18,39 @@ void check_times(double open, double close) {
 
 }  // namespace
 
+const char* shutter_scan_name(ShutterScan scan) {
+  switch (scan) {
+    case ShutterScan::kGlobal:
+      return "global";
+    case ShutterScan::kTopToBottom:
+      return "top-to-bottom";
+    case ShutterScan::kBottomToTop:
+      return "bottom-to-top";
+    case ShutterScan::kLeftToRight:
+      return "left-to-right";
+    case ShutterScan::kRightToLeft:
+      return "right-to-left";
+  }
+  return "unknown";
+}
+
+ShutterScan parse_shutter_scan(const std::string& name) {
+  for (ShutterScan scan : {ShutterScan::kGlobal, ShutterScan::kTopToBottom, ShutterScan::kBottomToTop,
+                           ShutterScan::kLeftToRight, ShutterScan::kRightToLeft})
+    if (name == shutter_scan_name(scan)) return scan;
+  throw std::invalid_argument(
+      "unknown shutter scan '" + name +
+      "' (known: global, top-to-bottom, bottom-to-top, left-to-right, right-to-left)");
+}
+
 void validate(const Shutter& shutter) {
   check_times(shutter.open, shutter.close);
   if (shutter.samples < 1 || shutter.samples > kMaxShutterSamples)
     throw std::invalid_argument("shutter: samples must be 1 to " + std::to_string(kMaxShutterSamples) +
                                 ", got " + std::to_string(shutter.samples));
   if (shutter.end_camera) validate(*shutter.end_camera);
+  if (std::string(shutter_scan_name(shutter.scan)) == "unknown")
+    throw std::invalid_argument("shutter: unknown scan " + std::to_string(int(shutter.scan)));
 }
 
 std::vector<double> shutter_times(double open, double close, int count) {

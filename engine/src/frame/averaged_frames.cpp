@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
+#include <vector>
 
 #include "settings_checks.h"
 
@@ -58,10 +60,54 @@ bool averages_samples(const RenderSettings& settings) {
   return settings.shutter.enabled() || settings.lens.enabled();
 }
 
+namespace {
+
+// A rolling shutter's frame: band k of the image (in the scan's order) copied from the frame at the k-th
+// of the shutter's times. Each sample frame is rendered whole (a band's pixels are then exactly the whole
+// frame's), so the frame costs `bands` frames, as a global shutter of as many samples does.
+RenderImage render_rolling(const Camera& camera, const RenderSettings& settings,
+                           const SampleRenderer& render_sample) {
+  const Shutter& shutter = settings.shutter;
+  const bool rows = shutter.scan == ShutterScan::kTopToBottom || shutter.scan == ShutterScan::kBottomToTop;
+  const bool reversed =
+      shutter.scan == ShutterScan::kBottomToTop || shutter.scan == ShutterScan::kRightToLeft;
+  const int extent = rows ? camera.height : camera.width;
+  const int bands = std::min(shutter.samples, extent);
+  RenderSettings sample_settings = settings;
+  sample_settings.shutter = {};
+  RenderImage image;
+  const std::vector<double> times = shutter_times(shutter.open, shutter.close, bands);
+  for (int k = 0; k < bands; ++k) {
+    const RenderImage frame =
+        render_sample(camera_between(camera, *shutter.end_camera, times[size_t(k)]), sample_settings);
+    if (k == 0) image = frame;  // sizes and outputs; every pixel is overwritten by its band below
+    // Band k in scan order covers [first, last) along the scan's axis, counted from where the scan starts.
+    const int first = int(int64_t(k) * extent / bands), last = int(int64_t(k + 1) * extent / bands);
+    for (int along = first; along < last; ++along) {
+      const int line = reversed ? extent - 1 - along : along;  // the row or column exposed
+      const int across = rows ? camera.width : camera.height;
+      for (int i = 0; i < across; ++i) {
+        const size_t p = rows ? size_t(line) * size_t(camera.width) + size_t(i)
+                              : size_t(i) * size_t(camera.width) + size_t(line);
+        for (size_t c = 0; c < 4; ++c) image.rgba[4 * p + c] = frame.rgba[4 * p + c];
+        if (!image.depth.empty()) image.depth[p] = frame.depth[p];
+        if (!image.splat_count.empty()) image.splat_count[p] = frame.splat_count[p];
+      }
+    }
+  }
+  return image;
+}
+
+}  // namespace
+
 RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
                             const SampleRenderer& render_sample) {
   LinearFrameMean mean(settings.background != std::array<float, 3>{0, 0, 0});
   RenderSettings sample_settings = settings;
+  if (settings.shutter.enabled() && settings.shutter.scan != ShutterScan::kGlobal) {
+    check_shutter(settings, camera);
+    return render_rolling(camera, settings, render_sample);
+  }
   if (settings.shutter.enabled()) {
     check_shutter(settings, camera);
     const Shutter& shutter = settings.shutter;

@@ -47,7 +47,9 @@ using SampleRenderer = std::function<RenderImage(const Camera&, const RenderSett
 // render_sample(camera_between(camera, end_camera, t), settings without the shutter) over shutter_times(...);
 // those settings may still hold a lens, which render_sample averages in turn. Otherwise, through the lens:
 // the mean of render_sample(lens_sample_camera(camera, lens, s), settings without the lens) over
-// lens_samples(lens.samples). Samples are rendered in that order.
+// lens_samples(lens.samples). A rolling shutter (ShutterScan other than kGlobal) stitches instead of
+// averaging: band k of its bands, in the scan's order, from render_sample(camera_between(...,
+// shutter_times(open, close, bands)[k]), settings without the shutter). Samples are rendered in that order.
 RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
                             const SampleRenderer& render_sample);
 
