@@ -12,11 +12,6 @@
 
 namespace tilesplat {
 
-/// A shutter over camera motion. The frame's time runs from 0, where the camera is the one rendered, to 1,
-/// where it is `end_camera`; between them camera_between() moves it. The shutter is open from `open` to
-/// `close`, and the frame is the mean, in linear light (as a ThinLens frame's: tilesplat/lens.h), of
-/// `samples` pinhole frames at shutter_times(open, close, samples). Off (the frame it always was) unless the
-/// shutter opens for a while (close > open) over a camera that moves (end_camera set).
 /// How a shutter exposes the image: all of it over the open interval (global), or a band at a time.
 /// A rolling shutter reads the image out in `samples` bands of rows (or columns) in the scan's direction,
 /// band k (counted from where the scan starts) exposed at shutter_times(open, close, samples)[k]; each
@@ -34,6 +29,12 @@ TILESPLAT_API const char* shutter_scan_name(ShutterScan scan);
 /// The scan named so (shutter_scan_name's names); throws std::invalid_argument naming the known ones.
 TILESPLAT_API ShutterScan parse_shutter_scan(const std::string& name);
 
+/// A shutter over camera motion. The frame's time runs from 0, where the camera is the one rendered, to 1,
+/// where it is `end_camera`; between them camera_between() moves it. The shutter is open from `open` to
+/// `close`, and the frame is the mean, in linear light (as a ThinLens frame's: tilesplat/lens.h), of
+/// `samples` pinhole frames at shutter_times(open, close, samples). Off (the frame it always was) unless the
+/// shutter opens for a while (close > open) over a camera that moves (end_camera set). A rolling shutter
+/// (`scan` other than ShutterScan::kGlobal) stitches its bands' frames instead of averaging them.
 struct Shutter {
   double open = 0;                   ///< when the shutter opens, in [0, 1]
   double close = 0;                  ///< when it closes, in [open, 1]
