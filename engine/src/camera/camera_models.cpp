@@ -98,26 +98,6 @@ double fisheye_theta_for(const std::array<double, 8>& k, double reach, double ra
   return 0.5 * (lo + hi);
 }
 
-// model_limits of the camera last asked about on this thread: project_point and pixel_ray are called per
-// pixel with one camera, and the fold's scan costs tens of thousands of evaluations.
-const ModelLimits& cached_limits(const Camera& camera) {
-  struct Entry {
-    bool valid = false;
-    CameraModel model = CameraModel::kPinhole;
-    std::array<double, 8> distortion{};
-    std::array<double, 4> intrinsics{};
-    std::array<int, 2> size{};
-    ModelLimits limits;
-  };
-  thread_local Entry entry;
-  const std::array<double, 4> intrinsics = {camera.fx, camera.fy, camera.cx, camera.cy};
-  const std::array<int, 2> size = {camera.width, camera.height};
-  if (!entry.valid || entry.model != camera.model || entry.distortion != camera.distortion ||
-      entry.intrinsics != intrinsics || entry.size != size)
-    entry = {true, camera.model, camera.distortion, intrinsics, size, model_limits(camera)};
-  return entry.limits;
-}
-
 }  // namespace
 
 Distorted distort(const std::array<double, 8>& k, double x, double y) {
@@ -140,7 +120,8 @@ std::array<double, 2> fisheye_theta_d(const std::array<double, 8>& k, double the
   return {theta * poly, slope};
 }
 
-ModelLimits model_limits(const Camera& camera) {
+// model_limits, computed: the fold's scan and the undistorted border cost tens of thousands of evaluations.
+ModelLimits compute_limits(const Camera& camera) {
   ModelLimits limits;
   limits.reach = kInfinity;
   // The image's extent from the principal point, in normalized (distorted) coordinates.
@@ -184,6 +165,26 @@ ModelLimits model_limits(const Camera& camera) {
       break;
   }
   return limits;
+}
+
+const ModelLimits& model_limits(const Camera& camera) {
+  // The camera last asked about on this thread: every frame (ProjectionPass::set_camera, each lens or
+  // shutter sample) and every Camera::project or ray_direction call asks again about the same intrinsics.
+  struct Entry {
+    bool valid = false;
+    CameraModel model = CameraModel::kPinhole;
+    std::array<double, 8> distortion{};
+    std::array<double, 4> intrinsics{};
+    std::array<int, 2> size{};
+    ModelLimits limits;
+  };
+  thread_local Entry entry;
+  const std::array<double, 4> intrinsics = {camera.fx, camera.fy, camera.cx, camera.cy};
+  const std::array<int, 2> size = {camera.width, camera.height};
+  if (!entry.valid || entry.model != camera.model || entry.distortion != camera.distortion ||
+      entry.intrinsics != intrinsics || entry.size != size)
+    entry = {true, camera.model, camera.distortion, intrinsics, size, compute_limits(camera)};
+  return entry.limits;
 }
 
 CentreProjection project_centre(const Camera& camera, const ModelLimits& limits,
@@ -275,7 +276,7 @@ CentreProjection project_centre(const Camera& camera, const ModelLimits& limits,
 }
 
 CentreProjection project_point(const Camera& camera, const std::array<double, 3>& t) {
-  return project_centre(camera, cached_limits(camera), t, 0.0);
+  return project_centre(camera, model_limits(camera), t, 0.0);
 }
 
 bool pixel_ray(const Camera& camera, double u, double v, std::array<double, 3>& ray) {
@@ -285,11 +286,11 @@ bool pixel_ray(const Camera& camera, double u, double v, std::array<double, 3>& 
     case CameraModel::kPinhole:
       break;
     case CameraModel::kOpenCV:
-      if (!undistort(camera.distortion, cached_limits(camera).reach, xd, yd, x, y)) return false;
+      if (!undistort(camera.distortion, model_limits(camera).reach, xd, yd, x, y)) return false;
       break;
     case CameraModel::kFisheye: {
       const double radius = std::hypot(xd, yd);
-      const double reach = cached_limits(camera).reach;
+      const double reach = model_limits(camera).reach;
       if (!(radius < fisheye_theta_d(camera.distortion, reach)[0])) return false;
       const double theta = fisheye_theta_for(camera.distortion, reach, radius);
       const double across = radius > 0 ? std::sin(theta) / radius : 0;

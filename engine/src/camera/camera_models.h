@@ -23,7 +23,9 @@ struct ModelLimits {
   // most pi. Centres at or beyond it are not drawn. Infinite where nothing folds.
   double reach = 0;
 };
-ModelLimits model_limits(const Camera& camera);
+// Those of `camera`, remembered for the last camera (its model, coefficients, intrinsics and size) asked
+// about on the calling thread; the reference lives until the next call on that thread.
+const ModelLimits& model_limits(const Camera& camera);
 
 // A splat centre t (camera space) through the camera's model.
 struct CentreProjection {
@@ -43,8 +45,8 @@ inline CameraModel drawn_model(const Camera& camera) {
 
 // How many records each Gaussian projects to: 2 for the equirectangular camera, whose splats across the
 // +-180 degree seam are drawn again one period (2 pi fx) to the other side; 1 for the others.
-inline uint32_t seam_copies(const Camera& camera) {
-  return camera.model == CameraModel::kEquirectangular ? 2 : 1;
+inline uint32_t seam_copies(CameraModel model) {
+  return model == CameraModel::kEquirectangular ? 2 : 1;
 }
 
 // For every model but the pinhole, whose projection the reference keeps written out in its own words.

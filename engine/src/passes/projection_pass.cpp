@@ -54,7 +54,7 @@ void ProjectionPass::set_camera(const Camera& camera, double near_plane) {
   p.focal_principal[1] = camera.fy;
   p.focal_principal[2] = camera.cx;
   p.focal_principal[3] = camera.cy;
-  const camera_models::ModelLimits limits = camera_models::model_limits(camera);
+  const camera_models::ModelLimits& limits = camera_models::model_limits(camera);
   p.clip[0] = limits.clamp_x;
   p.clip[1] = limits.clamp_y;
   p.clip[2] = near_plane;

@@ -6,9 +6,9 @@
 #include <utility>
 #include <vector>
 
+#include "camera/camera_models.h"
 #include "passes/key_buffers.h"
 #include "shader_io.h"
-#include "tilesplat/camera.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
 
@@ -49,7 +49,7 @@ struct ProjectionVariant {
   bool file_normals = false;  // lit, with the scene's normal buffer (else every splat's shortest axis)
   uint32_t camera_model = 0;  // tilesplat::CameraModel: the pinhole's code alone unless another is asked for
   // Records per Gaussian (camera_models::seam_copies): Gaussian i's are i and scene count + i.
-  uint32_t seam_copies() const { return camera_model == uint32_t(CameraModel::kEquirectangular) ? 2 : 1; }
+  uint32_t seam_copies() const { return camera_models::seam_copies(CameraModel(camera_model)); }
   auto operator<=>(const ProjectionVariant&) const = default;
 };
 

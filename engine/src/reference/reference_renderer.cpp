@@ -99,10 +99,11 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
 
   const PreparedLighting lighting = prepare_lighting(settings.lighting);  // validates
   if (settings.lighting.enabled()) reference::check_normals(scene);
-  const camera_models::ModelLimits limits = camera_models::model_limits(camera);
+  const camera_models::ModelLimits limits =
+      camera_models::model_limits(camera);  // a copy: model_limits' lasts until this thread asks again
 
   // One record per Gaussian, two for the equirectangular camera (its seam copies, records n..2n - 1).
-  const size_t records = n * camera_models::seam_copies(camera);
+  const size_t records = n * camera_models::seam_copies(camera.model);
   std::vector<ProjectedGaussian> projected(records);
   parallel_chunks(records, 4096, [&](size_t begin, size_t end) {
     for (size_t r = begin; r < end; ++r)

@@ -148,10 +148,15 @@ std::array<double, 9> read_camera_rotation(const Reader& reader, const Node& nod
   return m;
 }
 
-// A look_at camera (a pinhole). A fisheye's field of view (`fisheye_fov`, set for model "fisheye") may
-// reach 360 degrees; the pinhole returned then has a 50-degree one, for fisheye_camera() to replace.
-Camera read_look_at(const Reader& reader, const Node& node, int width, int height,
-                    double* fisheye_fov = nullptr) {
+// A look_at camera: the pinhole it describes, its distance to the target (a lens's default focus), and for
+// a fisheye the field of view, which may reach 360 degrees (the pinhole then has a 50-degree one, for
+// fisheye_camera() to replace).
+struct LookAt {
+  Camera camera;
+  double target_distance = 0;
+  double fisheye_fov = kDefaultFovDeg;
+};
+LookAt read_look_at(const Reader& reader, const Node& node, int width, int height, bool fisheye) {
   reader.expect_object(node, kLookAtKeys);
   const auto eye = reader.numbers<3>(reader.required_child(node, "eye", "the camera centre [x, y, z]"),
                                      -kMaxCoordinate, kMaxCoordinate);
@@ -161,11 +166,11 @@ Camera read_look_at(const Reader& reader, const Node& node, int width, int heigh
   const auto up_node = reader.optional_child(node, "up");
   if (up_node) up = reader.nonzero_vector(*up_node);
   double fov = kDefaultFovDeg;
-  if (fisheye_fov != nullptr) {
-    *fisheye_fov = kDefaultFovDeg;
+  LookAt out;
+  if (fisheye) {
     if (const auto fov_node = reader.optional_child(node, "fov_deg")) {
-      *fisheye_fov = reader.number(*fov_node, 0, 360);
-      if (!(*fisheye_fov > 0))
+      out.fisheye_fov = reader.number(*fov_node, 0, 360);
+      if (!(out.fisheye_fov > 0))
         reader.fail(fov_node->path, "a fisheye's field of view must be above 0 and at most 360 degrees");
     }
   } else if (const auto fov_node = reader.optional_child(node, "fov_deg")) {
@@ -182,7 +187,9 @@ Camera read_look_at(const Reader& reader, const Node& node, int width, int heigh
   if (std::hypot(side[0], side[1], side[2]) <= 1e-6 * up_length * distance)
     reader.fail(up_node ? up_node->path : node.path, "'up' is parallel to the view direction (eye to target): "
                                                      "the camera's roll is undefined");
-  return look_at_camera(eye, target, up, width, height, fov);
+  out.camera = look_at_camera(eye, target, up, width, height, fov);
+  out.target_distance = distance;
+  return out;
 }
 
 Camera read_pinhole(const Reader& reader, const Node& node, int width, int height) {
@@ -301,27 +308,21 @@ CameraView read_camera(const Reader& reader, const Node& node, size_t index, Thi
   const auto look_at = reader.optional_child(node, "look_at");
   const CameraModel model = read_model_name(reader, node);
   double fisheye_fov = kDefaultFovDeg;
+  std::optional<double> target_distance;  // a look_at camera's: its lens's default focus
   if (look_at) {
     for (const char* key : {"fx", "fy", "cx", "cy", "position", "rotation"})
       if (const auto conflict = reader.optional_child(node, key))
         reader.fail(conflict->path, "not allowed with 'look_at', which sets the pose and the focal length");
-    view.camera = read_look_at(reader, *look_at, width, height,
-                               model == CameraModel::kFisheye ? &fisheye_fov : nullptr);
+    const LookAt aimed = read_look_at(reader, *look_at, width, height, model == CameraModel::kFisheye);
+    view.camera = aimed.camera;
+    fisheye_fov = aimed.fisheye_fov;
+    target_distance = aimed.target_distance;
   } else {
     view.camera = read_pinhole(reader, node, width, height);
   }
   read_model(reader, node, model, look_at.has_value(), fisheye_fov, view.camera);
-  if (const auto lens_node = reader.optional_child(node, "lens")) {
-    std::optional<double> target_distance;
-    if (look_at) {
-      const auto eye =
-          reader.numbers<3>(reader.required_child(*look_at, "eye", ""), -kMaxCoordinate, kMaxCoordinate);
-      const auto target =
-          reader.numbers<3>(reader.required_child(*look_at, "target", ""), -kMaxCoordinate, kMaxCoordinate);
-      target_distance = std::hypot(target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]);
-    }
+  if (const auto lens_node = reader.optional_child(node, "lens"))
     lens = read_lens(reader, *lens_node, view.camera, target_distance);
-  }
   return view;
 }
 
