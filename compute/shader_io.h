@@ -165,6 +165,33 @@ TS_PUSH_CONSTANTS(StochasticCompositePush) {
 TS_PUSH_INSTANCE;
 #endif
 
+#if defined(__cplusplus) || defined(TS_RASTER_PUSH)
+// raster_quad.vert and raster_blend.frag (RasterCompositePass): one instance per visible splat, in
+// depth order, each a quad around its alpha >= alpha_min ellipse.
+TS_PUSH_CONSTANTS(RasterPush) {
+  TS_REF(Vec4Array) splats;
+  TS_REF(UintArray) depth_order;  // the depth sort's result: record indices, visible ones first
+  uint width;
+  uint height;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_RASTER_RESOLVE_PUSH)
+// raster_resolve.comp (RasterCompositePass): the attachments, copied to buffers, into the outputs.
+TS_PUSH_CONSTANTS(RasterResolvePush) {
+  TS_REF(Vec4Array) rgba;        // in: (sum of w rgb, 1 - T); out: with the background under it
+  TS_REF(Vec4Array) depth_sums;  // in: (sum of w depth, -, -, 1 - T), when the depth is written
+  TS_REF(FloatArray) out_depth;  // the weighted mean depth
+  TS_REF(UintArray) count;       // in: float counts; out: the same as uints
+  vec4 background;
+  uint pixels;
+  uint write_depth;
+  uint write_count;
+}
+TS_PUSH_INSTANCE;
+#endif
+
 // ---------------------------------------------------------------------------------------------
 // The push constants of the frame's other passes (engine/src/passes/), in frame order.
 

@@ -326,6 +326,44 @@ TEST(FramePlan, EveryModeStrategyAndCompositorGivesAWellFormedPlan) {
   EXPECT_EQ(plans, 15 * 3 + 10 * 3);  // five of the modes change the depth order
 }
 
+// The raster frame: the Gaussians sorted by depth (whatever the strategy's own plan), then drawn; no
+// tile lists. On reused lists it re-draws; re-sorting per pixel and a host's depth are refused.
+TEST(FramePlan, RasterFrameSortsByDepthThenDraws) {
+  RenderSettings settings;
+  settings.compositor = Compositor::kRaster;
+  for (const SortTraits& sort : {kRadix, kPairs, kHostSort}) {
+    const FramePlan plan = plan_frame(camera(), settings, context(sort));
+    EXPECT_EQ(plan.passes,
+              (std::vector<P>{P::kClearCounters, P::kProjection, P::kDepthSort, P::kRasterComposite}))
+        << sort.name;
+    EXPECT_EQ(plan.timed_passes(),
+              (std::vector<std::string>{"projection", "depth_sort", "raster_composite"}));
+    EXPECT_TRUE(plan.depth_first) << sort.name;
+    EXPECT_FALSE(plan.wide_keys) << sort.name;
+    EXPECT_EQ(plan.sort_bits, 32u) << sort.name;
+    EXPECT_EQ(plan.splits_submissions, sort.sorts_on_host) << sort.name;
+  }
+  settings.accuracy = parse_accuracy_modes("depth16");
+  FramePlan plan = plan_frame(camera(), settings, context());
+  EXPECT_EQ(plan.passes, (std::vector<P>{P::kClearCounters, P::kProjection, P::kDepthQuantize, P::kDepthSort,
+                                         P::kRasterComposite}));
+  EXPECT_EQ(plan.sort_bits, 16u);
+  settings.accuracy = {};
+  settings.reuse_lists = true;
+  FrameContext reuse = context();
+  reuse.lists = plan_frame(camera(), settings, reuse).lists;
+  plan = plan_frame(camera(), settings, reuse);
+  EXPECT_FALSE(plan.build_lists);
+  EXPECT_EQ(plan.passes, (std::vector<P>{P::kRasterComposite}));
+  settings.compositor = Compositor::kSorted;  // lists built for the raster frame are not tile lists
+  EXPECT_TRUE(plan_frame(camera(), settings, reuse).build_lists);
+
+  RenderSettings resort;
+  resort.compositor = Compositor::kRaster;
+  resort.accuracy = parse_accuracy_modes("resort8");
+  EXPECT_THROW(plan_frame(camera(), resort, context()), std::invalid_argument);
+}
+
 // CPU drivers take the texel-buffer layouts before Mesa 25 only (vk::texel_buffers_wanted), by the
 // driver's description.
 TEST(TexelLayouts, MesaMajorVersionFromTheDriverDescription) {

@@ -228,6 +228,18 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
           }
         throw UsageError("--antialiasing must be classic, antialiased or mip, got " + single_quoted(text));
       });
+  parser.add_value(
+      "--compositor", "NAME",
+      "how the splats become pixels: sorted (each tile's depth-sorted list blended in a compute "
+      "pass; the default), stochastic (sort-free, averaged) or raster (the depth-sorted splats "
+      "drawn as quads and blended by the graphics pipeline)",
+      [&options](const std::string& text) {
+        try {
+          options.compositor = parse_compositor(text);
+        } catch (const std::invalid_argument&) {
+          throw UsageError("--compositor must be sorted, stochastic or raster, got " + single_quoted(text));
+        }
+      });
   parser.add_value("--max-alpha", "A",
                    "the cap on one splat's alpha at a pixel the splats were trained with: 0.99 (3DGS, the "
                    "default) or 0.999 (gsplat)",
@@ -242,6 +254,7 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
 void apply_training_options(const CommonOptions& options, RenderSettings& settings) {
   if (options.antialiasing) settings.antialiasing = *options.antialiasing;
   if (options.max_alpha) settings.max_alpha = *options.max_alpha;
+  if (options.compositor) settings.compositor = *options.compositor;
 }
 
 void check_common_options(const ArgParser& parser, const CommonOptions& options) {

@@ -35,6 +35,8 @@ struct CommonOptions {
   std::optional<Antialiasing> antialiasing;
   // --max-alpha: the cap on a splat's alpha the asset was trained with; unset = kDefaultMaxAlpha.
   std::optional<double> max_alpha;
+  // --compositor: how the splats become pixels; unset = the app's default (sorted).
+  std::optional<Compositor> compositor;
 };
 
 inline constexpr int kOrbitDefaultWidth = 1920;
@@ -46,7 +48,8 @@ enum class SceneChoice { kOne, kList };
 
 // Declares SCENE, --cameras, --view, --width, --height, the orbit flags, --strict, --device,
 // --list-devices, --validation, --sort (one name, or a comma list / "all" for kList) and --mode
-// (one accuracy mode combination, or a comma list of them for kList), --antialiasing and --max-alpha.
+// (one accuracy mode combination, or a comma list of them for kList), --antialiasing, --max-alpha and
+// --compositor.
 void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice sort_choice,
                         SceneChoice scene_choice = SceneChoice::kOne);
 
@@ -69,7 +72,7 @@ void print_devices();
 RendererOptions renderer_options(const CommonOptions& options);
 
 // What the flags say of how the splats were trained (--antialiasing, --max-alpha), over `settings`
-// (which hold the scene file's).
+// (which hold the scene file's), and of how they become pixels (--compositor).
 void apply_training_options(const CommonOptions& options, RenderSettings& settings);
 
 // Whether any SCENE of the options is a scene file (.json).

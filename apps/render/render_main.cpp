@@ -479,7 +479,7 @@ int run(int argc, char** argv) {
   if (options.no_depth) settings.depth = false;
   if (options.no_count) settings.splat_count = false;
   cli::apply_training_options(options.common, settings);
-  if (options.stochastic_frames > 0) {
+  if (options.stochastic_frames > 0) {  // --compositor stochastic or none (check_render_options)
     settings.compositor = tilesplat::Compositor::kStochastic;
     settings.stochastic.frames = static_cast<uint32_t>(options.stochastic_frames);
   }

@@ -280,8 +280,16 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
                              {"--cameras", options.common.cameras},
                              {"-o", options.output},
                              {"--png", options.png}});
-  if (options.reference && parser.seen("--stochastic"))
-    throw cli::UsageError("--stochastic is a GPU compositor; the --reference renderer blends sorted lists");
+  const bool stochastic =
+      parser.seen("--stochastic") || options.common.compositor == tilesplat::Compositor::kStochastic;
+  if (options.reference && stochastic)
+    throw cli::UsageError(
+        "the stochastic compositor is the GPU's; the --reference renderer has the sorted and raster rules");
+  if (parser.seen("--stochastic") && options.common.compositor &&
+      *options.common.compositor != tilesplat::Compositor::kStochastic)
+    throw cli::UsageError(
+        "--stochastic N is the stochastic compositor; it cannot be combined with --compositor " +
+        tilesplat::to_string(*options.common.compositor));
   if (options.camera_model.given() > 1)
     throw cli::UsageError("--fisheye, --orthographic and --equirectangular are camera models: one of them");
   if (options.camera_model.enabled() && options.lens.enabled())

@@ -20,7 +20,21 @@ std::string to_string(Antialiasing mode) {
 }
 
 std::string to_string(Compositor compositor) {
-  return compositor == Compositor::kStochastic ? "stochastic" : "sorted";
+  switch (compositor) {
+    case Compositor::kSorted:
+      return "sorted";
+    case Compositor::kStochastic:
+      return "stochastic";
+    case Compositor::kRaster:
+      return "raster";
+  }
+  return "unknown";
+}
+
+Compositor parse_compositor(const std::string& name) {
+  for (Compositor c : {Compositor::kSorted, Compositor::kStochastic, Compositor::kRaster})
+    if (to_string(c) == name) return c;
+  throw std::invalid_argument("unknown compositor '" + name + "' (expected sorted, stochastic or raster)");
 }
 
 namespace {

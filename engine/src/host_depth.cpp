@@ -13,8 +13,8 @@ void validate_host_depth(const RenderSettings& settings, const Camera& camera) {
   const HostDepth& host = *settings.host;
   auto fail = [](const std::string& why) { throw std::invalid_argument("host depth: " + why); };
   if (settings.compositor != Compositor::kSorted)
-    fail(
-        "the stochastic compositor does not depth-test against a host's surfaces: use the sorted compositor");
+    fail("the " + to_string(settings.compositor) +
+         " compositor does not depth-test against a host's surfaces: use the sorted compositor");
   if (settings.accuracy.resort_window > 0)
     fail("per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
          ") does not depth-test against a host's surfaces: render without it");

@@ -65,7 +65,7 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
 
 FrameCounters Renderer::Impl::run_frame(const FramePlan& plan, const RenderSettings& settings, SortStrategy& sorter,
                                         const ExternalDepthImage* depth_image) {
-  recorder.prepare(plan, resources, sorter);
+  recorder.prepare(plan, settings, resources, sorter);
   vk::CommandStream stream(ctx);
   recorder.record(stream, plan, settings, resources, sorter, depth_image);
   stream.finish();

@@ -63,7 +63,7 @@ void Renderer::Impl::record_frame_into(const HostCommandBuffer& host, const Came
 void Renderer::Impl::record_frame_to_images(vk::CommandStream& stream, const FrameStart& start,
                                             const RenderSettings& settings, const ExternalImage& target,
                                             const ExternalDepthImage* depth_image) {
-  recorder.prepare(start.plan, resources, *start.sorter);
+  recorder.prepare(start.plan, settings, resources, *start.sorter);
   recorder.record(stream, start.plan, settings, resources, *start.sorter, depth_image);
   recorder.record_copies_to_images(stream.cmd(), settings, resources, target, depth_image);
 }

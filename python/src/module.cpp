@@ -120,7 +120,8 @@ RenderSettings make_settings(const std::string& sort, bool depth, bool splat_cou
       parse_choice("antialiasing", antialiasing,
                    std::array{Antialiasing::kClassic, Antialiasing::kAntialiased, Antialiasing::kMip});
   settings.compositor =
-      parse_choice("compositor", compositor, std::array{Compositor::kSorted, Compositor::kStochastic});
+      parse_choice("compositor", compositor,
+                   std::array{Compositor::kSorted, Compositor::kStochastic, Compositor::kRaster});
   settings.stochastic.frames = stochastic_frames;
   settings.stochastic.seed = seed;
   settings.background = background;
@@ -571,7 +572,8 @@ void bind(nb::module_& m) {
           "shutter"_a = nb::none(),
           "Renders the scene from `camera`. Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
-          "compositor 'sorted' or 'stochastic'; near_plane the view depth at or below which a Gaussian is "
+          "compositor 'sorted', 'stochastic' or 'raster' (the depth-sorted splats drawn as quads by the "
+          "graphics pipeline); near_plane the view depth at or below which a Gaussian is "
           "culled; max_alpha the cap on one splat's alpha (0.99 as 3DGS trains, 0.999 as gsplat does); lens "
           "a ThinLens for depth of field (the mean of its samples' pinhole frames in linear light); shutter "
           "a "

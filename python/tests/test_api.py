@@ -128,6 +128,16 @@ def test_settings_are_keyword_arguments(playbot_renderer):
     assert white.rgba[0, 0, :3].min() > 0.5 or exact.rgba[0, 0, 3] > 0.5
 
 
+def test_raster_compositor(playbot_renderer):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 96, 54)
+    raster = renderer.render(camera, compositor="raster")
+    # The raster rule differs from the tile compositor only by its missing early-out and tile rectangles.
+    assert tilesplat.compare_images(raster, renderer.render(camera))["psnr_db"] > 60
+    with pytest.raises(ValueError, match="raster"):
+        renderer.render(camera, compositor="billboard")
+
+
 def test_images_write_exr_and_png(playbot_renderer, tmp_path):
     scene, renderer = playbot_renderer
     camera = tilesplat.Camera.orbit(scene, 64, 36)

@@ -119,8 +119,15 @@ TILESPLAT_API void validate(const Lighting& lighting);
 enum class Compositor {
   kSorted,      ///< front-to-back blending of each tile's depth-sorted list (the reference)
   kStochastic,  ///< sort-free: each splat kept per pixel with probability alpha, nearest kept wins; averaged
+  /// Sorted billboards through the graphics pipeline: the Gaussians in depth order, each drawn as a
+  /// quad around its alpha >= alpha_cutoff ellipse and blended front to back by the hardware, with no
+  /// tiles and no transmittance early-out (render_reference's raster rule: every splat whose alpha at
+  /// a pixel passes the cut-off blends there). Needs a queue that draws and RGBA32F blending.
+  kRaster,
 };
-TILESPLAT_API std::string to_string(Compositor compositor);  ///< "sorted", "stochastic"
+TILESPLAT_API std::string to_string(Compositor compositor);  ///< "sorted", "stochastic", "raster"
+/// The compositor of a name to_string gives; throws std::invalid_argument listing the names.
+TILESPLAT_API Compositor parse_compositor(const std::string& name);
 /// The stochastic compositor draws, per pixel and frame, each splat of its tile with probability
 /// alpha (the sorted composite's alpha and cut-off) from a hash of (pixel, splat index, frame, seed)
 /// and shows the nearest drawn splat (by view depth, then index), or the background. Its expectation

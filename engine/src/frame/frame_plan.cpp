@@ -46,9 +46,20 @@ void check_camera(const Camera& camera, const DeviceCaps& device) {
          std::to_string(device.max_allocation_size >> 20) + " MiB)");
 }
 
+// Settings the raster compositor cannot honour: it blends in the Gaussians' depth order, each splat
+// over whole pixels.
+void validate_raster(const RenderSettings& settings) {
+  if (settings.accuracy.resort_window > 0)
+    throw std::invalid_argument(
+        "raster compositor: per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
+        ") re-orders each tile's list, and this compositor draws no tile lists: use the "
+        "sorted compositor");
+}
+
 // Settings the stochastic compositor cannot honour.
 constexpr uint32_t kMaxStochasticFrames = 4096;
 void validate_compositor(const RenderSettings& settings) {
+  if (settings.compositor == Compositor::kRaster) validate_raster(settings);
   if (settings.compositor != Compositor::kStochastic) return;
   auto fail = [](const std::string& why) { throw std::invalid_argument("stochastic compositor: " + why); };
   const AccuracyModes& modes = settings.accuracy;
@@ -76,6 +87,20 @@ TileGrid tile_grid(const Camera& camera) {
   return grid;
 }
 
+// The raster frame: projection -> depth sort -> the splats drawn in that order. It builds no tile
+// lists; "reusing its lists" re-draws the sorted splats.
+std::vector<FramePass> raster_frame_passes(const FramePlan& plan) {
+  std::vector<FramePass> passes;
+  if (plan.build_lists) {
+    passes.push_back(FramePass::kClearCounters);
+    passes.push_back(FramePass::kProjection);
+    if (plan.depth_key_bits == 16) passes.push_back(FramePass::kDepthQuantize);
+    passes.push_back(FramePass::kDepthSort);
+  }
+  passes.push_back(FramePass::kRasterComposite);
+  return passes;
+}
+
 // The frame's passes in order. The lists are built as
 //   sorted:     projection -> depth sort -> prefix sum (depth order) -> key emission -> tile sort
 //               (stable, so each tile's run stays front to back) -> tile ranges
@@ -86,6 +111,7 @@ TileGrid tile_grid(const Camera& camera) {
 // Its tile binning is the strategy's sort over the tile bits of 32-bit keys, used only to group the
 // pairs by tile. A frame on reused lists runs the composite alone.
 std::vector<FramePass> frame_passes(const FramePlan& plan) {
+  if (plan.compositor == Compositor::kRaster) return raster_frame_passes(plan);
   std::vector<FramePass> passes;
   if (plan.host.from_image) passes.push_back(FramePass::kHostDepthIn);  // every attempt converts it first
   const bool stochastic = plan.compositor == Compositor::kStochastic;
@@ -144,6 +170,8 @@ const char* timed_name(FramePass pass) {
       return "composite";
     case FramePass::kStochasticComposite:
       return "stochastic_composite";
+    case FramePass::kRasterComposite:
+      return "raster_composite";
   }
   return nullptr;
 }
@@ -206,11 +234,15 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
   plan.compositor = settings.compositor;
   plan.depth_key_bits = uint32_t(settings.accuracy.depth_key_bits);
   const bool stochastic = settings.compositor == Compositor::kStochastic;
-  plan.depth_first = context.sort.plan == FrameSortPlan::kDepthThenTile;
+  const bool raster = settings.compositor == Compositor::kRaster;
+  // The raster frame sorts the Gaussians by depth alone, with any strategy.
+  plan.depth_first = raster || context.sort.plan == FrameSortPlan::kDepthThenTile;
   // The stochastic frame only bins by tile, in 32-bit keys whatever the strategy.
   plan.wide_keys = !stochastic && !plan.depth_first;
   // In 64-bit keys the tile id sits above bit 32 whatever the depth key's width.
-  plan.sort_bits = stochastic ? plan.tiles.tile_bits : plan.depth_key_bits + plan.tiles.tile_bits;
+  plan.sort_bits = stochastic ? plan.tiles.tile_bits
+                   : raster   ? plan.depth_key_bits
+                              : plan.depth_key_bits + plan.tiles.tile_bits;
   plan.resort_window = stochastic ? 0 : uint32_t(settings.accuracy.resort_window);
   plan.stochastic_samples = stochastic ? settings.stochastic.frames : 0;
   if (settings.host) {

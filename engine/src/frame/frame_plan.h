@@ -34,6 +34,7 @@ enum class FramePass {
   kComposite,            // front-to-back blending (composite.comp)
   kResortComposite,      // blending with per-pixel re-sorting (composite_resort.comp)
   kStochasticComposite,  // the sort-free composite (composite_stochastic.comp)
+  kRasterComposite,      // the depth-sorted splats drawn as quads and blended by the hardware
 };
 // The pass's name in FrameStats::passes and the benchmark, or nullptr for a step that is not timed.
 const char* timed_name(FramePass pass);

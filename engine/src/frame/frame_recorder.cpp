@@ -19,6 +19,7 @@ FrameRecorder::FrameRecorder(vk::Context& ctx, vk::GpuTimer& timer)
       composite_(ctx),
       composite_resort_(ctx),
       stochastic_composite_(ctx),
+      raster_composite_(ctx),
       host_depth_(ctx),
       pack_colour_(ctx) {}
 
@@ -33,12 +34,16 @@ uint32_t FrameRecorder::chunks_for(Compositor compositor, uint64_t longest_tile_
                                                : composite_.chunks_for(longest_tile_list);
 }
 
-void FrameRecorder::prepare(const FramePlan& plan, FrameResources& resources, SortStrategy& sorter) {
+void FrameRecorder::prepare(const FramePlan& plan, const RenderSettings& settings, FrameResources& resources,
+                            SortStrategy& sorter) {
   const uint32_t chunks = composite_chunks(plan.compositor);
   const bool needs_state = plan.compositor == Compositor::kStochastic
                                ? StochasticCompositePass::needs_state(plan.stochastic_samples, chunks)
-                               : chunks > 1;
+                           : plan.compositor == Compositor::kRaster ? false
+                                                                    : chunks > 1;
   resources.prepare_frame(plan, needs_state);
+  if (plan.compositor == Compositor::kRaster)
+    raster_composite_.prepare(plan.tiles.width, plan.tiles.height, settings.depth, settings.splat_count);
   if (!plan.build_lists) return;
   projection_.prepare(resources.scene, plan.projection);
   sorter.reserve(std::max(plan.splat_records, resources.keys.capacity));
@@ -102,8 +107,9 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
       return;
     case FramePass::kDepthSort: {
       SortInput input{res.projected.depth_order, res.counters, kDepthSortOffset, plan.depth_key_bits, true};
-      r.depth_order = r.sorter.record(r.stream, input) ? &res.projected.depth_order.values_alt
-                                                       : &res.projected.depth_order.values;
+      res.depth_order_in_alt = r.sorter.record(r.stream, input);
+      r.depth_order =
+          res.depth_order_in_alt ? &res.projected.depth_order.values_alt : &res.projected.depth_order.values;
       return;
     }
     case FramePass::kPrefixSum:
@@ -142,6 +148,22 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
     case FramePass::kStochasticComposite:
       record_composite(r, pass);
       return;
+    case FramePass::kRasterComposite: {
+      // The depth order this frame's sort left, or the one a frame on reused lists finds.
+      const vk::Buffer& order =
+          res.depth_order_in_alt ? res.projected.depth_order.values_alt : res.projected.depth_order.values;
+      const AccuracyModes& modes = r.settings.accuracy;
+      raster_composite_.record(
+          cmd, {.splats = res.projected.splats,
+                .depth_order = order,
+                .counters = res.counters,
+                .out = res.outputs,
+                .background = r.settings.background,
+                .write_depth = r.settings.depth,
+                .write_count = r.settings.splat_count,
+                .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff, float(r.settings.max_alpha)}});
+      return;
+    }
   }
 }
 

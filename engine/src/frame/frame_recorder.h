@@ -15,6 +15,7 @@
 #include "passes/pack_colour_pass.h"
 #include "passes/prefix_sum_pass.h"
 #include "passes/projection_pass.h"
+#include "passes/raster_composite_pass.h"
 #include "passes/stochastic_composite_pass.h"
 #include "passes/tile_ranges_pass.h"
 #include "sort/sort_strategy.h"
@@ -32,8 +33,10 @@ class FrameRecorder {
   // scene's normals on its first lit frame) and the camera. Outside any command buffer; not needed for
   // a frame on reused lists, whose camera and lights are those in the buffers.
   void set_frame_inputs(const Camera& camera, const RenderSettings& settings, SceneBuffers& scene);
-  // Sizes the buffers and scratch the plan's passes use. Outside any command buffer, before record().
-  void prepare(const FramePlan& plan, FrameResources& resources, SortStrategy& sorter);
+  // Sizes the buffers, attachments and scratch the plan's passes use (the outputs the settings ask
+  // for). Outside any command buffer, before record().
+  void prepare(const FramePlan& plan, const RenderSettings& settings, FrameResources& resources,
+               SortStrategy& sorter);
   // Records the plan's passes (the GPU timer's frame begins with them).
   void record(vk::CommandStream& stream, const FramePlan& plan, const RenderSettings& settings,
               FrameResources& resources, SortStrategy& sorter, const ExternalDepthImage* depth_image);
@@ -50,7 +53,7 @@ class FrameRecorder {
   uint32_t chunks_for(Compositor compositor, uint64_t longest_tile_list) const;
   // The longest tile list per-pixel re-sorting can hold on this device.
   uint32_t max_resort_splats() const { return composite_resort_.max_tile_splats(); }
-  uint64_t device_bytes() const { return prefix_sum_.device_bytes(); }
+  uint64_t device_bytes() const { return prefix_sum_.device_bytes() + raster_composite_.device_bytes(); }
 
  private:
   struct Recording;  // the state one record() call carries from pass to pass
@@ -69,6 +72,7 @@ class FrameRecorder {
   CompositePass composite_;
   CompositeResortPass composite_resort_;
   StochasticCompositePass stochastic_composite_;
+  RasterCompositePass raster_composite_;
   HostDepthPass host_depth_;    // render_to_image with a depth image
   PackColourPass pack_colour_;  // render_to_image into a colour image of another format than RGBA32F
   uint32_t sorted_chunks_ = 1;

@@ -68,6 +68,7 @@ class FrameResources {
   vk::Buffer host_window_depth;   // a depth image's window depths, and the depth out before it is copied back
   vk::Buffer host_surface_depth;  // and the view depth at which the splats' alpha reached its threshold
   bool lists_in_alt = false;      // the tile lists ended in keys.values_alt (else keys.values)
+  bool depth_order_in_alt = false;  // the depth sort's order ended in projected.depth_order.values_alt
 
  private:
   void ensure_key_capacity(uint32_t capacity, bool wide);

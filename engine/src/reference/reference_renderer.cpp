@@ -28,6 +28,27 @@ namespace {
 constexpr double kMinAlpha = 1.0 / 255.0;
 constexpr double kMinTransmittance = 1e-4;
 
+// The raster rule's reach (Compositor::kRaster): the tiles that the bounding box of the splat's
+// alpha >= kMinAlpha ellipse meets, with a pixel's margin, in place of the projection's tile
+// rectangle. Alpha = opacity exp(-m^2 / 2) >= kMinAlpha inside the Mahalanobis radius m^2 = 2 ln(opacity /
+// kMinAlpha), whose box has half-widths m sqrt(cov a) and m sqrt(cov c). Pixels the box holds beyond
+// the ellipse are skipped by the alpha test, so the box's size changes no pixel, only the work.
+void bin_by_alpha_ellipse(ProjectedGaussian& g, int grid_x, int grid_y) {
+  const double m2 = 2.0 * std::log(g.opacity / kMinAlpha);
+  if (!(m2 > 0)) {
+    g.tile_min[0] = g.tile_max[0] = g.tile_min[1] = g.tile_max[1] = 0;  // never reaches the cut-off
+    return;
+  }
+  const double half[2] = {std::sqrt(m2 * g.cov2d[0]) + 1.0, std::sqrt(m2 * g.cov2d[2]) + 1.0};
+  const int grid[2] = {grid_x, grid_y};
+  for (int axis = 0; axis < 2; ++axis) {
+    const double low = std::floor((g.mean[axis] - half[axis]) / kTileSize);
+    const double high = std::floor((g.mean[axis] + half[axis]) / kTileSize) + 1;
+    g.tile_min[axis] = int(std::clamp(low, 0.0, double(grid[axis])));
+    g.tile_max[axis] = int(std::clamp(high, 0.0, double(grid[axis])));
+  }
+}
+
 unsigned worker_count(size_t work_items) {
   const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
   return static_cast<unsigned>(std::min<size_t>(hardware, std::max<size_t>(1, work_items)));
@@ -131,9 +152,12 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
   }
 
   // Bin the splats into per-tile lists (counting sort); filling in front-to-back order keeps
-  // every list sorted.
+  // every list sorted. The raster rule lists a splat wherever its alpha can pass the cut-off.
   const int grid_x = (camera.width + kTileSize - 1) / kTileSize;
   const int grid_y = (camera.height + kTileSize - 1) / kTileSize;
+  const bool raster = settings.compositor == Compositor::kRaster;
+  if (raster)
+    for (uint32_t index : order) bin_by_alpha_ellipse(projected[index], grid_x, grid_y);
   const size_t tiles = size_t(grid_x) * size_t(grid_y);
   std::vector<size_t> tile_offsets(tiles + 1, 0);
   for (uint32_t index : order) {
@@ -195,7 +219,8 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
               // Behind (or at) the host's opaque surface; compared as the float depths the GPU sorts on.
               if (!host_z.empty() && !(static_cast<float>(splat.depth) < surface_z)) continue;
               const double next_transmittance = transmittance * (1 - alpha);
-              if (next_transmittance < kMinTransmittance) break;
+              // The raster rule has no early-out: the hardware blend cannot skip a fragment.
+              if (!raster && next_transmittance < kMinTransmittance) break;
               const double weight = alpha * transmittance;
               for (int ch = 0; ch < 3; ++ch) color[ch] += splat.color[ch] * weight;
               depth_sum += weight * splat.depth;

@@ -76,8 +76,10 @@ Context::Context(const ExternalVulkanDevice& borrowed) : owns_handles_(false) {
       throw std::invalid_argument(device_name_ + ": borrowed queue family " + std::to_string(queue_family_) +
                                   " has no compute support with timestamps");
     limits_.timestamp_valid_bits = families[queue_family_].timestampValidBits;
+    features_.graphics_queue = (families[queue_family_].queueFlags & VK_QUEUE_GRAPHICS_BIT) != 0;
     // The host enabled the device's features; shaderFloat64 only counts if it says so.
     features_.shader_float64 = features_.shader_float64 && borrowed.shader_float64_enabled;
+    features_.independent_blend = false;  // the host does not say whether it enabled it
     create_command_objects();
   } catch (...) {
     destroy();
@@ -192,6 +194,7 @@ void Context::read_device_properties() {
   if (!has12.bufferDeviceAddress) throw std::runtime_error(device_name_ + ": bufferDeviceAddress is required");
   if (!has.features.shaderInt64) throw std::runtime_error(device_name_ + ": shaderInt64 is required");
   features_.shader_float64 = has.features.shaderFloat64 == VK_TRUE;
+  features_.independent_blend = has.features.independentBlend == VK_TRUE;
   vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
 }
 
@@ -201,15 +204,17 @@ uint32_t Context::pick_queue_family() {
   std::vector<VkQueueFamilyProperties> families(family_count);
   vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &family_count, families.data());
   bool found = false;
-  // A compute queue with timestamps; prefer one that is not also graphics (async compute on GPUs).
+  // A compute queue with timestamps; prefer one that also draws, which the raster compositor needs
+  // (the engine's own device runs nothing beside the frame, so a compute-only queue would gain nothing).
   for (int pass = 0; pass < 2 && !found; ++pass) {
     for (uint32_t i = 0; i < family_count; ++i) {
       const auto& f = families[i];
       bool compute = f.queueFlags & VK_QUEUE_COMPUTE_BIT;
       bool graphics = f.queueFlags & VK_QUEUE_GRAPHICS_BIT;
-      if (compute && f.timestampValidBits > 0 && (pass == 1 || !graphics)) {
+      if (compute && f.timestampValidBits > 0 && (pass == 1 || graphics)) {
         queue_family_ = i;
         limits_.timestamp_valid_bits = f.timestampValidBits;
+        features_.graphics_queue = graphics;
         found = true;
         break;
       }
@@ -226,6 +231,7 @@ void Context::create_device() {
   want.pNext = &want12;
   want.features.shaderInt64 = VK_TRUE;
   want.features.shaderFloat64 = features_.shader_float64 ? VK_TRUE : VK_FALSE;
+  want.features.independentBlend = features_.independent_blend ? VK_TRUE : VK_FALSE;
 
   float priority = 1.0f;
   VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

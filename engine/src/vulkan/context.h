@@ -36,6 +36,8 @@ struct DeviceLimits {
 struct DeviceFeatures {
   bool shader_float64 = false;  // exact float64 depth keys (else float32: rare order swaps)
   bool push_descriptor = false;  // VK_KHR_push_descriptor: texel-buffer layouts of the CPU-driver passes
+  bool graphics_queue = false;   // the queue also draws: the raster compositor (Compositor::kRaster)
+  bool independent_blend = false;  // attachments blended differently: the raster compositor's splat counts
 };
 
 // Semaphores a submission waits for and signals besides its fence: a host's, around a frame that

@@ -1,0 +1,81 @@
+// The raster compositor (Compositor::kRaster): the depth-sorted splats drawn as quads through the
+// graphics pipeline and blended front to back by the fixed-function blend ("under": the colour
+// attachment's alpha is 1 - T), then resolved into the frame's output buffers as the tile compositor
+// writes them. raster_quad.vert expands each splat around its alpha >= cut-off ellipse,
+// raster_blend.frag evaluates it with the tile compositor's expression, raster_resolve.comp puts the
+// background under it and turns the depth sums and counts into the outputs.
+//
+// It has no transmittance early-out (the blend cannot skip a fragment by what the pixel holds) and no
+// tile rectangles (a splat reaches every pixel where its alpha passes the cut-off): the reference's
+// raster rule (render_reference with Compositor::kRaster), against which it is tested.
+#pragma once
+
+#include <array>
+#include <compare>
+#include <cstdint>
+#include <map>
+
+#include "passes/composite_pass.h"
+#include "vulkan/buffer.h"
+#include "vulkan/compute_pipeline.h"
+#include "vulkan/graphics_pipeline.h"
+#include "vulkan/image.h"
+
+namespace tilesplat {
+
+// What the raster compositor draws: CompositeInputs' splats and outputs, the Gaussians' depth order in
+// place of the tile lists, and the frame counters (the visible count is the draw's instance count).
+struct RasterInputs {
+  const vk::Buffer& splats;       // ProjectedBuffers::splats
+  const vk::Buffer& depth_order;  // record indices front to back, the visible ones first
+  const vk::Buffer& counters;     // FrameCounters
+  OutputBuffers& out;
+  std::array<float, 3> background = {0, 0, 0};
+  bool write_depth = true;
+  bool write_count = true;
+  CompositeCutoffs cutoffs;  // alpha and max_alpha; the transmittance cut-off does not apply
+};
+
+class RasterCompositePass {
+ public:
+  // Throws std::runtime_error naming the device when its queue cannot draw or it cannot blend into
+  // RGBA32F attachments.
+  explicit RasterCompositePass(vk::Context& ctx);
+  // Sizes the attachments for a frame (outside any command buffer).
+  void prepare(uint32_t width, uint32_t height, bool write_depth, bool write_count);
+  void record(VkCommandBuffer cmd, const RasterInputs& in);
+  uint64_t device_bytes() const;
+
+ private:
+  // A pipeline of the pass: its outputs (which attachments exist) and its cut-offs.
+  struct Variant {
+    bool write_depth = true;
+    bool write_count = true;
+    CompositeCutoffs cutoffs;
+    auto operator<=>(const Variant&) const = default;
+  };
+  const vk::GraphicsPipeline& pipeline(const Variant& variant);
+  void check_device() const;
+
+  vk::Context& ctx_;
+  std::map<Variant, vk::GraphicsPipeline> pipelines_;
+  vk::ComputePipeline resolve_;
+  vk::Buffer draw_args_;  // VkDrawIndirectCommand: 4 vertices, the visible splats as instances
+  // The attachments of the current size and outputs, and their framebuffer (for the render pass of
+  // that set of outputs: every Variant with the same outputs has a compatible one).
+  struct Targets {
+    vk::Image colour, depth_sums, count;
+    vk::Buffer depth_sums_copy;  // the depth sums copied out for the resolve
+    VkFramebuffer framebuffer = VK_NULL_HANDLE;
+    uint32_t width = 0, height = 0;
+    bool write_depth = false, write_count = false;
+  } targets_;
+  void release_framebuffer();
+
+ public:
+  ~RasterCompositePass() { release_framebuffer(); }
+  RasterCompositePass(const RasterCompositePass&) = delete;
+  RasterCompositePass& operator=(const RasterCompositePass&) = delete;
+};
+
+}  // namespace tilesplat

@@ -1,0 +1,73 @@
+// A graphics pipeline of two embedded shaders (a vertex and a fragment stage) drawing into colour
+// attachments, with the render pass it draws in: the raster compositor's. Like ComputePipeline, the
+// shaders take everything through push constants (buffer device addresses and scalars) and draw no
+// vertex buffers. The render pass clears its attachments and leaves them ready to be copied out.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vulkan/compute_pipeline.h"
+#include "vulkan/context.h"
+
+namespace tilesplat::vk {
+
+// How a fragment's output meets what the attachment holds.
+enum class Blend {
+  kUnder,  // front to back: dst += src * (1 - dst alpha), the attachment's alpha being 1 - T
+  kAdd,    // dst += src
+};
+
+// A colour attachment at the fragment output location of its index; an unused one keeps its
+// location (the fragment stage's writes there go nowhere) and has no image.
+struct ColourAttachment {
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  Blend blend = Blend::kUnder;
+  bool used = true;
+};
+
+struct GraphicsPipelineDesc {
+  std::string vertex_shader;
+  std::string fragment_shader;
+  uint32_t push_constant_bytes = 0;  // seen by both stages
+  std::vector<SpecConstant> spec;    // given to both stages (each uses the ids it declares)
+  std::vector<ColourAttachment> attachments;
+  VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP;
+};
+
+class GraphicsPipeline {
+ public:
+  GraphicsPipeline() = default;
+  GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& desc);
+  ~GraphicsPipeline() { reset(); }
+  GraphicsPipeline(GraphicsPipeline&& other) noexcept { *this = std::move(other); }
+  GraphicsPipeline& operator=(GraphicsPipeline&& other) noexcept;
+  GraphicsPipeline(const GraphicsPipeline&) = delete;
+  GraphicsPipeline& operator=(const GraphicsPipeline&) = delete;
+  void reset();
+
+  // Clears the used attachments to zero; they end in TRANSFER_SRC_OPTIMAL, their writes visible to
+  // transfers. A framebuffer for it holds the used attachments' views, in order.
+  VkRenderPass render_pass() const { return render_pass_; }
+  // Binds the pipeline, its push constants and a viewport and scissor of the whole framebuffer.
+  template <typename PushConstants>
+  void bind(VkCommandBuffer cmd, const PushConstants& pc, uint32_t width, uint32_t height) const {
+    static_assert(sizeof(PushConstants) <= 128, "push constants beyond the portable 128-byte minimum");
+    bind_raw(cmd, &pc, uint32_t(sizeof(PushConstants)), width, height);
+  }
+  void bind_raw(VkCommandBuffer cmd, const void* data, uint32_t size, uint32_t width, uint32_t height) const;
+
+ private:
+  void create_render_pass(const std::vector<ColourAttachment>& attachments);
+  Context* ctx_ = nullptr;
+  VkRenderPass render_pass_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  uint32_t push_constant_bytes_ = 0;
+  std::string name_;
+};
+
+}  // namespace tilesplat::vk
