@@ -14,6 +14,11 @@
 #include "common.glsl"
 
 layout(constant_id = 0) const float ALPHA_INV = 255.0;  // 1 / ALPHA_MIN (AccuracyModes::alpha_cutoff)
+// A host's surfaces in the depth attachment (RenderSettings::host), as view depths times 2^-64
+// (raster_host_surfaces.comp): the splat's view depth scaled alike is its depth, and the depth test
+// LESS is the tile compositor's `splat depth < host depth` to the bit (a power-of-two scaling keeps
+// every float's order; view depths lie between the near plane and 2^64).
+layout(constant_id = 3) const bool HOST_DEPTH = false;
 
 // The splat's record as composite.comp reads it: (mean hi x, y, depth, opacity), (conic A, B, C,
 // mean lo x), (rgb, mean lo y). Flat: the fragment stage evaluates the Gaussian at its pixel.
@@ -50,5 +55,5 @@ void main() {
   vec2 corner = mean + CORNERS[gl_VertexIndex].x * half_axes.x * e1 + CORNERS[gl_VertexIndex].y * half_axes.y * e2;
   // A splat that can never reach ALPHA_MIN is a point: no pixel.
   corner = m2 > 0.0 ? corner : mean;
-  gl_Position = vec4(corner / vec2(pc.width, pc.height) * 2.0 - 1.0, 0.0, 1.0);
+  gl_Position = vec4(corner / vec2(pc.width, pc.height) * 2.0 - 1.0, HOST_DEPTH ? ldexp(mdo.z, -64) : 0.0, 1.0);
 }

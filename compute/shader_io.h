@@ -177,6 +177,16 @@ TS_PUSH_CONSTANTS(RasterPush) {
 TS_PUSH_INSTANCE;
 #endif
 
+#if defined(__cplusplus) || defined(TS_RASTER_HOST_SURFACES_PUSH)
+// raster_host_surfaces.comp (RasterCompositePass): the host's view depths for the depth attachment.
+TS_PUSH_CONSTANTS(RasterHostSurfacesPush) {
+  TS_REF(FloatArray) view_depth;  // per pixel, +inf where the host drew nothing
+  TS_REF(FloatArray) scaled;      // per pixel, view depth times 2^-64, at most 1
+  uint pixels;
+}
+TS_PUSH_INSTANCE;
+#endif
+
 #if defined(__cplusplus) || defined(TS_RASTER_RESOLVE_PUSH)
 // raster_resolve.comp (RasterCompositePass): the attachments, copied to buffers, into the outputs.
 TS_PUSH_CONSTANTS(RasterResolvePush) {

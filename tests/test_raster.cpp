@@ -222,8 +222,61 @@ TEST(Raster, AccuracyModesAndRefusals) {
   const std::vector<float> host_depth(size_t(camera.width) * camera.height, 0.5f);
   host.host = HostDepth{};
   host.host->depth = host_depth;
-  EXPECT_NE(testing::error_of<std::invalid_argument>([&] { renderer.render(camera, host); }).find("raster"),
+  host.host->write_depth = true;
+  EXPECT_NE(testing::error_of<std::invalid_argument>([&] {
+              renderer.render(camera, host);
+            }).find("the raster compositor cannot write the splats' depth out"),
             std::string::npos);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// A host's surfaces in the draw's depth attachment (test LESS, no writes) hide the splats behind them:
+// the same cut as the reference's raster rule and the tile compositor's, whose test is
+// `splat depth < host depth` on the same floats.
+TEST(Raster, HostDepthIsTheDepthAttachment) {
+  Renderer& renderer = testing::validated_renderer();
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  renderer.set_scene(scene);
+  const Camera camera = playbot_camera(240, 136);
+  // A slanted surface through the scene: from 0.8 to 1.2 times the splats' median depth, left to right,
+  // in the default convention d = 1 - 1 / z; the right quarter of the image is left empty (far).
+  const RenderImage unhidden = renderer.render(camera, raster_settings());
+  std::vector<float> depths;
+  for (float z : unhidden.depth)
+    if (z > 0) depths.push_back(z);
+  ASSERT_FALSE(depths.empty());
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  const double median = depths[depths.size() / 2];
+  std::vector<float> host_depth(size_t(camera.width) * camera.height);
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const double z = median * (0.8 + 0.4 * x / camera.width);
+      host_depth[size_t(y) * camera.width + x] = x >= camera.width * 3 / 4 ? 1.0f : float(1.0 - 1.0 / z);
+    }
+  RenderSettings settings = raster_settings();
+  settings.host = HostDepth{};
+  settings.host->depth = host_depth;
+  const RenderImage gpu = renderer.render(camera, settings);
+  const RenderImage reference = render_reference(scene, camera, settings);
+  const ImageDifference d = compare_images(gpu, reference);
+  std::printf(
+      "raster with a host's depth vs the reference raster rule: %.2f dB, counts differ at %zu pixels\n",
+      d.psnr_db, count_difference(gpu, reference).pixels);
+  EXPECT_GE(d.psnr_db, 60.0);
+  EXPECT_LE(count_difference(gpu, reference).pixels, gpu.pixels() / 1000);
+  // The surface hides something: fewer splats blend than without it, and none where it is far.
+  size_t hidden = 0;
+  for (size_t i = 0; i < gpu.pixels(); ++i) {
+    EXPECT_LE(gpu.splat_count[i], unhidden.splat_count[i]);
+    hidden += gpu.splat_count[i] < unhidden.splat_count[i] ? 1 : 0;
+    if (i % camera.width >= size_t(camera.width * 3 / 4)) {
+      EXPECT_EQ(gpu.splat_count[i], unhidden.splat_count[i]);
+    }
+  }
+  EXPECT_GT(hidden, gpu.pixels() / 10);
+  RenderSettings tiles = settings;
+  tiles.compositor = Compositor::kSorted;
+  EXPECT_GE(compare_images(gpu, renderer.render(camera, tiles)).psnr_db, 60.0);
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 

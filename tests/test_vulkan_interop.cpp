@@ -515,6 +515,49 @@ TEST_F(HostApplication, DepthImageCutsTheSplatsAndReceivesTheirDepth) {
   EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
 }
 
+// The raster compositor on the host's device: the depth image, converted, is the draw's depth
+// attachment; the image equals render()'s with the same surfaces in host memory. The host did not say
+// it enabled independentBlend, which the raster's splat counts need: they are refused by name.
+TEST_F(HostApplication, RasterCompositorTestsTheDepthImage) {
+  constexpr uint32_t kWidth = 160, kHeight = 90;
+  const auto [scene, camera, convention, wall] = wall_through_scene(kWidth, kHeight);
+  const auto [colour, depth] = draw_wall(wall, kWidth, kHeight);
+
+  RenderSettings settings;
+  settings.compositor = Compositor::kRaster;
+  settings.splat_count = false;
+  settings.host = HostDepth{convention, {}, false, 0.5f};
+  RenderImage expected, unhidden;
+  {
+    auto renderer = create_renderer(external());
+    renderer->set_scene(scene);
+    const ExternalImage target{colour.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT,
+                               VK_IMAGE_LAYOUT_UNDEFINED};
+    const ExternalDepthImage host_depth{depth.image, kWidth, kHeight, VK_FORMAT_D32_SFLOAT,
+                                        VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+    render_to_image(*renderer, camera, settings, target, host_depth);
+    RenderSettings in_memory = settings;
+    in_memory.host->depth = wall;
+    expected = renderer->render(camera, in_memory);
+    RenderSettings no_host = settings;
+    no_host.host.reset();
+    unhidden = renderer->render(camera, no_host);
+    RenderSettings counted = in_memory;
+    counted.splat_count = true;
+    EXPECT_NE(testing::error_of<std::runtime_error>([&] {
+                renderer->render(camera, counted);
+              }).find("independentBlend"),
+              std::string::npos);
+  }
+  const auto [rgba, depth_after] = read_colour_and_depth(colour, depth, kWidth, kHeight);
+  EXPECT_EQ(rgba, expected.rgba);
+  EXPECT_EQ(depth_after, wall);    // tested, never written
+  EXPECT_NE(rgba, unhidden.rgba);  // the wall hides some of the scene
+
+  release_host_objects();
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
 // A depth image cannot be checked for NaNs on the host without reading it back: on the device a NaN
 // means no surface at that pixel (every splat blends, as over a cleared infinite far plane), and the
 // depth out keeps the NaN where the splats do not reach the threshold.

@@ -12,9 +12,17 @@ void validate_host_depth(const RenderSettings& settings, const Camera& camera) {
   if (!settings.host) return;
   const HostDepth& host = *settings.host;
   auto fail = [](const std::string& why) { throw std::invalid_argument("host depth: " + why); };
-  if (settings.compositor != Compositor::kSorted)
-    fail("the " + to_string(settings.compositor) +
-         " compositor does not depth-test against a host's surfaces: use the sorted compositor");
+  if (settings.compositor == Compositor::kStochastic)
+    fail(
+        "the stochastic compositor does not depth-test against a host's surfaces: use the sorted compositor");
+  if (settings.compositor == Compositor::kRaster && host.write_depth)
+    fail(
+        "the raster compositor cannot write the splats' depth out: the hardware blend keeps each pixel's "
+        "running alpha from the fragment that would cross the threshold; use the sorted compositor");
+  // The raster compositor's depth attachment holds view depths times 2^-64, normal floats from 2^-62.
+  if (settings.compositor == Compositor::kRaster && !(settings.near_plane >= 0x1p-62))
+    fail("the raster compositor tests a host's depth for view depths above 2^-62; the near plane is " +
+         std::to_string(settings.near_plane));
   if (settings.accuracy.resort_window > 0)
     fail("per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
          ") does not depth-test against a host's surfaces: render without it");

@@ -87,10 +87,12 @@ TileGrid tile_grid(const Camera& camera) {
   return grid;
 }
 
-// The raster frame: projection -> depth sort -> the splats drawn in that order. It builds no tile
-// lists; "reusing its lists" re-draws the sorted splats.
+// The raster frame: projection -> depth sort -> the splats drawn in that order (a host's depth image
+// converted first, into the draw's depth attachment). It builds no tile lists; "reusing its lists"
+// re-draws the sorted splats.
 std::vector<FramePass> raster_frame_passes(const FramePlan& plan) {
   std::vector<FramePass> passes;
+  if (plan.host.from_image) passes.push_back(FramePass::kHostDepthIn);  // the depth attachment's source
   if (plan.build_lists) {
     passes.push_back(FramePass::kClearCounters);
     passes.push_back(FramePass::kProjection);

@@ -43,7 +43,8 @@ void FrameRecorder::prepare(const FramePlan& plan, const RenderSettings& setting
                                                                     : chunks > 1;
   resources.prepare_frame(plan, needs_state);
   if (plan.compositor == Compositor::kRaster)
-    raster_composite_.prepare(plan.tiles.width, plan.tiles.height, settings.depth, settings.splat_count);
+    raster_composite_.prepare({plan.tiles.width, plan.tiles.height, settings.depth, settings.splat_count,
+                               plan.host.from_memory || plan.host.from_image});
   if (!plan.build_lists) return;
   projection_.prepare(resources.scene, plan.projection);
   sorter.reserve(std::max(plan.splat_records, resources.keys.capacity));
@@ -161,7 +162,8 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
                 .background = r.settings.background,
                 .write_depth = r.settings.depth,
                 .write_count = r.settings.splat_count,
-                .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff, float(r.settings.max_alpha)}});
+                .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff, float(r.settings.max_alpha)},
+                .host_view_depth = res.host_surface(r.settings).view_depth});
       return;
     }
   }

@@ -12,21 +12,48 @@
 namespace tilesplat {
 
 namespace {
+using shader_io::RasterHostSurfacesPush;
 using shader_io::RasterPush;
 using shader_io::RasterResolvePush;
 
 // Float attachments: the blend runs in float32, as the tile compositor's sums do.
 constexpr VkFormat kColourFormat = VK_FORMAT_R32G32B32A32_SFLOAT;  // (sum of w rgb, 1 - T)
 constexpr VkFormat kCountFormat = VK_FORMAT_R32_SFLOAT;            // exact for counts below 2^24
+constexpr VkFormat kHostSurfacesFormat = VK_FORMAT_D32_SFLOAT;     // view depths times 2^-64
 constexpr VkImageUsageFlags kAttachmentUsage =
     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
 constexpr uint32_t kQuadVertices = 4;  // a triangle strip
 
-void copy_to_buffer(VkCommandBuffer cmd, const vk::Image& image, const vk::Buffer& buffer) {
+VkBufferImageCopy whole_image(const vk::Image& image) {
   VkBufferImageCopy region{};
-  region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.imageSubresource = {image.aspect(), 0, 0, 1};
   region.imageExtent = {image.width(), image.height(), 1};
+  return region;
+}
+
+void copy_to_buffer(VkCommandBuffer cmd, const vk::Image& image, const vk::Buffer& buffer) {
+  const VkBufferImageCopy region = whole_image(image);
   vkCmdCopyImageToBuffer(cmd, image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer.handle(), 1,
+                         &region);
+}
+
+// The buffer into the depth image, whose old contents are not needed, once the previous frame's depth
+// tests are done with it; the render pass then reads it from TRANSFER_DST_OPTIMAL (its dependency
+// waits for this copy).
+void copy_to_depth_image(VkCommandBuffer cmd, const vk::Buffer& buffer, const vk::Image& image) {
+  VkImageMemoryBarrier to_transfer{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  to_transfer.srcAccessMask = 0;
+  to_transfer.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  to_transfer.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  to_transfer.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+  to_transfer.srcQueueFamilyIndex = to_transfer.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  to_transfer.image = image.handle();
+  to_transfer.subresourceRange = {image.aspect(), 0, 1, 0, 1};
+  vkCmdPipelineBarrier(cmd,
+                       VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                       VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &to_transfer);
+  const VkBufferImageCopy region = whole_image(image);
+  vkCmdCopyBufferToImage(cmd, buffer.handle(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
                          &region);
 }
 
@@ -34,20 +61,31 @@ void copy_to_buffer(VkCommandBuffer cmd, const vk::Image& image, const vk::Buffe
 
 RasterCompositePass::RasterCompositePass(vk::Context& ctx) : ctx_(ctx) {}
 
-void RasterCompositePass::check_device() const {
+void RasterCompositePass::check_device(const Shape& shape) const {
+  auto fail = [&](const std::string& why) { throw std::runtime_error(ctx_.device_name() + ": " + why); };
   if (!ctx_.features().graphics_queue)
-    throw std::runtime_error(
-        ctx_.device_name() +
-        ": the raster compositor draws, and this device's queue has no graphics support: "
-        "use the sorted compositor");
+    fail(
+        "the raster compositor draws, and this device's queue has no graphics support: use the sorted "
+        "compositor");
   const VkFormatFeatureFlags attachment = VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT |
                                           VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
                                           VK_FORMAT_FEATURE_TRANSFER_SRC_BIT;
   for (VkFormat format : {kColourFormat, kCountFormat})
     if (!vk::format_supports(ctx_, format, attachment))
-      throw std::runtime_error(ctx_.device_name() + ": the raster compositor blends into " +
-                               (format == kColourFormat ? "R32G32B32A32_SFLOAT" : "R32_SFLOAT") +
-                               " attachments, which this device cannot: use the sorted compositor");
+      fail(std::string("the raster compositor blends into ") +
+           (format == kColourFormat ? "R32G32B32A32_SFLOAT" : "R32_SFLOAT") +
+           " attachments, which this device cannot: use the sorted compositor");
+  // The counts are added where the colour is blended under: two blend states in one pipeline.
+  if (shape.write_count && !ctx_.features().independent_blend)
+    fail(
+        "the raster compositor's splat counts need the independentBlend feature, which this device (or "
+        "the host that made it) has not enabled: render without splat counts");
+  if (shape.host_depth && !vk::format_supports(ctx_, kHostSurfacesFormat,
+                                               VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                                                   VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
+    fail(
+        "the raster compositor tests a host's depth in a D32_SFLOAT attachment, which this device cannot "
+        "make: use the sorted compositor");
 }
 
 void RasterCompositePass::release_framebuffer() {
@@ -55,37 +93,35 @@ void RasterCompositePass::release_framebuffer() {
   targets_.framebuffer = VK_NULL_HANDLE;
 }
 
-void RasterCompositePass::prepare(uint32_t width, uint32_t height, bool write_depth, bool write_count) {
-  // The counts are added where the colour is blended under: two blend states in one pipeline.
-  if (write_count && !ctx_.features().independent_blend)
-    throw std::runtime_error(
-        ctx_.device_name() +
-        ": the raster compositor's splat counts need the independentBlend feature, which "
-        "this device (or the host that made it) has not enabled: render without splat "
-        "counts");
-  if (!draw_args_) {  // the first raster frame: the device must draw
-    check_device();
+void RasterCompositePass::prepare(const Shape& shape) {
+  check_device(shape);
+  if (!draw_args_) {
     resolve_ = vk::ComputePipeline(ctx_, "raster_resolve", sizeof(RasterResolvePush));
+    host_surfaces_ = vk::ComputePipeline(ctx_, "raster_host_surfaces", sizeof(RasterHostSurfacesPush));
     draw_args_ =
         vk::Buffer(ctx_, sizeof(VkDrawIndirectCommand), vk::MemoryUse::Device, "raster draw arguments");
   }
   Targets& t = targets_;
-  if (t.colour && t.width == width && t.height == height && t.write_depth == write_depth &&
-      t.write_count == write_count)
-    return;
+  if (t.colour && t.shape == shape) return;
   release_framebuffer();
   t = {};
+  const uint32_t width = shape.width, height = shape.height;
+  const VkDeviceSize pixels = VkDeviceSize(width) * height;
   t.colour = vk::Image(ctx_, kColourFormat, width, height, kAttachmentUsage, "raster colour");
-  if (write_depth) {
+  if (shape.write_depth) {
     t.depth_sums = vk::Image(ctx_, kColourFormat, width, height, kAttachmentUsage, "raster depth sums");
-    t.depth_sums_copy = vk::Buffer(ctx_, VkDeviceSize(width) * height * 16, vk::MemoryUse::Device,
-                                   "raster depth sums (copy)");
+    t.depth_sums_copy = vk::Buffer(ctx_, pixels * 16, vk::MemoryUse::Device, "raster depth sums (copy)");
   }
-  if (write_count) t.count = vk::Image(ctx_, kCountFormat, width, height, kAttachmentUsage, "raster counts");
-  t.width = width;
-  t.height = height;
-  t.write_depth = write_depth;
-  t.write_count = write_count;
+  if (shape.write_count)
+    t.count = vk::Image(ctx_, kCountFormat, width, height, kAttachmentUsage, "raster counts");
+  if (shape.host_depth) {
+    t.host_surfaces = vk::Image(ctx_, kHostSurfacesFormat, width, height,
+                                VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                "raster host surfaces");
+    t.host_surfaces_input =
+        vk::Buffer(ctx_, pixels * 4, vk::MemoryUse::Device, "raster host surfaces (input)");
+  }
+  t.shape = shape;
 }
 
 const vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
@@ -97,33 +133,48 @@ const vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
   desc.push_constant_bytes = sizeof(RasterPush);
   desc.spec = {{0, std::bit_cast<uint32_t>(coverage_alpha_inv(v.cutoffs.alpha))},
                {1, std::bit_cast<uint32_t>(v.cutoffs.alpha)},
-               {2, std::bit_cast<uint32_t>(v.cutoffs.max_alpha)}};
+               {2, std::bit_cast<uint32_t>(v.cutoffs.max_alpha)},
+               {3, v.host_depth ? 1u : 0u}};
+  // Without the counts every blend state is the same, as a device without independentBlend requires.
   desc.attachments = {{kColourFormat, vk::Blend::kUnder, true},
                       {kColourFormat, vk::Blend::kUnder, v.write_depth},
-                      {kCountFormat, vk::Blend::kAdd, v.write_count}};
+                      {kCountFormat, v.write_count ? vk::Blend::kAdd : vk::Blend::kUnder, v.write_count}};
+  if (v.host_depth) desc.depth_test = vk::DepthTest{kHostSurfacesFormat, VK_COMPARE_OP_LESS};
   return pipelines_.emplace(v, vk::GraphicsPipeline(ctx_, desc)).first->second;
 }
 
 void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   Targets& t = targets_;
-  if (!t.colour || t.width != in.out.width || t.height != in.out.height || t.write_depth != in.write_depth ||
-      t.write_count != in.write_count)
-    throw std::logic_error("RasterCompositePass::record before prepare() for this frame's size and outputs");
+  const Shape shape{in.out.width, in.out.height, in.write_depth, in.write_count,
+                    in.host_view_depth != nullptr};
+  if (!t.colour || !(t.shape == shape))
+    throw std::logic_error("RasterCompositePass::record before prepare() for this frame's shape");
   // The transmittance cut-off does not apply: one pipeline whatever it is.
-  const Variant variant{in.write_depth, in.write_count, {in.cutoffs.alpha, 0.0f, in.cutoffs.max_alpha}};
+  const Variant variant{
+      in.write_depth, in.write_count, shape.host_depth, {in.cutoffs.alpha, 0.0f, in.cutoffs.max_alpha}};
   const vk::GraphicsPipeline& drawing = pipeline(variant);
   if (!t.framebuffer) {
     std::vector<VkImageView> views = {t.colour.view()};
-    if (t.write_depth) views.push_back(t.depth_sums.view());
-    if (t.write_count) views.push_back(t.count.view());
+    if (shape.write_depth) views.push_back(t.depth_sums.view());
+    if (shape.write_count) views.push_back(t.count.view());
+    if (shape.host_depth) views.push_back(t.host_surfaces.view());
     VkFramebufferCreateInfo info{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
-    info.renderPass = drawing.render_pass();  // compatible with every variant of these outputs
+    info.renderPass = drawing.render_pass();  // compatible with every variant of this shape
     info.attachmentCount = uint32_t(views.size());
     info.pAttachments = views.data();
-    info.width = t.width;
-    info.height = t.height;
+    info.width = shape.width;
+    info.height = shape.height;
     info.layers = 1;
     TS_VK_CHECK(vkCreateFramebuffer(ctx_.device(), &info, nullptr, &t.framebuffer));
+  }
+  const uint32_t pixels = shape.width * shape.height;
+  if (shape.host_depth) {
+    const RasterHostSurfacesPush surfaces{in.host_view_depth->address(), t.host_surfaces_input.address(),
+                                          pixels};
+    host_surfaces_.bind(cmd, surfaces);
+    host_surfaces_.dispatch(cmd, vk::div_ceil(pixels, 256));
+    vk::barrier(cmd);
+    copy_to_depth_image(cmd, t.host_surfaces_input, t.host_surfaces);
   }
 
   // The draw's arguments: 4 vertices, one instance per visible splat (the projection's count; the
@@ -134,45 +185,46 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
                              sizeof(uint32_t)};
   vkCmdCopyBuffer(cmd, in.counters.handle(), draw_args_.handle(), 1, &visible);
 
-  VkClearValue clears[3]{};  // all zero: no colour, T = 1, no depth, no splats
+  VkClearValue clears[3]{};  // all zero: no colour, T = 1, no depth, no splats (a host's depth is loaded)
   VkRenderPassBeginInfo begin{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
   begin.renderPass = drawing.render_pass();
   begin.framebuffer = t.framebuffer;
-  begin.renderArea = {{0, 0}, {t.width, t.height}};
-  begin.clearValueCount = 1 + (t.write_depth ? 1 : 0) + (t.write_count ? 1 : 0);
+  begin.renderArea = {{0, 0}, {shape.width, shape.height}};
+  begin.clearValueCount = 1 + (shape.write_depth ? 1 : 0) + (shape.write_count ? 1 : 0);
   begin.pClearValues = clears;
   vkCmdBeginRenderPass(cmd, &begin, VK_SUBPASS_CONTENTS_INLINE);
   RasterPush push{};
   push.splats = in.splats.address();
   push.depth_order = in.depth_order.address();
-  push.width = t.width;
-  push.height = t.height;
-  drawing.bind(cmd, push, t.width, t.height);
+  push.width = shape.width;
+  push.height = shape.height;
+  drawing.bind(cmd, push, shape.width, shape.height);
   vkCmdDrawIndirect(cmd, draw_args_.handle(), 0, 1, sizeof(VkDrawIndirectCommand));
   vkCmdEndRenderPass(cmd);
 
   // The attachments into the outputs, then the resolve in place.
   copy_to_buffer(cmd, t.colour, in.out.rgba);
-  if (t.write_depth) copy_to_buffer(cmd, t.depth_sums, t.depth_sums_copy);
-  if (t.write_count) copy_to_buffer(cmd, t.count, in.out.count);
+  if (shape.write_depth) copy_to_buffer(cmd, t.depth_sums, t.depth_sums_copy);
+  if (shape.write_count) copy_to_buffer(cmd, t.count, in.out.count);
   vk::barrier(cmd);
   RasterResolvePush resolve{};
   resolve.rgba = in.out.rgba.address();
-  resolve.depth_sums = t.write_depth ? t.depth_sums_copy.address() : in.out.rgba.address();
-  resolve.out_depth = t.write_depth ? in.out.depth.address() : in.out.rgba.address();
-  resolve.count = t.write_count ? in.out.count.address() : in.out.rgba.address();
+  resolve.depth_sums = shape.write_depth ? t.depth_sums_copy.address() : in.out.rgba.address();
+  resolve.out_depth = shape.write_depth ? in.out.depth.address() : in.out.rgba.address();
+  resolve.count = shape.write_count ? in.out.count.address() : in.out.rgba.address();
   resolve.background = {in.background[0], in.background[1], in.background[2], 0.0f};
-  resolve.pixels = t.width * t.height;
-  resolve.write_depth = t.write_depth ? 1 : 0;
-  resolve.write_count = t.write_count ? 1 : 0;
+  resolve.pixels = pixels;
+  resolve.write_depth = shape.write_depth ? 1 : 0;
+  resolve.write_count = shape.write_count ? 1 : 0;
   resolve_.bind(cmd, resolve);
-  resolve_.dispatch(cmd, vk::div_ceil(resolve.pixels, 256));
+  resolve_.dispatch(cmd, vk::div_ceil(pixels, 256));
   vk::barrier(cmd);
 }
 
 uint64_t RasterCompositePass::device_bytes() const {
-  return targets_.colour.bytes() + targets_.depth_sums.bytes() + targets_.count.bytes() +
-         targets_.depth_sums_copy.size() + draw_args_.size();
+  const Targets& t = targets_;
+  return t.colour.bytes() + t.depth_sums.bytes() + t.count.bytes() + t.host_surfaces.bytes() +
+         t.depth_sums_copy.size() + t.host_surfaces_input.size() + draw_args_.size();
 }
 
 }  // namespace tilesplat

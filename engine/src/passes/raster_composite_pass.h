@@ -34,6 +34,9 @@ struct RasterInputs {
   bool write_depth = true;
   bool write_count = true;
   CompositeCutoffs cutoffs;  // alpha and max_alpha; the transmittance cut-off does not apply
+  // A host's surfaces as view depths per pixel (+inf where none; FrameResources::host_view_depth):
+  // the depth attachment, which hides the splats behind them. Null: no depth test.
+  const vk::Buffer* host_view_depth = nullptr;
 };
 
 class RasterCompositePass {
@@ -41,8 +44,15 @@ class RasterCompositePass {
   // Throws std::runtime_error naming the device when its queue cannot draw or it cannot blend into
   // RGBA32F attachments.
   explicit RasterCompositePass(vk::Context& ctx);
-  // Sizes the attachments for a frame (outside any command buffer).
-  void prepare(uint32_t width, uint32_t height, bool write_depth, bool write_count);
+  // What a frame's attachments are: its size, its outputs and whether a host's surfaces are tested.
+  struct Shape {
+    uint32_t width = 0, height = 0;
+    bool write_depth = false, write_count = false, host_depth = false;
+    bool operator==(const Shape&) const = default;
+  };
+  // Sizes the attachments for a frame (outside any command buffer). Throws std::runtime_error naming
+  // the device when it cannot draw, blend or test what the frame asks.
+  void prepare(const Shape& shape);
   void record(VkCommandBuffer cmd, const RasterInputs& in);
   uint64_t device_bytes() const;
 
@@ -51,24 +61,26 @@ class RasterCompositePass {
   struct Variant {
     bool write_depth = true;
     bool write_count = true;
+    bool host_depth = false;  // the depth attachment holds a host's surfaces (HOST_DEPTH)
     CompositeCutoffs cutoffs;
     auto operator<=>(const Variant&) const = default;
   };
   const vk::GraphicsPipeline& pipeline(const Variant& variant);
-  void check_device() const;
+  void check_device(const Shape& shape) const;
 
   vk::Context& ctx_;
   std::map<Variant, vk::GraphicsPipeline> pipelines_;
   vk::ComputePipeline resolve_;
   vk::Buffer draw_args_;  // VkDrawIndirectCommand: 4 vertices, the visible splats as instances
-  // The attachments of the current size and outputs, and their framebuffer (for the render pass of
-  // that set of outputs: every Variant with the same outputs has a compatible one).
+  vk::ComputePipeline host_surfaces_;
+  // The attachments of the current shape and their framebuffer (for the render pass of that shape:
+  // every Variant of it has a compatible one).
   struct Targets {
-    vk::Image colour, depth_sums, count;
-    vk::Buffer depth_sums_copy;  // the depth sums copied out for the resolve
+    Shape shape;
+    vk::Image colour, depth_sums, count, host_surfaces;
+    vk::Buffer depth_sums_copy;      // the depth sums copied out for the resolve
+    vk::Buffer host_surfaces_input;  // the host's scaled view depths, copied into host_surfaces
     VkFramebuffer framebuffer = VK_NULL_HANDLE;
-    uint32_t width = 0, height = 0;
-    bool write_depth = false, write_count = false;
   } targets_;
   void release_framebuffer();
 

@@ -46,10 +46,10 @@ VkPipelineColorBlendAttachmentState blend_state(Blend blend) {
 
 }  // namespace
 
-void GraphicsPipeline::create_render_pass(const std::vector<ColourAttachment>& attachments) {
+void GraphicsPipeline::create_render_pass(const GraphicsPipelineDesc& desc) {
   std::vector<VkAttachmentDescription> descriptions;
   std::vector<VkAttachmentReference> references;
-  for (const ColourAttachment& a : attachments) {
+  for (const ColourAttachment& a : desc.attachments) {
     if (!a.used) {
       references.push_back({VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED});
       continue;
@@ -66,10 +66,25 @@ void GraphicsPipeline::create_render_pass(const std::vector<ColourAttachment>& a
     references.push_back({uint32_t(descriptions.size()), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL});
     descriptions.push_back(d);
   }
+  VkAttachmentReference depth_reference{VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED};
+  if (desc.depth_test) {
+    VkAttachmentDescription d{};
+    d.format = desc.depth_test->format;
+    d.samples = VK_SAMPLE_COUNT_1_BIT;
+    d.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+    d.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    d.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+    d.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    d.initialLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    d.finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+    depth_reference = {uint32_t(descriptions.size()), VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL};
+    descriptions.push_back(d);
+  }
   VkSubpassDescription subpass{};
   subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
   subpass.colorAttachmentCount = uint32_t(references.size());
   subpass.pColorAttachments = references.data();
+  if (desc.depth_test) subpass.pDepthStencilAttachment = &depth_reference;
   // Before: the compute passes' and transfers' writes that the draw reads (the splat records, the depth
   // order, the indirect arguments), and the last frame's copies out of the attachments (which the
   // clear must not overtake). After: the blended attachments to the copies that read them.
@@ -78,9 +93,12 @@ void GraphicsPipeline::create_render_pass(const std::vector<ColourAttachment>& a
   dependencies[0].dstSubpass = 0;
   dependencies[0].srcStageMask = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
   dependencies[0].dstStageMask = VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                                 VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                                 VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT |
                                  VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
   dependencies[0].srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   dependencies[0].dstAccessMask = VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
+                                  VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
                                   VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
   dependencies[1].srcSubpass = 0;
   dependencies[1].dstSubpass = VK_SUBPASS_EXTERNAL;
@@ -104,7 +122,7 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& des
       name_(desc.vertex_shader + "+" + desc.fragment_shader) {
   VkShaderModule vertex = VK_NULL_HANDLE, fragment = VK_NULL_HANDLE;
   try {
-    create_render_pass(desc.attachments);
+    create_render_pass(desc);
     VkPushConstantRange range{kStages, 0, desc.push_constant_bytes};
     VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
     layout_info.pushConstantRangeCount = desc.push_constant_bytes ? 1 : 0;
@@ -153,6 +171,12 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& des
     VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = uint32_t(blends.size());
     blend.pAttachments = blends.data();
+    VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    if (desc.depth_test) {
+      depth.depthTestEnable = VK_TRUE;
+      depth.depthWriteEnable = VK_FALSE;
+      depth.depthCompareOp = desc.depth_test->compare;
+    }
     const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
     VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
     dynamic.dynamicStateCount = 2;
@@ -167,6 +191,7 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& des
     info.pRasterizationState = &raster;
     info.pMultisampleState = &multisample;
     info.pColorBlendState = &blend;
+    info.pDepthStencilState = desc.depth_test ? &depth : nullptr;
     info.pDynamicState = &dynamic;
     info.layout = layout_;
     info.renderPass = render_pass_;

@@ -7,6 +7,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,12 +30,20 @@ struct ColourAttachment {
   bool used = true;
 };
 
+// A depth attachment the draw tests against and never writes: its contents come in by a transfer
+// (TRANSFER_DST_OPTIMAL when the render pass begins) and are not kept.
+struct DepthTest {
+  VkFormat format = VK_FORMAT_D32_SFLOAT;
+  VkCompareOp compare = VK_COMPARE_OP_LESS;
+};
+
 struct GraphicsPipelineDesc {
   std::string vertex_shader;
   std::string fragment_shader;
   uint32_t push_constant_bytes = 0;  // seen by both stages
   std::vector<SpecConstant> spec;    // given to both stages (each uses the ids it declares)
   std::vector<ColourAttachment> attachments;
+  std::optional<DepthTest> depth_test;  // after the used colour attachments in a framebuffer
   VkPrimitiveTopology topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP;
 };
 
@@ -49,8 +58,9 @@ class GraphicsPipeline {
   GraphicsPipeline& operator=(const GraphicsPipeline&) = delete;
   void reset();
 
-  // Clears the used attachments to zero; they end in TRANSFER_SRC_OPTIMAL, their writes visible to
-  // transfers. A framebuffer for it holds the used attachments' views, in order.
+  // Clears the used colour attachments to zero; they end in TRANSFER_SRC_OPTIMAL, their writes visible
+  // to transfers. A framebuffer for it holds the used colour attachments' views in order, then the
+  // depth attachment's.
   VkRenderPass render_pass() const { return render_pass_; }
   // Binds the pipeline, its push constants and a viewport and scissor of the whole framebuffer.
   template <typename PushConstants>
@@ -61,7 +71,7 @@ class GraphicsPipeline {
   void bind_raw(VkCommandBuffer cmd, const void* data, uint32_t size, uint32_t width, uint32_t height) const;
 
  private:
-  void create_render_pass(const std::vector<ColourAttachment>& attachments);
+  void create_render_pass(const GraphicsPipelineDesc& desc);
   Context* ctx_ = nullptr;
   VkRenderPass render_pass_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;

@@ -47,7 +47,7 @@ Image::Image(Context& ctx, VkFormat format, uint32_t width, uint32_t height, VkI
   view.image = image_;
   view.viewType = VK_IMAGE_VIEW_TYPE_2D;
   view.format = format;
-  view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  view.subresourceRange = {aspect(), 0, 1, 0, 1};
   TS_VK_CHECK(vkCreateImageView(ctx.device(), &view, nullptr, &view_));
 }
 
@@ -77,6 +77,10 @@ void Image::reset() {
   image_ = VK_NULL_HANDLE;
   memory_ = VK_NULL_HANDLE;
   bytes_ = 0;
+}
+
+VkImageAspectFlags Image::aspect() const {
+  return format_ == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
 }
 
 bool format_supports(const Context& ctx, VkFormat format, VkFormatFeatureFlags features) {

@@ -1,4 +1,5 @@
-// A device-local 2D image with one view: the raster compositor's colour attachments.
+// A device-local 2D image with one view: the raster compositor's colour attachments and its depth
+// attachment (VK_FORMAT_D32_SFLOAT, whose view and copies take the depth aspect).
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -27,6 +28,7 @@ class Image {
   VkImage handle() const { return image_; }
   VkImageView view() const { return view_; }
   VkFormat format() const { return format_; }
+  VkImageAspectFlags aspect() const;  // depth for VK_FORMAT_D32_SFLOAT, else colour
   uint32_t width() const { return width_; }
   uint32_t height() const { return height_; }
   VkDeviceSize bytes() const { return bytes_; }  // the memory it holds
