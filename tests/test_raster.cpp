@@ -3,10 +3,12 @@
 // reference (the raster rule: no tiles, no transmittance early-out), to the tile compositor within
 // the early-out's difference, and to the same image whatever exact sort orders it.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <stdexcept>
@@ -312,6 +314,87 @@ TEST(Raster, RenderCommandLine) {
   EXPECT_EQ(mixed.exit_code, 2);
   testing::expect_one_error_line(mixed, "tilesplat-render");
 }
+
+// The reports: a row in the effects table (with a host's depth too) and the accuracy report's raster row,
+// whose PSNR against the sorted compositor is a column of its own.
+TEST(Raster, EffectsAndAccuracyReportsHaveTheRasterRows) {
+  const std::filesystem::path out = testing::fresh_output_dir();
+  const std::string scene = testing::bundled_sh3().string();
+  const testing::ProcessResult effects =
+      testing::run_process("", TILESPLAT_BENCH_EXE,
+                           {scene, "--effects", "--width", "64", "--height", "36", "--warmup", "0",
+                            "--repeat", "1", "--sort", "radix"});
+  ASSERT_EQ(effects.exit_code, 0) << effects.err;
+  for (const char* row :
+       {"raster compositor", "raster, host depth in (a plane through the scene)", "raster_composite"})
+    EXPECT_NE(effects.out.find(row), std::string::npos) << row << "\n" << effects.out;
+
+  // The default report ends with the raster row of the reference modes; --compositor raster draws the
+  // modes given with it, leaving out those it cannot draw.
+  const std::filesystem::path md = out / "accuracy.md";
+  const std::vector<std::string> quick = {"--width",
+                                          "64",
+                                          "--height",
+                                          "36",
+                                          "--warmup",
+                                          "0",
+                                          "--repeat",
+                                          "1",
+                                          "--sort",
+                                          "radix",
+                                          "--path-frames",
+                                          "0",
+                                          "--consistency-angle",
+                                          "0"};
+  std::vector<std::string> default_args = {scene, "--accuracy", "--markdown", md.string()};
+  default_args.insert(default_args.end(), quick.begin(), quick.end());
+  const testing::ProcessResult defaults = testing::run_process("", TILESPLAT_BENCH_EXE, default_args);
+  ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
+  const std::string markdown = testing::read_file(md);
+  EXPECT_NE(markdown.find("PSNR vs sorted compositor dB |"), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("\n| raster | "), std::string::npos) << markdown;
+  EXPECT_NE(markdown.find("\n| resort4 | "), std::string::npos) << markdown;
+
+  std::vector<std::string> raster_args = {scene,    "--accuracy", "--compositor",
+                                          "raster", "--mode",     "reference,resort4"};
+  raster_args.insert(raster_args.end(), quick.begin(), quick.end());
+  const testing::ProcessResult raster = testing::run_process("", TILESPLAT_BENCH_EXE, raster_args);
+  ASSERT_EQ(raster.exit_code, 0) << raster.err;
+  EXPECT_NE(raster.out.find("\n  raster "), std::string::npos) << raster.out;
+  EXPECT_EQ(raster.out.find("resort4"), std::string::npos) << raster.out;
+}
+
+#ifdef TILESPLAT_VIEWER_EXE
+// The viewer draws the raster compositor too (--compositor raster, the key C): its screenshot is
+// tilesplat-render's image of the same view with the same compositor.
+TEST(Raster, ViewerScreenshotIsTheRasterRender) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0 && !std::getenv("DISPLAY"))
+    TILESPLAT_SKIP_OR_FAIL("no display for the viewer's window and no xvfb-run (Debian: xvfb xauth)");
+  const std::filesystem::path out = testing::fresh_output_dir();
+  const std::vector<std::string> view = {
+      testing::bundled_playbot().string(), "--width", "160", "--height", "90", "--compositor", "raster"};
+  std::vector<std::string> viewer_args = view;
+  viewer_args.insert(viewer_args.end(), {"--frames", "2", "--screenshot", (out / "viewer.exr").string()});
+  const std::string prefix =
+      std::getenv("DISPLAY") ? "" : "xvfb-run -n " + std::to_string(100 + ::getpid() % 800) + " -a ";
+  const testing::ProcessResult viewer = testing::run_process(prefix, TILESPLAT_VIEWER_EXE, viewer_args);
+  ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
+  std::vector<std::string> render_args = view;
+  render_args.insert(render_args.end(), {"-o", (out / "render.exr").string()});
+  const testing::ProcessResult render = testing::run_process("", TILESPLAT_RENDER_EXE, render_args);
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  const RenderImage shown = read_exr(out / "viewer.exr");
+  const RenderImage rendered = read_exr(out / "render.exr");
+  EXPECT_GE(compare_images(shown, rendered).psnr_db, 100.0);
+  EXPECT_EQ(shown.splat_count, rendered.splat_count);
+
+  const testing::ProcessResult resort = testing::run_process(
+      prefix, TILESPLAT_VIEWER_EXE,
+      {testing::bundled_playbot().string(), "--compositor", "raster", "--mode", "resort8"});
+  EXPECT_EQ(resort.exit_code, 2);
+  EXPECT_NE(resort.err.find("does not re-sort per pixel"), std::string::npos) << resort.err;
+}
+#endif
 
 }  // namespace
 }  // namespace tilesplat

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -99,23 +100,51 @@ std::vector<Camera> camera_path(CameraPath kind, const Camera& start, const std:
   return path;
 }
 
-int work_units(const Options& options, int scene_sh_degree) {
+std::vector<Row> report_rows(const Options& options, int scene_sh_degree) {
   const auto modes = options.modes.empty() ? default_modes() : options.modes;
-  int applicable = 0;
-  for (const auto& m : modes) applicable += applies_to(m, scene_sh_degree) ? 1 : 0;
+  auto draws = [](Compositor compositor, const AccuracyModes& m) {
+    if (compositor == Compositor::kSorted) return true;
+    if (compositor == Compositor::kRaster) return m.resort_window == 0;
+    return m.resort_window == 0 && m.depth_key_bits == 32;
+  };
+  std::vector<Row> rows;
+  const Compositor first = options.compositor.value_or(Compositor::kSorted);
+  for (const AccuracyModes& m : modes)
+    if (applies_to(m, scene_sh_degree) && draws(first, m)) rows.push_back({m, first});
+  // The default report: the raster compositor beside the sorted one, on the reference modes. (Modes
+  // given by name are measured as given, by the compositor given.)
+  if (options.modes.empty() && !options.compositor) rows.push_back({AccuracyModes{}, Compositor::kRaster});
+  return rows;
+}
+
+std::string row_name(const Row& row) {
+  if (row.compositor == Compositor::kSorted) return to_string(row.modes);
+  const std::string compositor = to_string(row.compositor);
+  return row.modes == AccuracyModes{} ? compositor : compositor + "+" + to_string(row.modes);
+}
+
+int work_units(const Options& options, int scene_sh_degree) {
+  const std::vector<Row> rows = report_rows(options, scene_sh_degree);
+  int applicable = 0, other_compositors = 0;
+  for (const Row& row : rows) {
+    ++applicable;
+    other_compositors += row.compositor != Compositor::kSorted ? 1 : 0;
+  }
   const int views = int(options.views.size());
   // The path starts at the first view, whose reference and render it reuses. References: each view and
   // each later path frame; renders: per mode, per view the timed frames, and the later path frames.
   const int later_path_frames = std::max(options.path_frames - 1, 0);
   const int consistency_pair = options.consistency_angle > 0 ? 2 : 0;
+  // A row of another compositor also renders the sorted compositor's image at each view.
   return views + later_path_frames + consistency_pair +
-         applicable * (views * (options.warmup + options.repeat) + later_path_frames + consistency_pair);
+         applicable * (views * (options.warmup + options.repeat) + later_path_frames + consistency_pair) +
+         other_compositors * views;
 }
 
 SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const Options& options,
                           const std::function<void(int, int, const std::string&)>& progress) {
   if (options.views.empty()) throw std::invalid_argument("accuracy report: no views");
-  const auto modes = options.modes.empty() ? default_modes() : options.modes;
+  const std::vector<Row> rows = report_rows(options, scene.sh_degree);
   const int total = work_units(options, scene.sh_degree);
   int done = 0;
   auto step = [&](const std::string& what) { progress(++done, total, what); };
@@ -185,17 +214,21 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
   }
 
   renderer.set_scene(scene);
-  for (const AccuracyModes& m : modes) {
-    if (!applies_to(m, scene.sh_degree)) continue;
+  for (const Row& row : rows) {
+    const AccuracyModes& m = row.modes;
     ModeResult result;
     result.modes = m;
-    result.name = to_string(m);
+    result.compositor = row.compositor;
+    result.name = row_name(row);
+    result.psnr_vs_sorted_db = std::numeric_limits<double>::quiet_NaN();
     RenderSettings settings;
     settings.sort = options.sort;
     settings.depth = false;
     settings.splat_count = false;
     settings.accuracy = m;
+    settings.compositor = row.compositor;
     settings.reuse_lists = false;  // the repeats time whole frames, not the composite on reused lists
+    double psnr_vs_sorted_sum = 0;
 
     std::vector<double> frame_ms_per_view;
     std::map<std::string, std::vector<double>> pass_ms_per_view;
@@ -225,6 +258,12 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
       }
       frame_ms_per_view.push_back(cli::median(frames));
       for (const auto& [name, samples] : passes) pass_ms_per_view[name].push_back(cli::median(samples));
+      if (row.compositor != Compositor::kSorted) {
+        RenderSettings sorted = settings;
+        sorted.compositor = Compositor::kSorted;
+        psnr_vs_sorted_sum += compare_images(image, renderer.render(options.views[v], sorted)).psnr_db;
+        step(result.name + ", the sorted compositor's image, " + options.view_names[v]);
+      }
       const ImageDifference difference = compare_images(image, references[v]);
       psnr_sum += difference.psnr_db;
       ssim_sum += ssim(image, references[v]);
@@ -234,6 +273,8 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     result.frame_ms = cli::median(frame_ms_per_view);
     for (const auto& name : pass_order) result.passes.push_back({name, cli::median(pass_ms_per_view[name])});
     result.psnr_db = psnr_sum / double(options.views.size());
+    if (row.compositor != Compositor::kSorted)
+      result.psnr_vs_sorted_db = psnr_vs_sorted_sum / double(options.views.size());
     result.ssim = ssim_sum / double(options.views.size());
 
     std::vector<RenderImage> frames;
@@ -272,6 +313,11 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
   return report;
 }
 
+// The PSNR against the sorted compositor's image, "-" for the sorted compositor's own rows.
+std::string psnr_vs_sorted(const ModeResult& m) {
+  return std::isnan(m.psnr_vs_sorted_db) ? "-" : cli::format_number(m.psnr_vs_sorted_db, 2);
+}
+
 std::string text_table(const SceneReport& report) {
   std::string text =
       "  " + report.scene + ", " + report.description + ", " + report.views + "; float64 reference on the " +
@@ -280,19 +326,20 @@ std::string text_table(const SceneReport& report) {
       cli::format_number(report.consistency_angle, 3) +
       " rad: " + cli::format_number(100.0 * report.reference_inconsistency, 3) + "% inconsistent\n";
   char line[512];
-  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s %9s\n", "mode", "GPU ms", "vs ref",
-                "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess", "pops%", "incons%");
+  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s %9s %9s\n", "mode",
+                "GPU ms", "vs ref", "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess", "pops%",
+                "incons%", "vs tiles");
   text += line;
   const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
   for (const auto& m : report.modes) {
-    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s %9s\n",
+    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s %9s %9s\n",
                   m.name.c_str(), cli::format_number(m.frame_ms, 2).c_str(),
                   cli::format_number(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2).c_str(),
                   cli::format_number(m.psnr_db, 2).c_str(), cli::format_number(m.ssim, 5).c_str(),
                   cli::format_number(m.max_abs, 4).c_str(), static_cast<unsigned long long>(m.intersections),
                   cli::format_number(100.0 * m.flicker, 3).c_str(), cli::format_number(m.excess, 5).c_str(),
                   cli::format_number(100.0 * m.pops, 3).c_str(),
-                  cli::format_number(100.0 * m.inconsistency, 3).c_str());
+                  cli::format_number(100.0 * m.inconsistency, 3).c_str(), psnr_vs_sorted(m).c_str());
     text += line;
   }
   return text;
@@ -326,9 +373,11 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
             " (inconsistent %), and a mean difference of " +
             cli::format_number(report.reference_inconsistency_mean, 6) + ".";
     md += "\n\n";
-    md += "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change | pops % "
-          "| inconsistent % | inconsistency |\n";
-    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    md +=
+        "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change "
+        "| pops % "
+        "| inconsistent % | inconsistency | PSNR vs sorted compositor dB |\n";
+    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
     for (const auto& m : report.modes)
       md += "| " + m.name + " | " + cli::format_number(m.frame_ms, 2) + " | " +
@@ -337,7 +386,7 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
             cli::format_number(m.max_abs, 4) + " | " + std::to_string(m.intersections) + " | " +
             cli::format_number(100.0 * m.flicker, 3) + " | " + cli::format_number(m.excess, 5) + " | " +
             cli::format_number(100.0 * m.pops, 3) + " | " + cli::format_number(100.0 * m.inconsistency, 3) +
-            " | " + cli::format_number(m.inconsistency_mean, 6) + " |\n";
+            " | " + cli::format_number(m.inconsistency_mean, 6) + " | " + psnr_vs_sorted(m) + " |\n";
     // Per-pass times: a column per mode would not fit; the passes whose time a mode changes.
     md += "\nPer-pass median GPU ms:\n\n| mode |";
     std::vector<std::string> names;
@@ -365,7 +414,8 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
 std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& device) {
   std::string out =
       "device,scene,mode,gpu_frame_ms,psnr_db,ssim,max_abs,intersections,frame_change,flicker_fraction,"
-      "excess_change,pop_fraction,pop_mean,inconsistent_fraction,inconsistency_mean,passes\n";
+      "excess_change,pop_fraction,pop_mean,inconsistent_fraction,inconsistency_mean,passes,psnr_vs_sorted_"
+      "db\n";
   for (const auto& report : reports)
     for (const auto& m : report.modes) {
       std::string passes;
@@ -378,7 +428,9 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
              cli::format_number(m.flicker, 6) + "," + cli::format_number(m.excess, 6) + "," +
              cli::format_number(m.pops, 6) + "," + cli::format_number(m.pop_mean, 6) + "," +
              cli::format_number(m.inconsistency, 6) + "," + cli::format_number(m.inconsistency_mean, 6) +
-             "," + cli::csv_field(passes) + "\n";
+             "," + cli::csv_field(passes) + "," +
+             (std::isnan(m.psnr_vs_sorted_db) ? std::string() : cli::format_number(m.psnr_vs_sorted_db, 4)) +
+             "\n";
     }
   return out;
 }

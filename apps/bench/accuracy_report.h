@@ -48,13 +48,17 @@ struct PassTime {
 
 struct ModeResult {
   AccuracyModes modes;
-  std::string name;  // to_string(modes)
+  Compositor compositor = Compositor::kSorted;
+  std::string name;     // to_string(modes), after the compositor's name when it is not the sorted one
   double frame_ms = 0;  // median GPU frame time: median over repeats per view, median over views
   std::vector<PassTime> passes;
   uint64_t intersections = 0;  // at the first view
   double psnr_db = 0;          // against the float64 reference, mean over the views
   double ssim = 0;             // mean over the views
   double max_abs = 0;          // largest over the views
+  // Another compositor than the sorted one: PSNR against the sorted compositor's image of the same
+  // modes, mean over the views (what the compositor costs by itself); NaN for the sorted rows.
+  double psnr_vs_sorted_db = 0;
   // Along the camera path, per consecutive pair of frames (means over the pairs):
   double frame_change = 0;     // mean |frame t+1 - frame t|
   double flicker = 0;          // fraction of pixels whose change exceeds kFlickerThreshold: pops
@@ -97,6 +101,8 @@ struct SceneReport {
 
 struct Options {
   std::vector<AccuracyModes> modes;  // empty: default_modes()
+  // The compositor of every row (tilesplat-bench --compositor); none: the sorted one (report_rows).
+  std::optional<Compositor> compositor;
   std::vector<Camera> views;         // the measured views (the first one starts the path)
   std::vector<std::string> view_names;
   int warmup = 1;
@@ -107,6 +113,19 @@ struct Options {
   double consistency_angle = 0.08;  // radians the camera turns in place for the view-consistency pair; 0: none
   std::string sort = "radix";
 };
+
+// One row of a report: a mode combination drawn by a compositor.
+struct Row {
+  AccuracyModes modes;
+  Compositor compositor = Compositor::kSorted;
+};
+// The rows of a report on a scene of this SH degree: Options::modes (or default_modes()) that apply,
+// by Options::compositor (the sorted one when none is given), leaving out the modes a compositor cannot
+// draw (re-sorting for the raster and the stochastic one, approximate depth keys for the stochastic
+// one); the default report (neither modes nor a compositor given) ends with the raster compositor's
+// row of the reference modes.
+std::vector<Row> report_rows(const Options& options, int scene_sh_degree);
+std::string row_name(const Row& row);  // "depth16", "raster", "raster+depth16"
 
 // Measures one scene. progress(done, total, what) is called as it goes.
 SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const Options& options,

@@ -54,6 +54,7 @@ int run_accuracy_report(const BenchOptions& options) {
       p.options.view_names.push_back(c.view_label);
     }
     p.options.modes = options.common.modes;
+    p.options.compositor = options.common.compositor;
     p.options.warmup = options.warmup;
     p.options.repeat = options.repeat;
     p.options.path = options.path;

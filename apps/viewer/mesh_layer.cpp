@@ -469,7 +469,11 @@ void MeshLayer::submit(VkCommandBuffer cmd, VkSemaphore wait, VkSemaphore signal
 }
 
 bool MeshLayer::depth_testable(const RenderSettings& settings) {
-  return settings.compositor == Compositor::kSorted && settings.accuracy.resort_window == 0;
+  return settings.compositor != Compositor::kStochastic && settings.accuracy.resort_window == 0;
+}
+
+bool MeshLayer::writes_depth_out(const RenderSettings& settings) {
+  return depth_testable(settings) && settings.compositor != Compositor::kRaster;
 }
 
 void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
@@ -519,7 +523,10 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
   RenderSettings splat_settings = settings;
   splat_settings.background = {0, 0, 0};
   if (mesh)
-    splat_settings.host = HostDepth{DepthConvention::from_projection(projection_matrix), {}, depth_out, 0.5f};
+    splat_settings.host = HostDepth{DepthConvention::from_projection(projection_matrix),
+                                    {},
+                                    depth_out && writes_depth_out(settings),
+                                    0.5f};
   const ExternalImage target{splats_.image, width_, height_, kSplatFormat, VK_IMAGE_LAYOUT_UNDEFINED};
   const ExternalDepthImage depth{depth_.image, width_, height_, kDepthFormat,
                                  VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};

@@ -7,6 +7,7 @@
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -18,16 +19,16 @@
 #include <vector>
 
 #include "cli.h"
-#include "viewer_options.h"
+#include "image_readback.h"
+#include "mesh_layer.h"
+#include "orbit_controller.h"
+#include "swapchain.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
-#include "image_readback.h"
-#include "mesh_layer.h"
-#include "orbit_controller.h"
-#include "swapchain.h"
+#include "viewer_options.h"
 #include "window_device.h"
 
 namespace {
@@ -45,7 +46,13 @@ constexpr int kDefaultWindowWidth = 960;  // the height follows the view's aspec
 // What key M steps through: the reference; depth16, the web viewers' sort keys; resort8, per-pixel
 // re-sorting, more exact than the reference; and the web viewers' shortcuts all together.
 constexpr const char* kModeCycle[] = {"reference", "depth16", "resort8", "depth16+opacity-extent+fp16-sh+fp16-cov"};
-
+// What key C steps through: the tile compositor and the raster one (which draws no re-sorting: M skips
+// resort8 while it is on).
+constexpr std::array<tilesplat::Compositor, 2> kCompositorCycle = {tilesplat::Compositor::kSorted,
+                                                                   tilesplat::Compositor::kRaster};
+bool draws(tilesplat::Compositor compositor, const tilesplat::AccuracyModes& modes) {
+  return compositor != tilesplat::Compositor::kRaster || modes.resort_window == 0;
+}
 
 bool validation_from_environment() {
   const char* value = std::getenv("TILESPLAT_VALIDATION");
@@ -99,6 +106,15 @@ class Viewer {
     for (const char* mode : kModeCycle) modes_.push_back(tilesplat::parse_accuracy_modes(mode));
     if (!options.common.modes.empty()) mode_ = find_or_append(modes_, options.common.modes.front());
     if (!options.common.sorts.empty()) sort_ = find_or_append(sorts_, options.common.sorts.front());
+    // --compositor: sorted or raster (the stochastic compositor is no viewer's: its frames are averages).
+    const auto start = std::find(kCompositorCycle.begin(), kCompositorCycle.end(), base_settings_.compositor);
+    if (start == kCompositorCycle.end())
+      throw cli::UsageError("the viewer shows the sorted or the raster compositor, not the " +
+                            tilesplat::to_string(base_settings_.compositor));
+    compositor_ = size_t(start - kCompositorCycle.begin());
+    if (!draws(kCompositorCycle[compositor_], modes_[mode_]))
+      throw cli::UsageError("the raster compositor does not re-sort per pixel (--mode " +
+                            tilesplat::to_string(modes_[mode_]) + ")");
 
     glfwSetWindowUserPointer(window_, this);
     glfwSetKeyCallback(window_, on_key);
@@ -150,6 +166,7 @@ class Viewer {
     tilesplat::RenderSettings settings = base_settings_;
     settings.sort = sorts_[sort_];
     settings.accuracy = modes_[mode_];
+    settings.compositor = kCompositorCycle[compositor_];
     // A scene file's sh_degree effect caps every mode, as in tilesplat-render.
     settings.accuracy.sh_degree_cap =
         std::min(settings.accuracy.sh_degree_cap, base_settings_.accuracy.sh_degree_cap);
@@ -203,8 +220,14 @@ class Viewer {
       case GLFW_KEY_RIGHT: viewer.step_view(1); return;
       case GLFW_KEY_P:
       case GLFW_KEY_LEFT: viewer.step_view(-1); return;
-      case GLFW_KEY_M: viewer.mode_ = (viewer.mode_ + 1) % viewer.modes_.size(); break;
+      case GLFW_KEY_M:
+        viewer.next_mode();
+        break;
       case GLFW_KEY_S: viewer.sort_ = (viewer.sort_ + 1) % viewer.sorts_.size(); break;
+      case GLFW_KEY_C:
+        viewer.compositor_ = (viewer.compositor_ + 1) % kCompositorCycle.size();
+        if (!draws(kCompositorCycle[viewer.compositor_], viewer.modes_[viewer.mode_])) viewer.next_mode();
+        break;
       case GLFW_KEY_D:
         viewer.depth_out_ = !viewer.depth_out_;
         break;
@@ -244,6 +267,13 @@ class Viewer {
   static void on_scroll(GLFWwindow* window, double, double steps) {
     self(window).controller_.zoom(steps);
     self(window).needs_render_ = true;
+  }
+
+  // The next accuracy mode the compositor draws (the reference always is one).
+  void next_mode() {
+    do {
+      mode_ = (mode_ + 1) % modes_.size();
+    } while (!draws(kCompositorCycle[compositor_], modes_[mode_]));
   }
 
   void step_view(int step) {
@@ -305,7 +335,8 @@ class Viewer {
     }
     const std::string& ran = renderer_.last_frame_stats().sort_strategy;
     const std::string sort = sorts_[sort_] == "auto" && !ran.empty() ? "auto (" + ran + ")" : sorts_[sort_];
-    title += " | " + tilesplat::to_string(modes_[mode_]) + " | " + sort + " | GPU " +
+    title += " | " + tilesplat::to_string(modes_[mode_]) + " | " + sort + " | " +
+             tilesplat::to_string(kCompositorCycle[compositor_]) + " | GPU " +
              cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
              cli::format_fixed(frame_ms, 1) + " ms (" +
              cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps)";
@@ -313,6 +344,8 @@ class Viewer {
       title += " | mesh off: this mode does not depth-test";
     else if (mesh_layer_ && !depth_out_)
       title += " | no depth out";
+    else if (mesh_layer_ && !MeshLayer::writes_depth_out(settings()))
+      title += " | no depth out: the raster compositor writes none";
     glfwSetWindowTitle(window_, title.c_str());
   }
 
@@ -334,6 +367,7 @@ class Viewer {
   size_t mode_ = 0;
   std::vector<std::string> sorts_;
   size_t sort_ = 0;
+  size_t compositor_ = 0;                    // in kCompositorCycle (C cycles)
   tilesplat::RenderSettings base_settings_;  // the scene file's background, effects and outputs
 
   int drag_button_ = -1;  // the mouse button held, or -1

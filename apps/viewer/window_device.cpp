@@ -122,7 +122,7 @@ void WindowDevice::destroy() {
 }
 
 ExternalVulkanDevice WindowDevice::external() const {
-  return {instance_, physical_device_, device_, queue_, queue_family_, shader_float64_};
+  return {instance_, physical_device_, device_, queue_, queue_family_, shader_float64_, independent_blend_};
 }
 
 std::string WindowDevice::name() const { return device_name(physical_device_); }
@@ -275,6 +275,9 @@ void WindowDevice::create_device() {
   vkGetPhysicalDeviceFeatures2(physical_device_, &has);
   // shaderFloat64 makes the projection's geometry exact (vulkan_interop.h); it is optional.
   shader_float64_ = has.features.shaderFloat64 == VK_TRUE;
+  // independentBlend lets the raster compositor count splats where it blends colours (a screenshot's
+  // EXR has the counts); optional too.
+  independent_blend_ = has.features.independentBlend == VK_TRUE;
 
   VkPhysicalDeviceVulkan12Features want12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   want12.bufferDeviceAddress = VK_TRUE;
@@ -282,6 +285,7 @@ void WindowDevice::create_device() {
   want.pNext = &want12;
   want.features.shaderInt64 = VK_TRUE;
   want.features.shaderFloat64 = shader_float64_ ? VK_TRUE : VK_FALSE;
+  want.features.independentBlend = independent_blend_ ? VK_TRUE : VK_FALSE;
 
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

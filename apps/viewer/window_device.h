@@ -68,6 +68,7 @@ class WindowDevice {
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
   bool shader_float64_ = false;
+  bool independent_blend_ = false;
   std::atomic<uint64_t> validation_messages_{0};
 };
 

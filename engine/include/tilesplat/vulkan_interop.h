@@ -26,6 +26,9 @@ struct ExternalVulkanDevice {
   VkQueue queue = VK_NULL_HANDLE;                     ///< from a family with compute and timestamp support
   uint32_t queue_family = 0;                          ///< the family `queue` belongs to
   bool shader_float64_enabled = false;                ///< whether `device` was created with shaderFloat64 on
+  /// Whether `device` was created with independentBlend on, which the raster compositor's splat counts
+  /// need (Compositor::kRaster); without it, render with RenderSettings::splat_count off.
+  bool independent_blend_enabled = false;
 };
 
 /// A renderer on the host's device. RendererOptions::device and RendererOptions::validation do not apply (the

@@ -79,7 +79,7 @@ Context::Context(const ExternalVulkanDevice& borrowed) : owns_handles_(false) {
     features_.graphics_queue = (families[queue_family_].queueFlags & VK_QUEUE_GRAPHICS_BIT) != 0;
     // The host enabled the device's features; shaderFloat64 only counts if it says so.
     features_.shader_float64 = features_.shader_float64 && borrowed.shader_float64_enabled;
-    features_.independent_blend = false;  // the host does not say whether it enabled it
+    features_.independent_blend = features_.independent_blend && borrowed.independent_blend_enabled;
     create_command_objects();
   } catch (...) {
     destroy();
