@@ -126,9 +126,11 @@ std::string row_name(const Row& row) {
 int work_units(const Options& options, int scene_sh_degree) {
   const std::vector<Row> rows = report_rows(options, scene_sh_degree);
   int applicable = 0, other_compositors = 0;
+  bool raster = false;
   for (const Row& row : rows) {
     ++applicable;
     other_compositors += row.compositor != Compositor::kSorted ? 1 : 0;
+    raster = raster || row.compositor == Compositor::kRaster;
   }
   const int views = int(options.views.size());
   // The path starts at the first view, whose reference and render it reuses. References: each view and
@@ -138,7 +140,7 @@ int work_units(const Options& options, int scene_sh_degree) {
   // A row of another compositor also renders the sorted compositor's image at each view.
   return views + later_path_frames + consistency_pair +
          applicable * (views * (options.warmup + options.repeat) + later_path_frames + consistency_pair) +
-         other_compositors * views;
+         other_compositors * views + (raster ? views : 0);  // the raster rule's references
 }
 
 SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const Options& options,
@@ -213,6 +215,18 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     report.reference_inconsistency_mean = inconsistency.mean_abs;
   }
 
+  // The float64 reference's raster rule at each view, when a row draws with the raster compositor.
+  std::vector<RenderImage> raster_references;
+  if (std::any_of(rows.begin(), rows.end(),
+                  [](const Row& row) { return row.compositor == Compositor::kRaster; })) {
+    RenderSettings raster_rule = reference_settings;
+    raster_rule.compositor = Compositor::kRaster;
+    for (size_t v = 0; v < options.views.size(); ++v) {
+      raster_references.push_back(render_reference(scene, options.views[v], raster_rule));
+      step("float64 reference's raster rule, " + options.view_names[v]);
+    }
+  }
+
   renderer.set_scene(scene);
   for (const Row& row : rows) {
     const AccuracyModes& m = row.modes;
@@ -221,6 +235,7 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     result.compositor = row.compositor;
     result.name = row_name(row);
     result.psnr_vs_sorted_db = std::numeric_limits<double>::quiet_NaN();
+    result.psnr_vs_rule_db = std::numeric_limits<double>::quiet_NaN();
     RenderSettings settings;
     settings.sort = options.sort;
     settings.depth = false;
@@ -228,7 +243,7 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     settings.accuracy = m;
     settings.compositor = row.compositor;
     settings.reuse_lists = false;  // the repeats time whole frames, not the composite on reused lists
-    double psnr_vs_sorted_sum = 0;
+    double psnr_vs_sorted_sum = 0, psnr_vs_rule_sum = 0;
 
     std::vector<double> frame_ms_per_view;
     std::map<std::string, std::vector<double>> pass_ms_per_view;
@@ -264,6 +279,8 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
         psnr_vs_sorted_sum += compare_images(image, renderer.render(options.views[v], sorted)).psnr_db;
         step(result.name + ", the sorted compositor's image, " + options.view_names[v]);
       }
+      if (row.compositor == Compositor::kRaster)
+        psnr_vs_rule_sum += compare_images(image, raster_references[v]).psnr_db;
       const ImageDifference difference = compare_images(image, references[v]);
       psnr_sum += difference.psnr_db;
       ssim_sum += ssim(image, references[v]);
@@ -275,6 +292,8 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     result.psnr_db = psnr_sum / double(options.views.size());
     if (row.compositor != Compositor::kSorted)
       result.psnr_vs_sorted_db = psnr_vs_sorted_sum / double(options.views.size());
+    if (row.compositor == Compositor::kRaster)
+      result.psnr_vs_rule_db = psnr_vs_rule_sum / double(options.views.size());
     result.ssim = ssim_sum / double(options.views.size());
 
     std::vector<RenderImage> frames;
@@ -317,6 +336,9 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
 std::string psnr_vs_sorted(const ModeResult& m) {
   return std::isnan(m.psnr_vs_sorted_db) ? "-" : cli::format_number(m.psnr_vs_sorted_db, 2);
 }
+std::string psnr_vs_rule(const ModeResult& m) {
+  return std::isnan(m.psnr_vs_rule_db) ? "-" : cli::format_number(m.psnr_vs_rule_db, 2);
+}
 
 std::string text_table(const SceneReport& report) {
   std::string text =
@@ -326,20 +348,21 @@ std::string text_table(const SceneReport& report) {
       cli::format_number(report.consistency_angle, 3) +
       " rad: " + cli::format_number(100.0 * report.reference_inconsistency, 3) + "% inconsistent\n";
   char line[512];
-  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s %9s %9s\n", "mode",
+  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s %9s %9s %9s\n", "mode",
                 "GPU ms", "vs ref", "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess", "pops%",
-                "incons%", "vs tiles");
+                "incons%", "vs tiles", "vs rule");
   text += line;
   const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
   for (const auto& m : report.modes) {
-    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s %9s %9s\n",
+    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s %9s %9s %9s\n",
                   m.name.c_str(), cli::format_number(m.frame_ms, 2).c_str(),
                   cli::format_number(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2).c_str(),
                   cli::format_number(m.psnr_db, 2).c_str(), cli::format_number(m.ssim, 5).c_str(),
                   cli::format_number(m.max_abs, 4).c_str(), static_cast<unsigned long long>(m.intersections),
                   cli::format_number(100.0 * m.flicker, 3).c_str(), cli::format_number(m.excess, 5).c_str(),
                   cli::format_number(100.0 * m.pops, 3).c_str(),
-                  cli::format_number(100.0 * m.inconsistency, 3).c_str(), psnr_vs_sorted(m).c_str());
+                  cli::format_number(100.0 * m.inconsistency, 3).c_str(), psnr_vs_sorted(m).c_str(),
+                  psnr_vs_rule(m).c_str());
     text += line;
   }
   return text;
@@ -376,8 +399,8 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
     md +=
         "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change "
         "| pops % "
-        "| inconsistent % | inconsistency | PSNR vs sorted compositor dB |\n";
-    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        "| inconsistent % | inconsistency | PSNR vs sorted compositor dB | PSNR vs own float64 rule dB |\n";
+    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
     for (const auto& m : report.modes)
       md += "| " + m.name + " | " + cli::format_number(m.frame_ms, 2) + " | " +
@@ -386,7 +409,8 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
             cli::format_number(m.max_abs, 4) + " | " + std::to_string(m.intersections) + " | " +
             cli::format_number(100.0 * m.flicker, 3) + " | " + cli::format_number(m.excess, 5) + " | " +
             cli::format_number(100.0 * m.pops, 3) + " | " + cli::format_number(100.0 * m.inconsistency, 3) +
-            " | " + cli::format_number(m.inconsistency_mean, 6) + " | " + psnr_vs_sorted(m) + " |\n";
+            " | " + cli::format_number(m.inconsistency_mean, 6) + " | " + psnr_vs_sorted(m) + " | " +
+            psnr_vs_rule(m) + " |\n";
     // Per-pass times: a column per mode would not fit; the passes whose time a mode changes.
     md += "\nPer-pass median GPU ms:\n\n| mode |";
     std::vector<std::string> names;
@@ -414,8 +438,8 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
 std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& device) {
   std::string out =
       "device,scene,mode,gpu_frame_ms,psnr_db,ssim,max_abs,intersections,frame_change,flicker_fraction,"
-      "excess_change,pop_fraction,pop_mean,inconsistent_fraction,inconsistency_mean,passes,psnr_vs_sorted_"
-      "db\n";
+      "excess_change,pop_fraction,pop_mean,inconsistent_fraction,inconsistency_mean,passes,psnr_vs_sorted_db,"
+      "psnr_vs_rule_db\n";
   for (const auto& report : reports)
     for (const auto& m : report.modes) {
       std::string passes;
@@ -430,6 +454,8 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
              cli::format_number(m.inconsistency, 6) + "," + cli::format_number(m.inconsistency_mean, 6) +
              "," + cli::csv_field(passes) + "," +
              (std::isnan(m.psnr_vs_sorted_db) ? std::string() : cli::format_number(m.psnr_vs_sorted_db, 4)) +
+             "," +
+             (std::isnan(m.psnr_vs_rule_db) ? std::string() : cli::format_number(m.psnr_vs_rule_db, 4)) +
              "\n";
     }
   return out;

@@ -59,6 +59,9 @@ struct ModeResult {
   // Another compositor than the sorted one: PSNR against the sorted compositor's image of the same
   // modes, mean over the views (what the compositor costs by itself); NaN for the sorted rows.
   double psnr_vs_sorted_db = 0;
+  // The raster compositor: PSNR against the float64 reference's raster rule (render_reference with
+  // Compositor::kRaster), mean over the views: the GPU held to its own definition; NaN for the others.
+  double psnr_vs_rule_db = 0;
   // Along the camera path, per consecutive pair of frames (means over the pairs):
   double frame_change = 0;     // mean |frame t+1 - frame t|
   double flicker = 0;          // fraction of pixels whose change exceeds kFlickerThreshold: pops

@@ -180,6 +180,7 @@ int run_scaling_report(const BenchOptions& options) {
   scaling_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
   scaling_options.repeat = options.repeat;
   if (!options.common.sorts.empty()) scaling_options.sort = options.common.sorts.front();
+  if (options.common.compositor) scaling_options.compositor = *options.common.compositor;
 
   std::vector<tilesplat::scaling::Scene> scenes;
   for (const std::string& file : options.common.scenes) {

@@ -229,6 +229,7 @@ Run measure(const RendererOptions& renderer_options, const std::vector<Scene>& s
         const size_t k = s * options.sizes.size() + z;
         RenderSettings settings;
         settings.sort = options.sort;
+        settings.compositor = options.compositor;
         settings.reuse_lists = false;
         renderers[s]->render(cameras[s][z], settings);
         const FrameStats& stats = renderers[s]->last_frame_stats();

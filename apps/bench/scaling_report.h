@@ -52,6 +52,7 @@ struct Options {
   int warmup = 1;
   int repeat = 3;
   std::string sort = "radix";
+  Compositor compositor = Compositor::kSorted;  // tilesplat-bench --compositor
 };
 
 struct Run {
