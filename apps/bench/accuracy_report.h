@@ -59,6 +59,7 @@ struct ModeResult {
   // Another compositor than the sorted one: PSNR against the sorted compositor's image of the same
   // modes, mean over the views (what the compositor costs by itself); NaN for the sorted rows.
   double psnr_vs_sorted_db = 0;
+  double sorted_frame_ms = 0;  // and the sorted compositor's frame time, timed alike in the same run
   // The raster compositor: PSNR against the float64 reference's raster rule (render_reference with
   // Compositor::kRaster), mean over the views: the GPU held to its own definition; NaN for the others.
   double psnr_vs_rule_db = 0;
