@@ -44,6 +44,21 @@ VkPipelineColorBlendAttachmentState blend_state(Blend blend) {
   return state;
 }
 
+// One single-sampled attachment without stencil: how it starts and ends the render pass.
+VkAttachmentDescription attachment(VkFormat format, VkAttachmentLoadOp load, VkAttachmentStoreOp store,
+                                   VkImageLayout initial, VkImageLayout final_layout) {
+  VkAttachmentDescription d{};
+  d.format = format;
+  d.samples = VK_SAMPLE_COUNT_1_BIT;
+  d.loadOp = load;
+  d.storeOp = store;
+  d.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
+  d.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+  d.initialLayout = initial;
+  d.finalLayout = final_layout;
+  return d;
+}
+
 }  // namespace
 
 void GraphicsPipeline::create_render_pass(const GraphicsPipelineDesc& desc) {
@@ -54,31 +69,18 @@ void GraphicsPipeline::create_render_pass(const GraphicsPipelineDesc& desc) {
       references.push_back({VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED});
       continue;
     }
-    VkAttachmentDescription d{};
-    d.format = a.format;
-    d.samples = VK_SAMPLE_COUNT_1_BIT;
-    d.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    d.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    d.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
-    d.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-    d.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;  // cleared: the last frame's contents are not needed
-    d.finalLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    // Cleared: the last frame's contents are not needed.
     references.push_back({uint32_t(descriptions.size()), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL});
-    descriptions.push_back(d);
+    descriptions.push_back(attachment(a.format, VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_STORE,
+                                      VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL));
   }
   VkAttachmentReference depth_reference{VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED};
   if (desc.depth_test) {
-    VkAttachmentDescription d{};
-    d.format = desc.depth_test->format;
-    d.samples = VK_SAMPLE_COUNT_1_BIT;
-    d.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
-    d.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-    d.stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE;
-    d.stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
-    d.initialLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    d.finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+    // Loaded from the transfer that filled it; tested, never written, so not stored.
     depth_reference = {uint32_t(descriptions.size()), VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL};
-    descriptions.push_back(d);
+    descriptions.push_back(attachment(desc.depth_test->format, VK_ATTACHMENT_LOAD_OP_LOAD,
+                                      VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                      VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL));
   }
   VkSubpassDescription subpass{};
   subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
