@@ -171,8 +171,22 @@ TS_PUSH_INSTANCE;
 TS_PUSH_CONSTANTS(RasterPush) {
   TS_REF(Vec4Array) splats;
   TS_REF(UintArray) depth_order;  // the depth sort's result: record indices, visible ones first
+  TS_REF(UintArray) counters;     // COUNTER_VISIBLE: how many of them the mesh stage draws
   uint width;
   uint height;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+// Splats one workgroup of raster_quads.mesh draws (4 vertices and 2 triangles each).
+TS_CONST uint RASTER_MESH_SPLATS = 32;
+
+#if defined(__cplusplus) || defined(TS_RASTER_MESH_ARGS_PUSH)
+// raster_mesh_args.comp (RasterCompositePass): the mesh-stage draw's workgroup counts.
+TS_PUSH_CONSTANTS(RasterMeshArgsPush) {
+  TS_REF(UintArray) counters;  // COUNTER_VISIBLE
+  TS_REF(UintArray) args;      // VkDrawMeshTasksIndirectCommandEXT
+  uint max_groups_x;           // VkPhysicalDeviceMeshShaderPropertiesEXT::maxMeshWorkGroupCount[0]
 }
 TS_PUSH_INSTANCE;
 #endif

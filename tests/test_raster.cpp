@@ -315,6 +315,56 @@ TEST(Raster, RenderCommandLine) {
   testing::expect_one_error_line(mixed, "tilesplat-render");
 }
 
+// The mesh stage (where the device has VK_EXT_mesh_shader, as Mesa 25's lavapipe does) and the vertex
+// stage draw the same image to the bit, with a host's depth too; asking for the mesh stage on a device
+// without it (Mesa 22's lavapipe) is an error that says so.
+TEST(RasterStages, MeshAndVertexStagesDrawTheSameImage) {
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const Camera camera = playbot_camera(240, 136);
+  const std::vector<float> host_depth(size_t(camera.width) * camera.height, float(1.0 - 1.0 / 4.0));
+  std::vector<RenderSettings> frames(2, raster_settings());
+  frames[1].host = HostDepth{};
+  frames[1].host->depth = host_depth;
+  frames[1].splat_count = false;
+  // One renderer per stage; the stage is chosen on its first raster frame.
+  auto render_with = [&](const char* stage, std::string& driver) {
+    ::setenv("TILESPLAT_RASTER_STAGE", stage, 1);
+    RendererOptions options;
+    options.validation = true;
+    auto renderer = Renderer::create(options);
+    driver = renderer->device_info().driver;
+    renderer->set_scene(scene);
+    std::vector<RenderImage> images;
+    try {
+      for (const RenderSettings& settings : frames) images.push_back(renderer->render(camera, settings));
+    } catch (...) {
+      ::unsetenv("TILESPLAT_RASTER_STAGE");
+      throw;
+    }
+    ::unsetenv("TILESPLAT_RASTER_STAGE");
+    EXPECT_EQ(renderer->validation_messages(), 0u) << stage;
+    return images;
+  };
+  std::string driver;
+  const std::vector<RenderImage> vertex = render_with("vertex", driver);
+  // Mesa's lavapipe has had VK_EXT_mesh_shader since its 24.1; Mesa 25 is what CI runs besides 22.
+  const size_t mesa = driver.find("Mesa ");
+  const bool mesa25_or_later = mesa != std::string::npos && std::atoi(driver.c_str() + mesa + 5) >= 25;
+  try {
+    const std::vector<RenderImage> mesh = render_with("mesh", driver);
+    for (size_t k = 0; k < frames.size(); ++k) {
+      EXPECT_EQ(mesh[k].rgba, vertex[k].rgba) << "frame " << k;
+      EXPECT_EQ(mesh[k].depth, vertex[k].depth) << "frame " << k;
+      EXPECT_EQ(mesh[k].splat_count, vertex[k].splat_count) << "frame " << k;
+    }
+    std::printf("mesh and vertex stages: the same images on %s\n", driver.c_str());
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("has no VK_EXT_mesh_shader"), std::string::npos) << e.what();
+    EXPECT_FALSE(mesa25_or_later) << driver << " has VK_EXT_mesh_shader: " << e.what();
+    std::printf("no mesh stage on %s: %s\n", driver.c_str(), e.what());
+  }
+}
+
 // The reports: a row in the effects table (with a host's depth too) and the accuracy report's raster row,
 // whose PSNR against the sorted compositor is a column of its own.
 TEST(Raster, EffectsAndAccuracyReportsHaveTheRasterRows) {

@@ -1,6 +1,7 @@
 #include "passes/raster_composite_pass.h"
 
 #include <bit>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -13,6 +14,7 @@ namespace tilesplat {
 
 namespace {
 using shader_io::RasterHostSurfacesPush;
+using shader_io::RasterMeshArgsPush;
 using shader_io::RasterPush;
 using shader_io::RasterResolvePush;
 
@@ -59,6 +61,23 @@ void copy_to_depth_image(VkCommandBuffer cmd, const vk::Buffer& buffer, const vk
 
 }  // namespace
 
+bool raster_stage_is_mesh(const vk::Context& ctx) {
+  const char* env = std::getenv("TILESPLAT_RASTER_STAGE");
+  const std::string stage = env ? env : "";
+  // llvmpipe runs the mesh stage slower than the instanced vertex stage (Mesa 25, 500k playbot at 1080p:
+  // 2032-2135 against 1512-1617 ms, interleaved; docs/compositors.md): there the vertex stage.
+  if (stage.empty()) return ctx.features().mesh_shader && !ctx.is_cpu_device();
+  if (stage == "vertex") return false;
+  if (stage != "mesh")
+    throw std::invalid_argument("TILESPLAT_RASTER_STAGE must be vertex or mesh, got '" + stage + "'");
+  if (!ctx.features().mesh_shader)
+    throw std::runtime_error(
+        ctx.device_name() +
+        ": TILESPLAT_RASTER_STAGE=mesh, and this device has no VK_EXT_mesh_shader (or the "
+        "renderer did not make it)");
+  return true;
+}
+
 RasterCompositePass::RasterCompositePass(vk::Context& ctx) : ctx_(ctx) {}
 
 void RasterCompositePass::check_device(const Shape& shape) const {
@@ -96,6 +115,8 @@ void RasterCompositePass::release_framebuffer() {
 void RasterCompositePass::prepare(const Shape& shape) {
   check_device(shape);
   if (!draw_args_) {
+    mesh_ = raster_stage_is_mesh(ctx_);
+    if (mesh_) mesh_args_ = vk::ComputePipeline(ctx_, "raster_mesh_args", sizeof(RasterMeshArgsPush));
     resolve_ = vk::ComputePipeline(ctx_, "raster_resolve", sizeof(RasterResolvePush));
     host_surfaces_ = vk::ComputePipeline(ctx_, "raster_host_surfaces", sizeof(RasterHostSurfacesPush));
     draw_args_ =
@@ -128,7 +149,10 @@ const vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
   auto it = pipelines_.find(v);
   if (it != pipelines_.end()) return it->second;
   vk::GraphicsPipelineDesc desc;
-  desc.vertex_shader = "raster_quad";
+  if (v.mesh)
+    desc.mesh_shader = "raster_quads";
+  else
+    desc.vertex_shader = "raster_quad";
   desc.fragment_shader = "raster_blend";
   desc.push_constant_bytes = sizeof(RasterPush);
   desc.spec = {{0, std::bit_cast<uint32_t>(coverage_alpha_inv(v.cutoffs.alpha))},
@@ -150,8 +174,11 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   if (!t.colour || !(t.shape == shape))
     throw std::logic_error("RasterCompositePass::record before prepare() for this frame's shape");
   // The transmittance cut-off does not apply: one pipeline whatever it is.
-  const Variant variant{
-      in.write_depth, in.write_count, shape.host_depth, {in.cutoffs.alpha, 0.0f, in.cutoffs.max_alpha}};
+  const Variant variant{mesh_,
+                        in.write_depth,
+                        in.write_count,
+                        shape.host_depth,
+                        {in.cutoffs.alpha, 0.0f, in.cutoffs.max_alpha}};
   const vk::GraphicsPipeline& drawing = pipeline(variant);
   if (!t.framebuffer) {
     std::vector<VkImageView> views = {t.colour.view()};
@@ -177,13 +204,20 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
     copy_to_depth_image(cmd, t.host_surfaces_input, t.host_surfaces);
   }
 
-  // The draw's arguments: 4 vertices, one instance per visible splat (the projection's count; the
-  // depth sort put them first), from the first instance.
-  vkCmdFillBuffer(cmd, draw_args_.handle(), offsetof(VkDrawIndirectCommand, vertexCount), 4, kQuadVertices);
-  vkCmdFillBuffer(cmd, draw_args_.handle(), offsetof(VkDrawIndirectCommand, firstVertex), 8, 0);
-  const VkBufferCopy visible{offsetof(FrameCounters, visible), offsetof(VkDrawIndirectCommand, instanceCount),
-                             sizeof(uint32_t)};
-  vkCmdCopyBuffer(cmd, in.counters.handle(), draw_args_.handle(), 1, &visible);
+  // The draw's arguments from the projection's visible count (the depth sort put those splats first):
+  // a workgroup per RASTER_MESH_SPLATS of them, or 4 vertices and an instance per splat.
+  if (mesh_) {
+    const RasterMeshArgsPush args{in.counters.address(), draw_args_.address(),
+                                  ctx_.limits().max_mesh_workgroup_count_x};
+    mesh_args_.bind(cmd, args);
+    mesh_args_.dispatch(cmd, 1);
+  } else {
+    vkCmdFillBuffer(cmd, draw_args_.handle(), offsetof(VkDrawIndirectCommand, vertexCount), 4, kQuadVertices);
+    vkCmdFillBuffer(cmd, draw_args_.handle(), offsetof(VkDrawIndirectCommand, firstVertex), 8, 0);
+    const VkBufferCopy visible{offsetof(FrameCounters, visible),
+                               offsetof(VkDrawIndirectCommand, instanceCount), sizeof(uint32_t)};
+    vkCmdCopyBuffer(cmd, in.counters.handle(), draw_args_.handle(), 1, &visible);
+  }
 
   VkClearValue clears[3]{};  // all zero: no colour, T = 1, no depth, no splats (a host's depth is loaded)
   VkRenderPassBeginInfo begin{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
@@ -196,10 +230,15 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   RasterPush push{};
   push.splats = in.splats.address();
   push.depth_order = in.depth_order.address();
+  push.counters = in.counters.address();
   push.width = shape.width;
   push.height = shape.height;
   drawing.bind(cmd, push, shape.width, shape.height);
-  vkCmdDrawIndirect(cmd, draw_args_.handle(), 0, 1, sizeof(VkDrawIndirectCommand));
+  if (mesh_)
+    ctx_.cmd_draw_mesh_tasks_indirect()(cmd, draw_args_.handle(), 0, 1,
+                                        sizeof(VkDrawMeshTasksIndirectCommandEXT));
+  else
+    vkCmdDrawIndirect(cmd, draw_args_.handle(), 0, 1, sizeof(VkDrawIndirectCommand));
   vkCmdEndRenderPass(cmd);
 
   // The attachments into the outputs, then the resolve in place.

@@ -39,6 +39,12 @@ struct RasterInputs {
   const vk::Buffer* host_view_depth = nullptr;
 };
 
+// Which stage draws the quads: the mesh stage where a GPU has VK_EXT_mesh_shader (each splat's record
+// read once, 32 splats a workgroup), else the vertex stage (four vertices an instance), which CPU drivers
+// run faster. TILESPLAT_RASTER_STAGE=vertex or mesh chooses, so that the tests hold both to the same
+// images; mesh on a device without it throws std::runtime_error naming the device.
+bool raster_stage_is_mesh(const vk::Context& ctx);
+
 class RasterCompositePass {
  public:
   // Throws std::runtime_error naming the device when its queue cannot draw or it cannot blend into
@@ -59,6 +65,7 @@ class RasterCompositePass {
  private:
   // A pipeline of the pass: its outputs (which attachments exist) and its cut-offs.
   struct Variant {
+    bool mesh = false;  // the mesh stage draws the quads (raster_quads.mesh), else the vertex stage
     bool write_depth = true;
     bool write_count = true;
     bool host_depth = false;  // the depth attachment holds a host's surfaces (HOST_DEPTH)
@@ -73,6 +80,8 @@ class RasterCompositePass {
   vk::ComputePipeline resolve_;
   vk::Buffer draw_args_;  // VkDrawIndirectCommand: 4 vertices, the visible splats as instances
   vk::ComputePipeline host_surfaces_;
+  vk::ComputePipeline mesh_args_;  // the mesh-stage draw's workgroup counts (raster_mesh_args.comp)
+  bool mesh_ = false;              // raster_stage_is_mesh(), decided on the first raster frame
   // The attachments of the current shape and their framebuffer (for the render pass of that shape:
   // every Variant of it has a compatible one).
   struct Targets {

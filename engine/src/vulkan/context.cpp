@@ -244,9 +244,39 @@ void Context::create_device() {
   std::vector<VkExtensionProperties> available(extension_count);
   vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &extension_count, available.data());
   std::vector<const char*> extensions;
-  for (const auto& e : available)
-    if (std::string_view(e.extensionName) == VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME)
-      extensions.push_back(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+  bool has_push_descriptor = false, has_mesh_shader = false;
+  for (const auto& e : available) {
+    has_push_descriptor =
+        has_push_descriptor || std::string_view(e.extensionName) == VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME;
+    has_mesh_shader =
+        has_mesh_shader || std::string_view(e.extensionName) == VK_EXT_MESH_SHADER_EXTENSION_NAME;
+  }
+  if (has_push_descriptor) extensions.push_back(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+  // Mesh shaders draw the raster compositor's quads a workgroup of splats at a time; the mesh stage
+  // alone (no task stage).
+  VkPhysicalDeviceMeshShaderFeaturesEXT want_mesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+  if (has_mesh_shader) {
+    VkPhysicalDeviceMeshShaderFeaturesEXT has_mesh{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+    VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    has.pNext = &has_mesh;
+    vkGetPhysicalDeviceFeatures2(physical_device_, &has);
+    VkPhysicalDeviceMeshShaderPropertiesEXT mesh_properties{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_PROPERTIES_EXT};
+    VkPhysicalDeviceProperties2 properties{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    properties.pNext = &mesh_properties;
+    vkGetPhysicalDeviceProperties2(physical_device_, &properties);
+    // 32 splats a workgroup: 128 vertices and 64 triangles of 12 flat components a vertex.
+    const bool fits = mesh_properties.maxMeshOutputVertices >= 128 &&
+                      mesh_properties.maxMeshOutputPrimitives >= 64 &&
+                      mesh_properties.maxMeshWorkGroupInvocations >= 32;
+    if (has_mesh.meshShader && fits) {
+      extensions.push_back(VK_EXT_MESH_SHADER_EXTENSION_NAME);
+      want_mesh.meshShader = VK_TRUE;
+      want12.pNext = &want_mesh;
+      limits_.max_mesh_workgroup_count_x = mesh_properties.maxMeshWorkGroupCount[0];
+    }
+  }
 
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   info.pNext = &want;
@@ -256,10 +286,14 @@ void Context::create_device() {
   info.ppEnabledExtensionNames = extensions.data();
   TS_VK_CHECK(vkCreateDevice(physical_device_, &info, nullptr, &device_));
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
-  if (!extensions.empty())
+  if (has_push_descriptor)
     cmd_push_descriptor_set_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
         vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
   features_.push_descriptor = cmd_push_descriptor_set_ != nullptr;
+  if (want_mesh.meshShader)
+    cmd_draw_mesh_tasks_indirect_ = reinterpret_cast<PFN_vkCmdDrawMeshTasksIndirectEXT>(
+        vkGetDeviceProcAddr(device_, "vkCmdDrawMeshTasksIndirectEXT"));
+  features_.mesh_shader = cmd_draw_mesh_tasks_indirect_ != nullptr;
 }
 
 void Context::create_command_objects() {

@@ -30,6 +30,7 @@ struct DeviceLimits {
   uint32_t max_texel_buffer_elements = 0;
   double timestamp_period_ns = 0;
   uint32_t timestamp_valid_bits = 0;
+  uint32_t max_mesh_workgroup_count_x = 0;  // VK_EXT_mesh_shader's, when DeviceFeatures::mesh_shader
 };
 
 // Optional features the engine uses when present.
@@ -38,6 +39,7 @@ struct DeviceFeatures {
   bool push_descriptor = false;  // VK_KHR_push_descriptor: texel-buffer layouts of the CPU-driver passes
   bool graphics_queue = false;   // the queue also draws: the raster compositor (Compositor::kRaster)
   bool independent_blend = false;  // attachments blended differently: the raster compositor's splat counts
+  bool mesh_shader = false;  // VK_EXT_mesh_shader: the raster compositor's mesh stage (an engine-made device)
 };
 
 // Semaphores a submission waits for and signals besides its fence: a host's, around a frame that
@@ -75,6 +77,10 @@ class Context {
   uint32_t vendor_id() const { return vendor_id_; }  // VkPhysicalDeviceProperties::vendorID (PCI)
   // vkCmdPushDescriptorSetKHR when features().push_descriptor, else null.
   PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set() const { return cmd_push_descriptor_set_; }
+  // vkCmdDrawMeshTasksIndirectEXT when features().mesh_shader, else null.
+  PFN_vkCmdDrawMeshTasksIndirectEXT cmd_draw_mesh_tasks_indirect() const {
+    return cmd_draw_mesh_tasks_indirect_;
+  }
 
   // Index of a memory type with all `required` flags (and `preferred` ones when possible).
   uint32_t find_memory_type(uint32_t type_bits, VkMemoryPropertyFlags required,
@@ -140,6 +146,7 @@ class Context {
   bool is_cpu_ = false;
   uint32_t vendor_id_ = 0;
   PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set_ = nullptr;
+  PFN_vkCmdDrawMeshTasksIndirectEXT cmd_draw_mesh_tasks_indirect_ = nullptr;
   std::atomic<uint64_t> validation_messages_{0};
   std::atomic<uint64_t> uploaded_bytes_{0};
 };

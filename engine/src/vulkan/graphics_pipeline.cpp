@@ -15,8 +15,6 @@ namespace tilesplat::vk {
 
 namespace {
 
-constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-
 VkShaderModule make_module(Context& ctx, const std::string& shader) {
   const std::span<const uint32_t> words = shaders::find(shader);
   if (words.empty()) throw std::runtime_error("shader '" + shader + "' is not embedded in the library");
@@ -94,7 +92,9 @@ void GraphicsPipeline::create_render_pass(const GraphicsPipelineDesc& desc) {
   dependencies[0].srcSubpass = VK_SUBPASS_EXTERNAL;
   dependencies[0].dstSubpass = 0;
   dependencies[0].srcStageMask = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
-  dependencies[0].dstStageMask = VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+  dependencies[0].dstStageMask = VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
+                                 (desc.mesh_shader.empty() ? VK_PIPELINE_STAGE_VERTEX_SHADER_BIT
+                                                           : VK_PIPELINE_STAGE_MESH_SHADER_BIT_EXT) |
                                  VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
                                  VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT |
                                  VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
@@ -120,17 +120,20 @@ void GraphicsPipeline::create_render_pass(const GraphicsPipelineDesc& desc) {
 
 GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& desc)
     : ctx_(&ctx),
+      stages_((desc.mesh_shader.empty() ? VK_SHADER_STAGE_VERTEX_BIT : VK_SHADER_STAGE_MESH_BIT_EXT) |
+              VK_SHADER_STAGE_FRAGMENT_BIT),
       push_constant_bytes_(desc.push_constant_bytes),
-      name_(desc.vertex_shader + "+" + desc.fragment_shader) {
+      name_((desc.mesh_shader.empty() ? desc.vertex_shader : desc.mesh_shader) + "+" + desc.fragment_shader) {
+  const bool mesh = !desc.mesh_shader.empty();
   VkShaderModule vertex = VK_NULL_HANDLE, fragment = VK_NULL_HANDLE;
   try {
     create_render_pass(desc);
-    VkPushConstantRange range{kStages, 0, desc.push_constant_bytes};
+    VkPushConstantRange range{stages_, 0, desc.push_constant_bytes};
     VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
     layout_info.pushConstantRangeCount = desc.push_constant_bytes ? 1 : 0;
     layout_info.pPushConstantRanges = &range;
     TS_VK_CHECK(vkCreatePipelineLayout(ctx.device(), &layout_info, nullptr, &layout_));
-    vertex = make_module(ctx, desc.vertex_shader);
+    vertex = make_module(ctx, mesh ? desc.mesh_shader : desc.vertex_shader);
     fragment = make_module(ctx, desc.fragment_shader);
 
     std::vector<VkSpecializationMapEntry> entries;
@@ -143,7 +146,7 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& des
                                     values.size() * sizeof(uint32_t), values.data()};
     VkPipelineShaderStageCreateInfo stages[2]{};
     stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stages[0].stage = mesh ? VK_SHADER_STAGE_MESH_BIT_EXT : VK_SHADER_STAGE_VERTEX_BIT;
     stages[0].module = vertex;
     stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
     stages[1].module = fragment;
@@ -187,8 +190,8 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& des
     VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
     info.stageCount = 2;
     info.pStages = stages;
-    info.pVertexInputState = &vertex_input;
-    info.pInputAssemblyState = &assembly;
+    info.pVertexInputState = mesh ? nullptr : &vertex_input;  // a mesh stage has no vertex input
+    info.pInputAssemblyState = mesh ? nullptr : &assembly;
     info.pViewportState = &viewport;
     info.pRasterizationState = &raster;
     info.pMultisampleState = &multisample;
@@ -219,6 +222,7 @@ GraphicsPipeline& GraphicsPipeline::operator=(GraphicsPipeline&& other) noexcept
     render_pass_ = std::exchange(other.render_pass_, VK_NULL_HANDLE);
     layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
     pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
+    stages_ = other.stages_;
     push_constant_bytes_ = other.push_constant_bytes_;
     name_ = std::move(other.name_);
   }
@@ -242,7 +246,7 @@ void GraphicsPipeline::bind_raw(VkCommandBuffer cmd, const void* data, uint32_t 
     throw std::logic_error("pipeline '" + name_ + "' expects " + std::to_string(push_constant_bytes_) +
                            " push-constant bytes, got " + std::to_string(size));
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
-  if (size) vkCmdPushConstants(cmd, layout_, kStages, 0, size, data);
+  if (size) vkCmdPushConstants(cmd, layout_, stages_, 0, size, data);
   const VkViewport viewport{0.0f, 0.0f, float(width), float(height), 0.0f, 1.0f};
   const VkRect2D scissor{{0, 0}, {width, height}};
   vkCmdSetViewport(cmd, 0, 1, &viewport);

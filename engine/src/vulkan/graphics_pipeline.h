@@ -1,5 +1,5 @@
-// A graphics pipeline of two embedded shaders (a vertex and a fragment stage) drawing into colour
-// attachments, with the render pass it draws in: the raster compositor's. Like ComputePipeline, the
+// A graphics pipeline of two embedded shaders (a vertex or mesh stage and a fragment stage) drawing into
+// colour attachments, with the render pass it draws in: the raster compositor's. Like ComputePipeline, the
 // shaders take everything through push constants (buffer device addresses and scalars) and draw no
 // vertex buffers. The render pass clears its attachments and leaves them ready to be copied out.
 #pragma once
@@ -39,6 +39,7 @@ struct DepthTest {
 
 struct GraphicsPipelineDesc {
   std::string vertex_shader;
+  std::string mesh_shader;  // instead of the vertex stage (VK_EXT_mesh_shader): drawn with mesh tasks
   std::string fragment_shader;
   uint32_t push_constant_bytes = 0;  // seen by both stages
   std::vector<SpecConstant> spec;    // given to both stages (each uses the ids it declares)
@@ -76,6 +77,7 @@ class GraphicsPipeline {
   VkRenderPass render_pass_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkShaderStageFlags stages_ = 0;  // the two stages, which see the push constants
   uint32_t push_constant_bytes_ = 0;
   std::string name_;
 };
