@@ -65,7 +65,7 @@ bool raster_stage_is_mesh(const vk::Context& ctx) {
   const char* env = std::getenv("TILESPLAT_RASTER_STAGE");
   const std::string stage = env ? env : "";
   // llvmpipe runs the mesh stage slower than the instanced vertex stage (Mesa 25, 500k playbot at 1080p:
-  // 2032-2135 against 1512-1617 ms, interleaved; docs/compositors.md): there the vertex stage.
+  // 1244-1316 against 807-815 ms, interleaved; docs/compositors.md): there the vertex stage.
   if (stage.empty()) return ctx.features().mesh_shader && !ctx.is_cpu_device();
   if (stage == "vertex") return false;
   if (stage != "mesh")
