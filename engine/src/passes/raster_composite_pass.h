@@ -1,9 +1,10 @@
 // The raster compositor (Compositor::kRaster): the depth-sorted splats drawn as quads through the
 // graphics pipeline and blended front to back by the fixed-function blend ("under": the colour
 // attachment's alpha is 1 - T), then resolved into the frame's output buffers as the tile compositor
-// writes them. raster_quad.vert expands each splat around its alpha >= cut-off ellipse,
-// raster_blend.frag evaluates it with the tile compositor's expression, raster_resolve.comp puts the
-// background under it and turns the depth sums and counts into the outputs.
+// writes them. raster_quad.vert (or, on a GPU with VK_EXT_mesh_shader, raster_quads.mesh) expands each
+// splat around its alpha >= cut-off ellipse, raster_blend.frag evaluates it with the tile compositor's
+// expression, raster_resolve.comp puts the background under it and turns the depth sums and counts into
+// the outputs.
 //
 // It has no transmittance early-out (the blend cannot skip a fragment by what the pixel holds) and no
 // tile rectangles (a splat reaches every pixel where its alpha passes the cut-off): the reference's
@@ -47,9 +48,12 @@ bool raster_stage_is_mesh(const vk::Context& ctx);
 
 class RasterCompositePass {
  public:
-  // Throws std::runtime_error naming the device when its queue cannot draw or it cannot blend into
-  // RGBA32F attachments.
+  // Makes nothing yet: a renderer that never draws with the raster compositor needs no graphics support.
   explicit RasterCompositePass(vk::Context& ctx);
+  ~RasterCompositePass() { release_framebuffer(); }
+  RasterCompositePass(const RasterCompositePass&) = delete;
+  RasterCompositePass& operator=(const RasterCompositePass&) = delete;
+
   // What a frame's attachments are: its size, its outputs and whether a host's surfaces are tested.
   struct Shape {
     uint32_t width = 0, height = 0;
@@ -78,7 +82,9 @@ class RasterCompositePass {
   vk::Context& ctx_;
   std::map<Variant, vk::GraphicsPipeline> pipelines_;
   vk::ComputePipeline resolve_;
-  vk::Buffer draw_args_;  // VkDrawIndirectCommand: 4 vertices, the visible splats as instances
+  // VkDrawIndirectCommand (4 vertices, the visible splats as instances) or, for the mesh stage,
+  // VkDrawMeshTasksIndirectCommandEXT.
+  vk::Buffer draw_args_;
   vk::ComputePipeline host_surfaces_;
   vk::ComputePipeline mesh_args_;  // the mesh-stage draw's workgroup counts (raster_mesh_args.comp)
   bool mesh_ = false;              // raster_stage_is_mesh(), decided on the first raster frame
@@ -92,11 +98,6 @@ class RasterCompositePass {
     VkFramebuffer framebuffer = VK_NULL_HANDLE;
   } targets_;
   void release_framebuffer();
-
- public:
-  ~RasterCompositePass() { release_framebuffer(); }
-  RasterCompositePass(const RasterCompositePass&) = delete;
-  RasterCompositePass& operator=(const RasterCompositePass&) = delete;
 };
 
 }  // namespace tilesplat
