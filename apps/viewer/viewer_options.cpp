@@ -22,6 +22,13 @@ void add_viewer_options(cli::ArgParser& parser, ViewerOptions& options) {
 
 void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& options) {
   cli::check_common_options(parser, options.common);
+  // The compositors the window shows (key C), checked before a window opens.
+  if (options.common.compositor == Compositor::kStochastic)
+    throw cli::UsageError("the viewer shows the sorted or the raster compositor, not the stochastic one");
+  if (options.common.compositor == Compositor::kRaster && !options.common.modes.empty() &&
+      options.common.modes.front().resort_window > 0)
+    throw cli::UsageError("the raster compositor does not re-sort per pixel (--mode " +
+                          to_string(options.common.modes.front()) + ")");
   if (!options.screenshot.empty()) {
     if (!cli::has_extension(options.screenshot, ".exr") && !cli::has_extension(options.screenshot, ".png"))
       throw cli::UsageError("--screenshot expects an .exr or .png file, got '" + options.screenshot + "'");
