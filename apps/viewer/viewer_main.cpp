@@ -106,15 +106,10 @@ class Viewer {
     for (const char* mode : kModeCycle) modes_.push_back(tilesplat::parse_accuracy_modes(mode));
     if (!options.common.modes.empty()) mode_ = find_or_append(modes_, options.common.modes.front());
     if (!options.common.sorts.empty()) sort_ = find_or_append(sorts_, options.common.sorts.front());
-    // --compositor: sorted or raster (the stochastic compositor is no viewer's: its frames are averages).
-    const auto start = std::find(kCompositorCycle.begin(), kCompositorCycle.end(), base_settings_.compositor);
-    if (start == kCompositorCycle.end())
-      throw cli::UsageError("the viewer shows the sorted or the raster compositor, not the " +
-                            tilesplat::to_string(base_settings_.compositor));
-    compositor_ = size_t(start - kCompositorCycle.begin());
-    if (!draws(kCompositorCycle[compositor_], modes_[mode_]))
-      throw cli::UsageError("the raster compositor does not re-sort per pixel (--mode " +
-                            tilesplat::to_string(modes_[mode_]) + ")");
+    // --compositor: sorted or raster, and no re-sorting mode with the raster (check_viewer_flags; a scene
+    // file sets no compositor).
+    compositor_ =
+        base_settings_.compositor == tilesplat::Compositor::kRaster ? 1 : 0;  // kCompositorCycle order
 
     glfwSetWindowUserPointer(window_, this);
     glfwSetKeyCallback(window_, on_key);

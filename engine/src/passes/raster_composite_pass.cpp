@@ -113,6 +113,8 @@ void RasterCompositePass::release_framebuffer() {
 }
 
 void RasterCompositePass::prepare(const Shape& shape) {
+  Targets& t = targets_;
+  if (t.colour && t.shape == shape) return;  // checked and sized when this shape first came
   check_device(shape);
   if (!draw_args_) {
     mesh_ = raster_stage_is_mesh(ctx_);
@@ -122,8 +124,6 @@ void RasterCompositePass::prepare(const Shape& shape) {
     draw_args_ =
         vk::Buffer(ctx_, sizeof(VkDrawIndirectCommand), vk::MemoryUse::Device, "raster draw arguments");
   }
-  Targets& t = targets_;
-  if (t.colour && t.shape == shape) return;
   release_framebuffer();
   t = {};
   const uint32_t width = shape.width, height = shape.height;
