@@ -48,8 +48,22 @@ TILESPLAT_API std::array<double, 3> eval_sh(int degree, const float* coeffs,
 TILESPLAT_API std::array<double, 9> covariance3d(const float log_scale[3], const float quat_wxyz[4]);
 
 /// Renders the whole image in float64: projection, per-tile lists ordered by (depth, index),
-/// front-to-back blending with the reference cut-offs. Uses all CPU cores.
+/// front-to-back blending with the reference cut-offs. Uses all CPU cores. With
+/// AccuracyModes::resort_window set, each pixel blends in the order the GPU's re-sorting composite
+/// blends (the same window, in float64).
 TILESPLAT_API RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
                                            const RenderSettings& settings = {});
+
+/// The order in which each pixel of render_reference blends its splats.
+enum class ReferenceOrder {
+  kSettings,  ///< as the settings say: the tile's centre-depth list, or the re-sorting mode's window
+  kRayDepth,  ///< every splat the pixel's tile lists, by the depth of its density maximum along the
+              ///< pixel's ray: the exact order that the re-sorting modes approximate (pinhole only)
+};
+
+/// render_reference in the given order (ReferenceOrder::kRayDepth ignores the settings' re-sorting
+/// modes). Throws std::invalid_argument for kRayDepth with a camera model other than the pinhole.
+TILESPLAT_API RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
+                                           const RenderSettings& settings, ReferenceOrder order);
 
 }  // namespace tilesplat

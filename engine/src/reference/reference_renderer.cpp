@@ -16,6 +16,7 @@
 #include "frame/averaged_frames.h"
 #include "host_depth.h"
 #include "lighting.h"
+#include "reference/pixel_order.h"
 #include "reference/reference_projection.h"
 #include "settings_checks.h"
 #include "tilesplat/reference.h"
@@ -93,17 +94,37 @@ struct Splat {
   double depth;
 };
 
+// The order each pixel blends in (ReferenceOrder and AccuracyModes::resort_window): the tile's list
+// (window 0), or through a window of splats ordered by depth along the pixel's ray, as
+// composite_resort.comp keeps it (the exact order where the window is unbounded).
+struct PixelRule {
+  bool by_ray_depth = false;
+  size_t window = 0;  // 0: unbounded
+};
+
+PixelRule pixel_rule(const RenderSettings& settings, ReferenceOrder order) {
+  if (order == ReferenceOrder::kRayDepth) return {true, 0};
+  if (settings.accuracy.resort_window > 0) return {true, size_t(settings.accuracy.resort_window)};
+  return {};
+}
+
 }  // namespace
 
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
                              const RenderSettings& settings) {
+  return render_reference(scene, camera, settings, ReferenceOrder::kSettings);
+}
+
+RenderImage render_reference(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+                             ReferenceOrder reference_order) {
   if (averages_samples(settings)) {
     // Depth of field, motion blur: the reference's own sample frames, averaged as the GPU's are.
     return render_averaged(camera, settings,
                            [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
-                             return render_reference(scene, sample_camera, sample_settings);
+                             return render_reference(scene, sample_camera, sample_settings, reference_order);
                            });
   }
+  const PixelRule rule = pixel_rule(settings, reference_order);
   validate(camera);
   check_scene(scene);
   validate_host_depth(settings, camera);
@@ -111,6 +132,16 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
   check_max_alpha(settings);
   check_single_frame(settings);
   check_camera_model(settings, camera);
+  if (rule.by_ray_depth) {
+    // The rays of the per-pixel orders are the pinhole's; the raster rule and a host's depth have none.
+    if (camera_models::drawn_model(camera) != CameraModel::kPinhole)
+      throw std::invalid_argument("render_reference: the per-pixel depth order needs a pinhole camera, not " +
+                                  std::string(camera_model_name(camera.model)));
+    if (settings.compositor == Compositor::kRaster)
+      throw std::invalid_argument("render_reference: the raster compositor blends in the tile lists' order");
+    if (settings.host)
+      throw std::invalid_argument("render_reference: the per-pixel depth order does not test a host's depth");
+  }
   // A host's surfaces, as view depths: a splat blends only in front of them (RenderSettings::host).
   const std::vector<float> host_z = settings.host ? host_view_depths(*settings.host) : std::vector<float>{};
   const bool surface_out = settings.host && settings.host->write_depth;
@@ -150,6 +181,11 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
                  {g.color[0], g.color[1], g.color[2]},
                  g.depth};
   }
+  // The per-pixel orders' depths along any ray (one record per Gaussian: they are pinhole only).
+  std::vector<reference::RayDepthQuadric> quadrics(rule.by_ray_depth ? order.size() : 0);
+  parallel_chunks(quadrics.size(), 4096, [&](size_t begin, size_t end) {
+    for (size_t s = begin; s < end; ++s) quadrics[s] = reference::ray_depth_quadric(scene, order[s], camera);
+  });
 
   // Bin the splats into per-tile lists (counting sort); filling in front-to-back order keeps
   // every list sorted. The raster rule lists a splat wherever its alpha can pass the cut-off.
@@ -207,20 +243,24 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
             double surface = 0;  // the depth at which 1 - T reached the host's threshold; 0: never
             uint32_t blended = 0;
             const float surface_z = host_z.empty() ? 0.0f : host_z[py * width + px];
-            for (const uint32_t* it = list_begin; it != list_end; ++it) {
-              const Splat& splat = splats[*it];
+            // The splat's alpha at this pixel, or -1 where it is skipped.
+            auto alpha_at = [&](const Splat& splat) {
               const double dx = splat.mean[0] - pixel_x;
               const double dy = splat.mean[1] - pixel_y;
               const double power =
                   -0.5 * (splat.conic[0] * dx * dx + splat.conic[2] * dy * dy) - splat.conic[1] * dx * dy;
-              if (power > 0) continue;
+              if (power > 0) return -1.0;
               const double alpha = std::min(max_alpha, splat.opacity * std::exp(power));
-              if (alpha < kMinAlpha) continue;
+              if (alpha < kMinAlpha) return -1.0;
               // Behind (or at) the host's opaque surface; compared as the float depths the GPU sorts on.
-              if (!host_z.empty() && !(static_cast<float>(splat.depth) < surface_z)) continue;
+              if (!host_z.empty() && !(static_cast<float>(splat.depth) < surface_z)) return -1.0;
+              return alpha;
+            };
+            // Blends the splat; false once the pixel is done (this splat not blended).
+            auto blend = [&](const Splat& splat, double alpha) {
               const double next_transmittance = transmittance * (1 - alpha);
               // The raster rule has no early-out: the hardware blend cannot skip a fragment.
-              if (!raster && next_transmittance < kMinTransmittance) break;
+              if (!raster && next_transmittance < kMinTransmittance) return false;
               const double weight = alpha * transmittance;
               for (int ch = 0; ch < 3; ++ch) color[ch] += splat.color[ch] * weight;
               depth_sum += weight * splat.depth;
@@ -228,6 +268,26 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
               transmittance = next_transmittance;
               if (surface_out && surface == 0 && 1 - transmittance >= surface_alpha) surface = splat.depth;
               ++blended;
+              return true;
+            };
+            if (!rule.by_ray_depth) {
+              for (const uint32_t* it = list_begin; it != list_end; ++it) {
+                const double alpha = alpha_at(splats[*it]);
+                if (alpha >= 0 && !blend(splats[*it], alpha)) break;
+              }
+            } else {
+              bool done = false;
+              auto release = [&](const std::pair<uint32_t, double>& entry) {
+                done = done || !blend(splats[entry.first], entry.second);
+              };
+              reference::DepthQueue<std::pair<uint32_t, double>> queue(rule.window);
+              for (const uint32_t* it = list_begin; it != list_end && !done; ++it) {
+                const double alpha = alpha_at(splats[*it]);
+                if (alpha >= 0)
+                  queue.offer(reference::ray_depth(quadrics[*it], camera, pixel_x, pixel_y), {*it, alpha},
+                              release);
+              }
+              queue.flush(release);
             }
             const size_t pixel = py * width + px;
             for (size_t ch = 0; ch < 3; ++ch)
