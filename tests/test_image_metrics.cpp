@@ -521,3 +521,95 @@ TEST(RotationInconsistency, RefusesCamerasThatDoNotDifferByARotationAndPropagate
   EXPECT_TRUE(std::isnan(nan.mean_abs));
   EXPECT_TRUE(std::isnan(nan.flicker_fraction));
 }
+
+// depth_warp_difference: a plane at depth 5 seen by two cameras 0.1 apart sideways (fx 50), so that
+// pixel x of b sees what pixel x + 1 of a sees.
+namespace warp {
+
+using tilesplat::Camera;
+using tilesplat::depth_warp_difference;
+
+Camera camera(double x) {
+  Camera c;
+  c.width = 64;
+  c.height = 32;
+  c.fx = c.fy = 50;
+  c.cx = 32;
+  c.cy = 16;
+  c.position = {x, 0, 0};
+  return c;
+}
+
+// Red = 0.01 (column + shift), opaque, at depth 5: the plane's colour is a function of the world point.
+RenderImage plane(int shift) {
+  RenderImage image;
+  image.width = 64;
+  image.height = 32;
+  image.rgba.assign(4 * image.pixels(), 0.0f);
+  image.depth.assign(image.pixels(), 5.0f);
+  for (size_t i = 0; i < image.pixels(); ++i) {
+    image.rgba[4 * i] = 0.01f * float(int(i % 64) + shift);
+    image.rgba[4 * i + 1] = 0.5f;
+    image.rgba[4 * i + 3] = 1.0f;
+  }
+  return image;
+}
+
+}  // namespace warp
+
+TEST(DepthWarpDifference, AStillSceneWarpsOntoItselfAndAChangedBlockStays) {
+  using namespace warp;
+  const Camera a = camera(0), b = camera(0.1);
+  const RenderImage image_a = plane(0);
+  RenderImage image_b = plane(1);
+  // Columns 0..62 of b land inside a (u = x + 1); the last block of each row reaches u = 64 and is left out.
+  const TemporalDifference still = depth_warp_difference(image_a, a, image_b, b, 8);
+  EXPECT_NEAR(still.mean_abs, 0.0, 1e-6);
+  EXPECT_EQ(still.flicker_fraction, 0.0);
+  // One block of b changes colour where the scene did not move: one of the 7 x 4 blocks kept.
+  for (int y = 8; y < 16; ++y)
+    for (int x = 8; x < 16; ++x) image_b.rgba[4 * size_t(y * 64 + x) + 2] += 0.5f;
+  const TemporalDifference popped = depth_warp_difference(image_a, a, image_b, b, 8);
+  EXPECT_NEAR(popped.flicker_fraction, 1.0 / 28.0, 1e-12);
+  EXPECT_NEAR(popped.mean_abs, 0.5 / 3.0 / 28.0, 1e-6);
+}
+
+TEST(DepthWarpDifference, WhatTheMotionRevealsOrHidesIsLeftOut) {
+  using namespace warp;
+  const Camera a = camera(0), b = camera(0.1);
+  RenderImage image_a = plane(0);
+  RenderImage image_b = plane(1);
+  // In a, something nearer covers columns 20..23: b's points there are hidden from a. Their pixels (x + 1
+  // or x + 2 in 20..23: x 18..22) leave blocks 16..23 of every row out, changed colour and all.
+  for (int y = 0; y < 32; ++y)
+    for (int x = 20; x < 24; ++x) {
+      image_a.depth[size_t(y * 64 + x)] = 2.0f;
+      image_a.rgba[4 * size_t(y * 64 + x)] = 1.0f;
+    }
+  const TemporalDifference hidden = depth_warp_difference(image_a, a, image_b, b, 8, 0.01);
+  EXPECT_EQ(hidden.flicker_fraction, 0.0);
+  // A half-covered pixel of b (alpha < 0.5) has no trusted depth: its block is left out too, so one
+  // changed block among the 24 kept counts 1/23 once another block is dropped that way.
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) image_b.rgba[4 * size_t(y * 64 + x) + 2] += 0.5f;
+  image_b.rgba[4 * size_t(9 * 64 + 9) + 3] = 0.25f;
+  const TemporalDifference one = depth_warp_difference(image_a, a, image_b, b, 8, 0.01);
+  EXPECT_NEAR(one.flicker_fraction, 1.0 / 23.0, 1e-12);
+}
+
+TEST(DepthWarpDifference, RefusesImagesWithoutDepthAndOtherCameraModels) {
+  using namespace warp;
+  const Camera a = camera(0), b = camera(0.1);
+  const RenderImage image_a = plane(0), image_b = plane(1);
+  RenderImage flat = image_b;
+  flat.depth.clear();
+  EXPECT_THROW(depth_warp_difference(image_a, a, flat, b, 8), std::invalid_argument);
+  Camera fisheye = b;
+  fisheye.model = tilesplat::CameraModel::kFisheye;
+  EXPECT_THROW(depth_warp_difference(image_a, a, image_b, fisheye, 8), std::invalid_argument);
+  EXPECT_THROW(depth_warp_difference(image_a, a, image_b, b, 0), std::invalid_argument);
+  EXPECT_THROW(depth_warp_difference(image_a, a, image_b, b, 8, 0.01, -1), std::invalid_argument);
+  RenderImage broken = image_b;
+  broken.rgba[1] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_TRUE(std::isnan(depth_warp_difference(image_a, a, broken, b, 8).mean_abs));
+}

@@ -266,4 +266,21 @@ TILESPLAT_API TemporalDifference rotation_inconsistency(const RenderImage& a, co
                                                         const RenderImage& b, const Camera& camera_b,
                                                         int block, double threshold = 0.01);
 
+/// Popping between two frames of any camera motion, without optical flow: the renderer knows each
+/// frame's camera and depth (RenderSettings::depth), so each pixel of b is lifted to the world point at
+/// its depth along its ray and projected into a. Where a sees the same point (its depth at the four
+/// pixels around the projection within `depth_tolerance`, relative, of the point's depth in a), a is
+/// resampled there (bilinearly) and compared with b per pixel and RGB channel, e = |b - warp(a)|,
+/// averaged over blocks of block x block pixels before the threshold, as in rotation_inconsistency.
+/// What the motion reveals or hides, what leaves a's image, and pixels of b less than half covered
+/// (alpha < 0.5, whose depth is a few faint splats') leave their block out. A scene without popping
+/// warps onto itself up to resampling; a splat that changes colour between the frames, as a flipped
+/// blending order does, stays. Pinhole cameras of the images' size (std::invalid_argument otherwise,
+/// also for images without depth, a block below 1, or a threshold or tolerance that is negative or not
+/// finite); NaN or infinity in either image gives NaN, as in ssim; no block kept gives {0, 0}.
+TILESPLAT_API TemporalDifference depth_warp_difference(const RenderImage& a, const Camera& camera_a,
+                                                       const RenderImage& b, const Camera& camera_b,
+                                                       int block, double threshold = 0.01,
+                                                       double depth_tolerance = 0.05);
+
 }  // namespace tilesplat

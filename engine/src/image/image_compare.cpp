@@ -288,62 +288,13 @@ std::array<double, 3> pixel_ray(const Camera& camera, double x, double y) {
   return world;
 }
 
-}  // namespace
-
-TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& camera_a, const RenderImage& b,
-                                          const Camera& camera_b, int block, double threshold) {
-  constexpr const char* kFunction = "rotation_inconsistency";
-  check_same_size(kFunction, {&a, &b}, {"a", "b"});
-  validate(camera_a);
-  validate(camera_b);
-  if (camera_a.width != a.width || camera_a.height != a.height || camera_b.width != a.width ||
-      camera_b.height != a.height)
-    throw std::invalid_argument(std::string(kFunction) + ": the images are " + size_text(a) + ", the cameras " +
-                                std::to_string(camera_a.width) + "x" + std::to_string(camera_a.height) + " and " +
-                                std::to_string(camera_b.width) + "x" + std::to_string(camera_b.height));
-  if (camera_a.fx != camera_b.fx || camera_a.fy != camera_b.fy || camera_a.cx != camera_b.cx ||
-      camera_a.cy != camera_b.cy || camera_a.position != camera_b.position)
-    throw std::invalid_argument(std::string(kFunction) +
-                                ": the cameras must differ by a rotation alone (same intrinsics and position)");
-  if (block < 1) throw std::invalid_argument(std::string(kFunction) + ": block must be >= 1, got " + std::to_string(block));
-  if (!std::isfinite(threshold) || threshold < 0)
-    throw std::invalid_argument(std::string(kFunction) + ": the threshold must be finite and >= 0, got " +
-                                std::to_string(threshold));
+// The per-pixel differences (RGB) averaged over blocks of block x block pixels, the blocks with a pixel
+// not `inside` left out: mean_abs over the blocks kept and RGB, flicker_fraction the fraction of them
+// whose largest channel exceeds the threshold.
+TemporalDifference block_statistics(const std::vector<std::array<double, 3>>& difference,
+                                    const std::vector<char>& inside, int width, int height, int block,
+                                    double threshold) {
   TemporalDifference result;
-  if (!all_finite(a) || !all_finite(b)) {
-    result.mean_abs = std::numeric_limits<double>::quiet_NaN();
-    result.flicker_fraction = std::numeric_limits<double>::quiet_NaN();
-    return result;
-  }
-  const int width = a.width, height = a.height;
-  // Per pixel of b: b - warp(a) over RGB, and whether the ray landed inside a (with its 2x2 neighbourhood).
-  std::vector<std::array<double, 3>> difference(b.pixels());
-  std::vector<char> inside(b.pixels(), 0);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const std::array<double, 3> world = pixel_ray(camera_b, x, y);
-      double in_a[3] = {0, 0, 0};
-      for (int r = 0; r < 3; ++r)
-        for (int k = 0; k < 3; ++k) in_a[r] += camera_a.rotation[3 * r + k] * world[k];
-      if (!(in_a[2] > 0)) continue;
-      // Continuous coordinates with pixel centres on the integers.
-      const double u = camera_a.fx * in_a[0] / in_a[2] + camera_a.cx - 0.5;
-      const double v = camera_a.fy * in_a[1] / in_a[2] + camera_a.cy - 0.5;
-      if (!(u >= 0 && v >= 0 && u <= width - 1 && v <= height - 1)) continue;
-      const int x0 = std::min(int(u), std::max(width - 2, 0));
-      const int y0 = std::min(int(v), std::max(height - 2, 0));
-      const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
-      const double fx = u - x0, fy = v - y0;
-      const size_t pixel = size_t(y) * size_t(width) + size_t(x);
-      auto at = [&](int px, int py, int c) { return double{a.rgba[4 * (size_t(py) * size_t(width) + size_t(px)) + c]}; };
-      for (int c = 0; c < 3; ++c) {
-        const double warped = (1 - fy) * ((1 - fx) * at(x0, y0, c) + fx * at(x1, y0, c)) +
-                              fy * ((1 - fx) * at(x0, y1, c) + fx * at(x1, y1, c));
-        difference[pixel][c] = double{b.rgba[4 * pixel + c]} - warped;
-      }
-      inside[pixel] = 1;
-    }
-  }
   double sum = 0;
   size_t kept = 0, over = 0;
   for (int by = 0; by + block <= height; by += block) {
@@ -374,6 +325,141 @@ TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& ca
   result.mean_abs = sum / (3.0 * double(kept));
   result.flicker_fraction = double(over) / double(kept);
   return result;
+}
+
+TemporalDifference not_a_number() {
+  TemporalDifference result;
+  result.mean_abs = std::numeric_limits<double>::quiet_NaN();
+  result.flicker_fraction = std::numeric_limits<double>::quiet_NaN();
+  return result;
+}
+
+// Bilinear sample of channel c of `image` at continuous coordinates (u, v) with pixel centres on the
+// integers; (u, v) within [0, width - 1] x [0, height - 1].
+double bilinear(const RenderImage& image, double u, double v, int c) {
+  const int width = image.width, height = image.height;
+  const int x0 = std::min(int(u), std::max(width - 2, 0));
+  const int y0 = std::min(int(v), std::max(height - 2, 0));
+  const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
+  const double fx = u - x0, fy = v - y0;
+  auto at = [&](int px, int py) {
+    return double{image.rgba[4 * (size_t(py) * size_t(width) + size_t(px)) + size_t(c)]};
+  };
+  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) +
+         fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+}
+
+}  // namespace
+
+TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& camera_a, const RenderImage& b,
+                                          const Camera& camera_b, int block, double threshold) {
+  constexpr const char* kFunction = "rotation_inconsistency";
+  check_same_size(kFunction, {&a, &b}, {"a", "b"});
+  validate(camera_a);
+  validate(camera_b);
+  if (camera_a.width != a.width || camera_a.height != a.height || camera_b.width != a.width ||
+      camera_b.height != a.height)
+    throw std::invalid_argument(std::string(kFunction) + ": the images are " + size_text(a) + ", the cameras " +
+                                std::to_string(camera_a.width) + "x" + std::to_string(camera_a.height) + " and " +
+                                std::to_string(camera_b.width) + "x" + std::to_string(camera_b.height));
+  if (camera_a.fx != camera_b.fx || camera_a.fy != camera_b.fy || camera_a.cx != camera_b.cx ||
+      camera_a.cy != camera_b.cy || camera_a.position != camera_b.position)
+    throw std::invalid_argument(std::string(kFunction) +
+                                ": the cameras must differ by a rotation alone (same intrinsics and position)");
+  if (block < 1) throw std::invalid_argument(std::string(kFunction) + ": block must be >= 1, got " + std::to_string(block));
+  if (!std::isfinite(threshold) || threshold < 0)
+    throw std::invalid_argument(std::string(kFunction) + ": the threshold must be finite and >= 0, got " +
+                                std::to_string(threshold));
+  if (!all_finite(a) || !all_finite(b)) return not_a_number();
+  const int width = a.width, height = a.height;
+  // Per pixel of b: b - warp(a) over RGB, and whether the ray landed inside a (with its 2x2 neighbourhood).
+  std::vector<std::array<double, 3>> difference(b.pixels());
+  std::vector<char> inside(b.pixels(), 0);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::array<double, 3> world = pixel_ray(camera_b, x, y);
+      double in_a[3] = {0, 0, 0};
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) in_a[r] += camera_a.rotation[3 * r + k] * world[k];
+      if (!(in_a[2] > 0)) continue;
+      // Continuous coordinates with pixel centres on the integers.
+      const double u = camera_a.fx * in_a[0] / in_a[2] + camera_a.cx - 0.5;
+      const double v = camera_a.fy * in_a[1] / in_a[2] + camera_a.cy - 0.5;
+      if (!(u >= 0 && v >= 0 && u <= width - 1 && v <= height - 1)) continue;
+      const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+      for (int c = 0; c < 3; ++c)
+        difference[pixel][c] = double{b.rgba[4 * pixel + size_t(c)]} - bilinear(a, u, v, c);
+      inside[pixel] = 1;
+    }
+  }
+  return block_statistics(difference, inside, width, height, block, threshold);
+}
+
+TemporalDifference depth_warp_difference(const RenderImage& a, const Camera& camera_a, const RenderImage& b,
+                                         const Camera& camera_b, int block, double threshold,
+                                         double depth_tolerance) {
+  constexpr const char* kFunction = "depth_warp_difference";
+  check_same_size(kFunction, {&a, &b}, {"a", "b"});
+  validate(camera_a);
+  validate(camera_b);
+  if (camera_a.width != a.width || camera_a.height != a.height || camera_b.width != a.width ||
+      camera_b.height != a.height)
+    throw std::invalid_argument(std::string(kFunction) + ": the images are " + size_text(a) +
+                                ", the cameras " + std::to_string(camera_a.width) + "x" +
+                                std::to_string(camera_a.height) + " and " + std::to_string(camera_b.width) +
+                                "x" + std::to_string(camera_b.height));
+  if (camera_a.model != CameraModel::kPinhole || camera_b.model != CameraModel::kPinhole)
+    throw std::invalid_argument(std::string(kFunction) + ": the cameras must be pinhole cameras");
+  if (a.depth.size() != a.pixels() || b.depth.size() != b.pixels())
+    throw std::invalid_argument(std::string(kFunction) +
+                                ": both images need their depth (RenderSettings::depth)");
+  if (block < 1)
+    throw std::invalid_argument(std::string(kFunction) + ": block must be >= 1, got " +
+                                std::to_string(block));
+  if (!std::isfinite(threshold) || threshold < 0 || !std::isfinite(depth_tolerance) || depth_tolerance < 0)
+    throw std::invalid_argument(std::string(kFunction) +
+                                ": the threshold and the depth tolerance must be finite and >= 0, got " +
+                                std::to_string(threshold) + " and " + std::to_string(depth_tolerance));
+  if (!all_finite(a) || !all_finite(b)) return not_a_number();
+  const int width = a.width, height = a.height;
+  auto depth_at = [&](const RenderImage& image, int x, int y) {
+    return double{image.depth[size_t(y) * size_t(width) + size_t(x)]};
+  };
+  std::vector<std::array<double, 3>> difference(b.pixels());
+  std::vector<char> inside(b.pixels(), 0);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+      const double z_b = depth_at(b, x, y);
+      if (!(b.rgba[4 * pixel + 3] >= 0.5f) || !(z_b > 0) || !std::isfinite(z_b)) continue;
+      // The world point at depth z_b on the ray through the pixel's centre, in a's camera space.
+      const std::array<double, 3> ray = pixel_ray(camera_b, x, y);  // camera z = 1
+      std::array<double, 3> in_a{};
+      for (int r = 0; r < 3; ++r) {
+        for (int k = 0; k < 3; ++k)
+          in_a[size_t(r)] +=
+              camera_a.rotation[size_t(3 * r + k)] *
+              (camera_b.position[size_t(k)] + z_b * ray[size_t(k)] - camera_a.position[size_t(k)]);
+      }
+      if (!(in_a[2] > 0)) continue;
+      const double u = camera_a.fx * in_a[0] / in_a[2] + camera_a.cx - 0.5;
+      const double v = camera_a.fy * in_a[1] / in_a[2] + camera_a.cy - 0.5;
+      if (!(u >= 0 && v >= 0 && u <= width - 1 && v <= height - 1)) continue;
+      // a sees the point where its depth at all four neighbours agrees with the point's.
+      const int x0 = std::min(int(u), std::max(width - 2, 0)), y0 = std::min(int(v), std::max(height - 2, 0));
+      bool seen = true;
+      for (int dy = 0; dy < 2 && seen; ++dy)
+        for (int dx = 0; dx < 2; ++dx) {
+          const double z_a = depth_at(a, std::min(x0 + dx, width - 1), std::min(y0 + dy, height - 1));
+          if (!(std::fabs(z_a - in_a[2]) <= depth_tolerance * in_a[2])) seen = false;
+        }
+      if (!seen) continue;
+      for (int c = 0; c < 3; ++c)
+        difference[pixel][size_t(c)] = double{b.rgba[4 * pixel + size_t(c)]} - bilinear(a, u, v, c);
+      inside[pixel] = 1;
+    }
+  }
+  return block_statistics(difference, inside, width, height, block, threshold);
 }
 
 }  // namespace tilesplat
