@@ -777,6 +777,11 @@ TEST(CliBench, AccuracyReportMeasuresPoppingAndViewConsistencyPerMode) {
   EXPECT_TRUE(contains(md_text, "3-frame orbit (step 0.0100)")) << md_text;
   EXPECT_TRUE(contains(md_text, "turned in place by 0.050 rad")) << md_text;
   EXPECT_TRUE(contains(md_text, "| inconsistent % | inconsistency |")) << md_text;
+  // The depth-warped pops and the PSNR against the exact per-pixel order, in every output.
+  EXPECT_TRUE(contains(result.out, "warp%") && contains(result.out, "vs ray")) << result.out;
+  EXPECT_TRUE(contains(csv_text, ",warp_pop_fraction,warp_pop_mean,psnr_vs_ray_order_db,")) << csv_text;
+  EXPECT_TRUE(contains(md_text, "| pops % | warped pops % |")) << md_text;
+  EXPECT_TRUE(contains(md_text, "| PSNR vs exact ray order dB |")) << md_text;
   EXPECT_TRUE(contains(read_file(plot), "PSNR against the float64 reference"));
   EXPECT_TRUE(contains(read_file(out / "p_consistency.svg"), "blocks inconsistent under the turn"));
   EXPECT_EQ(entries(out), (std::vector<std::string>{"a.csv", "a.md", "p.svg", "p_consistency.svg"}));

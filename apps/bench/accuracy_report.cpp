@@ -133,13 +133,14 @@ int work_units(const Options& options, int scene_sh_degree) {
     raster = raster || row.compositor == Compositor::kRaster;
   }
   const int views = int(options.views.size());
-  // The path starts at the first view, whose reference and render it reuses. References: each view and
-  // each later path frame; renders: per mode, per view the timed frames, and the later path frames.
+  // The path starts at the first view, whose reference it reuses. References: each view in both orders
+  // and each later path frame; renders: per mode, per view the timed frames, and the path's frames (with
+  // their depth, which the timed frames do not write).
   const int later_path_frames = std::max(options.path_frames - 1, 0);
   const int consistency_pair = options.consistency_angle > 0 ? 2 : 0;
   // A row of another compositor also renders (and times) the sorted compositor's frames at each view.
-  return views + later_path_frames + consistency_pair +
-         applicable * (views * (options.warmup + options.repeat) + later_path_frames + consistency_pair) +
+  return 2 * views + later_path_frames + consistency_pair +
+         applicable * (views * (options.warmup + options.repeat) + options.path_frames + consistency_pair) +
          other_compositors * views * (options.warmup + options.repeat) +
          (raster ? views : 0);  // the raster rule's references
 }
@@ -157,13 +158,18 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
   report.path_frames = options.path_frames;
   report.path_step = options.path_step;
   RenderSettings reference_settings;
-  reference_settings.depth = false;
+  reference_settings.depth = true;  // the path's depth-warped popping needs it
   reference_settings.splat_count = false;
 
-  std::vector<RenderImage> references;
+  std::vector<RenderImage> references, ray_order_references;
   for (size_t v = 0; v < options.views.size(); ++v) {
     references.push_back(render_reference(scene, options.views[v], reference_settings));
     step("float64 reference, " + options.view_names[v]);
+    // The exact per-pixel order's rays are a pinhole's; other views get no such reference.
+    if (options.views[v].model == CameraModel::kPinhole)
+      ray_order_references.push_back(
+          render_reference(scene, options.views[v], reference_settings, ReferenceOrder::kRayDepth));
+    step("float64 reference in exact ray order, " + options.view_names[v]);
   }
   const Bounds bounds = compute_bounds(scene);
   const std::vector<Camera> path =
@@ -192,6 +198,11 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     report.reference_pops += popping(path_references[f - 2], path_references[f - 1], path_references[f],
                                      kFlickerThreshold).flicker_fraction /
                              double(path.size() - 2);
+  auto warp_of = [&path](const std::vector<RenderImage>& frames, size_t f) {
+    return depth_warp_difference(frames[f - 1], path[f - 1], frames[f], path[f], kWarpBlock, kWarpThreshold);
+  };
+  for (size_t f = 1; f < path_references.size(); ++f)
+    report.reference_warp_pops += warp_of(path_references, f).flicker_fraction / double(path.size() - 1);
 
   // The view-consistency pair: the first view and the same camera turned in place, at a size where a
   // block of pixels stands for one pixel of the view.
@@ -244,14 +255,13 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     settings.accuracy = m;
     settings.compositor = row.compositor;
     settings.reuse_lists = false;  // the repeats time whole frames, not the composite on reused lists
-    double psnr_vs_sorted_sum = 0, psnr_vs_rule_sum = 0;
+    double psnr_vs_sorted_sum = 0, psnr_vs_rule_sum = 0, psnr_vs_ray_order_sum = 0;
     std::vector<double> sorted_ms_per_view;
 
     std::vector<double> frame_ms_per_view;
     std::map<std::string, std::vector<double>> pass_ms_per_view;
     std::vector<std::string> pass_order;
     double psnr_sum = 0, ssim_sum = 0;
-    RenderImage first_view;  // also the path's first frame
     for (size_t v = 0; v < options.views.size(); ++v) {
       RenderImage image;
       std::vector<double> frames;
@@ -290,11 +300,12 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
       }
       if (row.compositor == Compositor::kRaster)
         psnr_vs_rule_sum += compare_images(image, raster_references[v]).psnr_db;
+      if (ray_order_references.size() == options.views.size())
+        psnr_vs_ray_order_sum += compare_images(image, ray_order_references[v]).psnr_db;
       const ImageDifference difference = compare_images(image, references[v]);
       psnr_sum += difference.psnr_db;
       ssim_sum += ssim(image, references[v]);
       result.max_abs = std::max(result.max_abs, difference.max_abs);
-      if (v == 0) first_view = std::move(image);
     }
     result.frame_ms = cli::median(frame_ms_per_view);
     for (const auto& name : pass_order) result.passes.push_back({name, cli::median(pass_ms_per_view[name])});
@@ -305,15 +316,17 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     }
     if (row.compositor == Compositor::kRaster)
       result.psnr_vs_rule_db = psnr_vs_rule_sum / double(options.views.size());
+    result.psnr_vs_ray_order_db = ray_order_references.size() == options.views.size()
+                                      ? psnr_vs_ray_order_sum / double(options.views.size())
+                                      : std::numeric_limits<double>::quiet_NaN();
     result.ssim = ssim_sum / double(options.views.size());
 
+    // The path with each frame's depth (the timed frames leave it out).
+    RenderSettings path_settings = settings;
+    path_settings.depth = true;
     std::vector<RenderImage> frames;
     for (size_t f = 0; f < path.size(); ++f) {
-      if (f == 0) {
-        frames.push_back(std::move(first_view));
-        continue;
-      }
-      frames.push_back(renderer.render(path[f], settings));
+      frames.push_back(renderer.render(path[f], path_settings));
       step(result.name + ", path frame " + std::to_string(f));
     }
     for (size_t f = 1; f < frames.size(); ++f) {
@@ -327,6 +340,11 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
       const TemporalDifference pops = popping(frames[f - 2], frames[f - 1], frames[f], kFlickerThreshold);
       result.pops += pops.flicker_fraction / double(frames.size() - 2);
       result.pop_mean += pops.mean_abs / double(frames.size() - 2);
+    }
+    for (size_t f = 1; f < frames.size(); ++f) {
+      const TemporalDifference warped = warp_of(frames, f);
+      result.warp_pops += warped.flicker_fraction / double(frames.size() - 1);
+      result.warp_mean += warped.mean_abs / double(frames.size() - 1);
     }
     if (!turned.empty()) {
       std::vector<RenderImage> pair;
@@ -356,29 +374,35 @@ std::string psnr_vs_rule(const ModeResult& m) {
   return std::isnan(m.psnr_vs_rule_db) ? "-" : cli::format_number(m.psnr_vs_rule_db, 2);
 }
 
+std::string psnr_vs_ray_order(const ModeResult& m) {
+  return std::isnan(m.psnr_vs_ray_order_db) ? "-" : cli::format_number(m.psnr_vs_ray_order_db, 2);
+}
+
 std::string text_table(const SceneReport& report) {
   std::string text =
       "  " + report.scene + ", " + report.description + ", " + report.views + "; float64 reference on the " +
       to_string(report.path) + ": " + cli::format_number(100.0 * report.reference_flicker, 3) +
-      "% flicker, " + cli::format_number(100.0 * report.reference_pops, 3) + "% pops; turned " +
+      "% flicker, " + cli::format_number(100.0 * report.reference_pops, 3) + "% pops, " +
+      cli::format_number(100.0 * report.reference_warp_pops, 3) + "% warped pops; turned " +
       cli::format_number(report.consistency_angle, 3) +
       " rad: " + cli::format_number(100.0 * report.reference_inconsistency, 3) + "% inconsistent\n";
   char line[512];
-  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s %9s %9s %8s %9s\n", "mode",
-                "GPU ms", "vs ref", "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess", "pops%",
-                "incons%", "vs tiles", "t/tiles", "vs rule");
+  std::snprintf(line, sizeof(line), "  %-58s %10s %8s %9s %8s %9s %10s %9s %9s %8s %8s %9s %8s %9s %8s %9s\n",
+                "mode", "GPU ms", "vs ref", "PSNR dB", "SSIM", "max abs", "pairs", "flicker%", "excess",
+                "pops%", "warp%", "incons%", "vs ray", "vs tiles", "t/tiles", "vs rule");
   text += line;
   const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
   for (const auto& m : report.modes) {
-    std::snprintf(line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s %9s %9s %8s %9s\n",
-                  m.name.c_str(), cli::format_number(m.frame_ms, 2).c_str(),
-                  cli::format_number(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2).c_str(),
-                  cli::format_number(m.psnr_db, 2).c_str(), cli::format_number(m.ssim, 5).c_str(),
-                  cli::format_number(m.max_abs, 4).c_str(), static_cast<unsigned long long>(m.intersections),
-                  cli::format_number(100.0 * m.flicker, 3).c_str(), cli::format_number(m.excess, 5).c_str(),
-                  cli::format_number(100.0 * m.pops, 3).c_str(),
-                  cli::format_number(100.0 * m.inconsistency, 3).c_str(), psnr_vs_sorted(m).c_str(),
-                  time_vs_sorted(m).c_str(), psnr_vs_rule(m).c_str());
+    std::snprintf(
+        line, sizeof(line), "  %-58s %10s %7sx %9s %8s %9s %10llu %9s %9s %8s %8s %9s %8s %9s %8s %9s\n",
+        m.name.c_str(), cli::format_number(m.frame_ms, 2).c_str(),
+        cli::format_number(reference_ms > 0 ? m.frame_ms / reference_ms : 0, 2).c_str(),
+        cli::format_number(m.psnr_db, 2).c_str(), cli::format_number(m.ssim, 5).c_str(),
+        cli::format_number(m.max_abs, 4).c_str(), static_cast<unsigned long long>(m.intersections),
+        cli::format_number(100.0 * m.flicker, 3).c_str(), cli::format_number(m.excess, 5).c_str(),
+        cli::format_number(100.0 * m.pops, 3).c_str(), cli::format_number(100.0 * m.warp_pops, 3).c_str(),
+        cli::format_number(100.0 * m.inconsistency, 3).c_str(), psnr_vs_ray_order(m).c_str(),
+        psnr_vs_sorted(m).c_str(), time_vs_sorted(m).c_str(), psnr_vs_rule(m).c_str());
     text += line;
   }
   return text;
@@ -399,7 +423,14 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
           cli::format_number(kFlickerThreshold, 2) + " (flicker), and " +
           cli::format_number(100.0 * report.reference_pops, 3) +
           "% of pixels popping: their second difference over three frames exceeds that (`popping()`, which "
-          "smooth motion cancels).";
+          "smooth motion cancels). Warped pops: each frame warped onto the next by its rendered depth, what "
+          "the "
+          "motion reveals or hides left out, the share of " +
+          std::to_string(kWarpBlock) + "x" + std::to_string(kWarpBlock) + " blocks differing by more than " +
+          cli::format_number(kWarpThreshold, 2) + " (`depth_warp_difference()`; the float64 reference: " +
+          cli::format_number(100.0 * report.reference_warp_pops, 3) +
+          "%). PSNR vs exact ray order: against the float64 reference blending each pixel's splats in the "
+          "order of their depth along its ray (`ReferenceOrder::kRayDepth`).";
     if (report.consistency_angle > 0)
       md += " View consistency: the first view and the same camera turned in place by " +
             cli::format_number(report.consistency_angle, 3) + " rad, rendered at " +
@@ -414,11 +445,10 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
     md += "\n\n";
     md +=
         "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change "
-        "| pops % "
-        "| inconsistent % | inconsistency | PSNR vs sorted compositor dB | time vs sorted compositor | PSNR "
-        "vs own "
-        "float64 rule dB |\n";
-    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        "| pops % | warped pops % "
+        "| inconsistent % | inconsistency | PSNR vs exact ray order dB | PSNR vs sorted compositor dB | time "
+        "vs sorted compositor | PSNR vs own float64 rule dB |\n";
+    md += "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     const double reference_ms = report.modes.empty() ? 0 : report.modes.front().frame_ms;
     for (const auto& m : report.modes)
       md += "| " + m.name + " | " + cli::format_number(m.frame_ms, 2) + " | " +
@@ -426,9 +456,10 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
             cli::format_number(m.psnr_db, 2) + " | " + cli::format_number(m.ssim, 5) + " | " +
             cli::format_number(m.max_abs, 4) + " | " + std::to_string(m.intersections) + " | " +
             cli::format_number(100.0 * m.flicker, 3) + " | " + cli::format_number(m.excess, 5) + " | " +
-            cli::format_number(100.0 * m.pops, 3) + " | " + cli::format_number(100.0 * m.inconsistency, 3) +
-            " | " + cli::format_number(m.inconsistency_mean, 6) + " | " + psnr_vs_sorted(m) + " | " +
-            time_vs_sorted(m) + " | " + psnr_vs_rule(m) + " |\n";
+            cli::format_number(100.0 * m.pops, 3) + " | " + cli::format_number(100.0 * m.warp_pops, 3) +
+            " | " + cli::format_number(100.0 * m.inconsistency, 3) + " | " +
+            cli::format_number(m.inconsistency_mean, 6) + " | " + psnr_vs_ray_order(m) + " | " +
+            psnr_vs_sorted(m) + " | " + time_vs_sorted(m) + " | " + psnr_vs_rule(m) + " |\n";
     // Per-pass times: a column per mode would not fit; the passes whose time a mode changes.
     md += "\nPer-pass median GPU ms:\n\n| mode |";
     std::vector<std::string> names;
@@ -457,7 +488,7 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
   std::string out =
       "device,scene,mode,gpu_frame_ms,psnr_db,ssim,max_abs,intersections,frame_change,flicker_fraction,"
       "excess_change,pop_fraction,pop_mean,inconsistent_fraction,inconsistency_mean,passes,psnr_vs_sorted_db,"
-      "psnr_vs_rule_db\n";
+      "psnr_vs_rule_db,warp_pop_fraction,warp_pop_mean,psnr_vs_ray_order_db\n";
   for (const auto& report : reports)
     for (const auto& m : report.modes) {
       std::string passes;
@@ -474,6 +505,9 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
              (std::isnan(m.psnr_vs_sorted_db) ? std::string() : cli::format_number(m.psnr_vs_sorted_db, 4)) +
              "," +
              (std::isnan(m.psnr_vs_rule_db) ? std::string() : cli::format_number(m.psnr_vs_rule_db, 4)) +
+             "," + cli::format_number(m.warp_pops, 6) + "," + cli::format_number(m.warp_mean, 6) + "," +
+             (std::isnan(m.psnr_vs_ray_order_db) ? std::string()
+                                                 : cli::format_number(m.psnr_vs_ray_order_db, 4)) +
              "\n";
     }
   return out;

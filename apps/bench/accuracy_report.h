@@ -63,6 +63,9 @@ struct ModeResult {
   // The raster compositor: PSNR against the float64 reference's raster rule (render_reference with
   // Compositor::kRaster), mean over the views: the GPU held to its own definition; NaN for the others.
   double psnr_vs_rule_db = 0;
+  // PSNR against the float64 reference's exact per-pixel order (ReferenceOrder::kRayDepth), mean over
+  // the views: what per-pixel re-sorting approaches; NaN where a view's camera is not a pinhole.
+  double psnr_vs_ray_order_db = 0;
   // Along the camera path, per consecutive pair of frames (means over the pairs):
   double frame_change = 0;     // mean |frame t+1 - frame t|
   double flicker = 0;          // fraction of pixels whose change exceeds kFlickerThreshold: pops
@@ -71,6 +74,10 @@ struct ModeResult {
   // which smooth motion cancels and order flips do not.
   double pops = 0;             // fraction of pixels whose second difference exceeds kFlickerThreshold
   double pop_mean = 0;         // mean second difference over pixels and RGB
+  // Per consecutive pair of frames, depth_warp_difference(): frame t warped onto frame t + 1 by the
+  // rendered depth (what the motion reveals or hides left out), over blocks of kWarpBlock pixels.
+  double warp_pops = 0;  // fraction of blocks whose difference exceeds kWarpThreshold
+  double warp_mean = 0;  // mean difference over the blocks and RGB
   // Between the first view and the same camera turned by Options::consistency_angle, both rendered at
   // kConsistencyScale times its size: rotation_inconsistency() over blocks of kConsistencyScale * 4
   // pixels, what re-sorting along each pixel's ray is for.
@@ -87,6 +94,10 @@ constexpr int kConsistencyScale = 2;
 constexpr int kConsistencyBlock = 4 * kConsistencyScale;
 constexpr double kConsistencyThreshold = 0.01;
 
+// The depth-warped popping of the path compares blocks of this many pixels of the view's size.
+constexpr int kWarpBlock = 4;
+constexpr double kWarpThreshold = 0.01;
+
 struct SceneReport {
   std::string scene;  // file name
   std::string description;  // "31,000 Gaussians (SH2)"
@@ -97,6 +108,7 @@ struct SceneReport {
   double reference_change = 0;   // the float64 reference's own mean frame-to-frame change on the path
   double reference_flicker = 0;  // and its fraction of popping pixels
   double reference_pops = 0;     // its popping() fraction (it blends in centre-depth order: it pops too)
+  double reference_warp_pops = 0;  // its depth_warp_difference() fraction (ModeResult::warp_pops)
   double consistency_angle = 0;  // radians; 0: not measured
   double reference_inconsistency = 0;       // the float64 reference's (centre-depth order: not 0)
   double reference_inconsistency_mean = 0;

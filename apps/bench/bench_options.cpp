@@ -68,9 +68,10 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
       "--accuracy",
       "measure what each accuracy mode costs: per --mode combination (default: each approximation "
       "alone and the combinations that matter), the GPU time per pass and frame and the error "
-      "against the float64 CPU reference (PSNR, SSIM, max abs) at each view, and the popping "
-      "along a short camera path from the first view (--path) and the view consistency under a turn "
-      "(--consistency-angle); --plot draws the Pareto charts",
+      "against the float64 CPU reference (PSNR, SSIM, max abs) and against its exact per-pixel "
+      "ray-depth order at each view, the popping along a short camera path from the first view "
+      "(--path; also each frame warped onto the next by its rendered depth) and the view consistency "
+      "under a turn (--consistency-angle); --plot draws the Pareto charts",
       &options.accuracy);
   parser.add_string(
       "--markdown", "FILE.md",
