@@ -288,6 +288,20 @@ std::array<double, 3> pixel_ray(const Camera& camera, double x, double y) {
   return world;
 }
 
+// Two images and the cameras that framed them: valid cameras of the images' (equal) size.
+void check_framed_pair(const char* function, const RenderImage& a, const Camera& camera_a,
+                       const RenderImage& b, const Camera& camera_b) {
+  check_same_size(function, {&a, &b}, {"a", "b"});
+  validate(camera_a);
+  validate(camera_b);
+  if (camera_a.width != a.width || camera_a.height != a.height || camera_b.width != a.width ||
+      camera_b.height != a.height)
+    throw std::invalid_argument(std::string(function) + ": the images are " + size_text(a) +
+                                ", the cameras " + std::to_string(camera_a.width) + "x" +
+                                std::to_string(camera_a.height) + " and " + std::to_string(camera_b.width) +
+                                "x" + std::to_string(camera_b.height));
+}
+
 // The per-pixel differences (RGB) averaged over blocks of block x block pixels, the blocks with a pixel
 // not `inside` left out: mean_abs over the blocks kept and RGB, flicker_fraction the fraction of them
 // whose largest channel exceeds the threshold.
@@ -354,14 +368,7 @@ double bilinear(const RenderImage& image, double u, double v, int c) {
 TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& camera_a, const RenderImage& b,
                                           const Camera& camera_b, int block, double threshold) {
   constexpr const char* kFunction = "rotation_inconsistency";
-  check_same_size(kFunction, {&a, &b}, {"a", "b"});
-  validate(camera_a);
-  validate(camera_b);
-  if (camera_a.width != a.width || camera_a.height != a.height || camera_b.width != a.width ||
-      camera_b.height != a.height)
-    throw std::invalid_argument(std::string(kFunction) + ": the images are " + size_text(a) + ", the cameras " +
-                                std::to_string(camera_a.width) + "x" + std::to_string(camera_a.height) + " and " +
-                                std::to_string(camera_b.width) + "x" + std::to_string(camera_b.height));
+  check_framed_pair(kFunction, a, camera_a, b, camera_b);
   if (camera_a.fx != camera_b.fx || camera_a.fy != camera_b.fy || camera_a.cx != camera_b.cx ||
       camera_a.cy != camera_b.cy || camera_a.position != camera_b.position)
     throw std::invalid_argument(std::string(kFunction) +
@@ -399,15 +406,7 @@ TemporalDifference depth_warp_difference(const RenderImage& a, const Camera& cam
                                          const Camera& camera_b, int block, double threshold,
                                          double depth_tolerance) {
   constexpr const char* kFunction = "depth_warp_difference";
-  check_same_size(kFunction, {&a, &b}, {"a", "b"});
-  validate(camera_a);
-  validate(camera_b);
-  if (camera_a.width != a.width || camera_a.height != a.height || camera_b.width != a.width ||
-      camera_b.height != a.height)
-    throw std::invalid_argument(std::string(kFunction) + ": the images are " + size_text(a) +
-                                ", the cameras " + std::to_string(camera_a.width) + "x" +
-                                std::to_string(camera_a.height) + " and " + std::to_string(camera_b.width) +
-                                "x" + std::to_string(camera_b.height));
+  check_framed_pair(kFunction, a, camera_a, b, camera_b);
   if (camera_a.model != CameraModel::kPinhole || camera_b.model != CameraModel::kPinhole)
     throw std::invalid_argument(std::string(kFunction) + ": the cameras must be pinhole cameras");
   if (a.depth.size() != a.pixels() || b.depth.size() != b.pixels())
