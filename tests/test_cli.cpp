@@ -784,7 +784,11 @@ TEST(CliBench, AccuracyReportMeasuresPoppingAndViewConsistencyPerMode) {
   EXPECT_TRUE(contains(md_text, "| PSNR vs exact ray order dB |")) << md_text;
   EXPECT_TRUE(contains(read_file(plot), "PSNR against the float64 reference"));
   EXPECT_TRUE(contains(read_file(out / "p_consistency.svg"), "blocks inconsistent under the turn"));
-  EXPECT_EQ(entries(out), (std::vector<std::string>{"a.csv", "a.md", "p.svg", "p_consistency.svg"}));
+  const std::string popping_chart = read_file(out / "p_popping.svg");
+  EXPECT_TRUE(contains(popping_chart, "Popping along the path") && contains(popping_chart, "resort4"))
+      << popping_chart;
+  EXPECT_EQ(entries(out),
+            (std::vector<std::string>{"a.csv", "a.md", "p.svg", "p_consistency.svg", "p_popping.svg"}));
   EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
 
   for (const auto& [flag, value, message] :

@@ -201,8 +201,10 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
   auto warp_of = [&path](const std::vector<RenderImage>& frames, size_t f) {
     return depth_warp_difference(frames[f - 1], path[f - 1], frames[f], path[f], kWarpBlock, kWarpThreshold);
   };
-  for (size_t f = 1; f < path_references.size(); ++f)
-    report.reference_warp_pops += warp_of(path_references, f).flicker_fraction / double(path.size() - 1);
+  for (size_t f = 1; f < path_references.size(); ++f) {
+    report.reference_warp_pops_per_step.push_back(warp_of(path_references, f).flicker_fraction);
+    report.reference_warp_pops += report.reference_warp_pops_per_step.back() / double(path.size() - 1);
+  }
 
   // The view-consistency pair: the first view and the same camera turned in place, at a size where a
   // block of pixels stands for one pixel of the view.
@@ -343,6 +345,7 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
     }
     for (size_t f = 1; f < frames.size(); ++f) {
       const TemporalDifference warped = warp_of(frames, f);
+      result.warp_pops_per_step.push_back(warped.flicker_fraction);
       result.warp_pops += warped.flicker_fraction / double(frames.size() - 1);
       result.warp_mean += warped.mean_abs / double(frames.size() - 1);
     }
@@ -543,6 +546,25 @@ std::string pareto_svg(const SceneReport& report, const DeviceInfo& device) {
     chart.points.push_back({m.name, m.frame_ms, m.psnr_db, i});
   }
   return plot::scatter_svg(chart);
+}
+
+std::string popping_svg(const SceneReport& report, const DeviceInfo& device) {
+  plot::LineChart chart;
+  chart.title = "Popping along the path: " + report.scene;
+  chart.subtitle = report.description + ", " + std::to_string(report.path_frames) + "-frame " +
+                   to_string(report.path) + " (step " + cli::format_fixed(report.path_step, 4) +
+                   "), each frame warped onto the next by its depth; " + device.name;
+  chart.x_label = "frame pair along the path";
+  chart.y_label = "blocks differing after the warp (%)";
+  auto series = [](const std::string& label, const std::vector<double>& per_step, size_t color, size_t dash) {
+    plot::LineSeries line{label, color, dash, {}};
+    for (size_t i = 0; i < per_step.size(); ++i) line.points.push_back({double(i + 1), 100.0 * per_step[i]});
+    return line;
+  };
+  chart.series.push_back(series("float64 reference", report.reference_warp_pops_per_step, 0, 1));
+  for (size_t i = 0; i < report.modes.size(); ++i)
+    chart.series.push_back(series(report.modes[i].name, report.modes[i].warp_pops_per_step, i, 0));
+  return plot::line_chart_svg(chart);
 }
 
 }  // namespace tilesplat::accuracy

@@ -78,6 +78,7 @@ struct ModeResult {
   // rendered depth (what the motion reveals or hides left out), over blocks of kWarpBlock pixels.
   double warp_pops = 0;  // fraction of blocks whose difference exceeds kWarpThreshold
   double warp_mean = 0;  // mean difference over the blocks and RGB
+  std::vector<double> warp_pops_per_step;  // the fraction for each pair, frames 0-1, 1-2, ...
   // Between the first view and the same camera turned by Options::consistency_angle, both rendered at
   // kConsistencyScale times its size: rotation_inconsistency() over blocks of kConsistencyScale * 4
   // pixels, what re-sorting along each pixel's ray is for.
@@ -109,6 +110,7 @@ struct SceneReport {
   double reference_flicker = 0;  // and its fraction of popping pixels
   double reference_pops = 0;     // its popping() fraction (it blends in centre-depth order: it pops too)
   double reference_warp_pops = 0;  // its depth_warp_difference() fraction (ModeResult::warp_pops)
+  std::vector<double> reference_warp_pops_per_step;
   double consistency_angle = 0;  // radians; 0: not measured
   double reference_inconsistency = 0;       // the float64 reference's (centre-depth order: not 0)
   double reference_inconsistency_mean = 0;
@@ -153,6 +155,9 @@ std::string csv(const std::vector<SceneReport>& reports, const DeviceInfo& devic
 std::string pareto_svg(const SceneReport& report, const DeviceInfo& device);
 // The same modes' rotation_inconsistency() fraction against time (lower is better), when measured.
 std::string consistency_svg(const SceneReport& report, const DeviceInfo& device);
+// The depth-warped popping (ModeResult::warp_pops_per_step) along the path, a line per mode and the
+// float64 reference's dashed, when the path has two frames or more.
+std::string popping_svg(const SceneReport& report, const DeviceInfo& device);
 // The stdout table of one scene.
 std::string text_table(const SceneReport& report);
 

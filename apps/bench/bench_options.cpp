@@ -59,8 +59,8 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
       "--plot", "FILE.svg",
       "also draw an SVG chart: the median GPU time of each pass as stacked bars, one per scene, "
       "size and sort; with --sort-bench, Mkeys/s against key count per sort and key width; with "
-      "--accuracy, per scene PSNR against time and, beside it (..._consistency.svg), the view "
-      "inconsistency against time",
+      "--accuracy, per scene PSNR against time and, beside it, the view inconsistency against time "
+      "(..._consistency.svg) and the warped popping along the path (..._popping.svg)",
       &options.plot);
 
   parser.section("accuracy report");

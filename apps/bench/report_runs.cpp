@@ -111,6 +111,13 @@ int run_accuracy_report(const BenchOptions& options) {
           return tilesplat::accuracy::consistency_svg(report, device);
         });
       }
+      if (report.path_frames >= 2) {
+        fs::path popping = scene_plot_path(options.plot, report.scene, reports.size());
+        popping.replace_filename(popping.stem().string() + "_popping.svg");
+        plot_paths.push_back(popping.string());
+        files.emplace_back(plot_paths.back(),
+                           [&report, &device] { return tilesplat::accuracy::popping_svg(report, device); });
+      }
     }
   const std::string written = write_outputs(files, renderer->validation_messages());
   std::fprintf(stderr, "%s: accuracy report, %d renders%s\n", kProgram, total, written.c_str());
