@@ -4,6 +4,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -348,19 +349,51 @@ TemporalDifference not_a_number() {
   return result;
 }
 
-// Bilinear sample of channel c of `image` at continuous coordinates (u, v) with pixel centres on the
-// integers; (u, v) within [0, width - 1] x [0, height - 1].
-double bilinear(const RenderImage& image, double u, double v, int c) {
-  const int width = image.width, height = image.height;
-  const int x0 = std::min(int(u), std::max(width - 2, 0));
-  const int y0 = std::min(int(v), std::max(height - 2, 0));
-  const int x1 = std::min(x0 + 1, width - 1), y1 = std::min(y0 + 1, height - 1);
-  const double fx = u - x0, fy = v - y0;
-  auto at = [&](int px, int py) {
-    return double{image.rgba[4 * (size_t(py) * size_t(width) + size_t(px)) + size_t(c)]};
+// The blocks and threshold of block_statistics: a block of at least one pixel, a finite threshold >= 0.
+void check_blocks(const char* function, int block, double threshold) {
+  if (block < 1)
+    throw std::invalid_argument(std::string(function) + ": block must be >= 1, got " + std::to_string(block));
+  if (!std::isfinite(threshold) || threshold < 0)
+    throw std::invalid_argument(std::string(function) + ": the threshold must be finite and >= 0, got " +
+                                std::to_string(threshold));
+}
+
+// Where a point in camera space lands in the camera's image of width x height pixels, in continuous
+// coordinates with pixel centres on the integers; nothing when it is not in front of the camera or
+// lies outside the outer pixel centres (so that all four neighbours exist).
+std::optional<std::array<double, 2>> image_point(const Camera& camera, const std::array<double, 3>& in_camera,
+                                                 int width, int height) {
+  if (!(in_camera[2] > 0)) return std::nullopt;
+  const double u = camera.fx * in_camera[0] / in_camera[2] + camera.cx - 0.5;
+  const double v = camera.fy * in_camera[1] / in_camera[2] + camera.cy - 0.5;
+  if (!(u >= 0 && v >= 0 && u <= width - 1 && v <= height - 1)) return std::nullopt;
+  return std::array<double, 2>{u, v};
+}
+
+// The 2x2 pixels around an image point (image_point) and its bilinear weights.
+struct Neighbourhood {
+  int x0, y0, x1, y1;
+  double fx, fy;
+};
+Neighbourhood neighbourhood(const std::array<double, 2>& point, int width, int height) {
+  const int x0 = std::min(int(point[0]), std::max(width - 2, 0));
+  const int y0 = std::min(int(point[1]), std::max(height - 2, 0));
+  return {x0, y0, std::min(x0 + 1, width - 1), std::min(y0 + 1, height - 1), point[0] - x0, point[1] - y0};
+}
+
+// b - a resampled bilinearly at the neighbourhood, per RGB channel, for pixel `pixel` of b.
+std::array<double, 3> difference_to(const RenderImage& a, const Neighbourhood& n, const RenderImage& b,
+                                    size_t pixel) {
+  auto at = [&](int px, int py, int c) {
+    return double{a.rgba[4 * (size_t(py) * size_t(a.width) + size_t(px)) + size_t(c)]};
   };
-  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) +
-         fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+  std::array<double, 3> difference{};
+  for (int c = 0; c < 3; ++c) {
+    const double warped = (1 - n.fy) * ((1 - n.fx) * at(n.x0, n.y0, c) + n.fx * at(n.x1, n.y0, c)) +
+                          n.fy * ((1 - n.fx) * at(n.x0, n.y1, c) + n.fx * at(n.x1, n.y1, c));
+    difference[size_t(c)] = double{b.rgba[4 * pixel + size_t(c)]} - warped;
+  }
+  return difference;
 }
 
 }  // namespace
@@ -373,10 +406,7 @@ TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& ca
       camera_a.cy != camera_b.cy || camera_a.position != camera_b.position)
     throw std::invalid_argument(std::string(kFunction) +
                                 ": the cameras must differ by a rotation alone (same intrinsics and position)");
-  if (block < 1) throw std::invalid_argument(std::string(kFunction) + ": block must be >= 1, got " + std::to_string(block));
-  if (!std::isfinite(threshold) || threshold < 0)
-    throw std::invalid_argument(std::string(kFunction) + ": the threshold must be finite and >= 0, got " +
-                                std::to_string(threshold));
+  check_blocks(kFunction, block, threshold);
   if (!all_finite(a) || !all_finite(b)) return not_a_number();
   const int width = a.width, height = a.height;
   // Per pixel of b: b - warp(a) over RGB, and whether the ray landed inside a (with its 2x2 neighbourhood).
@@ -385,17 +415,13 @@ TemporalDifference rotation_inconsistency(const RenderImage& a, const Camera& ca
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const std::array<double, 3> world = pixel_ray(camera_b, x, y);
-      double in_a[3] = {0, 0, 0};
-      for (int r = 0; r < 3; ++r)
-        for (int k = 0; k < 3; ++k) in_a[r] += camera_a.rotation[3 * r + k] * world[k];
-      if (!(in_a[2] > 0)) continue;
-      // Continuous coordinates with pixel centres on the integers.
-      const double u = camera_a.fx * in_a[0] / in_a[2] + camera_a.cx - 0.5;
-      const double v = camera_a.fy * in_a[1] / in_a[2] + camera_a.cy - 0.5;
-      if (!(u >= 0 && v >= 0 && u <= width - 1 && v <= height - 1)) continue;
+      std::array<double, 3> in_a{};
+      for (size_t r = 0; r < 3; ++r)
+        for (size_t k = 0; k < 3; ++k) in_a[r] += camera_a.rotation[3 * r + k] * world[k];
+      const auto point = image_point(camera_a, in_a, width, height);
+      if (!point) continue;
       const size_t pixel = size_t(y) * size_t(width) + size_t(x);
-      for (int c = 0; c < 3; ++c)
-        difference[pixel][c] = double{b.rgba[4 * pixel + size_t(c)]} - bilinear(a, u, v, c);
+      difference[pixel] = difference_to(a, neighbourhood(*point, width, height), b, pixel);
       inside[pixel] = 1;
     }
   }
@@ -412,13 +438,11 @@ TemporalDifference depth_warp_difference(const RenderImage& a, const Camera& cam
   if (a.depth.size() != a.pixels() || b.depth.size() != b.pixels())
     throw std::invalid_argument(std::string(kFunction) +
                                 ": both images need their depth (RenderSettings::depth)");
-  if (block < 1)
-    throw std::invalid_argument(std::string(kFunction) + ": block must be >= 1, got " +
-                                std::to_string(block));
-  if (!std::isfinite(threshold) || threshold < 0 || !std::isfinite(depth_tolerance) || depth_tolerance < 0)
+  check_blocks(kFunction, block, threshold);
+  if (!std::isfinite(depth_tolerance) || depth_tolerance < 0)
     throw std::invalid_argument(std::string(kFunction) +
-                                ": the threshold and the depth tolerance must be finite and >= 0, got " +
-                                std::to_string(threshold) + " and " + std::to_string(depth_tolerance));
+                                ": the depth tolerance must be finite and >= 0, got " +
+                                std::to_string(depth_tolerance));
   if (!all_finite(a) || !all_finite(b)) return not_a_number();
   const int width = a.width, height = a.height;
   auto depth_at = [&](const RenderImage& image, int x, int y) {
@@ -440,21 +464,17 @@ TemporalDifference depth_warp_difference(const RenderImage& a, const Camera& cam
               camera_a.rotation[size_t(3 * r + k)] *
               (camera_b.position[size_t(k)] + z_b * ray[size_t(k)] - camera_a.position[size_t(k)]);
       }
-      if (!(in_a[2] > 0)) continue;
-      const double u = camera_a.fx * in_a[0] / in_a[2] + camera_a.cx - 0.5;
-      const double v = camera_a.fy * in_a[1] / in_a[2] + camera_a.cy - 0.5;
-      if (!(u >= 0 && v >= 0 && u <= width - 1 && v <= height - 1)) continue;
+      const auto point = image_point(camera_a, in_a, width, height);
+      if (!point) continue;
       // a sees the point where its depth at all four neighbours agrees with the point's.
-      const int x0 = std::min(int(u), std::max(width - 2, 0)), y0 = std::min(int(v), std::max(height - 2, 0));
+      const Neighbourhood n = neighbourhood(*point, width, height);
       bool seen = true;
-      for (int dy = 0; dy < 2 && seen; ++dy)
-        for (int dx = 0; dx < 2; ++dx) {
-          const double z_a = depth_at(a, std::min(x0 + dx, width - 1), std::min(y0 + dy, height - 1));
-          if (!(std::fabs(z_a - in_a[2]) <= depth_tolerance * in_a[2])) seen = false;
-        }
+      for (int neighbour_y : {n.y0, n.y1})
+        for (int neighbour_x : {n.x0, n.x1})
+          seen =
+              seen && std::fabs(depth_at(a, neighbour_x, neighbour_y) - in_a[2]) <= depth_tolerance * in_a[2];
       if (!seen) continue;
-      for (int c = 0; c < 3; ++c)
-        difference[pixel][size_t(c)] = double{b.rgba[4 * pixel + size_t(c)]} - bilinear(a, u, v, c);
+      difference[pixel] = difference_to(a, n, b, pixel);
       inside[pixel] = 1;
     }
   }
