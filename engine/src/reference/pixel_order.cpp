@@ -37,8 +37,12 @@ RayDepthQuadric ray_depth_quadric(const GaussianScene& scene, size_t i, const Ca
   return out;
 }
 
-double ray_depth(const RayDepthQuadric& quadric, const Camera& camera, double x, double y) {
-  const double dx = (x - camera.cx) / camera.fx, dy = (y - camera.cy) / camera.fy;
+std::array<double, 2> pixel_direction(const Camera& camera, double x, double y) {
+  return {(x - camera.cx) / camera.fx, (y - camera.cy) / camera.fy};
+}
+
+double ray_depth(const RayDepthQuadric& quadric, const std::array<double, 2>& d) {
+  const double dx = d[0], dy = d[1];
   const auto& q = quadric.q;
   const double numerator = dx * quadric.q_mu[0] + dy * quadric.q_mu[1] + quadric.q_mu[2];
   const double denominator = dx * (q[0] * dx + 2 * (q[1] * dy + q[2])) + dy * (q[3] * dy + 2 * q[4]) + q[5];

@@ -24,9 +24,11 @@ struct RayDepthQuadric {
   double mean_depth = 0;         // where the quadratic form vanishes
 };
 RayDepthQuadric ray_depth_quadric(const GaussianScene& scene, size_t i, const Camera& camera);
-// The depth of the density maximum along the ray through image point (x, y) (pixel centres at
-// + 0.5); the mean depth where d . Q d is not positive or t is not finite (as the GPU falls back).
-double ray_depth(const RayDepthQuadric& quadric, const Camera& camera, double x, double y);
+// The ray d = (dx, dy, 1) through image point (x, y) (pixel centres at + 0.5): (dx, dy).
+std::array<double, 2> pixel_direction(const Camera& camera, double x, double y);
+// The depth of the density maximum along the ray with direction `d` (pixel_direction); the mean depth
+// where d . Q d is not positive or t is not finite (as the GPU falls back).
+double ray_depth(const RayDepthQuadric& quadric, const std::array<double, 2>& d);
 
 // A queue of at most `capacity` items ordered by depth, as the GPU's re-sorting composite keeps its
 // window (composite_resort.comp): offering an item to a full queue releases the

@@ -276,6 +276,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
                 if (alpha >= 0 && !blend(splats[*it], alpha)) break;
               }
             } else {
+              const std::array<double, 2> direction = reference::pixel_direction(camera, pixel_x, pixel_y);
               bool done = false;
               auto release = [&](const std::pair<uint32_t, double>& entry) {
                 done = done || !blend(splats[entry.first], entry.second);
@@ -284,8 +285,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
               for (const uint32_t* it = list_begin; it != list_end && !done; ++it) {
                 const double alpha = alpha_at(splats[*it]);
                 if (alpha >= 0)
-                  queue.offer(reference::ray_depth(quadrics[*it], camera, pixel_x, pixel_y), {*it, alpha},
-                              release);
+                  queue.offer(reference::ray_depth(quadrics[*it], direction), {*it, alpha}, release);
               }
               queue.flush(release);
             }
