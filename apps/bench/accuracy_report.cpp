@@ -426,9 +426,8 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
           cli::format_number(kFlickerThreshold, 2) + " (flicker), and " +
           cli::format_number(100.0 * report.reference_pops, 3) +
           "% of pixels popping: their second difference over three frames exceeds that (`popping()`, which "
-          "smooth motion cancels). Warped pops: each frame warped onto the next by its rendered depth, what "
-          "the "
-          "motion reveals or hides left out, the share of " +
+          "smooth motion cancels). Warped pops: each frame warped onto the next by its rendered depth, "
+          "what the motion reveals or hides left out, the share of " +
           std::to_string(kWarpBlock) + "x" + std::to_string(kWarpBlock) + " blocks differing by more than " +
           cli::format_number(kWarpThreshold, 2) + " (`depth_warp_difference()`; the float64 reference: " +
           cli::format_number(100.0 * report.reference_warp_pops, 3) +
