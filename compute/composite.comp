@@ -22,6 +22,12 @@
 // that stays within the limit (GPUs use one chunk). Chunk 0 records the longest list that did not
 // fit, and the host re-renders the frame with enough chunks.
 //
+// A scene rendered in depth-ordered parts (Renderer::render with a memory budget) composites each part's
+// lists in turn: COMPOSITE_CARRY_IN starts each pixel from the state the previous part left, and
+// COMPOSITE_CARRY_OUT leaves the state for the next part instead of writing the outputs. The state
+// buffer then has two halves, read from one and written to the other (COMPOSITE_STATE_HIGH says which
+// is written), so that a part whose composite re-runs (more chunks) starts again from intact state.
+//
 // A host's depth (HOST_DEPTH): a splat blends into a pixel only in front of the surface the host drew
 // there (its view depth in host_z, +inf where none), which is opaque. SURFACE_DEPTH writes the view
 // depth of the splat at which a pixel's alpha first reaches surface_alpha (0 where it never does),
@@ -190,13 +196,20 @@ void main() {
 
   uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
   uint list_length = range.y - range.x;
-  bool resume = CHUNKED && pc.chunk_start > 0;
-  if (resume && list_length <= pc.chunk_start) return;  // an earlier chunk finished this tile
-  if (!resume && list_length > pc.chunk_size && thread == 0)
+  if (CHUNKED && pc.chunk_start > 0 && list_length <= pc.chunk_start) return;  // an earlier chunk finished this tile
+  if (pc.chunk_start == 0 && list_length > pc.chunk_size && thread == 0)
     atomicMax(pc.counters.v[COUNTER_MAX_TILE_PAIRS], list_length);
   uint list_begin = range.x + pc.chunk_start;
   uint list_end = list_length - pc.chunk_start <= pc.chunk_size ? range.y : list_begin + pc.chunk_size;
-  bool write_outputs = !CHUNKED || list_end == range.y || pc.last_chunk != 0;
+  // The state this dispatch reads: the previous chunk's, or at chunk 0 the previous part's (the other
+  // half of the buffer); it writes its own half. Without parts, one half (COMPOSITE_STATE_HIGH off).
+  uint half_vec4s = 2 * pc.width * pc.height;
+  uint state_out = (pc.flags & COMPOSITE_STATE_HIGH) != 0 ? half_vec4s : 0u;
+  bool carry_in = CHUNKED && (pc.flags & COMPOSITE_CARRY_IN) != 0;
+  bool resume = CHUNKED && (pc.chunk_start > 0 || carry_in);
+  uint state_in = pc.chunk_start > 0 ? state_out : half_vec4s - state_out;
+  bool tile_done = list_end == range.y || (pc.flags & COMPOSITE_LAST_CHUNK) != 0;
+  bool write_outputs = !CHUNKED || ((pc.flags & COMPOSITE_CARRY_OUT) == 0 && tile_done);
 
   for (uint p = 0; p < P; ++p) {
     bool outside = px >= pc.width || py0 + p >= pc.height;
@@ -209,8 +222,8 @@ void main() {
     if (HOST_DEPTH) host_z[p] = outside ? 0.0 : pc.host_z.v[(py0 + p) * pc.width + px];
     if (resume && !outside) {
       uint i = (py0 + p) * pc.width + px;
-      vec4 colour_T = pc.state.v[2 * i];
-      vec4 sums = pc.state.v[2 * i + 1];
+      vec4 colour_T = pc.state.v[state_in + 2 * i];
+      vec4 sums = pc.state.v[state_in + 2 * i + 1];
       colour[p] = colour_T.rgb;
       T[p] = colour_T.a;
       depth_sum[p] = sums.x;
@@ -297,8 +310,8 @@ void main() {
     if (px >= pc.width || py >= pc.height) continue;
     uint i = py * pc.width + px;
     if (!write_outputs) {
-      pc.state.v[2 * i] = vec4(colour[p], T[p]);
-      pc.state.v[2 * i + 1] = vec4(depth_sum[p], weight_sum[p], uintBitsToFloat(blended[p]), surface[p]);
+      pc.state.v[state_out + 2 * i] = vec4(colour[p], T[p]);
+      pc.state.v[state_out + 2 * i + 1] = vec4(depth_sum[p], weight_sum[p], uintBitsToFloat(blended[p]), surface[p]);
       continue;
     }
     float transmittance = abs(T[p]);

@@ -90,6 +90,12 @@ TS_CONST uint RAY_DEPTH_VEC4S = 3;
 // The push constants, the composites first. A shader declares the block of its pass by defining
 // the macro before including common.glsl; C++ sees them all.
 
+// CompositePush::flags.
+TS_CONST uint COMPOSITE_LAST_CHUNK = 1;  // the last dispatch: write the outputs whatever is left
+TS_CONST uint COMPOSITE_CARRY_IN = 2;    // a later part of the scene: start from the previous part's state
+TS_CONST uint COMPOSITE_CARRY_OUT = 4;   // not the last part: leave the state for the next, no outputs
+TS_CONST uint COMPOSITE_STATE_HIGH = 8;  // write the state buffer's upper half (read the lower at chunk 0)
+
 #if defined(__cplusplus) || defined(TS_COMPOSITE_PUSH)
 // composite.comp (CompositePass).
 TS_PUSH_CONSTANTS(CompositePush) {
@@ -110,7 +116,7 @@ TS_PUSH_CONSTANTS(CompositePush) {
   uint tiles_x;
   uint chunk_start;  // position in each tile's list where this dispatch starts
   uint chunk_size;   // splats per tile this dispatch blends at most
-  uint last_chunk;   // 1: write the outputs whatever is left
+  uint flags;        // COMPOSITE_LAST_CHUNK, COMPOSITE_CARRY_IN, COMPOSITE_CARRY_OUT, COMPOSITE_STATE_HIGH
   float surface_alpha;
 }
 TS_PUSH_INSTANCE;

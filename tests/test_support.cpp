@@ -119,8 +119,7 @@ void expect_composite_layouts_identical(const GaussianScene& scene, const Camera
     auto renderer = Renderer::create(options);
     ::unsetenv("TILESPLAT_COMPOSITE_PIXELS");
     ::unsetenv("TILESPLAT_TEXEL_BUFFERS");
-    renderer->set_scene(scene);
-    images.push_back(renderer->render(camera, settings));
+    images.push_back(renderer->render(scene, camera, settings));  // in parts under settings.memory_budget
     EXPECT_EQ(renderer->validation_messages(), 0u)
         << layout.pixels << " pixels per invocation, texel buffers " << layout.texel_buffers;
   }

@@ -45,6 +45,7 @@ Renderer& validated_renderer();
 // buffers (TILESPLAT_TEXEL_BUFFERS overrides it). Renders the scene once in each layout (1 pixel per
 // invocation; 4 with texel buffers; 16 without and with), each with a fresh validated renderer, and
 // expects them to agree bit for bit (rgba, depth, splat counts) and the validation layer to stay silent.
+// With a RenderSettings::memory_budget the scene may render in parts, in every layout.
 void expect_composite_layouts_identical(const GaussianScene& scene, const Camera& camera,
                                         const RenderSettings& settings = {});
 

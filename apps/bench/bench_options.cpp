@@ -48,6 +48,13 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
   parser.add_int("--repeat", "N",
                  "frames measured per camera and sort (default 10): the median, min and max are over these",
                  &options.repeat, 1, 1000000);
+  parser.add_value("--memory-budget", "SIZE",
+                   "render every frame within this much device memory, e.g. 512M: a scene whose frame needs "
+                   "more renders in depth-ordered parts (docs/big-scenes.md); the table adds the parts and "
+                   "the peak device memory (frame benchmark only; default: no budget)",
+                   [&options](const std::string& text) {
+                     options.memory_budget = cli::parse_byte_size("--memory-budget", text);
+                   });
   parser.add_string(
       "--csv", "FILE.csv",
       "also write the results as CSV: one line per scene, size, view, sort and metric; with several "
@@ -209,6 +216,9 @@ void check_frame_options(const cli::ArgParser& parser, const BenchOptions& optio
     throw cli::UsageError("--accuracy, --effects, --formats and --scaling are separate runs");
   if (parser.seen("--tile-copies") && !options.scaling)
     throw cli::UsageError("--tile-copies applies only with --scaling");
+  if (parser.seen("--memory-budget") &&
+      (options.accuracy || options.effects || options.formats || options.scaling))
+    throw cli::UsageError("--memory-budget applies only to the frame benchmark");
   if (!options.accuracy) {
     if (parser.seen("--path-frames")) throw cli::UsageError("--path-frames applies only with --accuracy");
     if (parser.seen("--markdown") && !options.effects && !options.formats && !options.scaling)

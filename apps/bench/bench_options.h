@@ -1,6 +1,7 @@
 // tilesplat-bench's options: the flags of every mode and the checks that span several of them.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -40,6 +41,7 @@ struct BenchOptions {
   bool formats = false;   // --formats: what each file of a scene costs against its lossless PLY
   bool scaling = false;   // --scaling: frame time and memory against Gaussian count and image size
   int tile_copies = 0;    // --tile-copies N: with --scaling, also N copies of the largest scene
+  uint64_t memory_budget = 0;  // --memory-budget: frames under RenderSettings::memory_budget (0: none)
   std::string markdown;
   accuracy::CameraPath path = accuracy::CameraPath::kPan;
   int path_frames = 6;

@@ -86,6 +86,10 @@ class Collector {
     add_frame("retries", Unit::kCount, double(stats.retries));
     add_frame("sort fallbacks", Unit::kCount, double(stats.sort_fallbacks));
     add_frame("device memory", Unit::kMebibytes, double(stats.device_bytes) / (1024.0 * 1024.0));
+    if (stats.scene_parts > 1) {  // a scene rendered in depth-ordered parts (--memory-budget)
+      add_frame("scene parts", Unit::kCount, double(stats.scene_parts));
+      add_frame("peak device memory", Unit::kMebibytes, double(stats.peak_device_bytes) / (1024.0 * 1024.0));
+    }
   }
 
   StrategyResult take() { return std::move(result_); }

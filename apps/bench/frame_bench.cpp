@@ -395,8 +395,10 @@ int run_frame_bench(const BenchOptions& options) {
     for (size_t i = 0; i < cases.size(); ++i) {
       Case& c = cases[i];
       BenchScene& scene = scenes[c.scene];
-      // One renderer for the whole run: set_scene replaces the scene, once per scene.
-      if (i == 0 || cases[i - 1].scene != c.scene) renderer->set_scene(scene.loaded.scene);
+      // One renderer for the whole run: set_scene replaces the scene, once per scene. Under a memory
+      // budget every frame takes the scene instead (in parts where it does not fit).
+      const bool budgeted = options.memory_budget > 0;
+      if (!budgeted && (i == 0 || cases[i - 1].scene != c.scene)) renderer->set_scene(scene.loaded.scene);
       const std::string where = scene.name + " " + size_of(c) + " " + c.view_label + " ";
       for (const auto& sort : sorts) {
         tilesplat::RenderSettings settings;
@@ -404,13 +406,16 @@ int run_frame_bench(const BenchOptions& options) {
         settings.reuse_lists =
             false;  // every measured frame is a whole frame, not a composite on reused lists
         if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
+        settings.memory_budget = options.memory_budget;
         cli::apply_scene_settings(scene.loaded, settings);
         cli::apply_training_options(options.common, settings);
         Collector collector(sort);
         for (int frame = 0; frame < frames_per_row; ++frame) {
           // Rendering reads the image back, which is part of cpu frame; the first measured image of
           // each strategy is kept to check that the strategies agree.
-          tilesplat::RenderImage image = renderer->render(c.camera.camera, settings);
+          tilesplat::RenderImage image = budgeted
+                                             ? renderer->render(scene.loaded.scene, c.camera.camera, settings)
+                                             : renderer->render(c.camera.camera, settings);
           if (frame == options.warmup) images.push_back(std::move(image));
           if (frame >= options.warmup) collector.add(renderer->last_frame_stats());
           progress.update(++done, where + sort);

@@ -281,6 +281,27 @@ double parse_double(std::string_view flag, std::string_view text) {
   return value;
 }
 
+uint64_t parse_byte_size(std::string_view flag, std::string_view text) {
+  const std::string trimmed = trim(text);
+  const std::string expectation =
+      std::string(flag) + " expects a size in bytes (512M, 1.5G, 8GiB, 1048576), got " + single_quoted(text);
+  double value = 0;
+  const auto [end, error] = std::from_chars(trimmed.data(), trimmed.data() + trimmed.size(), value);
+  if (trimmed.empty() || error != std::errc()) throw UsageError(expectation);
+  std::string unit(end, trimmed.data() + trimmed.size());
+  if (unit.ends_with("iB")) unit.resize(unit.size() - 2);
+  const std::string units = "KMGT";
+  double scale = 1;
+  if (unit.size() == 1 && units.find(unit[0]) != std::string::npos)
+    scale = std::ldexp(1.0, 10 * int(units.find(unit[0]) + 1));
+  else if (!unit.empty() && unit != "B")
+    throw UsageError(expectation);
+  const double bytes = value * scale;
+  if (!std::isfinite(bytes) || bytes < 1 || bytes > 0x1p63)
+    throw UsageError(std::string(flag) + " must be a positive size below 8 EiB, got " + single_quoted(text));
+  return uint64_t(bytes);
+}
+
 std::array<float, 3> parse_rgb(std::string_view flag, std::string_view text) {
   const auto parts = split(text, ',');
   const std::string expectation =

@@ -93,6 +93,9 @@ int parse_int(std::string_view flag, std::string_view text, int min, int max);
 double parse_double(std::string_view flag, std::string_view text);
 // "r,g,b": three finite floats.
 std::array<float, 3> parse_rgb(std::string_view flag, std::string_view text);
+// A positive size in bytes: a number with an optional binary unit, K, M, G or T (KiB, MiB, GiB, TiB
+// too): "512M", "1.5G", "8GiB", "1048576".
+uint64_t parse_byte_size(std::string_view flag, std::string_view text);
 
 struct ImageSize {
   int width = 0;

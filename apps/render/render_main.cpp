@@ -113,7 +113,11 @@ void print_frame_stats(const tilesplat::FrameStats& stats, const tilesplat::Devi
   print_row("sort", stats.sort_strategy, "");
   print_row("sort bits", std::to_string(stats.sort_bits), "");
   print_row("retries", std::to_string(stats.retries), "");
-  print_row("device memory", cli::format_fixed(double(stats.device_bytes) / (1024.0 * 1024.0), 2), "MiB");
+  auto mib = [](uint64_t bytes) { return cli::format_fixed(double(bytes) / (1024.0 * 1024.0), 2); };
+  print_row("device memory", mib(stats.device_bytes), "MiB");
+  print_row("peak device memory", mib(stats.peak_device_bytes), "MiB");
+  print_row("scene parts", std::to_string(stats.scene_parts), "");
+  print_row("peak resident memory", mib(cli::peak_memory_bytes()), "MiB");
 }
 
 
@@ -272,14 +276,15 @@ struct FrameWriter {
 class FrameRenderer {
  public:
   FrameRenderer(const RenderOptions& options, const tilesplat::GaussianScene& scene)
-      : scene_(scene), lens_(options.lens) {
+      : scene_(scene), lens_(options.lens), in_parts_(options.memory_budget > 0) {
     if (lens_.enabled()) {
       const tilesplat::Bounds bounds = tilesplat::compute_bounds(scene);
       scene_centre_ = {bounds.center[0], bounds.center[1], bounds.center[2]};
     }
     if (options.reference) return;
     renderer_ = tilesplat::Renderer::create(cli::renderer_options(options.common));
-    renderer_->set_scene(scene);
+    // Under a memory budget each frame takes the scene (in parts where it does not fit).
+    if (!in_parts_) renderer_->set_scene(scene);
   }
 
   tilesplat::RenderImage render(const tilesplat::Camera& camera,
@@ -289,7 +294,7 @@ class FrameRenderer {
     if (lens_.enabled()) settings.lens = lens_for_frame(lens_, camera, scene_centre_);
     tilesplat::RenderImage image;
     if (renderer_) {
-      image = renderer_->render(camera, settings);
+      image = in_parts_ ? renderer_->render(scene_, camera, settings) : renderer_->render(camera, settings);
       gpu_ms_ = renderer_->last_frame_stats().gpu_ms;
       cpu_ms_ = renderer_->last_frame_stats().cpu_ms;
     } else {
@@ -320,6 +325,7 @@ class FrameRenderer {
  private:
   const tilesplat::GaussianScene& scene_;
   LensFlags lens_;
+  bool in_parts_ = false;                           // --memory-budget
   std::array<double, 3> scene_centre_ = {0, 0, 0};  // where the lens focuses unless --focus-distance says
   std::unique_ptr<tilesplat::Renderer> renderer_;
   double gpu_ms_ = 0, cpu_ms_ = 0;
@@ -478,6 +484,7 @@ int run(int argc, char** argv) {
   if (parser.seen("--background") || !loaded.description) settings.background = options.background;
   if (options.no_depth) settings.depth = false;
   if (options.no_count) settings.splat_count = false;
+  settings.memory_budget = options.memory_budget;
   cli::apply_training_options(options.common, settings);
   if (options.stochastic_frames > 0) {  // --compositor stochastic or none (check_render_options)
     settings.compositor = tilesplat::Compositor::kStochastic;

@@ -223,8 +223,15 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
       &options.camera_model.equirectangular);
   parser.add_switch("--stats",
                     "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
-                    "intersections, retries",
+                    "intersections, retries, device memory and its peak, scene parts, peak resident memory",
                     &options.stats);
+  parser.add_value("--memory-budget", "SIZE",
+                   "device memory a frame may hold, e.g. 512M or 2G: a scene whose frame needs more renders "
+                   "in parts that follow the depth order, into the same image bit for bit "
+                   "(docs/big-scenes.md; default: no budget)",
+                   [&options](const std::string& text) {
+                     options.memory_budget = cli::parse_byte_size("--memory-budget", text);
+                   });
 
   parser.section("many frames (one process; -o and --png then take a frame number: out/view_%04d.exr)");
   parser.add_string(
@@ -282,6 +289,10 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
                              {"--png", options.png}});
   const bool stochastic =
       parser.seen("--stochastic") || options.common.compositor == tilesplat::Compositor::kStochastic;
+  if (options.reference && options.memory_budget > 0)
+    throw cli::UsageError(
+        "--memory-budget bounds the GPU renderer's device memory; the --reference renderer renders on the "
+        "host");
   if (options.reference && stochastic)
     throw cli::UsageError(
         "the stochastic compositor is the GPU's; the --reference renderer has the sorted and raster rules");

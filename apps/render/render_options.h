@@ -91,6 +91,7 @@ struct RenderOptions {
   CameraModelFlags camera_model;
   ShutterFlags shutter;
   bool stats = false;
+  uint64_t memory_budget = 0;  // --memory-budget: RenderSettings::memory_budget (0: none)
   // Many frames in one run.
   std::string views;      // --views: a selection of the camera set's views
   int orbit_frames = 0;   // --orbit N

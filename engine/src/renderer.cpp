@@ -44,15 +44,20 @@ uint64_t Renderer::Impl::device_bytes() const {
 }
 
 Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, const RenderSettings& settings,
-                                                       bool depth_image, bool without_waiting) {
+                                                       bool depth_image, bool without_waiting,
+                                                       const ScenePart& part) {
+  if (scene_in_parts && part.whole())
+    throw std::logic_error(
+        "the renderer holds the last part of a scene rendered in parts (render(scene, camera, settings) "
+        "under a memory budget), not a whole scene: call set_scene before render(camera, settings)");
   FrameStart start;
   start.time = std::chrono::steady_clock::now();
   wait_for_submitted_frame();
   const DeviceCaps device = device_caps();
   start.sorter = &sort(choose_sort_strategy(settings.sort, device, without_waiting));
   const SortTraits traits{start.sorter->name(), start.sorter->frame_plan(), start.sorter->sorts_on_host()};
-  start.plan = plan_frame(camera, settings,
-                          {resources.scene_shape(scene_generation), device, traits, lists, depth_image});
+  start.plan = plan_frame(
+      camera, settings, {resources.scene_shape(scene_generation), device, traits, lists, depth_image, part});
   resources.prepare_outputs(start.plan, settings);
   stats = {};
   lists.reset();  // valid again once this frame's lists are complete (not if it throws)
@@ -77,8 +82,8 @@ FrameCounters Renderer::Impl::run_frame(const FramePlan& plan, const RenderSetti
 // grow, or re-runs its composite when a tile's list needs more composite chunks than it had (CPU
 // drivers only; the lists are complete then). A frame on reused lists cannot overflow.
 void Renderer::Impl::render_frame(const Camera& camera, const RenderSettings& settings,
-                                  const ExternalDepthImage* depth_image) {
-  const FrameStart start = begin_frame(camera, settings, depth_image != nullptr);
+                                  const ExternalDepthImage* depth_image, const ScenePart& part) {
+  const FrameStart start = begin_frame(camera, settings, depth_image != nullptr, false, part);
   const FramePlan& plan = start.plan;
   SortStrategy& sorter = *start.sorter;
   uint32_t& chunks = recorder.composite_chunks(plan.compositor);
@@ -88,7 +93,7 @@ void Renderer::Impl::render_frame(const Camera& camera, const RenderSettings& se
     add_timings(passes);
     if (frame.overflow) {
       if (retry > kMaxRetries) throw FrameResources::beyond_key_limit(frame, camera);
-      resources.grow_keys_for(frame, camera);
+      resources.grow_keys_for(frame, camera, /*tight=*/!part.whole());
       frame = run_frame(plan, settings, sorter, depth_image);
       stats.retries = retry;
       continue;
@@ -144,6 +149,7 @@ void Renderer::Impl::end_frame(const FrameStart& start, const FrameCounters& fra
   stats.intersections = frame.tile_sort.count;
   stats.sort_fallbacks = start.sorter->stall_fallbacks() - start.fallbacks_before;
   stats.device_bytes = device_bytes();
+  stats.peak_device_bytes = stats.device_bytes;
   stats.uploaded_bytes = ctx.uploaded_bytes() - uploaded_bytes_reported;
   uploaded_bytes_reported = ctx.uploaded_bytes();
 }
@@ -167,6 +173,7 @@ void Renderer::set_scene(const GaussianScene& scene) {
   r.wait_for_submitted_frame();  // it reads the scene's buffers
   ++r.scene_generation;          // the tile lists in the buffers are the previous scene's
   r.resources.upload_scene(scene);
+  r.scene_in_parts = false;
 }
 
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
@@ -189,16 +196,21 @@ RenderImage Renderer::render(const Camera& camera, const RenderSettings& setting
     return image;
   }
   r.render_frame(camera, settings);
+  RenderImage image = r.read_image(camera, settings);
+  r.stats.cpu_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return image;
+}
+
+RenderImage Renderer::Impl::read_image(const Camera& camera, const RenderSettings& settings) {
   RenderImage image;
   image.width = camera.width;
   image.height = camera.height;
   const size_t pixels = image.pixels();
-  r.read_output(r.resources.outputs.rgba, image.rgba, pixels * 4);
-  if (settings.depth) r.read_output(r.resources.outputs.depth, image.depth, pixels);
-  if (settings.splat_count) r.read_output(r.resources.outputs.count, image.splat_count, pixels);
-  if (settings.host && settings.host->write_depth)
-    r.read_host_depth(*settings.host, image.host_depth, pixels);
-  r.stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  read_output(resources.outputs.rgba, image.rgba, pixels * 4);
+  if (settings.depth) read_output(resources.outputs.depth, image.depth, pixels);
+  if (settings.splat_count) read_output(resources.outputs.count, image.splat_count, pixels);
+  if (settings.host && settings.host->write_depth) read_host_depth(*settings.host, image.host_depth, pixels);
   return image;
 }
 

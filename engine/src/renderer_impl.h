@@ -18,6 +18,7 @@
 #include "frame/frame_plan.h"
 #include "frame/frame_recorder.h"
 #include "frame/frame_resources.h"
+#include "frame/scene_parts.h"
 #include "sort/sort_strategy.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/vulkan_interop.h"
@@ -50,14 +51,23 @@ struct Renderer::Impl {
   // frame reads from the host. Waits for a frame in flight first: its buffers are the same.
   // without_waiting: a frame render_to_image submits or records and returns (choose_sort_strategy).
   FrameStart begin_frame(const Camera& camera, const RenderSettings& settings, bool depth_image,
-                         bool without_waiting = false);
+                         bool without_waiting = false, const ScenePart& part = {});
   // Records and runs one attempt at the plan; returns the counters the GPU wrote. A composite-only
   // frame rewrites only max_tile_pairs, so the others still describe the lists it read.
   FrameCounters run_frame(const FramePlan& plan, const RenderSettings& settings, SortStrategy& sorter,
                           const ExternalDepthImage* depth_image);
   // Renders into the output buffers with retries, and fills the statistics (all but cpu_ms).
   void render_frame(const Camera& camera, const RenderSettings& settings,
-                    const ExternalDepthImage* depth_image = nullptr);
+                    const ExternalDepthImage* depth_image = nullptr, const ScenePart& part = {});
+  // The frame's images, read back from the outputs.
+  RenderImage read_image(const Camera& camera, const RenderSettings& settings);
+  // A scene within a memory budget (renderer_parts.cpp): whether its frame would exceed
+  // settings.memory_budget, and the rendering in depth-ordered parts that leaves the image in the
+  // outputs and the parts' statistics.
+  bool needs_parts(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings);
+  void render_in_parts(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings);
+  PartCosts part_costs_for(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+                           const std::string& sort_name);
   void end_frame(const FrameStart& start, const FrameCounters& frame, std::vector<PassTiming> passes,
                  bool lists_whole);
   void add_timings(std::vector<PassTiming>& passes);
@@ -100,7 +110,8 @@ struct Renderer::Impl {
   // The tile lists in the buffers: what they were built for (none after set_scene or a frame that
   // failed).
   std::optional<ListKey> lists;
-  uint64_t scene_generation = 0;            // counts set_scene calls
+  uint64_t scene_generation = 0;            // counts set_scene calls (and scene parts uploaded)
+  bool scene_in_parts = false;              // the buffers hold a part of a scene, not a whole one
   uint64_t uploaded_bytes_reported = 0;     // vk::Context::uploaded_bytes() at the last frame's statistics
   std::optional<SubmittedFrame> submitted;  // the frame render_to_image submitted without waiting
   // Its fence and command buffer: declared last, so that it is destroyed first and waits for the

@@ -110,7 +110,7 @@ RenderSettings make_settings(const std::string& sort, bool depth, bool splat_cou
                              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
                              const std::array<float, 3>& background, bool reuse_lists, double near_plane,
                              double max_alpha, const std::optional<ThinLens>& lens,
-                             const std::optional<Shutter>& shutter) {
+                             const std::optional<Shutter>& shutter, uint64_t memory_budget) {
   RenderSettings settings;
   settings.sort = sort;
   settings.depth = depth;
@@ -130,6 +130,7 @@ RenderSettings make_settings(const std::string& sort, bool depth, bool splat_cou
   settings.max_alpha = max_alpha;
   if (lens) settings.lens = *lens;
   if (shutter) settings.shutter = *shutter;
+  settings.memory_budget = memory_budget;
   return settings;
 }
 
@@ -150,6 +151,8 @@ nb::dict stats_dict(const FrameStats& stats) {
   out["device_bytes"] = stats.device_bytes;
   out["reused_sorted_lists"] = stats.reused_sorted_lists;
   out["samples"] = stats.samples;  // frames averaged (lens, shutter)
+  out["scene_parts"] = stats.scene_parts;  // depth-ordered parts under a memory budget
+  out["peak_device_bytes"] = stats.peak_device_bytes;
   return out;
 }
 
@@ -558,19 +561,24 @@ void bind(nb::module_& m) {
              bool splat_count, const std::string& accuracy, const std::string& antialiasing,
              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
              const std::array<float, 3>& background, bool reuse_lists, double near_plane, double max_alpha,
-             const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter) {
-            const RenderSettings settings =
-                make_settings(sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames,
-                              seed, background, reuse_lists, near_plane, max_alpha, lens, shutter);
+             const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter,
+             const GaussianScene* scene, uint64_t memory_budget) {
+            const RenderSettings settings = make_settings(
+                sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames, seed,
+                background, reuse_lists, near_plane, max_alpha, lens, shutter, memory_budget);
             nb::gil_scoped_release release;
-            return self.renderer->render(camera, settings);
+            return scene ? self.renderer->render(*scene, camera, settings)
+                         : self.renderer->render(camera, settings);
           },
           "camera"_a, "sort"_a = "auto", "depth"_a = true, "splat_count"_a = true, "accuracy"_a = "reference",
           "antialiasing"_a = "classic", "compositor"_a = "sorted", "stochastic_frames"_a = 16, "seed"_a = 1,
           "background"_a = std::array<float, 3>{0, 0, 0}, "reuse_lists"_a = true,
           "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
-          "shutter"_a = nb::none(),
-          "Renders the scene from `camera`. Keyword arguments are RenderSettings' fields: accuracy is a mode "
+          "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0,
+          "Renders the scene from `camera`: the one set_scene uploaded, or `scene`, which replaces it and is "
+          "rendered within memory_budget bytes of device memory (0: none), in depth-ordered parts into the "
+          "same image where the whole frame would need more (docs/big-scenes.md). "
+          "Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted', 'stochastic' or 'raster' (the depth-sorted splats drawn as quads by the "
           "graphics pipeline); near_plane the view depth at or below which a Gaussian is "

@@ -128,6 +128,22 @@ def test_settings_are_keyword_arguments(playbot_renderer):
     assert white.rgba[0, 0, :3].min() > 0.5 or exact.rgba[0, 0, 3] > 0.5
 
 
+def test_a_scene_in_parts_under_a_memory_budget(playbot_renderer):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 160, 90, azimuth_deg=30)
+    whole = renderer.render(camera)
+    other = tilesplat.Renderer(validation=True)
+    parts = other.render(camera, scene=scene, memory_budget=4 << 20)
+    stats = other.last_frame_stats
+    assert stats["scene_parts"] >= 4 and stats["peak_device_bytes"] <= (4 << 20) * 1.01
+    assert np.array_equal(parts.rgba, whole.rgba)
+    assert np.array_equal(parts.depth, whole.depth)
+    assert np.array_equal(parts.splat_count, whole.splat_count)
+    with pytest.raises(ValueError, match="leaves no room for a Gaussian"):
+        other.render(camera, scene=scene, memory_budget=1 << 16)
+    assert other.validation_messages == 0
+
+
 def test_raster_compositor(playbot_renderer):
     scene, renderer = playbot_renderer
     camera = tilesplat.Camera.orbit(scene, 96, 54)

@@ -212,6 +212,11 @@ struct RenderSettings {
   /// Motion blur: a shutter open over camera motion (tilesplat/shutter.h). Off by default (closed, no end
   /// camera). Taken and refused where the lens is; with both, every time sample is a lens frame.
   Shutter shutter;
+  /// Device memory, in bytes, that Renderer::render(scene, camera, settings) may hold for a frame: a
+  /// scene whose frame would need more is rendered in parts that follow the depth order, each within
+  /// the budget, into the same image bit for bit (docs/big-scenes.md). 0 (the default): no budget, the
+  /// scene is rendered whole. render(camera, settings) on a scene set_scene uploaded ignores it.
+  uint64_t memory_budget = 0;
 };
 
 }  // namespace tilesplat

@@ -76,6 +76,13 @@ struct FrameStats {
   /// (RenderSettings::lens, shutter). Over several, gpu_ms and passes are the sums, visible and
   /// intersections the largest of any sample.
   int samples = 1;
+  /// Parts the scene was rendered in (Renderer::render(scene, camera, settings) under
+  /// RenderSettings::memory_budget): 1 for a whole scene. Over several, gpu_ms, passes, visible,
+  /// intersections, retries, submissions and uploaded_bytes are the sums over the parts.
+  int scene_parts = 1;
+  /// The most device memory the renderer's buffers held at the end of any part (device_bytes is the
+  /// last part's); the same as device_bytes for a whole scene.
+  uint64_t peak_device_bytes = 0;
 };
 
 /// The Vulkan device a renderer runs on, and the limits that shape its passes.
@@ -142,6 +149,17 @@ class TILESPLAT_API Renderer {
   /// beyond the device's limits) and std::invalid_argument for invalid settings (accuracy modes,
   /// lights, compositor) or an unknown sort strategy. The renderer stays usable after either.
   RenderImage render(const Camera& camera, const RenderSettings& settings = {});
+
+  /// Renders one frame of `scene`, which replaces the scene last set, within settings.memory_budget:
+  /// whole (as set_scene and render(camera, settings)) when its frame fits the budget or there is none;
+  /// else in parts that follow the frame's depth order (docs/big-scenes.md), each part's Gaussians
+  /// uploaded, sorted and composited in turn with every pixel's state carried to the next, into the
+  /// image the whole scene renders, bit for bit. The scene is read during the call only. After a frame
+  /// in parts the renderer holds no whole scene: render(camera, settings) needs a set_scene first.
+  /// Parts take the sorted compositor, 24- or 32-bit depth keys, an exact sort strategy and no
+  /// per-pixel re-sorting (std::invalid_argument otherwise, and for a budget too small for one
+  /// Gaussian); otherwise it throws as set_scene and render do.
+  RenderImage render(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings = {});
 
   /// What the last render() (or render_to_image()) did and cost. The reference is valid until the
   /// next frame. A frame render_to_image submitted without waiting (HostFrameSync) is described once

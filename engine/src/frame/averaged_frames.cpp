@@ -145,6 +145,8 @@ void add_sample_stats(FrameStats& frame, const FrameStats& sample) {
   frame.submissions += sample.submissions;
   frame.sort_fallbacks += sample.sort_fallbacks;
   frame.device_bytes = std::max(frame.device_bytes, sample.device_bytes);
+  frame.peak_device_bytes = std::max(frame.peak_device_bytes, sample.peak_device_bytes);
+  frame.scene_parts = std::max(frame.scene_parts, sample.scene_parts);
   frame.uploaded_bytes += sample.uploaded_bytes;
   frame.reused_sorted_lists = frame.reused_sorted_lists && sample.reused_sorted_lists;
   frame.complete = frame.complete && sample.complete;

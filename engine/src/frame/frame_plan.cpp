@@ -76,6 +76,30 @@ void validate_compositor(const RenderSettings& settings) {
          std::to_string(settings.stochastic.frames));
 }
 
+}  // namespace
+
+// Each part's lists are exact only for an order every part agrees on.
+void validate_scene_parts(const RenderSettings& settings, const std::string& sort_name) {
+  auto fail = [](const std::string& why) {
+    throw std::invalid_argument("a scene rendered in parts (memory budget): " + why);
+  };
+  if (settings.compositor != Compositor::kSorted)
+    fail(std::string(settings.compositor == Compositor::kRaster ? "the raster" : "the stochastic") +
+         " compositor has no per-pixel state to carry from part to part: use the sorted compositor");
+  if (settings.accuracy.resort_window > 0)
+    fail("per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
+         ") re-orders within a window that would stop at each part's end: render without it");
+  if (settings.accuracy.depth_key_bits == 16)
+    fail(
+        "16-bit depth keys are quantized over each frame's visible depth range, which differs from part to "
+        "part: use 24- or 32-bit keys");
+  if (!sort_strategy_exact(sort_name))
+    fail("the sort strategy '" + sort_name +
+         "' quantizes depths per frame, which differs from part to part: " + "use an exact strategy");
+}
+
+namespace {
+
 TileGrid tile_grid(const Camera& camera) {
   TileGrid grid;
   grid.width = uint32_t(camera.width);
@@ -222,6 +246,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
   check_max_alpha(settings);
   check_single_frame(settings);
   check_camera_model(settings, camera);
+  if (!context.part.whole()) validate_scene_parts(settings, context.sort.name);
 
   FramePlan plan;
   plan.sort = context.sort;
@@ -229,7 +254,10 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
                 context.sort.name,        settings.accuracy,
                 settings.antialiasing,    settings.lighting,
                 settings.compositor,      settings.near_plane};
-  plan.build_lists = !(settings.reuse_lists && context.lists && *context.lists == plan.lists);
+  plan.part = context.part;
+  // A part's lists are never whole-scene lists: always built, and never reused (renderer_parts.cpp).
+  plan.build_lists =
+      !(settings.reuse_lists && context.part.whole() && context.lists && *context.lists == plan.lists);
   plan.projection = projection_variant(settings, context.scene, camera_models::drawn_model(camera));
   plan.splat_records = context.scene.count * plan.projection.seam_copies();
   plan.tiles = tile_grid(camera);

@@ -102,6 +102,20 @@ struct TileGrid {
   uint32_t tile_bits = 0;
 };
 
+// One part of a scene rendered in depth-ordered parts (Renderer::render(scene, camera, settings) under
+// RenderSettings::memory_budget, renderer_parts.cpp): part `index`, the last or not. Each part's lists
+// are built and composited like a frame's, each pixel's composite state going on from part to part
+// (CompositePass::Carry); only the last part writes the images. A whole scene is the one part 0.
+struct ScenePart {
+  uint32_t index = 0;
+  bool last = true;
+  bool whole() const { return index == 0 && last; }
+  bool carries_in() const { return index > 0; }
+  bool carries_out() const { return !last; }
+  bool state_high() const { return index % 2 == 1; }  // the composite state's halves alternate
+  bool operator==(const ScenePart&) const = default;
+};
+
 // A frame's use of RenderSettings::host.
 struct HostDepthPlan {
   bool from_memory = false;  // HostDepth::depth uploaded as view depths
@@ -129,6 +143,7 @@ struct FramePlan {
   uint32_t resort_window = 0;       // kResortComposite's window (AccuracyModes::resort_window)
   uint32_t stochastic_samples = 0;  // kStochasticComposite's averaged samples (StochasticSettings::frames)
   HostDepthPlan host;
+  ScenePart part;                 // of a scene rendered in parts (or the whole scene)
   std::vector<FramePass> passes;  // in order
   // The frame ends its command buffer and goes on in another where the host must act: a host sort
   // (SortTraits::sorts_on_host), and the stochastic composite after every 64 samples
@@ -146,12 +161,17 @@ struct FrameContext {
   SortTraits sort;               // of choose_sort_strategy(settings.sort, ...)
   std::optional<ListKey> lists;  // the lists in the buffers, if whole
   bool depth_image = false;      // render_to_image with a host depth image
+  ScenePart part;                // the part of the scene in the buffers
 };
 
 // Validates the camera for this device, the accuracy modes, the compositor's settings and the host
 // depth (throwing std::runtime_error for a camera the device cannot render, std::invalid_argument
 // for settings, as render() documents), then decides the frame.
 FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const FrameContext& context);
+
+// Refuses (std::invalid_argument) settings a scene rendered in depth-ordered parts cannot render
+// exactly: another compositor, per-pixel re-sorting, 16-bit depth keys or an approximate sort.
+void validate_scene_parts(const RenderSettings& settings, const std::string& sort_name);
 
 // The same frame's composite alone, on the lists its first attempt built: the re-run of a composite
 // that needed more dispatches than it had (FrameRecorder::composite_chunks).

@@ -40,14 +40,15 @@ void FrameRecorder::prepare(const FramePlan& plan, const RenderSettings& setting
   const bool needs_state = plan.compositor == Compositor::kStochastic
                                ? StochasticCompositePass::needs_state(plan.stochastic_samples, chunks)
                            : plan.compositor == Compositor::kRaster ? false
-                                                                    : chunks > 1;
+                                                                    : chunks > 1 || !plan.part.whole();
   resources.prepare_frame(plan, needs_state);
   if (plan.compositor == Compositor::kRaster)
     raster_composite_.prepare({plan.tiles.width, plan.tiles.height, settings.depth, settings.splat_count,
                                plan.host.from_memory || plan.host.from_image});
   if (!plan.build_lists) return;
   projection_.prepare(resources.scene, plan.projection);
-  sorter.reserve(std::max(plan.splat_records, resources.keys.capacity));
+  // The depth sort's buffers hold the projected records (more than this frame's after a larger part).
+  sorter.reserve(std::max(resources.projected.records, resources.keys.capacity));
 }
 
 struct FrameRecorder::Recording {
@@ -190,7 +191,8 @@ void FrameRecorder::record_composite(Recording& r, FramePass pass) {
                              r.plan.resort_window, counters);
   else
     composite_.record(r.stream.cmd(), inputs, {sorted_chunks_, res.composite_state, counters},
-                      res.host_surface(r.settings));
+                      res.host_surface(r.settings),
+                      {r.plan.part.carries_in(), r.plan.part.carries_out(), r.plan.part.state_high()});
 }
 
 // The host's depth image into host_window_depth and, as view depths, into host_view_depth.

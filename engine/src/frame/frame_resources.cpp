@@ -33,7 +33,7 @@ vk::Buffer make_buffer(vk::Context& ctx, size_t count, const char* name) {
 FrameResources::FrameResources(vk::Context& ctx)
     : counters(ctx, sizeof(FrameCounters), vk::MemoryUse::Readback, "frame counters"), ctx_(ctx) {}
 
-void FrameResources::upload_scene(const GaussianScene& source) {
+void FrameResources::upload_scene(const GaussianScene& source, bool reuse_buffers) {
   const size_t n = source.size();
   if (n > (1u << 30))
     throw std::runtime_error("scene has " + std::to_string(n) + " Gaussians; the limit is 2^30");
@@ -44,7 +44,8 @@ void FrameResources::upload_scene(const GaussianScene& source) {
     throw std::invalid_argument("set_scene: inconsistent GaussianScene array sizes");
   SceneBuffers& s = scene;
   auto upload = [&](vk::Buffer& dst, const std::vector<float>& src, const char* name) {
-    dst = make_buffer<float>(ctx_, src.size(), name);
+    if (!reuse_buffers || dst.size() < src.size() * sizeof(float))
+      dst = make_buffer<float>(ctx_, src.size(), name);
     vk::upload(ctx_, dst, src.data(), src.size() * sizeof(float));
   };
   upload(s.positions, source.positions, "positions");
@@ -69,9 +70,25 @@ void FrameResources::upload_scene(const GaussianScene& source) {
   s.count = uint32_t(n);
   s.sh_degree = source.sh_degree;
 
+  if (reuse_buffers) return;  // a part of a scene: the frame sizes the rest (prepare_frame, reserve_pairs)
   projected = ProjectedBuffers();  // the previous scene's, released before this one's are made
   ensure_projected_records(uint32_t(n));
   ensure_key_capacity(grow_capacity(std::max<uint64_t>(kMinKeyCapacity, 4ull * n)), /*wide=*/false);
+}
+
+void FrameResources::release_scene() {
+  scene = SceneBuffers();
+  projected = ProjectedBuffers();
+  keys = KeyBuffers();
+}
+
+void FrameResources::reserve_pairs(uint64_t pairs, bool wide) {
+  constexpr uint64_t kMinPartPairs = 1024;  // a part's own minimum: kMinKeyCapacity would be a MiB
+  const uint32_t capacity = uint32_t(std::clamp<uint64_t>(pairs, kMinPartPairs, kMaxKeyCapacity));
+  if (keys.capacity != capacity || keys.wide_keys != wide) {
+    keys = KeyBuffers();  // released before the new ones are made: the budget holds one set
+    keys = KeyBuffers::allocate(ctx_, capacity, wide ? 64 : 32, "sort");
+  }
 }
 
 // The projection's per-record buffers for at least `records` records (ProjectedBuffers): the scene's
@@ -134,9 +151,11 @@ void FrameResources::prepare_outputs(const FramePlan& plan, const RenderSettings
 void FrameResources::prepare_frame(const FramePlan& plan, bool needs_composite_state) {
   // One buffer serves every composite: the state they carry between their dispatches (chunks,
   // samples) lives only within a frame.
+  // A scene rendered in parts carries the state from part to part in two halves.
   const VkDeviceSize state_bytes =
-      std::max(CompositePass::state_bytes(plan.tiles.width, plan.tiles.height),
-               StochasticCompositePass::state_bytes(plan.tiles.width, plan.tiles.height));
+      plan.part.whole() ? std::max(CompositePass::state_bytes(plan.tiles.width, plan.tiles.height),
+                                   StochasticCompositePass::state_bytes(plan.tiles.width, plan.tiles.height))
+                        : CompositePass::part_state_bytes(plan.tiles.width, plan.tiles.height);
   if (needs_composite_state && composite_state.size() < state_bytes)
     composite_state =
         vk::Buffer(ctx_, state_bytes, vk::MemoryUse::Device, "composite state (chunks, samples)");
@@ -169,10 +188,14 @@ std::runtime_error FrameResources::beyond_key_limit(const FrameCounters& frame, 
                             std::to_string(kMaxKeyCapacity) + " (2^31)");
 }
 
-void FrameResources::grow_keys_for(const FrameCounters& frame, const Camera& camera) {
+void FrameResources::grow_keys_for(const FrameCounters& frame, const Camera& camera, bool tight) {
   if (frame.wanted_intersections() > kMaxKeyCapacity) throw beyond_key_limit(frame, camera);
   try {  // larger key and sort buffers, which the device may not have room for
-    ensure_key_capacity(grow_capacity(frame.wanted_intersections()), keys.wide_keys);
+    const uint64_t wanted = frame.wanted_intersections();
+    if (tight)
+      reserve_pairs(wanted + wanted / 16, keys.wide_keys);
+    else
+      ensure_key_capacity(grow_capacity(wanted), keys.wide_keys);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(intersections_needed(frame, camera) + ": " + e.what());
   }

@@ -30,7 +30,15 @@ class FrameResources {
 
   // The scene's attributes on the device and the per-Gaussian buffers of its size. Throws
   // std::invalid_argument for inconsistent arrays, std::runtime_error for more than 2^30 Gaussians.
-  void upload_scene(const GaussianScene& scene);
+  // reuse_buffers (a part of a scene rendered in parts): the attributes go into the buffers already
+  // there where they are large enough, and the per-Gaussian buffers are left to the frame.
+  void upload_scene(const GaussianScene& scene, bool reuse_buffers = false);
+  // Releases the scene's buffers and everything sized by it (projected records, pairs): before the
+  // first part of a scene rendered in parts, which sizes them anew.
+  void release_scene();
+  // Key buffers for exactly `pairs` (tile, Gaussian) pairs (at least the minimum), made anew only when
+  // their capacity differs: a frame under a memory budget holds no headroom.
+  void reserve_pairs(uint64_t pairs, bool wide);
   SceneShape scene_shape(uint64_t generation) const {
     return {generation, scene.count, scene.sh_degree, scene.file_normals};
   }
@@ -43,8 +51,9 @@ class FrameResources {
   void prepare_frame(const FramePlan& plan, bool needs_composite_state);
 
   // A frame that wanted more pairs than the key buffers hold: they grow, within kMaxKeyCapacity
-  // (std::runtime_error naming the frame's needs beyond it, or when the device has no room).
-  void grow_keys_for(const FrameCounters& frame, const Camera& camera);
+  // (std::runtime_error naming the frame's needs beyond it, or when the device has no room), with
+  // headroom for the next frames, or (tight, under a memory budget) to what this frame needs.
+  void grow_keys_for(const FrameCounters& frame, const Camera& camera, bool tight = false);
   // The error of a frame whose pairs are beyond kMaxKeyCapacity.
   static std::runtime_error beyond_key_limit(const FrameCounters& frame, const Camera& camera);
   // "frame needs N tile intersections (pairs of V visible Gaussians and the WxH image's tiles)".

@@ -71,7 +71,7 @@ CompositePass::CompositePass(vk::Context& ctx)
 }
 
 void CompositePass::record(VkCommandBuffer cmd, const CompositeInputs& in, const Chunks& chunks,
-                           const HostSurface& host) {
+                           const HostSurface& host, const Carry& carry) {
   OutputBuffers& out = in.out;
   const std::vector<VkBufferView> views =
       texel_buffers_ ? composite_texel_views(in.splats, in.tile_lists, out, in.write_depth, in.write_count,
@@ -85,7 +85,7 @@ void CompositePass::record(VkCommandBuffer cmd, const CompositeInputs& in, const
   variant.surface_depth_out = host.surface_depth != nullptr;
   variant.exact_depth_order = variant.host_depth_in && host.exact_depth_order;
   variant.texel_buffers = !views.empty();
-  variant.chunked = chunks.count > 1;
+  variant.chunked = chunks.count > 1 || carry.any();
   auto it = pipelines_.find(variant);
   if (it == pipelines_.end()) {
     const float alpha_inv = coverage_alpha_inv(variant.cutoffs.alpha);
@@ -111,17 +111,24 @@ void CompositePass::record(VkCommandBuffer cmd, const CompositeInputs& in, const
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
-  if (chunks.count > 1 && chunks.state.size() < state_bytes(out.width, out.height))
+  const VkDeviceSize needed = carry.any()        ? part_state_bytes(out.width, out.height)
+                              : chunks.count > 1 ? state_bytes(out.width, out.height)
+                                                 : 0;
+  if (chunks.state.size() < needed)
     throw std::logic_error("composite: the chunk state buffer is smaller than the image");
+  const uint32_t carry_flags = (carry.in ? shader_io::COMPOSITE_CARRY_IN : 0u) |
+                               (carry.out ? shader_io::COMPOSITE_CARRY_OUT : 0u) |
+                               (carry.state_high ? shader_io::COMPOSITE_STATE_HIGH : 0u);
   for (uint32_t chunk = 0; chunk < chunks.count; ++chunk) {
     if (chunk > 0) vk::barrier(cmd);
+    const uint32_t flags = carry_flags | (chunk + 1 == chunks.count ? shader_io::COMPOSITE_LAST_CHUNK : 0u);
     CompositePush push{in.splats.address(),
                        in.tile_lists.address(),
                        in.ranges.address(),
                        out.rgba.address(),
                        in.write_depth ? out.depth.address() : 0,
                        in.write_count ? out.count.address() : 0,
-                       chunks.count > 1 ? chunks.state.address() : 0,
+                       needed > 0 ? chunks.state.address() : 0,
                        chunks.counters,
                        variant.host_depth_in ? host.view_depth->address() : 0,
                        variant.surface_depth_out ? host.surface_depth->address() : 0,
@@ -131,7 +138,7 @@ void CompositePass::record(VkCommandBuffer cmd, const CompositeInputs& in, const
                        tiles_x,
                        chunk * chunk_splats_,
                        chunk_splats_,
-                       chunk + 1 == chunks.count ? 1u : 0u,
+                       flags,
                        host.surface_alpha};
     it->second.bind(cmd, push);
     if (variant.texel_buffers) it->second.push_texel_views(cmd, views);

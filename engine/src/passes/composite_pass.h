@@ -72,6 +72,15 @@ class CompositePass {
     const vk::Buffer& state;
     VkDeviceAddress counters = 0;
   };
+  // A part of a scene rendered in depth-ordered parts (frame_plan.h, ScenePart): each pixel's state
+  // comes from the previous part (carry_in) and goes on to the next (carry_out) through the halves of
+  // `state` (part_state_bytes), which alternate (state_high: this part writes the upper half).
+  struct Carry {
+    bool in = false;
+    bool out = false;
+    bool state_high = false;
+    bool any() const { return in || out; }
+  };
   // A host's depth (RenderSettings::host): the surface per pixel as view depth in, the depth at which
   // alpha reaches surface_alpha out. Null buffers: that half is off (and its pipeline the one without).
   struct HostSurface {
@@ -80,9 +89,13 @@ class CompositePass {
     float surface_alpha = 0.5f;
     bool exact_depth_order = false;  // 32-bit depth keys: a pixel is done at its first splat behind the host
   };
-  void record(VkCommandBuffer cmd, const CompositeInputs& in, const Chunks& chunks, const HostSurface& host);
+  void record(VkCommandBuffer cmd, const CompositeInputs& in, const Chunks& chunks, const HostSurface& host,
+              const Carry& carry);
   uint32_t chunks_for(uint64_t longest_tile_list) const;
   static VkDeviceSize state_bytes(uint32_t width, uint32_t height) { return VkDeviceSize(width) * height * 32; }
+  static VkDeviceSize part_state_bytes(uint32_t width, uint32_t height) {
+    return 2 * state_bytes(width, height);
+  }
 
  private:
   vk::Context& ctx_;

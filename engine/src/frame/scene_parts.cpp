@@ -1,0 +1,167 @@
+#include "frame/scene_parts.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "camera/camera_models.h"
+#include "passes/projection_pass.h"
+#include "tilesplat/reference.h"
+#include "tilesplat/sort.h"
+
+namespace tilesplat {
+
+namespace {
+
+// The depth the projection sorts by: the distance for the models that project by direction (fisheye,
+// panorama), the view z for the others (projection.comp, project_centre).
+bool sorts_by_distance(const Camera& camera) {
+  const CameraModel model = camera_models::drawn_model(camera);
+  return model == CameraModel::kFisheye || model == CameraModel::kEquirectangular;
+}
+
+// A depth's key as the projection forms it: the float's bits (positive floats order as integers),
+// their top 24 for 24-bit keys. Depths at or below 0 (lower bounds only) are key 0.
+uint32_t depth_key(double depth, int key_bits) {
+  const float f = depth > 0 ? float(depth) : 0.0f;
+  return std::bit_cast<uint32_t>(f) >> (32 - key_bits);
+}
+
+}  // namespace
+
+DepthOrder::DepthOrder(const GaussianScene& scene, const Camera& camera, double near_plane,
+                       int depth_key_bits, double relative_margin) {
+  if (depth_key_bits != 24 && depth_key_bits != 32)
+    throw std::invalid_argument("a scene in parts sorts by 24- or 32-bit depth keys, not " +
+                                std::to_string(depth_key_bits));
+  const size_t n = scene.size();
+  const bool distance = sorts_by_distance(camera);
+  const double centre_size =
+      std::abs(camera.position[0]) + std::abs(camera.position[1]) + std::abs(camera.position[2]);
+  // Each Gaussian's depth, and how far the GPU's may lie from it.
+  std::vector<double> depth(n), margin(n);
+  std::vector<uint32_t> keys, values;
+  keys.reserve(n);
+  values.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    const std::array<double, 3> rel = {double(scene.positions[3 * i]) - camera.position[0],
+                                       double(scene.positions[3 * i + 1]) - camera.position[1],
+                                       double(scene.positions[3 * i + 2]) - camera.position[2]};
+    const std::array<double, 3> t =
+        camera.to_camera({double(scene.positions[3 * i]), double(scene.positions[3 * i + 1]),
+                          double(scene.positions[3 * i + 2])});
+    depth[i] = distance ? std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]) : t[2];
+    margin[i] = relative_margin * (std::abs(rel[0]) + std::abs(rel[1]) + std::abs(rel[2]) + centre_size);
+    // The GPU culls at or below the near plane (and non-finite depths): only a Gaussian it surely culls
+    // is left out.
+    if (!std::isfinite(depth[i]) || depth[i] + margin[i] <= near_plane) continue;
+    keys.push_back(depth_key(depth[i], 32));
+    values.push_back(uint32_t(i));
+  }
+  const size_t m = keys.size();
+  std::vector<uint32_t> key_scratch(m), value_scratch(m);
+  // Stable: equal keys stay in scene order.
+  if (cpu_radix_sort(std::span(keys), std::span(values), std::span(key_scratch), std::span(value_scratch),
+                     32))
+    values.swap(value_scratch);
+  order_ = std::move(values);
+
+  upper_max_.resize(m);
+  lower_min_.resize(m);
+  uint32_t running = 0;
+  for (size_t k = 0; k < m; ++k) {
+    const uint32_t g = order_[k];
+    running = std::max(running, depth_key(depth[g] + margin[g], depth_key_bits));
+    upper_max_[k] = running;
+  }
+  running = ~0u;
+  for (size_t k = m; k-- > 0;) {
+    const uint32_t g = order_[k];
+    running = std::min(running, depth_key(depth[g] - margin[g], depth_key_bits));
+    lower_min_[k] = running;
+  }
+}
+
+bool DepthOrder::boundary(size_t i) const {
+  if (i >= order_.size()) return true;
+  return i > 0 && upper_max_[i - 1] < lower_min_[i];
+}
+
+size_t DepthOrder::part_end(size_t begin, size_t most) const {
+  const size_t n = order_.size();
+  const size_t wanted = std::min(n, begin + std::max<size_t>(most, 1));
+  for (size_t end = wanted; end > begin; --end)
+    if (boundary(end)) return end;
+  for (size_t end = wanted + 1; end < n; ++end)
+    if (boundary(end)) return end;
+  return n;
+}
+
+std::vector<uint32_t> DepthOrder::part_indices(size_t begin, size_t end) const {
+  std::vector<uint32_t> indices(order_.begin() + std::ptrdiff_t(begin), order_.begin() + std::ptrdiff_t(end));
+  std::sort(indices.begin(), indices.end());
+  return indices;
+}
+
+GaussianScene gather_gaussians(const GaussianScene& scene, std::span<const uint32_t> indices) {
+  GaussianScene part;
+  part.sh_degree = scene.sh_degree;
+  const size_t n = indices.size();
+  auto gather = [&](const std::vector<float>& from, std::vector<float>& to, size_t per) {
+    to.resize(n * per);
+    for (size_t k = 0; k < n; ++k)
+      std::copy_n(from.begin() + std::ptrdiff_t(indices[k] * per), per, to.begin() + std::ptrdiff_t(k * per));
+  };
+  gather(scene.positions, part.positions, 3);
+  gather(scene.log_scales, part.log_scales, 3);
+  gather(scene.rotations, part.rotations, 4);
+  gather(scene.opacity_logits, part.opacity_logits, 1);
+  gather(scene.sh, part.sh, size_t(scene.sh_coefficients()) * 3);
+  if (scene.has_normals()) gather(scene.normals, part.normals, 3);
+  return part;
+}
+
+PartCosts part_costs(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+                     uint32_t seam_copies, bool wide_keys) {
+  const uint64_t pixels = uint64_t(camera.width) * uint64_t(camera.height);
+  const uint64_t tiles = ((uint64_t(camera.width) + kTileSize - 1) / kTileSize) *
+                         ((uint64_t(camera.height) + kTileSize - 1) / kTileSize);
+  PartCosts costs;
+  // Colour, depth and counts out; the composite state's two halves of 32 bytes; the tile ranges.
+  costs.fixed = pixels * (16 + (settings.depth ? 4 : 0) + (settings.splat_count ? 4 : 0) + 64) + tiles * 8;
+  if (settings.host) costs.fixed += pixels * 4 * (settings.host->write_depth ? 2 : 1);
+  const uint64_t k = uint64_t(scene.sh_coefficients());
+  const AccuracyModes& modes = settings.accuracy;
+  costs.per_gaussian = 4 * (3 + 3 + 4 + 1 + 3 * k);  // the attributes
+  if (settings.lighting.enabled() && scene.has_normals()) costs.per_gaussian += 12;
+  if (modes.fp16_sh) costs.per_gaussian += 6 * k;
+  if (modes.fp16_covariance) costs.per_gaussian += 12;
+  // Per projected record: the splat, its tile rect, four counts and offsets, the depth sort's pairs.
+  costs.per_gaussian += uint64_t(seam_copies) * (kSplatRecordBytes + 8 + 4 * 4 + 16);
+  costs.per_pair = wide_keys ? 2 * (8 + 4) : 2 * (4 + 4);  // keys and values, and their ping-pong copies
+  return costs;
+}
+
+size_t part_capacity(uint64_t budget, const PartCosts& costs, uint64_t overhead, double pairs_per_gaussian) {
+  const double per_gaussian = double(costs.per_gaussian) + pairs_per_gaussian * double(costs.per_pair);
+  const uint64_t before = costs.fixed + overhead;
+  if (budget <= before || double(budget - before) < per_gaussian) {
+    auto mib = [](uint64_t bytes) {
+      char text[32];
+      std::snprintf(text, sizeof(text), "%.2f MiB", double(bytes) / double(1 << 20));
+      return std::string(text);
+    };
+    throw std::invalid_argument(
+        "memory budget of " + mib(budget) + " leaves no room for a Gaussian: this frame holds " +
+        mib(before) +
+        " before any (its images, the per-pixel state carried between parts and the sort's buffers) and " +
+        std::to_string(uint64_t(per_gaussian)) +
+        " bytes per Gaussian: raise the budget or render a smaller image");
+  }
+  return size_t(double(budget - before) / per_gaussian);
+}
+
+}  // namespace tilesplat

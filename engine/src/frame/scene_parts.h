@@ -1,0 +1,76 @@
+// A scene rendered in parts that follow the frame's depth order (Renderer::render(scene, camera,
+// settings) under RenderSettings::memory_budget; renderer_parts.cpp runs them). The host sorts the
+// Gaussians once by the depth the GPU sorts them by (view z, or the distance for the fisheye and the
+// panorama); each part is then a run of consecutive Gaussians of that order, uploaded in scene order,
+// projected, sorted and composited like a frame, with each pixel's state carried from part to part.
+//
+// The GPU sorts each part again by its own float keys and breaks ties by scene index, so a part may
+// end only where the host's order and the GPU's cannot disagree: where every Gaussian before the
+// boundary has a smaller key than every Gaussian after it, however the GPU rounds its depth (within a
+// margin of the depth's magnitude, kDepthMarginFloat64 or kDepthMarginFloat32). Then each tile's lists,
+// concatenated over the parts, are the whole frame's list, and the image is the whole frame's, bit for bit.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "tilesplat/camera.h"
+#include "tilesplat/render_settings.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat {
+
+// How far the GPU's view depth of a Gaussian may lie from the host's float64 one, relative to the
+// magnitudes it is computed from (|x - camera| and |camera|). The projection computes in float64
+// where the device has it (the last bits may differ, by FMA contraction and summation order), else in
+// float32, within a few 1e-7 of them: the margins are far above either.
+constexpr double kDepthMarginFloat64 = 1e-12;
+constexpr double kDepthMarginFloat32 = 2e-6;
+
+class DepthOrder {
+ public:
+  // The Gaussians the GPU may draw (those clearly behind the near plane, or with non-finite depths,
+  // are left out), front to back. depth_key_bits is the frame's (24 or 32; std::invalid_argument
+  // otherwise); relative_margin kDepthMarginFloat64 or kDepthMarginFloat32, as the device projects.
+  DepthOrder(const GaussianScene& scene, const Camera& camera, double near_plane, int depth_key_bits,
+             double relative_margin);
+
+  size_t size() const { return order_.size(); }
+  // The end of the part that starts at `begin` (< size()) and should hold at most `most` (>= 1)
+  // Gaussians: the last boundary where a part may end in (begin, begin + most], else the first after
+  // it (a part larger than asked, where the keys leave no gap sooner), else size().
+  size_t part_end(size_t begin, size_t most) const;
+  // Whether a part may end before position i (0 < i < size(); size() always).
+  bool boundary(size_t i) const;
+  // The scene indices of positions [begin, end), ascending: the order the GPU breaks ties in.
+  std::vector<uint32_t> part_indices(size_t begin, size_t end) const;
+
+ private:
+  std::vector<uint32_t> order_;      // scene indices, front to back
+  std::vector<uint32_t> upper_max_;  // upper_max_[i]: the largest key any of positions [0, i] may get
+  std::vector<uint32_t> lower_min_;  // lower_min_[i]: the smallest key any of positions [i, size) may get
+};
+
+// The Gaussians `indices` of `scene`, in that order, as a scene of their own.
+GaussianScene gather_gaussians(const GaussianScene& scene, std::span<const uint32_t> indices);
+
+// What a part holds on the device, for sizing parts under a memory budget: the frame's buffers that do
+// not depend on the part (outputs, the carried state, tile ranges, a host's depth), and the bytes per
+// Gaussian (attributes and projected records) and per (tile, Gaussian) pair (key buffers). The sort
+// strategy's own buffers are measured as the parts run (renderer_parts.cpp).
+struct PartCosts {
+  uint64_t fixed = 0;
+  uint64_t per_gaussian = 0;
+  uint64_t per_pair = 0;
+};
+PartCosts part_costs(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+                     uint32_t seam_copies, bool wide_keys);
+
+// The most Gaussians a part may hold when `budget` bytes are to cover costs.fixed, `overhead` bytes
+// measured besides, and each Gaussian with `pairs_per_gaussian` pairs. Throws std::invalid_argument
+// when not even one fits, naming the budget and what the frame needs before any Gaussian.
+size_t part_capacity(uint64_t budget, const PartCosts& costs, uint64_t overhead, double pairs_per_gaussian);
+
+}  // namespace tilesplat

@@ -1,0 +1,153 @@
+// A scene rendered within a memory budget (Renderer::render(scene, camera, settings)): whole, as set_scene
+// and render(camera, settings) do, when its frame fits; else in depth-ordered parts (frame/scene_parts.h).
+// Each part's Gaussians go into the same scene buffers and render as one frame of the usual plan, its
+// composite carrying every pixel's state to the next part (ScenePart); the parts are sized to the budget
+// from what the frame holds before any Gaussian, the bytes per Gaussian and per pair, the pairs each
+// Gaussian brought in the parts before, and what the sort strategy's buffers measured.
+#include <algorithm>
+#include <chrono>
+
+#include "camera/camera_models.h"
+#include "frame/averaged_frames.h"
+#include "frame/scene_parts.h"
+#include "renderer_impl.h"
+
+namespace tilesplat {
+
+namespace {
+
+// The first part's guess of (tile, Gaussian) pairs per Gaussian, as set_scene's first key buffers (4 n).
+constexpr double kFirstPairsPerGaussian = 4;
+
+// The statistics of the parts so far, with one more part's.
+void add_part_stats(FrameStats& total, const FrameStats& part) {
+  if (total.scene_parts == 0) {
+    total = part;
+    total.scene_parts = 1;
+    return;
+  }
+  for (const PassTiming& pass : part.passes) {
+    auto it = std::find_if(total.passes.begin(), total.passes.end(),
+                           [&](const PassTiming& p) { return p.name == pass.name; });
+    if (it == total.passes.end())
+      total.passes.push_back(pass);
+    else
+      it->gpu_ms += pass.gpu_ms;
+  }
+  total.gpu_ms += part.gpu_ms;
+  total.visible += part.visible;
+  total.intersections += part.intersections;
+  total.retries += part.retries;
+  total.submissions += part.submissions;
+  total.sort_fallbacks += part.sort_fallbacks;
+  total.uploaded_bytes += part.uploaded_bytes;
+  total.device_bytes = part.device_bytes;
+  total.peak_device_bytes = std::max(total.peak_device_bytes, part.device_bytes);
+  total.scene_parts += 1;
+}
+
+}  // namespace
+
+// What a part of this frame costs on the device, with the strategy's key width.
+PartCosts Renderer::Impl::part_costs_for(const GaussianScene& scene, const Camera& camera,
+                                         const RenderSettings& settings, const std::string& sort_name) {
+  const bool wide_keys = sort(sort_name).frame_plan() == FrameSortPlan::kTileDepthPairs;
+  const SceneShape shape{0, uint32_t(std::min<size_t>(scene.size(), UINT32_MAX)), scene.sh_degree,
+                         scene.has_normals()};
+  const uint32_t seam_copies =
+      projection_variant(settings, shape, camera_models::drawn_model(camera)).seam_copies();
+  return part_costs(scene, camera, settings, seam_copies, wide_keys);
+}
+
+bool Renderer::Impl::needs_parts(const GaussianScene& scene, const Camera& camera,
+                                 const RenderSettings& settings) {
+  if (settings.memory_budget == 0) return false;
+  const std::string sort_name = choose_sort_strategy(settings.sort, device_caps(), /*without_waiting=*/false);
+  const PartCosts costs = part_costs_for(scene, camera, settings, sort_name);
+  const double whole_bytes =
+      double(costs.fixed) +
+      double(scene.size()) * (double(costs.per_gaussian) + kFirstPairsPerGaussian * double(costs.per_pair));
+  return whole_bytes > double(settings.memory_budget);
+}
+
+void Renderer::Impl::render_in_parts(const GaussianScene& scene, const Camera& camera,
+                                     const RenderSettings& settings) {
+  wait_for_submitted_frame();
+  const std::string sort_name = choose_sort_strategy(settings.sort, device_caps(), /*without_waiting=*/false);
+  const PartCosts costs = part_costs_for(scene, camera, settings, sort_name);
+  const bool wide_keys = sort(sort_name).frame_plan() == FrameSortPlan::kTileDepthPairs;
+  validate_scene_parts(settings, sort_name);
+  double pairs_per_gaussian = kFirstPairsPerGaussian;
+  size_t capacity = part_capacity(settings.memory_budget, costs, 0, pairs_per_gaussian);  // or a clear error
+  const DepthOrder order(scene, camera, settings.near_plane, settings.accuracy.depth_key_bits,
+                         ctx.features().shader_float64 ? kDepthMarginFloat64 : kDepthMarginFloat32);
+
+  scene_in_parts = true;  // from the first upload on, even if a part fails
+  ++scene_generation;
+  lists.reset();
+  resources.release_scene();  // the whole scene's buffers, if any: the parts size their own
+  FrameStats total;
+  total.scene_parts = 0;
+  size_t begin = 0;
+  size_t largest_part = 0;  // the scene buffers keep the size of the largest part so far
+  double most_pairs_per_gaussian = 0;
+  for (uint32_t index = 0;; ++index) {
+    const size_t end = order.size() == 0 ? 0 : order.part_end(begin, capacity);
+    const std::vector<uint32_t> indices = order.part_indices(begin, end);
+    resources.upload_scene(gather_gaussians(scene, indices), /*reuse_buffers=*/true);
+    ++scene_generation;  // the lists in the buffers are the previous part's
+    lists.reset();
+    resources.reserve_pairs(uint64_t(pairs_per_gaussian * double(indices.size())) + 1, wide_keys);
+    render_frame(camera, settings, nullptr, ScenePart{index, end == order.size()});
+    lists.reset();  // a part's lists are no frame's
+    add_part_stats(total, stats);
+    largest_part = std::max(largest_part, indices.size());
+    if (end == order.size()) break;
+    // The next parts: as many pairs per Gaussian as the most any part had (with a margin, as a part with
+    // more pairs than its key buffers hold renders again), and room for the buffers beyond the estimate
+    // (the sort strategy's, the pipelines' own).
+    most_pairs_per_gaussian = std::max(
+        most_pairs_per_gaussian, double(stats.intersections) / double(std::max<size_t>(indices.size(), 1)));
+    pairs_per_gaussian = std::max(1.0, 1.25 * most_pairs_per_gaussian);
+    const uint64_t estimated =
+        costs.fixed + uint64_t(largest_part) * costs.per_gaussian + resources.keys.bytes();
+    const uint64_t overhead = stats.device_bytes > estimated ? stats.device_bytes - estimated : 0;
+    // Never larger than a part before: the scene buffers keep the largest part's size.
+    capacity = std::min(capacity, part_capacity(settings.memory_budget, costs, overhead, pairs_per_gaussian));
+    begin = end;
+  }
+  total.gaussians = scene.size();
+  stats = total;
+}
+
+RenderImage Renderer::render(const GaussianScene& scene, const Camera& camera,
+                             const RenderSettings& settings) {
+  Impl& r = *impl_;
+  if (!r.needs_parts(scene, camera, settings)) {
+    set_scene(scene);
+    return render(camera, settings);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  if (averages_samples(settings)) {
+    // Depth of field, motion blur: every sample frame in parts, as render(camera, settings) averages.
+    FrameStats frame;
+    frame.samples = 0;
+    RenderImage image = render_averaged(
+        camera, settings, [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
+          RenderImage sample = render(scene, sample_camera, sample_settings);
+          add_sample_stats(frame, r.stats);
+          return sample;
+        });
+    r.stats = frame;
+    r.stats.cpu_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return image;
+  }
+  r.render_in_parts(scene, camera, settings);
+  RenderImage image = r.read_image(camera, settings);
+  r.stats.cpu_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return image;
+}
+
+}  // namespace tilesplat

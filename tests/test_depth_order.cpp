@@ -1,0 +1,128 @@
+// The host's depth order of a scene rendered in parts (engine/src/frame/scene_parts.h): the order, the
+// boundaries where a part may end, the parts' indices and the budget's arithmetic, without a device.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <string>
+#include <vector>
+
+#include "frame/scene_parts.h"
+#include "test_support.h"
+
+namespace tilesplat {
+namespace {
+
+// Gaussians on the camera's axis (the axis camera looks down +z from the origin) at these depths.
+GaussianScene on_axis(const std::vector<float>& depths) {
+  GaussianScene scene;
+  for (float z : depths) {
+    scene.positions.insert(scene.positions.end(), {0.0f, 0.0f, z});
+    scene.log_scales.insert(scene.log_scales.end(), {-3.0f, -3.0f, -3.0f});
+    scene.rotations.insert(scene.rotations.end(), {1.0f, 0.0f, 0.0f, 0.0f});
+    scene.opacity_logits.push_back(1.0f);
+    scene.sh.insert(scene.sh.end(), {0.5f, 0.25f, float(scene.size())});
+  }
+  return scene;
+}
+
+TEST(DepthOrder, SortsFrontToBackAndLeavesOutWhatIsBehindTheNearPlane) {
+  const GaussianScene scene = on_axis({5, 1, -2, 3, 0.1f, 2});
+  const DepthOrder order(scene, testing::axis_camera(64, 64, 50), 0.2, 32, kDepthMarginFloat64);
+  ASSERT_EQ(order.size(), 4u);  // -2 and 0.1 are behind the near plane (0.2)
+  EXPECT_EQ(order.part_indices(0, 4), (std::vector<uint32_t>{0, 1, 3, 5}));  // ascending: the GPU's tie order
+  // Front to back: 1 (index 1), 2 (5), 3 (3), 5 (0); each position alone is that Gaussian.
+  EXPECT_EQ(order.part_indices(0, 1), std::vector<uint32_t>{1});
+  EXPECT_EQ(order.part_indices(1, 2), std::vector<uint32_t>{5});
+  EXPECT_EQ(order.part_indices(3, 4), std::vector<uint32_t>{0});
+  for (size_t i = 1; i < 4; ++i) EXPECT_TRUE(order.boundary(i)) << i;
+  EXPECT_FALSE(order.boundary(0));
+  EXPECT_TRUE(order.boundary(4));
+}
+
+TEST(DepthOrder, NoBoundaryBetweenDepthsTheGpuMayOrderEitherWay) {
+  // Equal depths tie (the GPU then orders by index, which parts cannot follow); depths one float apart
+  // stay apart in a float64 projection, not in a float32 one.
+  const float z = 3.0f;
+  const float next = std::bit_cast<float>(std::bit_cast<uint32_t>(z) + 1);
+  const GaussianScene scene = on_axis({z, 4.0f, next, z, 2.0f});
+  const Camera camera = testing::axis_camera(64, 64, 50);
+  const DepthOrder order(scene, camera, 0.2, 32, kDepthMarginFloat64);
+  ASSERT_EQ(order.size(), 5u);
+  // 2 | 3, 3 | 3+ulp | 4
+  EXPECT_TRUE(order.boundary(1));
+  EXPECT_FALSE(order.boundary(2));
+  EXPECT_TRUE(order.boundary(3));
+  EXPECT_TRUE(order.boundary(4));
+  EXPECT_FALSE(DepthOrder(scene, camera, 0.2, 32, kDepthMarginFloat32).boundary(3));
+  // A part asked to end inside the tie ends before it, or, starting in it, after it.
+  EXPECT_EQ(order.part_end(0, 2), 1u);
+  EXPECT_EQ(order.part_end(1, 1), 3u);
+  EXPECT_EQ(order.part_end(0, 100), 5u);
+}
+
+TEST(DepthOrder, TheFloat32MarginAndTwentyFourBitKeysWidenTheGaps) {
+  // 1e-6 apart at depth 3: apart in 32-bit keys of float64 depths, not within float32's margin.
+  const GaussianScene scene = on_axis({3.0f, 3.000001f, 3.5f});
+  const Camera camera = testing::axis_camera(64, 64, 50);
+  EXPECT_TRUE(DepthOrder(scene, camera, 0.2, 32, kDepthMarginFloat64).boundary(1));
+  EXPECT_FALSE(DepthOrder(scene, camera, 0.2, 32, kDepthMarginFloat32).boundary(1));
+  // 24-bit keys drop 8 bits: 3 and 3.000001 share one.
+  EXPECT_FALSE(DepthOrder(scene, camera, 0.2, 24, kDepthMarginFloat64).boundary(1));
+  EXPECT_TRUE(DepthOrder(scene, camera, 0.2, 24, kDepthMarginFloat64).boundary(2));
+  EXPECT_NE(testing::error_of<std::invalid_argument>([&] {
+              DepthOrder(scene, camera, 0.2, 16, kDepthMarginFloat64);
+            }).find("24- or 32-bit depth keys"),
+            std::string::npos);
+}
+
+TEST(DepthOrder, AFisheyeSortsByDistance) {
+  // (0, 0, 2) is at distance 2; (3, 0, 1) at z 1 but distance sqrt(10).
+  GaussianScene scene = on_axis({2.0f, 1.0f});
+  scene.positions[3] = 3.0f;
+  const Camera pinhole = testing::axis_camera(64, 64, 50);
+  EXPECT_EQ(DepthOrder(scene, pinhole, 0.2, 32, kDepthMarginFloat64).part_indices(0, 1),
+            std::vector<uint32_t>{1});
+  EXPECT_EQ(DepthOrder(scene, fisheye_camera(pinhole, 180), 0.2, 32, kDepthMarginFloat64).part_indices(0, 1),
+            std::vector<uint32_t>{0});
+}
+
+TEST(PartSizing, GatherKeepsEveryAttributeOfTheIndices) {
+  GaussianScene scene = on_axis({1, 2, 3});
+  scene.normals = {0, 0, 1, 0, 1, 0, 1, 0, 0};
+  const std::vector<uint32_t> indices = {2, 0};
+  const GaussianScene part = gather_gaussians(scene, indices);
+  ASSERT_EQ(part.size(), 2u);
+  EXPECT_EQ(part.positions, (std::vector<float>{0, 0, 3, 0, 0, 1}));
+  EXPECT_EQ(part.sh, (std::vector<float>{0.5f, 0.25f, 3, 0.5f, 0.25f, 1}));
+  EXPECT_EQ(part.normals, (std::vector<float>{1, 0, 0, 0, 0, 1}));
+  EXPECT_EQ(part.log_scales.size(), 6u);
+  EXPECT_EQ(part.rotations.size(), 8u);
+  EXPECT_EQ(part.sh_degree, scene.sh_degree);
+}
+
+TEST(PartSizing, CapacityIsTheBudgetOverTheCostsOrAClearError) {
+  const PartCosts costs{1000, 100, 10};
+  EXPECT_EQ(part_capacity(1000 + 200 + 1500, costs, 200, 5.0), 10u);  // 1500 / (100 + 5 * 10)
+  const std::string error =
+      testing::error_of<std::invalid_argument>([&] { part_capacity(1100, costs, 50, 5.0); });
+  EXPECT_NE(error.find("leaves no room for a Gaussian"), std::string::npos) << error;
+  EXPECT_NE(error.find("150 bytes per Gaussian"), std::string::npos) << error;
+}
+
+TEST(PartSizing, CostsFollowTheFrame) {
+  const GaussianScene scene = on_axis({1, 2});
+  const Camera camera = testing::axis_camera(32, 16, 50);
+  RenderSettings settings;
+  const PartCosts plain = part_costs(scene, camera, settings, 1, false);
+  // Colour, depth, counts and two 32-byte halves of state per pixel; two tiles of ranges.
+  EXPECT_EQ(plain.fixed, 32u * 16u * (16 + 4 + 4 + 64) + 2 * 8);
+  settings.depth = false;
+  settings.splat_count = false;
+  EXPECT_EQ(part_costs(scene, camera, settings, 1, false).fixed, 32u * 16u * (16 + 64) + 2 * 8);
+  const PartCosts seams = part_costs(scene, camera, settings, 2, true);
+  EXPECT_GT(seams.per_gaussian, plain.per_gaussian);
+  EXPECT_GT(seams.per_pair, plain.per_pair);
+}
+
+}  // namespace
+}  // namespace tilesplat
