@@ -361,6 +361,47 @@ TEST(CliBench, EffectsTableMeasuresEachEffectBesideItsNeverHadItRow) {
   EXPECT_EQ(with_accuracy.exit_code, 2) << with_accuracy.err;
 }
 
+// --memory-budget: the same EXR in parts (docs/big-scenes.md), the parts and peaks in --stats, sizes
+// with units, and what cannot work refused before anything is written.
+TEST(CliRender, MemoryBudgetRendersTheSameImageInParts) {
+  const auto out = fresh_output_dir();
+  auto render = [&](const std::vector<std::string>& extra, const std::string& name) {
+    std::vector<std::string> args = {bundled_playbot().string(), "--width", "160", "--height", "90", "-o",
+                                     (out / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_exe(kRenderExe, args);
+  };
+  ASSERT_EQ(render({}, "whole.exr").exit_code, 0);
+  const auto parts = render({"--memory-budget", "4M", "--stats"}, "parts.exr");
+  ASSERT_EQ(parts.exit_code, 0) << parts.err;
+  EXPECT_TRUE(contains(parts.out, "scene parts")) << parts.out;
+  EXPECT_FALSE(contains(parts.out, "scene parts                         1\n")) << parts.out;
+  EXPECT_TRUE(contains(parts.out, "peak device memory")) << parts.out;
+  EXPECT_TRUE(contains(parts.out, "peak resident memory")) << parts.out;
+  const tilesplat::RenderImage whole = tilesplat::read_exr(out / "whole.exr");
+  const tilesplat::RenderImage in_parts = tilesplat::read_exr(out / "parts.exr");
+  EXPECT_EQ(in_parts.rgba, whole.rgba);
+  EXPECT_EQ(in_parts.depth, whole.depth);
+  EXPECT_EQ(render({"--memory-budget", "0.5GiB"}, "half_gib.exr").exit_code, 0);
+  EXPECT_EQ(tilesplat::read_exr(out / "half_gib.exr").rgba, whole.rgba);
+
+  const auto bad_unit = render({"--memory-budget", "12X"}, "bad.exr");
+  EXPECT_EQ(bad_unit.exit_code, 2) << bad_unit.err;
+  EXPECT_TRUE(contains(bad_unit.err,
+                       "--memory-budget expects a size in bytes (512M, 1.5G, 8GiB, 1048576), got '12X'"))
+      << bad_unit.err;
+  const auto too_small = render({"--memory-budget", "64K"}, "small.exr");
+  EXPECT_NE(too_small.exit_code, 0);
+  EXPECT_TRUE(contains(too_small.err, "leaves no room for a Gaussian")) << too_small.err;
+  const auto raster = render({"--memory-budget", "4M", "--compositor", "raster"}, "raster.exr");
+  EXPECT_NE(raster.exit_code, 0);
+  EXPECT_TRUE(contains(raster.err, "raster compositor has no per-pixel state")) << raster.err;
+  const auto reference = render({"--memory-budget", "4M", "--reference"}, "reference.exr");
+  EXPECT_EQ(reference.exit_code, 2) << reference.err;
+  for (const char* name : {"bad.exr", "small.exr", "raster.exr", "reference.exr"})
+    EXPECT_FALSE(fs::exists(out / name)) << name;
+}
+
 TEST(CliRender, AntialiasingFlagSetsTheFootprintFilter) {
   const auto out = fresh_output_dir();
   auto render = [&](const std::string& mode, const std::string& name) {

@@ -82,10 +82,13 @@ void Renderer::Impl::render_in_parts(const GaussianScene& scene, const Camera& c
   const DepthOrder order(scene, camera, settings.near_plane, settings.accuracy.depth_key_bits,
                          ctx.features().shader_float64 ? kDepthMarginFloat64 : kDepthMarginFloat32);
 
+  // A whole scene's buffers go: the parts size their own, which the next frame under the same budget
+  // reuses.
+  if (!scene_in_parts || parts_budget != settings.memory_budget) resources.release_scene();
   scene_in_parts = true;  // from the first upload on, even if a part fails
+  parts_budget = settings.memory_budget;
   ++scene_generation;
   lists.reset();
-  resources.release_scene();  // the whole scene's buffers, if any: the parts size their own
   FrameStats total;
   total.scene_parts = 0;
   size_t begin = 0;
@@ -97,7 +100,9 @@ void Renderer::Impl::render_in_parts(const GaussianScene& scene, const Camera& c
     resources.upload_scene(gather_gaussians(scene, indices), /*reuse_buffers=*/true);
     ++scene_generation;  // the lists in the buffers are the previous part's
     lists.reset();
-    resources.reserve_pairs(uint64_t(pairs_per_gaussian * double(indices.size())) + 1, wide_keys);
+    // Pairs for a part of the capacity the budget was reckoned for (the same from part to part: no new
+    // buffers for each).
+    resources.reserve_pairs(uint64_t(pairs_per_gaussian * double(capacity)) + 1, wide_keys);
     render_frame(camera, settings, nullptr, ScenePart{index, end == order.size()});
     lists.reset();  // a part's lists are no frame's
     add_part_stats(total, stats);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "scene/json_reader.h"
+#include "scene/scene_merge.h"
 #include "scene/scene_readers.h"
 
 namespace tilesplat {
@@ -499,26 +501,53 @@ GaussianScene load_described_scene(const SceneDescription& description, const Lo
                                    LoadReport* report) {
   LoadReport total;
   total.format = "scene description (";
-  std::vector<GaussianScene> scenes;
-  scenes.reserve(description.models.size());
+  // Each file once, however many models name it; then the models' transformed copies one at a time into
+  // the merged scene, so that at most one copy exists besides the files' scenes and the result.
+  struct File {
+    GaussianScene scene;
+    LoadReport report;
+  };
+  std::map<fs::path, File> files;
+  std::vector<const File*> model_files;
+  auto where = [&](size_t i) { return description.file.string() + ": models[" + std::to_string(i) + "]: "; };
   for (size_t i = 0; i < description.models.size(); ++i) {
     const SceneModel& model = description.models[i];
-    const std::string where = description.file.string() + ": models[" + std::to_string(i) + "]: ";
-    LoadReport part;
-    try {
-      scenes.push_back(transform_scene(load_scene(model.path, options, &part), model.transform));
-    } catch (const SceneError& error) {
-      throw SceneError(where + error.what());
-    } catch (const std::invalid_argument& error) {
-      throw SceneError(where + model.path.string() + ": " + error.what());
+    auto found = files.find(model.path);
+    if (found == files.end()) {
+      File file;
+      try {
+        file.scene = load_scene(model.path, options, &file.report);
+      } catch (const SceneError& error) {
+        throw SceneError(where(i) + error.what());
+      } catch (const std::invalid_argument& error) {
+        throw SceneError(where(i) + model.path.string() + ": " + error.what());
+      }
+      found = files.emplace(model.path, std::move(file)).first;
     }
-    add_report(total, part, model.path);
+    model_files.push_back(&found->second);
+    add_report(total, found->second.report, model.path);
   }
   total.format += ")";
-  GaussianScene merged = merge_scenes(scenes);
+  size_t gaussians = 0;
+  int sh_degree = 0;
+  bool normals = false;
+  for (const File* file : model_files) {
+    gaussians += file->scene.size();
+    sh_degree = std::max(sh_degree, file->scene.sh_degree);
+    normals = normals || file->scene.has_normals();
+  }
   // Bands the sh_degree effect never evaluates are not kept (nor uploaded, nor allocated on a device).
-  if (description.effects.sh_degree && *description.effects.sh_degree < merged.sh_degree)
-    merged = with_sh_degree(merged, *description.effects.sh_degree);
+  if (description.effects.sh_degree) sh_degree = std::min(sh_degree, *description.effects.sh_degree);
+  GaussianScene merged;
+  detail::reserve_merged(merged, gaussians, sh_degree, normals);
+  for (size_t i = 0; i < description.models.size(); ++i) {
+    const SceneModel& model = description.models[i];
+    try {
+      detail::append_merged(merged, transform_scene(model_files[i]->scene, model.transform), normals);
+    } catch (const std::invalid_argument& error) {
+      throw SceneError(where(i) + model.path.string() + ": " + error.what());
+    }
+  }
   if (report) *report = std::move(total);
   return merged;
 }

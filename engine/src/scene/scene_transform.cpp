@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "scene/scene_merge.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/scene_description.h"
 
@@ -363,34 +364,47 @@ GaussianScene with_sh_degree(const GaussianScene& scene, int degree) {
   return out;
 }
 
-GaussianScene merge_scenes(std::span<const GaussianScene> scenes) {
-  GaussianScene out;
-  size_t total = 0;
-  bool any_normals = false;
-  for (const GaussianScene& scene : scenes) {
-    check_arrays(scene, "merge_scenes");
-    out.sh_degree = std::max(out.sh_degree, scene.sh_degree);
-    total += scene.size();
-    any_normals = any_normals || scene.has_normals();
-  }
+namespace detail {
+
+void reserve_merged(GaussianScene& out, size_t total, int sh_degree, bool with_normals) {
+  out.sh_degree = sh_degree;
   out.positions.reserve(3 * total);
   out.log_scales.reserve(3 * total);
   out.rotations.reserve(4 * total);
   out.opacity_logits.reserve(total);
-  out.sh.reserve(total * sh_values_per_gaussian(out.sh_degree));
-  if (any_normals) out.normals.reserve(3 * total);
+  out.sh.reserve(total * sh_values_per_gaussian(sh_degree));
+  if (with_normals) out.normals.reserve(3 * total);
+}
+
+void append_merged(GaussianScene& out, const GaussianScene& scene, bool with_normals) {
+  check_arrays(scene, "merge_scenes");
+  append(out.positions, scene.positions);
+  append(out.log_scales, scene.log_scales);
+  append(out.rotations, scene.rotations);
+  append(out.opacity_logits, scene.opacity_logits);
+  append_sh(out.sh, scene, out.sh_degree);
+  if (!with_normals) return;
+  if (scene.has_normals())
+    append(out.normals, scene.normals);
+  else
+    out.normals.insert(out.normals.end(), 3 * scene.size(), 0.0f);
+}
+
+}  // namespace detail
+
+GaussianScene merge_scenes(std::span<const GaussianScene> scenes) {
+  GaussianScene out;
+  size_t total = 0;
+  int sh_degree = 0;
+  bool any_normals = false;
   for (const GaussianScene& scene : scenes) {
-    append(out.positions, scene.positions);
-    append(out.log_scales, scene.log_scales);
-    append(out.rotations, scene.rotations);
-    append(out.opacity_logits, scene.opacity_logits);
-    append_sh(out.sh, scene, out.sh_degree);
-    if (!any_normals) continue;
-    if (scene.has_normals())
-      append(out.normals, scene.normals);
-    else
-      out.normals.insert(out.normals.end(), 3 * scene.size(), 0.0f);
+    check_arrays(scene, "merge_scenes");
+    sh_degree = std::max(sh_degree, scene.sh_degree);
+    total += scene.size();
+    any_normals = any_normals || scene.has_normals();
   }
+  detail::reserve_merged(out, total, sh_degree, any_normals);
+  for (const GaussianScene& scene : scenes) detail::append_merged(out, scene, any_normals);
   return out;
 }
 

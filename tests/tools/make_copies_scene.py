@@ -1,0 +1,67 @@
+#!/usr/bin/env python3
+"""Writes a scene file (docs/scene-format.md) of many transformed copies of one capture: a big test scene
+without a big download. The copies stand on a square grid in the x-z plane, `--spacing` world units apart,
+each turned about the vertical axis by its own angle, so that no two views of copies are alike. A camera
+named "overview" looks at the whole grid from above the front edge.
+
+  python3 tests/tools/make_copies_scene.py ../shared/scenes/playbot_lod0_500000_sh2.ply --copies 216 \\
+      --spacing 2.5 -o /tmp/big/playbot_x216.json
+
+tilesplat reads the capture once however many copies name it (docs/big-scenes.md).
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("model", help="the capture every copy is of (any format tilesplat reads)")
+    parser.add_argument("--copies", type=int, required=True, help="how many copies (1 to 100000)")
+    parser.add_argument("--spacing", type=float, default=2.5, help="world units between neighbours (default 2.5)")
+    parser.add_argument("--width", type=int, default=1920, help="the overview camera's width (default 1920)")
+    parser.add_argument("--height", type=int, default=1080, help="its height (default 1080)")
+    parser.add_argument("-o", "--output", required=True, help="the scene file to write (.json)")
+    args = parser.parse_args()
+    if not 1 <= args.copies <= 100000:
+        sys.exit(f"make_copies_scene: --copies must be 1 to 100000, got {args.copies}")
+    if not (args.spacing > 0 and math.isfinite(args.spacing)):
+        sys.exit(f"make_copies_scene: --spacing must be positive, got {args.spacing}")
+    if not os.path.exists(args.model):
+        sys.exit(f"make_copies_scene: {args.model}: no such file")
+    if not args.output.endswith(".json"):
+        sys.exit(f"make_copies_scene: the scene file must end in .json, got {args.output}")
+
+    out_dir = os.path.dirname(os.path.abspath(args.output))
+    model = os.path.relpath(os.path.abspath(args.model), out_dir)
+    side = math.ceil(math.sqrt(args.copies))
+    half = (side - 1) * args.spacing / 2
+    models = []
+    for i in range(args.copies):
+        row, column = divmod(i, side)
+        models.append({
+            "path": model,
+            "translation": [round(column * args.spacing - half, 6), 0, round(row * args.spacing - half, 6)],
+            "rotation_deg": [0, (i * 137.5) % 360, 0],  # the golden angle: every copy turned differently
+        })
+    # Looking down at the grid's centre from above its front edge (world up is -y, as the trainer's).
+    extent = max(half, args.spacing)
+    eye = [0, -0.9 * extent, 1.6 * extent]
+    scene = {
+        "version": 1,
+        "models": models,
+        "cameras": [{"name": "overview", "width": args.width, "height": args.height,
+                     "look_at": {"eye": eye, "target": [0, 0, 0], "fov_deg": 50}}],
+    }
+    os.makedirs(out_dir, exist_ok=True)
+    with open(args.output, "w") as f:
+        json.dump(scene, f, indent=1)
+        f.write("\n")
+    print(f"make_copies_scene: {args.copies} copies of {args.model} on a {side}x{side} grid -> {args.output}")
+
+
+if __name__ == "__main__":
+    main()
