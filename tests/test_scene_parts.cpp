@@ -145,6 +145,18 @@ TEST(SceneParts, EffectsAndOutputsThatApplyAreTheWholeFrame) {
   }
 }
 
+// Depth of field: every lens sample frame in parts, averaged as the whole scene's are.
+TEST(SceneParts, LensSamplesAreEachInParts) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  const BigScene& big = big_scene();
+  RenderSettings settings;
+  settings.lens.aperture_diameter = 0.05;
+  settings.lens.focus_distance = 3.0;
+  settings.lens.samples = 3;
+  expect_parts_equal_whole(big.scene, big.camera, settings, 16, "thin lens, 3 samples");
+  EXPECT_EQ(parts_renderer().last_frame_stats().samples, 3);
+}
+
 TEST(SceneParts, WideCamerasAreTheWholeFrame) {
   TILESPLAT_REQUIRE_SHARED_SCENES();
   const BigScene& big = big_scene();

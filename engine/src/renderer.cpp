@@ -176,25 +176,30 @@ void Renderer::set_scene(const GaussianScene& scene) {
   r.scene_in_parts = false;
 }
 
+RenderImage Renderer::Impl::average_samples(const Camera& camera, const RenderSettings& settings,
+                                            const SampleRenderer& render_sample) {
+  const auto start = std::chrono::steady_clock::now();
+  FrameStats frame;
+  frame.samples = 0;
+  RenderImage image = render_averaged(
+      camera, settings, [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
+        RenderImage sample = render_sample(sample_camera, sample_settings);
+        add_sample_stats(frame, stats);
+        return sample;
+      });
+  stats = frame;
+  stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return image;
+}
+
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
   Impl& r = *impl_;
+  if (averages_samples(settings))  // depth of field, motion blur
+    return r.average_samples(camera, settings,
+                             [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
+                               return render(sample_camera, sample_settings);
+                             });
   const auto start = std::chrono::steady_clock::now();
-  if (averages_samples(settings)) {
-    // Depth of field, motion blur: sample frames averaged (frame/averaged_frames.h), rendered here; the
-    // frame's statistics are the samples' summed.
-    FrameStats frame;
-    frame.samples = 0;
-    RenderImage image = render_averaged(
-        camera, settings, [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
-          RenderImage sample = render(sample_camera, sample_settings);
-          add_sample_stats(frame, r.stats);
-          return sample;
-        });
-    r.stats = frame;
-    r.stats.cpu_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    return image;
-  }
   r.render_frame(camera, settings);
   RenderImage image = r.read_image(camera, settings);
   r.stats.cpu_ms =

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "frame/averaged_frames.h"
 #include "frame/frame_plan.h"
 #include "frame/frame_recorder.h"
 #include "frame/frame_resources.h"
@@ -61,6 +62,10 @@ struct Renderer::Impl {
                     const ExternalDepthImage* depth_image = nullptr, const ScenePart& part = {});
   // The frame's images, read back from the outputs.
   RenderImage read_image(const Camera& camera, const RenderSettings& settings);
+  // Depth of field, motion blur: the sample frames averaged (frame/averaged_frames.h), each rendered by
+  // render_sample; the frame's statistics are the samples' summed.
+  RenderImage average_samples(const Camera& camera, const RenderSettings& settings,
+                              const SampleRenderer& render_sample);
   // A scene within a memory budget (renderer_parts.cpp): whether its frame would exceed
   // settings.memory_budget, and the rendering in depth-ordered parts that leaves the image in the
   // outputs and the parts' statistics.

@@ -132,22 +132,12 @@ RenderImage Renderer::render(const GaussianScene& scene, const Camera& camera,
     set_scene(scene);
     return render(camera, settings);
   }
+  if (averages_samples(settings))  // depth of field, motion blur: every sample frame in parts
+    return r.average_samples(camera, settings,
+                             [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
+                               return render(scene, sample_camera, sample_settings);
+                             });
   const auto start = std::chrono::steady_clock::now();
-  if (averages_samples(settings)) {
-    // Depth of field, motion blur: every sample frame in parts, as render(camera, settings) averages.
-    FrameStats frame;
-    frame.samples = 0;
-    RenderImage image = render_averaged(
-        camera, settings, [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
-          RenderImage sample = render(scene, sample_camera, sample_settings);
-          add_sample_stats(frame, r.stats);
-          return sample;
-        });
-    r.stats = frame;
-    r.stats.cpu_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    return image;
-  }
   r.render_in_parts(scene, camera, settings);
   RenderImage image = r.read_image(camera, settings);
   r.stats.cpu_ms =
