@@ -48,13 +48,9 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
   parser.add_int("--repeat", "N",
                  "frames measured per camera and sort (default 10): the median, min and max are over these",
                  &options.repeat, 1, 1000000);
-  parser.add_value("--memory-budget", "SIZE",
-                   "render every frame within this much device memory, e.g. 512M: a scene whose frame needs "
-                   "more renders in depth-ordered parts (docs/big-scenes.md); the table adds the parts and "
-                   "the peak device memory (frame benchmark only; default: no budget)",
-                   [&options](const std::string& text) {
-                     options.memory_budget = cli::parse_byte_size("--memory-budget", text);
-                   });
+  cli::add_memory_budget_option(
+      parser, options.memory_budget,
+      "the table adds the parts and the peak device memory; frame benchmark only; ");
   parser.add_string(
       "--csv", "FILE.csv",
       "also write the results as CSV: one line per scene, size, view, sort and metric; with several "

@@ -251,6 +251,15 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                    });
 }
 
+void add_memory_budget_option(ArgParser& parser, uint64_t& budget, const std::string& what_it_adds) {
+  parser.add_value(
+      "--memory-budget", "SIZE",
+      "device memory a frame may hold, e.g. 512M or 2G: a scene whose frame needs more renders in "
+      "parts that follow the depth order, into the same image bit for bit (docs/big-scenes.md; " +
+          what_it_adds + "default: no budget)",
+      [&budget](const std::string& text) { budget = parse_byte_size("--memory-budget", text); });
+}
+
 void apply_training_options(const CommonOptions& options, RenderSettings& settings) {
   if (options.antialiasing) settings.antialiasing = *options.antialiasing;
   if (options.max_alpha) settings.max_alpha = *options.max_alpha;

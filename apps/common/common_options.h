@@ -75,6 +75,10 @@ RendererOptions renderer_options(const CommonOptions& options);
 // (which hold the scene file's), and of how they become pixels (--compositor).
 void apply_training_options(const CommonOptions& options, RenderSettings& settings);
 
+// --memory-budget SIZE (parse_byte_size) into `budget`, RenderSettings::memory_budget; `what_it_adds`
+// ends the help text with what the app does besides rendering in parts.
+void add_memory_budget_option(ArgParser& parser, uint64_t& budget, const std::string& what_it_adds);
+
 // Whether any SCENE of the options is a scene file (.json).
 bool any_scene_file(const CommonOptions& options);
 

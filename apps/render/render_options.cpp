@@ -225,13 +225,7 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                     "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
                     "intersections, retries, device memory and its peak, scene parts, peak resident memory",
                     &options.stats);
-  parser.add_value("--memory-budget", "SIZE",
-                   "device memory a frame may hold, e.g. 512M or 2G: a scene whose frame needs more renders "
-                   "in parts that follow the depth order, into the same image bit for bit "
-                   "(docs/big-scenes.md; default: no budget)",
-                   [&options](const std::string& text) {
-                     options.memory_budget = cli::parse_byte_size("--memory-budget", text);
-                   });
+  cli::add_memory_budget_option(parser, options.memory_budget, "--stats prints the parts and peaks; ");
 
   parser.section("many frames (one process; -o and --png then take a frame number: out/view_%04d.exr)");
   parser.add_string(
