@@ -400,6 +400,21 @@ TEST(CliRender, MemoryBudgetRendersTheSameImageInParts) {
   EXPECT_EQ(reference.exit_code, 2) << reference.err;
   for (const char* name : {"bad.exr", "small.exr", "raster.exr", "reference.exr"})
     EXPECT_FALSE(fs::exists(out / name)) << name;
+
+  // A scene file under a budget: its models stay placed copies of their file, never merged.
+  const fs::path two = tilesplat::testing::bundled_scene_dir() / "two_playbots.json";
+  auto scene_file = [&](const std::vector<std::string>& extra, const std::string& name) {
+    std::vector<std::string> args = {two.string(),         "--view", "0", "--width", "320", "-o",
+                                     (out / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_exe(kRenderExe, args);
+  };
+  ASSERT_EQ(scene_file({}, "two_whole.exr").exit_code, 0);
+  const auto placed = scene_file({"--memory-budget", "8M", "--stats"}, "two_parts.exr");
+  ASSERT_EQ(placed.exit_code, 0) << placed.err;
+  EXPECT_TRUE(contains(placed.err, "62,000 Gaussians (SH2), 2 placed copies of 1 file")) << placed.err;
+  EXPECT_FALSE(contains(placed.out, "scene parts                         1\n")) << placed.out;
+  EXPECT_EQ(tilesplat::read_exr(out / "two_parts.exr").rgba, tilesplat::read_exr(out / "two_whole.exr").rgba);
 }
 
 TEST(CliRender, AntialiasingFlagSetsTheFootprintFilter) {

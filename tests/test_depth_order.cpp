@@ -27,7 +27,7 @@ GaussianScene on_axis(const std::vector<float>& depths) {
 
 TEST(DepthOrder, SortsFrontToBackAndLeavesOutWhatIsBehindTheNearPlane) {
   const GaussianScene scene = on_axis({5, 1, -2, 3, 0.1f, 2});
-  const DepthOrder order(scene, testing::axis_camera(64, 64, 50), 0.2, 32, kDepthMarginFloat64);
+  const DepthOrder order(PartSource(scene), testing::axis_camera(64, 64, 50), 0.2, 32, kDepthMarginFloat64);
   ASSERT_EQ(order.size(), 4u);  // -2 and 0.1 are behind the near plane (0.2)
   EXPECT_EQ(order.part_indices(0, 4), (std::vector<uint32_t>{0, 1, 3, 5}));  // ascending: the GPU's tie order
   // Front to back: 1 (index 1), 2 (5), 3 (3), 5 (0); each position alone is that Gaussian.
@@ -46,14 +46,14 @@ TEST(DepthOrder, NoBoundaryBetweenDepthsTheGpuMayOrderEitherWay) {
   const float next = std::bit_cast<float>(std::bit_cast<uint32_t>(z) + 1);
   const GaussianScene scene = on_axis({z, 4.0f, next, z, 2.0f});
   const Camera camera = testing::axis_camera(64, 64, 50);
-  const DepthOrder order(scene, camera, 0.2, 32, kDepthMarginFloat64);
+  const DepthOrder order(PartSource(scene), camera, 0.2, 32, kDepthMarginFloat64);
   ASSERT_EQ(order.size(), 5u);
   // 2 | 3, 3 | 3+ulp | 4
   EXPECT_TRUE(order.boundary(1));
   EXPECT_FALSE(order.boundary(2));
   EXPECT_TRUE(order.boundary(3));
   EXPECT_TRUE(order.boundary(4));
-  EXPECT_FALSE(DepthOrder(scene, camera, 0.2, 32, kDepthMarginFloat32).boundary(3));
+  EXPECT_FALSE(DepthOrder(PartSource(scene), camera, 0.2, 32, kDepthMarginFloat32).boundary(3));
   // A part asked to end inside the tie ends before it, or, starting in it, after it.
   EXPECT_EQ(order.part_end(0, 2), 1u);
   EXPECT_EQ(order.part_end(1, 1), 3u);
@@ -64,13 +64,13 @@ TEST(DepthOrder, TheFloat32MarginAndTwentyFourBitKeysWidenTheGaps) {
   // 1e-6 apart at depth 3: apart in 32-bit keys of float64 depths, not within float32's margin.
   const GaussianScene scene = on_axis({3.0f, 3.000001f, 3.5f});
   const Camera camera = testing::axis_camera(64, 64, 50);
-  EXPECT_TRUE(DepthOrder(scene, camera, 0.2, 32, kDepthMarginFloat64).boundary(1));
-  EXPECT_FALSE(DepthOrder(scene, camera, 0.2, 32, kDepthMarginFloat32).boundary(1));
+  EXPECT_TRUE(DepthOrder(PartSource(scene), camera, 0.2, 32, kDepthMarginFloat64).boundary(1));
+  EXPECT_FALSE(DepthOrder(PartSource(scene), camera, 0.2, 32, kDepthMarginFloat32).boundary(1));
   // 24-bit keys drop 8 bits: 3 and 3.000001 share one.
-  EXPECT_FALSE(DepthOrder(scene, camera, 0.2, 24, kDepthMarginFloat64).boundary(1));
-  EXPECT_TRUE(DepthOrder(scene, camera, 0.2, 24, kDepthMarginFloat64).boundary(2));
+  EXPECT_FALSE(DepthOrder(PartSource(scene), camera, 0.2, 24, kDepthMarginFloat64).boundary(1));
+  EXPECT_TRUE(DepthOrder(PartSource(scene), camera, 0.2, 24, kDepthMarginFloat64).boundary(2));
   EXPECT_NE(testing::error_of<std::invalid_argument>([&] {
-              DepthOrder(scene, camera, 0.2, 16, kDepthMarginFloat64);
+              DepthOrder(PartSource(scene), camera, 0.2, 16, kDepthMarginFloat64);
             }).find("24- or 32-bit depth keys"),
             std::string::npos);
 }
@@ -80,9 +80,10 @@ TEST(DepthOrder, AFisheyeSortsByDistance) {
   GaussianScene scene = on_axis({2.0f, 1.0f});
   scene.positions[3] = 3.0f;
   const Camera pinhole = testing::axis_camera(64, 64, 50);
-  EXPECT_EQ(DepthOrder(scene, pinhole, 0.2, 32, kDepthMarginFloat64).part_indices(0, 1),
+  EXPECT_EQ(DepthOrder(PartSource(scene), pinhole, 0.2, 32, kDepthMarginFloat64).part_indices(0, 1),
             std::vector<uint32_t>{1});
-  EXPECT_EQ(DepthOrder(scene, fisheye_camera(pinhole, 180), 0.2, 32, kDepthMarginFloat64).part_indices(0, 1),
+  EXPECT_EQ(DepthOrder(PartSource(scene), fisheye_camera(pinhole, 180), 0.2, 32, kDepthMarginFloat64)
+                .part_indices(0, 1),
             std::vector<uint32_t>{0});
 }
 
@@ -113,13 +114,13 @@ TEST(PartSizing, CostsFollowTheFrame) {
   const GaussianScene scene = on_axis({1, 2});
   const Camera camera = testing::axis_camera(32, 16, 50);
   RenderSettings settings;
-  const PartCosts plain = part_costs(scene, camera, settings, 1, false);
+  const PartCosts plain = part_costs(PartSource(scene), camera, settings, 1, false);
   // Colour, depth, counts and two 32-byte halves of state per pixel; two tiles of ranges.
   EXPECT_EQ(plain.fixed, 32u * 16u * (16 + 4 + 4 + 64) + 2 * 8);
   settings.depth = false;
   settings.splat_count = false;
-  EXPECT_EQ(part_costs(scene, camera, settings, 1, false).fixed, 32u * 16u * (16 + 64) + 2 * 8);
-  const PartCosts seams = part_costs(scene, camera, settings, 2, true);
+  EXPECT_EQ(part_costs(PartSource(scene), camera, settings, 1, false).fixed, 32u * 16u * (16 + 64) + 2 * 8);
+  const PartCosts seams = part_costs(PartSource(scene), camera, settings, 2, true);
   EXPECT_GT(seams.per_gaussian, plain.per_gaussian);
   EXPECT_GT(seams.per_pair, plain.per_pair);
 }

@@ -12,6 +12,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/scene_description.h"
 
 namespace tilesplat {
 namespace {
@@ -181,6 +182,68 @@ TEST(SceneParts, EveryCompositeLayoutCarriesTheState) {
   RenderSettings settings;
   settings.memory_budget = kSmallBudget;
   testing::expect_composite_layouts_identical(big.scene, resize_camera(big.camera, 120, 68), settings);
+}
+
+// A scene file's placed copies rendered in parts, each part's Gaussians placed as it is drawn: the
+// merged scene's frame, bit for bit (a rotation turns the SH, a scale the log scales).
+TEST(SceneParts, InstancesInPartsAreTheMergedScene) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  const BigScene& big = big_scene();
+  SceneInstances instances;
+  instances.files = {big.scene};
+  instances.sh_degree = big.scene.sh_degree;
+  ModelTransform turned;
+  turned.translation = {0.3, -0.1, 0.4};
+  turned.rotation = {0.9659258262890683, 0, 0.25881904510252074, 0};  // 30 degrees about y
+  turned.scale = {0.8, 0.8, 0.8};
+  instances.instances = {{0, ModelTransform{}}, {0, turned}};
+  const GaussianScene merged = merge_instances(instances);
+  ASSERT_EQ(merged.size(), 2 * big.scene.size());
+  RenderSettings settings;
+  expect_parts_equal_whole(merged, big.camera, settings, 16, "two placed copies, merged");
+  const RenderImage merged_in_parts = parts_renderer().render(merged, big.camera, [] {
+    RenderSettings budget;
+    budget.memory_budget = kSmallBudget;
+    return budget;
+  }());
+  settings.memory_budget = kSmallBudget;
+  const RenderImage placed_in_parts = parts_renderer().render(instances, big.camera, settings);
+  EXPECT_GE(parts_renderer().last_frame_stats().scene_parts, 16);
+  EXPECT_EQ(parts_renderer().last_frame_stats().gaussians, merged.size());
+  expect_bit_identical(placed_in_parts, merged_in_parts,
+                       "instances in parts against the merged scene in parts");
+  // Without a budget (or one it fits) the instances are merged and set: render(camera) draws them again.
+  settings.memory_budget = 0;
+  expect_bit_identical(parts_renderer().render(instances, big.camera, settings), merged_in_parts,
+                       "merged whole");
+  expect_bit_identical(parts_renderer().render(big.camera, settings), merged_in_parts,
+                       "set by render(instances)");
+  EXPECT_EQ(parts_renderer().validation_messages(), 0u);
+}
+
+// A scene file's instances are the scene load_described_scene merges, each file read once.
+TEST(SceneParts, SceneFileInstancesMergeToTheLoadedScene) {
+  const SceneDescription description =
+      load_scene_description(testing::bundled_scene_dir() / "two_playbots.json");
+  LoadReport report;
+  const SceneInstances instances = load_scene_instances(description, {}, &report);
+  ASSERT_EQ(instances.files.size(), 1u);  // one file, named by both models
+  ASSERT_EQ(instances.instances.size(), 2u);
+  EXPECT_EQ(report.gaussians_in_file, 2 * instances.files[0].size());
+  const GaussianScene loaded = load_described_scene(description);
+  const GaussianScene merged = merge_instances(instances);
+  EXPECT_EQ(merged.positions, loaded.positions);
+  EXPECT_EQ(merged.rotations, loaded.rotations);
+  EXPECT_EQ(merged.log_scales, loaded.log_scales);
+  EXPECT_EQ(merged.sh, loaded.sh);
+  EXPECT_EQ(merged.opacity_logits, loaded.opacity_logits);
+  const Bounds from_instances = compute_bounds(instances);
+  const Bounds from_merged = compute_bounds(loaded);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_EQ(from_instances.min[a], from_merged.min[a]) << a;
+    EXPECT_EQ(from_instances.max[a], from_merged.max[a]) << a;
+    EXPECT_EQ(from_instances.center[a], from_merged.center[a]) << a;
+  }
 }
 
 TEST(SceneParts, SceneThatFitsRendersWholeAndStaysSet) {

@@ -46,7 +46,8 @@ double elapsed_ms(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view program) {
+LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view program,
+                            SceneHolding holding) {
   LoadedScene loaded;
   loaded.path = path;
   require_input_file(loaded.path, "scene");
@@ -57,7 +58,10 @@ LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view 
   try {
     if (is_scene_description(loaded.path)) {
       loaded.description = load_scene_description(loaded.path);
-      loaded.scene = load_described_scene(*loaded.description, load_options, &loaded.report);
+      if (holding == SceneHolding::kInstances)
+        loaded.instances = load_scene_instances(*loaded.description, load_options, &loaded.report);
+      else
+        loaded.scene = load_described_scene(*loaded.description, load_options, &loaded.report);
     } else {
       loaded.scene = load_scene(loaded.path, load_options, &loaded.report);
     }
@@ -159,12 +163,12 @@ ImageSize orbit_image_size(int width, int height) {
 }
 
 NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const OrbitParams& orbit) {
-  if (loaded.scene.empty())
+  if (loaded.gaussians() == 0)
     throw std::runtime_error(single_quoted(loaded.path.string()) +
                              " has no Gaussians for the orbit camera to frame; pass --cameras FILE.json");
   const ImageSize size = orbit_image_size(width, height);
   NamedCamera named;
-  named.camera = orbit_camera(loaded.scene, size.width, size.height, orbit);
+  named.camera = orbit_camera(loaded.bounds(), size.width, size.height, orbit);
   named.description = "orbit azimuth " + format_fixed(orbit.azimuth_deg, 1) + " elevation " +
                       format_fixed(orbit.elevation_deg, 1) + " fov " +
                       format_fixed(orbit.vertical_fov_deg, 1);
@@ -177,8 +181,9 @@ SceneViews camera_views(const CommonOptions& options, const LoadedScene& loaded)
   return {load_camera_views(options.cameras), options.cameras};
 }
 
-LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program) {
-  LoadedScene loaded = load_scene_file(options.scene, options.strict, program);
+LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program,
+                                  SceneHolding holding) {
+  LoadedScene loaded = load_scene_file(options.scene, options.strict, program, holding);
   const SceneViews cameras = camera_views(options, loaded);
   NamedCamera named;
   if (!cameras.views.empty()) {
@@ -204,6 +209,15 @@ LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view
 
 std::string describe_scene(const GaussianScene& scene) {
   return group_thousands(scene.size()) + " Gaussians (SH" + std::to_string(scene.sh_degree) + ")";
+}
+
+std::string describe_scene(const LoadedScene& loaded) {
+  if (!loaded.instances) return describe_scene(loaded.scene);
+  return group_thousands(loaded.gaussians()) + " Gaussians (SH" +
+         std::to_string(loaded.instances->sh_degree) + "), " +
+         std::to_string(loaded.instances->instances.size()) + " placed copies of " +
+         std::to_string(loaded.instances->files.size()) +
+         (loaded.instances->files.size() == 1 ? " file" : " files");
 }
 
 }  // namespace tilesplat::cli

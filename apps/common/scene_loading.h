@@ -18,12 +18,20 @@
 
 namespace tilesplat::cli {
 
+// How a scene file's models are held: merged into one scene, or as placed copies of their files (for a
+// renderer under a memory budget, which places the copies part by part: docs/big-scenes.md).
+enum class SceneHolding { kMerged, kInstances };
+
 struct LoadedScene {
   std::filesystem::path path;
   GaussianScene scene;
   // Set when the SCENE is a scene file (.json, docs/scene-format.md): its cameras, background,
-  // effects and outputs. Its models are already loaded, transformed and merged into `scene`.
+  // effects and outputs. Its models are already loaded, transformed and merged into `scene`, or, held
+  // as SceneHolding::kInstances, placed in `instances` (and `scene` is empty).
   std::optional<SceneDescription> description;
+  std::optional<SceneInstances> instances;
+  size_t gaussians() const { return instances ? instances->size() : scene.size(); }
+  Bounds bounds() const { return instances ? compute_bounds(*instances) : compute_bounds(scene); }
   LoadReport report;
   Camera camera;
   std::string camera_description;  // "view 0 of cams.json" or "orbit azimuth 0 elevation 20 fov 50"
@@ -37,11 +45,13 @@ struct LoadedScene {
 // dropped) and builds the camera at the requested size: --cameras, else the scene file's cameras,
 // else the orbit. A missing or unreadable file throws std::runtime_error naming it; an
 // out-of-range --view throws UsageError naming the file and its number of views.
-LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program);
+LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program,
+                                  SceneHolding holding = SceneHolding::kMerged);
 
 // The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
 // load_scene_file fills path, scene, description, report and load_ms only.
-LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program);
+LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program,
+                            SceneHolding holding = SceneHolding::kMerged);
 
 // The views a scene file brings ("cameras") and the file that names them (the cameras.json it
 // refers to, else the scene file). No views for a .ply, or a scene file without cameras.
@@ -84,7 +94,8 @@ ImageSize orbit_image_size(int width, int height);
 // The orbit camera framing the scene (which must not be empty) at width x height (0: see CommonOptions).
 NamedCamera orbit_view(const LoadedScene& loaded, int width, int height, const OrbitParams& orbit);
 
-// "SH3" style summary of the scene: "64 Gaussians (SH3)".
+// "SH3" style summary of the scene: "64 Gaussians (SH3)"; of a loaded scene held either way.
 std::string describe_scene(const GaussianScene& scene);
+std::string describe_scene(const LoadedScene& loaded);
 
 }  // namespace tilesplat::cli

@@ -159,11 +159,11 @@ std::vector<Frame> plan_sequence(const cli::ArgParser& parser, const RenderOptio
     std::vector<tilesplat::Camera> cameras;
     std::string what;
     if (parser.seen("--orbit")) {
-      if (loaded.scene.empty())
+      if (loaded.gaussians() == 0)
         throw std::runtime_error(single_quoted(loaded.path.string()) +
                                  " has no Gaussians for --orbit to frame");
-      cameras =
-          tilesplat::orbit_cameras(loaded.scene, options.orbit_frames, size.width, size.height, common.orbit);
+      cameras = tilesplat::orbit_cameras(loaded.bounds(), options.orbit_frames, size.width, size.height,
+                                         common.orbit);
       what = "orbit";
     } else {
       tilesplat::CameraPath path;
@@ -275,16 +275,19 @@ struct FrameWriter {
 // Renders one camera with the GPU renderer or the float64 reference; `gpu_ms` gets the frame's time.
 class FrameRenderer {
  public:
-  FrameRenderer(const RenderOptions& options, const tilesplat::GaussianScene& scene)
-      : scene_(scene), lens_(options.lens), in_parts_(options.memory_budget > 0) {
+  FrameRenderer(const RenderOptions& options, const cli::LoadedScene& loaded)
+      : scene_(loaded.scene),
+        instances_(loaded.instances ? &*loaded.instances : nullptr),
+        lens_(options.lens),
+        in_parts_(options.memory_budget > 0) {
     if (lens_.enabled()) {
-      const tilesplat::Bounds bounds = tilesplat::compute_bounds(scene);
+      const tilesplat::Bounds bounds = loaded.bounds();
       scene_centre_ = {bounds.center[0], bounds.center[1], bounds.center[2]};
     }
     if (options.reference) return;
     renderer_ = tilesplat::Renderer::create(cli::renderer_options(options.common));
     // Under a memory budget each frame takes the scene (in parts where it does not fit).
-    if (!in_parts_) renderer_->set_scene(scene);
+    if (!in_parts_) renderer_->set_scene(scene_);
   }
 
   tilesplat::RenderImage render(const tilesplat::Camera& camera,
@@ -294,7 +297,9 @@ class FrameRenderer {
     if (lens_.enabled()) settings.lens = lens_for_frame(lens_, camera, scene_centre_);
     tilesplat::RenderImage image;
     if (renderer_) {
-      image = in_parts_ ? renderer_->render(scene_, camera, settings) : renderer_->render(camera, settings);
+      image = !in_parts_   ? renderer_->render(camera, settings)
+              : instances_ ? renderer_->render(*instances_, camera, settings)
+                           : renderer_->render(scene_, camera, settings);
       gpu_ms_ = renderer_->last_frame_stats().gpu_ms;
       cpu_ms_ = renderer_->last_frame_stats().cpu_ms;
     } else {
@@ -324,6 +329,7 @@ class FrameRenderer {
 
  private:
   const tilesplat::GaussianScene& scene_;
+  const tilesplat::SceneInstances* instances_;  // a scene file's placed copies, held so under --memory-budget
   LensFlags lens_;
   bool in_parts_ = false;                           // --memory-budget
   std::array<double, 3> scene_centre_ = {0, 0, 0};  // where the lens focuses unless --focus-distance says
@@ -377,7 +383,7 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
   std::vector<double> gpu_ms;
   if (!to_render.empty()) {
     // The device first: a run that cannot create it leaves no (empty) manifest behind.
-    FrameRenderer renderer(options, loaded.scene);
+    FrameRenderer renderer(options, loaded);
     writer.exr.attributes["sortStrategy"] = renderer.sort_strategy(settings);
     cli::ManifestAppender manifest(folder / cli::manifest_file_name(shard));
     cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()), progress_style(options.quiet));
@@ -453,9 +459,12 @@ int run(int argc, char** argv) {
   if (!options.png.empty())
     cli::check_output_path(sequence ? cli::frame_file("--png", options.png, 0) : options.png, "--png");
 
-  cli::LoadedScene loaded = sequence
-                                ? cli::load_scene_file(options.common.scene, options.common.strict, kProgram)
-                                : cli::load_scene_and_camera(options.common, kProgram);
+  // Under a memory budget a scene file's models stay placed copies of their files, never merged.
+  const cli::SceneHolding holding =
+      options.memory_budget > 0 ? cli::SceneHolding::kInstances : cli::SceneHolding::kMerged;
+  cli::LoadedScene loaded =
+      sequence ? cli::load_scene_file(options.common.scene, options.common.strict, kProgram, holding)
+               : cli::load_scene_and_camera(options.common, kProgram, holding);
   std::vector<Frame> frames;
   if (sequence) {
     frames = plan_sequence(parser, options, loaded);
@@ -526,7 +535,7 @@ int run(int argc, char** argv) {
   }
 
   const Frame& frame = frames.front();
-  FrameRenderer renderer(options, loaded.scene);
+  FrameRenderer renderer(options, loaded);
   writer.exr.attributes["sortStrategy"] = renderer.sort_strategy(settings);
   const tilesplat::RenderImage image = renderer.render(frame.camera, settings);
   std::string timing;
@@ -541,7 +550,7 @@ int run(int argc, char** argv) {
     timing = "CPU reference " + cli::format_fixed(renderer.cpu_ms(), 1) + " ms";
     if (options.stats) {
       print_row("cpu reference", cli::format_fixed(renderer.cpu_ms(), 3), "ms");
-      print_row("gaussians", std::to_string(loaded.scene.size()), "");
+      print_row("gaussians", std::to_string(loaded.gaussians()), "");
     }
   }
   writer.write(frame, image);
@@ -550,9 +559,9 @@ int run(int argc, char** argv) {
 
   std::fflush(stdout);
   const std::string summary = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
-                              cli::describe_scene(loaded.scene) + ", " + std::to_string(image.width) + "x" +
-                              std::to_string(image.height) + ", " + loaded.camera_description + ", " + timing +
-                              " -> " + written + "\n";
+                              cli::describe_scene(loaded) + ", " + std::to_string(image.width) + "x" +
+                              std::to_string(image.height) + ", " + loaded.camera_description + ", " +
+                              timing + " -> " + written + "\n";
   std::fputs(summary.c_str(), stderr);
   return cli::kExitOk;
 }

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -69,10 +70,14 @@ struct Renderer::Impl {
   // A scene within a memory budget (renderer_parts.cpp): whether its frame would exceed
   // settings.memory_budget, and the rendering in depth-ordered parts that leaves the image in the
   // outputs and the parts' statistics.
-  bool needs_parts(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings);
-  void render_in_parts(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings);
-  PartCosts part_costs_for(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+  bool needs_parts(const PartSource& scene, const Camera& camera, const RenderSettings& settings);
+  void render_in_parts(const PartSource& scene, const Camera& camera, const RenderSettings& settings);
+  PartCosts part_costs_for(const PartSource& scene, const Camera& camera, const RenderSettings& settings,
                            const std::string& sort_name);
+  // Renderer::render(scene, camera, settings) for either kind of scene: set_whole uploads it whole when
+  // its frame fits the budget, and `renderer` renders it then.
+  RenderImage render_scene(const PartSource& scene, const std::function<void()>& set_whole,
+                           const Camera& camera, const RenderSettings& settings, Renderer& renderer);
   void end_frame(const FrameStart& start, const FrameCounters& frame, std::vector<PassTiming> passes,
                  bool lists_whole);
   void add_timings(std::vector<PassTiming>& passes);

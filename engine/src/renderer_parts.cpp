@@ -6,11 +6,13 @@
 // Gaussian brought in the parts before, and what the sort strategy's buffers measured.
 #include <algorithm>
 #include <chrono>
+#include <functional>
 
 #include "camera/camera_models.h"
 #include "frame/averaged_frames.h"
 #include "frame/scene_parts.h"
 #include "renderer_impl.h"
+#include "tilesplat/scene_description.h"
 
 namespace tilesplat {
 
@@ -49,17 +51,17 @@ void add_part_stats(FrameStats& total, const FrameStats& part) {
 }  // namespace
 
 // What a part of this frame costs on the device, with the strategy's key width.
-PartCosts Renderer::Impl::part_costs_for(const GaussianScene& scene, const Camera& camera,
+PartCosts Renderer::Impl::part_costs_for(const PartSource& scene, const Camera& camera,
                                          const RenderSettings& settings, const std::string& sort_name) {
   const bool wide_keys = sort(sort_name).frame_plan() == FrameSortPlan::kTileDepthPairs;
-  const SceneShape shape{0, uint32_t(std::min<size_t>(scene.size(), UINT32_MAX)), scene.sh_degree,
+  const SceneShape shape{0, uint32_t(std::min<size_t>(scene.size(), UINT32_MAX)), scene.sh_degree(),
                          scene.has_normals()};
   const uint32_t seam_copies =
       projection_variant(settings, shape, camera_models::drawn_model(camera)).seam_copies();
   return part_costs(scene, camera, settings, seam_copies, wide_keys);
 }
 
-bool Renderer::Impl::needs_parts(const GaussianScene& scene, const Camera& camera,
+bool Renderer::Impl::needs_parts(const PartSource& scene, const Camera& camera,
                                  const RenderSettings& settings) {
   if (settings.memory_budget == 0) return false;
   const std::string sort_name = choose_sort_strategy(settings.sort, device_caps(), /*without_waiting=*/false);
@@ -70,7 +72,7 @@ bool Renderer::Impl::needs_parts(const GaussianScene& scene, const Camera& camer
   return whole_bytes > double(settings.memory_budget);
 }
 
-void Renderer::Impl::render_in_parts(const GaussianScene& scene, const Camera& camera,
+void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& camera,
                                      const RenderSettings& settings) {
   wait_for_submitted_frame();
   const std::string sort_name = choose_sort_strategy(settings.sort, device_caps(), /*without_waiting=*/false);
@@ -97,7 +99,7 @@ void Renderer::Impl::render_in_parts(const GaussianScene& scene, const Camera& c
   for (uint32_t index = 0;; ++index) {
     const size_t end = order.size() == 0 ? 0 : order.part_end(begin, capacity);
     const std::vector<uint32_t> indices = order.part_indices(begin, end);
-    resources.upload_scene(gather_gaussians(scene, indices), /*reuse_buffers=*/true);
+    resources.upload_scene(scene.gather(indices), /*reuse_buffers=*/true);
     ++scene_generation;  // the lists in the buffers are the previous part's
     lists.reset();
     // Pairs for a part of the capacity the budget was reckoned for (the same from part to part: no new
@@ -125,24 +127,35 @@ void Renderer::Impl::render_in_parts(const GaussianScene& scene, const Camera& c
   stats = total;
 }
 
-RenderImage Renderer::render(const GaussianScene& scene, const Camera& camera,
-                             const RenderSettings& settings) {
-  Impl& r = *impl_;
-  if (!r.needs_parts(scene, camera, settings)) {
-    set_scene(scene);
-    return render(camera, settings);
+RenderImage Renderer::Impl::render_scene(const PartSource& scene, const std::function<void()>& set_whole,
+                                         const Camera& camera, const RenderSettings& settings,
+                                         Renderer& renderer) {
+  if (!needs_parts(scene, camera, settings)) {
+    set_whole();
+    return renderer.render(camera, settings);
   }
   if (averages_samples(settings))  // depth of field, motion blur: every sample frame in parts
-    return r.average_samples(camera, settings,
-                             [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
-                               return render(scene, sample_camera, sample_settings);
-                             });
+    return average_samples(camera, settings,
+                           [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
+                             return render_scene(scene, set_whole, sample_camera, sample_settings, renderer);
+                           });
   const auto start = std::chrono::steady_clock::now();
-  r.render_in_parts(scene, camera, settings);
-  RenderImage image = r.read_image(camera, settings);
-  r.stats.cpu_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  render_in_parts(scene, camera, settings);
+  RenderImage image = read_image(camera, settings);
+  stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return image;
+}
+
+RenderImage Renderer::render(const GaussianScene& scene, const Camera& camera,
+                             const RenderSettings& settings) {
+  return impl_->render_scene(
+      PartSource(scene), [&] { set_scene(scene); }, camera, settings, *this);
+}
+
+RenderImage Renderer::render(const SceneInstances& scene, const Camera& camera,
+                             const RenderSettings& settings) {
+  return impl_->render_scene(
+      PartSource(scene), [&] { set_scene(merge_instances(scene)); }, camera, settings, *this);
 }
 
 }  // namespace tilesplat

@@ -185,6 +185,9 @@ struct OrbitParams {
 /// `width` and `height` in pixels. Throws std::invalid_argument for a size that is not positive.
 TILESPLAT_API Camera orbit_camera(const GaussianScene& scene, int width, int height,
                                   const OrbitParams& params = {});
+/// The same around given bounds (compute_bounds of a scene, or of a scene file's instances).
+TILESPLAT_API Camera orbit_camera(const Bounds& bounds, int width, int height,
+                                  const OrbitParams& params = {});
 
 /// The camera turned by `radians` (right-handed) about the line through `pivot` along the unit
 /// `axis`: its position moves around the line and its axes turn with it, so the scene turns the

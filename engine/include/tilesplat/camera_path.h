@@ -53,5 +53,8 @@ TILESPLAT_API std::vector<Camera> sample_camera_path(const CameraPath& path, int
 /// is not positive.
 TILESPLAT_API std::vector<Camera> orbit_cameras(const GaussianScene& scene, int frames, int width, int height,
                                                 const OrbitParams& params = {});
+/// The same around given bounds (compute_bounds).
+TILESPLAT_API std::vector<Camera> orbit_cameras(const Bounds& bounds, int frames, int width, int height,
+                                                const OrbitParams& params = {});
 
 }  // namespace tilesplat

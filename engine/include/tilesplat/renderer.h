@@ -101,6 +101,7 @@ struct DeviceInfo {
       0;  ///< VkPhysicalDeviceProperties::vendorID, the PCI vendor (0x10DE NVIDIA, 0x1002 AMD, ...)
 };
 
+struct SceneInstances;        // tilesplat/scene_description.h
 struct ExternalVulkanDevice;  // tilesplat/vulkan_interop.h
 struct ExternalImage;
 struct ExternalDepthImage;
@@ -160,6 +161,9 @@ class TILESPLAT_API Renderer {
   /// per-pixel re-sorting (std::invalid_argument otherwise, and for a budget too small for one
   /// Gaussian); otherwise it throws as set_scene and render do.
   RenderImage render(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings = {});
+  /// The same for a scene file's placed copies (load_scene_instances): in parts, each part's Gaussians are
+  /// placed as they are drawn, so the merged scene is never held; whole, it is merged and set.
+  RenderImage render(const SceneInstances& scene, const Camera& camera, const RenderSettings& settings = {});
 
   /// What the last render() (or render_to_image()) did and cost. The reference is valid until the
   /// next frame. A frame render_to_image submitted without waiting (HostFrameSync) is described once

@@ -158,6 +158,38 @@ TILESPLAT_API GaussianScene load_described_scene(const SceneDescription& descrip
                                                  const LoadOptions& options = {},
                                                  LoadReport* report = nullptr);
 
+/// A scene description's models as placed copies of the files they name, each file's Gaussians held
+/// once: the scene load_described_scene() merges, without the merged copy. Renderer::render takes it
+/// under a memory budget and places the copies part by part (docs/big-scenes.md), so that a scene of
+/// many copies needs host memory for its files only.
+struct SceneInstances {
+  /// One placed copy: a file's Gaussians through a transform.
+  struct Instance {
+    size_t file = 0;           ///< index into `files`
+    ModelTransform transform;  ///< where the copy goes (transform_scene)
+  };
+  std::vector<GaussianScene> files;  ///< each file the description names, once, as load_scene read it
+  std::vector<Instance> instances;   ///< the models in the description's order: the merged scene's order
+  int sh_degree = 0;     ///< the merged scene's SH degree (the largest, capped by the sh_degree effect)
+  bool normals = false;  ///< whether the merged scene has normals (any file has them)
+
+  /// The merged scene's Gaussians: the sum over the instances.
+  size_t size() const;
+};
+
+/// Loads every file the description names once and places its models as instances (what
+/// load_described_scene merges). Throws as load_described_scene does; the report sums the models'.
+TILESPLAT_API SceneInstances load_scene_instances(const SceneDescription& description,
+                                                  const LoadOptions& options = {},
+                                                  LoadReport* report = nullptr);
+
+/// The instances transformed and merged, in order: load_described_scene's scene, bit for bit.
+TILESPLAT_API GaussianScene merge_instances(const SceneInstances& scene);
+
+/// The bounds of the merged scene (compute_bounds of merge_instances(scene)), from the placed positions
+/// alone.
+TILESPLAT_API Bounds compute_bounds(const SceneInstances& scene);
+
 /// Whether the path names a scene description (a .json file) rather than a splat file.
 TILESPLAT_API bool is_scene_description(const std::filesystem::path& path);
 

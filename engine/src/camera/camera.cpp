@@ -222,7 +222,12 @@ Camera look_at_camera(const std::array<double, 3>& eye, const std::array<double,
 
 Camera orbit_camera(const GaussianScene& scene, int width, int height, const OrbitParams& params) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("orbit_camera: width and height must be positive");
-  const Bounds bounds = compute_bounds(scene);
+  return orbit_camera(compute_bounds(scene), width, height, params);
+}
+
+Camera orbit_camera(const Bounds& bounds, int width, int height, const OrbitParams& params) {
+  if (width <= 0 || height <= 0)
+    throw std::invalid_argument("orbit_camera: width and height must be positive");
   const Vec3 center = {bounds.center[0], bounds.center[1], bounds.center[2]};
   const double radius = (bounds.radius > 0 && std::isfinite(bounds.radius)) ? bounds.radius : 1.0;
 

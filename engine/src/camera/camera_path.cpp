@@ -154,12 +154,19 @@ std::vector<Camera> orbit_cameras(const GaussianScene& scene, int frames, int wi
                                   const OrbitParams& params) {
   if (frames < 1) throw std::invalid_argument("orbit_cameras: frames must be at least 1");
   check_size(width, height);
+  return orbit_cameras(compute_bounds(scene), frames, width, height, params);
+}
+
+std::vector<Camera> orbit_cameras(const Bounds& bounds, int frames, int width, int height,
+                                  const OrbitParams& params) {
+  if (frames < 1) throw std::invalid_argument("orbit_cameras: frames must be at least 1");
+  check_size(width, height);
   std::vector<Camera> cameras;
   cameras.reserve(static_cast<size_t>(frames));
   for (int f = 0; f < frames; ++f) {
     OrbitParams at = params;
     at.azimuth_deg = params.azimuth_deg + 360.0 * f / frames;
-    cameras.push_back(orbit_camera(scene, width, height, at));
+    cameras.push_back(orbit_camera(bounds, width, height, at));
   }
   return cameras;
 }

@@ -32,8 +32,55 @@ uint32_t depth_key(double depth, int key_bits) {
 
 }  // namespace
 
-DepthOrder::DepthOrder(const GaussianScene& scene, const Camera& camera, double near_plane,
-                       int depth_key_bits, double relative_margin) {
+PartSource::PartSource(const GaussianScene& scene) : scene_(&scene), size_(scene.size()) {}
+
+PartSource::PartSource(const SceneInstances& scene) : instances_(&scene) {
+  for (const SceneInstances::Instance& instance : scene.instances) {
+    first_.push_back(size_);
+    size_ += scene.files.at(instance.file).size();
+    placements_.emplace_back(instance.transform);
+  }
+  first_.push_back(size_);
+}
+
+int PartSource::sh_degree() const {
+  return scene_ ? scene_->sh_degree : instances_->sh_degree;
+}
+bool PartSource::has_normals() const {
+  return scene_ ? scene_->has_normals() : instances_->normals;
+}
+
+std::array<float, 3> PartSource::position(size_t i) const {
+  if (scene_) return {scene_->positions[3 * i], scene_->positions[3 * i + 1], scene_->positions[3 * i + 2]};
+  const size_t k = size_t(std::upper_bound(first_.begin(), first_.end(), i) - first_.begin()) - 1;
+  const GaussianScene& file = instances_->files[instances_->instances[k].file];
+  const size_t local = i - first_[k];
+  return placements_[k].place(&file.positions[3 * local], local);
+}
+
+GaussianScene PartSource::gather(std::span<const uint32_t> indices) const {
+  if (scene_) return gather_gaussians(*scene_, indices);
+  // Instance by instance (the indices ascend): its Gaussians gathered, placed as transform_scene places
+  // them and appended as the merged scene appends them.
+  GaussianScene part;
+  detail::reserve_merged(part, indices.size(), instances_->sh_degree, instances_->normals);
+  std::vector<uint32_t> local;
+  for (size_t next = 0; next < indices.size();) {
+    const size_t k =
+        size_t(std::upper_bound(first_.begin(), first_.end(), size_t(indices[next])) - first_.begin()) - 1;
+    local.clear();
+    for (; next < indices.size() && indices[next] < first_[k + 1]; ++next)
+      local.push_back(uint32_t(indices[next] - first_[k]));
+    const SceneInstances::Instance& instance = instances_->instances[k];
+    detail::append_merged(
+        part, transform_scene(gather_gaussians(instances_->files[instance.file], local), instance.transform),
+        instances_->normals);
+  }
+  return part;
+}
+
+DepthOrder::DepthOrder(const PartSource& scene, const Camera& camera, double near_plane, int depth_key_bits,
+                       double relative_margin) {
   if (depth_key_bits != 24 && depth_key_bits != 32)
     throw std::invalid_argument("a scene in parts sorts by 24- or 32-bit depth keys, not " +
                                 std::to_string(depth_key_bits));
@@ -47,8 +94,8 @@ DepthOrder::DepthOrder(const GaussianScene& scene, const Camera& camera, double 
     double depth, margin;
   };
   auto bounds = [&](size_t i) {
-    const std::array<double, 3> world = {double(scene.positions[3 * i]), double(scene.positions[3 * i + 1]),
-                                         double(scene.positions[3 * i + 2])};
+    const std::array<float, 3> position = scene.position(i);
+    const std::array<double, 3> world = {double(position[0]), double(position[1]), double(position[2])};
     const std::array<double, 3> t = camera.to_camera(world);
     const double rel = std::abs(world[0] - camera.position[0]) + std::abs(world[1] - camera.position[1]) +
                        std::abs(world[2] - camera.position[2]);
@@ -135,7 +182,7 @@ GaussianScene gather_gaussians(const GaussianScene& scene, std::span<const uint3
   return part;
 }
 
-PartCosts part_costs(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+PartCosts part_costs(const PartSource& scene, const Camera& camera, const RenderSettings& settings,
                      uint32_t seam_copies, bool wide_keys) {
   const uint64_t pixels = uint64_t(camera.width) * uint64_t(camera.height);
   const uint64_t tiles = ((uint64_t(camera.width) + kTileSize - 1) / kTileSize) *
@@ -144,7 +191,7 @@ PartCosts part_costs(const GaussianScene& scene, const Camera& camera, const Ren
   // Colour, depth and counts out; the composite state's two halves of 32 bytes; the tile ranges.
   costs.fixed = pixels * (16 + (settings.depth ? 4 : 0) + (settings.splat_count ? 4 : 0) + 64) + tiles * 8;
   if (settings.host) costs.fixed += pixels * 4 * (settings.host->write_depth ? 2 : 1);
-  const uint64_t k = uint64_t(scene.sh_coefficients());
+  const uint64_t k = uint64_t((scene.sh_degree() + 1) * (scene.sh_degree() + 1));
   const AccuracyModes& modes = settings.accuracy;
   costs.per_gaussian = 4 * (3 + 3 + 4 + 1 + 3 * k);  // the attributes
   if (settings.lighting.enabled() && scene.has_normals()) costs.per_gaussian += 12;

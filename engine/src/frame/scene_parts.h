@@ -11,14 +11,17 @@
 // concatenated over the parts, are the whole frame's list, and the image is the whole frame's, bit for bit.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
 
+#include "scene/scene_merge.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/scene_description.h"
 
 namespace tilesplat {
 
@@ -29,12 +32,37 @@ namespace tilesplat {
 constexpr double kDepthMarginFloat64 = 1e-12;
 constexpr double kDepthMarginFloat32 = 2e-6;
 
+// The Gaussians a scene in parts draws from: one GaussianScene, or the placed copies of a
+// SceneInstances, numbered as in their merged scene (merge_instances), whose parts it places one
+// Gaussian at a time (so that a scene of many copies is never held whole).
+class PartSource {
+ public:
+  explicit PartSource(const GaussianScene& scene);
+  explicit PartSource(const SceneInstances& scene);
+
+  size_t size() const { return size_; }
+  int sh_degree() const;
+  bool has_normals() const;
+  // Gaussian i's position, as the merged scene holds it and the GPU reads it.
+  std::array<float, 3> position(size_t i) const;
+  // The Gaussians `indices` (ascending) as a scene of their own: the merged scene's Gaussians, bit for bit.
+  GaussianScene gather(std::span<const uint32_t> indices) const;
+
+ private:
+  const GaussianScene* scene_ = nullptr;
+  const SceneInstances* instances_ = nullptr;
+  std::vector<size_t>
+      first_;  // instances: each instance's first Gaussian in the merged scene, then the total
+  std::vector<detail::PositionPlacement> placements_;
+  size_t size_ = 0;
+};
+
 class DepthOrder {
  public:
   // The Gaussians the GPU may draw (those clearly behind the near plane, or with non-finite depths,
   // are left out), front to back. depth_key_bits is the frame's (24 or 32; std::invalid_argument
   // otherwise); relative_margin kDepthMarginFloat64 or kDepthMarginFloat32, as the device projects.
-  DepthOrder(const GaussianScene& scene, const Camera& camera, double near_plane, int depth_key_bits,
+  DepthOrder(const PartSource& scene, const Camera& camera, double near_plane, int depth_key_bits,
              double relative_margin);
 
   size_t size() const { return order_.size(); }
@@ -65,7 +93,7 @@ struct PartCosts {
   uint64_t per_gaussian = 0;
   uint64_t per_pair = 0;
 };
-PartCosts part_costs(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+PartCosts part_costs(const PartSource& scene, const Camera& camera, const RenderSettings& settings,
                      uint32_t seam_copies, bool wide_keys);
 
 // The most Gaussians a part may hold when `budget` bytes are to cover costs.fixed, `overhead` bytes

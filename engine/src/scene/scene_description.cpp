@@ -497,58 +497,95 @@ SceneDescription parse_scene_description(std::string_view text, const fs::path& 
 
 SceneDescription load_scene_description(const fs::path& path) { return parse_scene_description(read_text(path), path); }
 
-GaussianScene load_described_scene(const SceneDescription& description, const LoadOptions& options,
-                                   LoadReport* report) {
+size_t SceneInstances::size() const {
+  size_t total = 0;
+  for (const Instance& instance : instances) total += files.at(instance.file).size();
+  return total;
+}
+
+SceneInstances load_scene_instances(const SceneDescription& description, const LoadOptions& options,
+                                    LoadReport* report) {
   LoadReport total;
   total.format = "scene description (";
-  // Each file once, however many models name it; then the models' transformed copies one at a time into
-  // the merged scene, so that at most one copy exists besides the files' scenes and the result.
-  struct File {
-    GaussianScene scene;
-    LoadReport report;
-  };
-  std::map<fs::path, File> files;
-  std::vector<const File*> model_files;
-  auto where = [&](size_t i) { return description.file.string() + ": models[" + std::to_string(i) + "]: "; };
+  SceneInstances out;
+  std::map<fs::path, size_t> file_index;  // each file once, however many models name it
+  std::vector<LoadReport> file_reports;
   for (size_t i = 0; i < description.models.size(); ++i) {
     const SceneModel& model = description.models[i];
-    auto found = files.find(model.path);
-    if (found == files.end()) {
-      File file;
+    const std::string where = description.file.string() + ": models[" + std::to_string(i) + "]: ";
+    auto found = file_index.find(model.path);
+    if (found == file_index.end()) {
+      LoadReport part;
       try {
-        file.scene = load_scene(model.path, options, &file.report);
+        out.files.push_back(load_scene(model.path, options, &part));
       } catch (const SceneError& error) {
-        throw SceneError(where(i) + error.what());
+        throw SceneError(where + error.what());
       } catch (const std::invalid_argument& error) {
-        throw SceneError(where(i) + model.path.string() + ": " + error.what());
+        throw SceneError(where + model.path.string() + ": " + error.what());
       }
-      found = files.emplace(model.path, std::move(file)).first;
+      file_reports.push_back(std::move(part));
+      found = file_index.emplace(model.path, out.files.size() - 1).first;
     }
-    model_files.push_back(&found->second);
-    add_report(total, found->second.report, model.path);
+    try {
+      validate(model.transform);
+    } catch (const std::invalid_argument& error) {
+      throw SceneError(where + model.path.string() + ": transform_scene: " + error.what());
+    }
+    out.instances.push_back({found->second, model.transform});
+    add_report(total, file_reports[found->second], model.path);
+    const GaussianScene& file = out.files[found->second];
+    out.sh_degree = std::max(out.sh_degree, file.sh_degree);
+    out.normals = out.normals || file.has_normals();
   }
   total.format += ")";
-  size_t gaussians = 0;
-  int sh_degree = 0;
-  bool normals = false;
-  for (const File* file : model_files) {
-    gaussians += file->scene.size();
-    sh_degree = std::max(sh_degree, file->scene.sh_degree);
-    normals = normals || file->scene.has_normals();
-  }
   // Bands the sh_degree effect never evaluates are not kept (nor uploaded, nor allocated on a device).
-  if (description.effects.sh_degree) sh_degree = std::min(sh_degree, *description.effects.sh_degree);
+  if (description.effects.sh_degree) out.sh_degree = std::min(out.sh_degree, *description.effects.sh_degree);
+  if (report) *report = std::move(total);
+  return out;
+}
+
+GaussianScene merge_instances(const SceneInstances& scene) {
+  // One transformed copy at a time into the merged scene: at most one copy exists besides the files and
+  // the result.
   GaussianScene merged;
-  detail::reserve_merged(merged, gaussians, sh_degree, normals);
-  for (size_t i = 0; i < description.models.size(); ++i) {
-    const SceneModel& model = description.models[i];
-    try {
-      detail::append_merged(merged, transform_scene(model_files[i]->scene, model.transform), normals);
-    } catch (const std::invalid_argument& error) {
-      throw SceneError(where(i) + model.path.string() + ": " + error.what());
+  detail::reserve_merged(merged, scene.size(), scene.sh_degree, scene.normals);
+  for (const SceneInstances::Instance& instance : scene.instances)
+    detail::append_merged(merged, transform_scene(scene.files.at(instance.file), instance.transform),
+                          scene.normals);
+  return merged;
+}
+
+Bounds compute_bounds(const SceneInstances& scene) {
+  GaussianScene positions;  // the placed positions alone, which is all compute_bounds reads
+  positions.positions.reserve(3 * scene.size());
+  for (const SceneInstances::Instance& instance : scene.instances) {
+    const GaussianScene& file = scene.files.at(instance.file);
+    const detail::PositionPlacement placement(instance.transform);
+    for (size_t i = 0; i < file.size(); ++i) {
+      const std::array<float, 3> p = placement.place(&file.positions[3 * i], i);
+      positions.positions.insert(positions.positions.end(), p.begin(), p.end());
     }
   }
-  if (report) *report = std::move(total);
+  positions.opacity_logits.assign(positions.positions.size() / 3, 0.0f);
+  return compute_bounds(positions);
+}
+
+GaussianScene load_described_scene(const SceneDescription& description, const LoadOptions& options,
+                                   LoadReport* report) {
+  const SceneInstances instances = load_scene_instances(description, options, report);
+  // merge_instances, naming the model whose placement fails.
+  GaussianScene merged;
+  detail::reserve_merged(merged, instances.size(), instances.sh_degree, instances.normals);
+  for (size_t i = 0; i < instances.instances.size(); ++i) {
+    const SceneInstances::Instance& instance = instances.instances[i];
+    try {
+      detail::append_merged(merged, transform_scene(instances.files[instance.file], instance.transform),
+                            instances.normals);
+    } catch (const std::invalid_argument& error) {
+      throw SceneError(description.file.string() + ": models[" + std::to_string(i) +
+                       "]: " + description.models[i].path.string() + ": " + error.what());
+    }
+  }
   return merged;
 }
 

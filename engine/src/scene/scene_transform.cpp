@@ -157,16 +157,6 @@ float to_float_checked(double value, size_t gaussian, const char* what) {
   return static_cast<float>(value);
 }
 
-void transform_positions(GaussianScene& scene, const Matrix3& r, bool rotates, double s,
-                         const std::array<double, 3>& t) {
-  for (size_t i = 0; i < scene.size(); ++i) {
-    float* p = &scene.positions[3 * i];
-    std::array<double, 3> v = {p[0], p[1], p[2]};
-    if (rotates) v = times(r, v);
-    for (size_t a = 0; a < 3; ++a) p[a] = to_float_checked(s * v[a] + t[a], i, "position");
-  }
-}
-
 void scale_log_scales(GaussianScene& scene, double s) {
   const double log_s = std::log(s);
   for (size_t i = 0; i < scene.log_scales.size(); ++i)
@@ -325,7 +315,11 @@ GaussianScene transform_scene(const GaussianScene& scene, const ModelTransform& 
   const double s = transform.scale[0];
 
   GaussianScene out = scene;
-  transform_positions(out, r, rotates, s, transform.translation);
+  const detail::PositionPlacement placement(transform);
+  for (size_t i = 0; i < out.size(); ++i) {
+    const std::array<float, 3> p = placement.place(&out.positions[3 * i], i);
+    std::copy(p.begin(), p.end(), &out.positions[3 * i]);
+  }
   if (s != 1.0) scale_log_scales(out, s);
   if (rotates) {
     rotate_quaternions(out, q_r);
@@ -365,6 +359,21 @@ GaussianScene with_sh_degree(const GaussianScene& scene, int degree) {
 }
 
 namespace detail {
+
+PositionPlacement::PositionPlacement(const ModelTransform& transform)
+    : rotation_(rotation_matrix(normalized(total_rotation(transform)))),
+      rotates_(!is_identity_rotation(normalized(total_rotation(transform)))),
+      scale_(transform.scale[0]),
+      translation_(transform.translation) {}
+
+std::array<float, 3> PositionPlacement::place(const float* p, size_t gaussian) const {
+  std::array<double, 3> v = {p[0], p[1], p[2]};
+  if (rotates_) v = times(rotation_, v);
+  std::array<float, 3> out;
+  for (size_t a = 0; a < 3; ++a)
+    out[a] = to_float_checked(scale_ * v[a] + translation_[a], gaussian, "position");
+  return out;
+}
 
 void reserve_merged(GaussianScene& out, size_t total, int sh_degree, bool with_normals) {
   out.sh_degree = sh_degree;
