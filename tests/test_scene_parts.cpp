@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "test_support.h"
 #include "tilesplat/camera.h"
@@ -17,20 +18,19 @@
 namespace tilesplat {
 namespace {
 
-// Every channel bit for bit (memcmp: NaN-safe and -0 distinct).
+// The same floats bit for bit (memcmp: NaN-safe and -0 distinct; empty channels are equal, and memcmp
+// must not see their null data()).
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
+}
+
+// Every channel bit for bit.
 void expect_bit_identical(const RenderImage& parts, const RenderImage& whole, const std::string& what) {
-  ASSERT_EQ(parts.rgba.size(), whole.rgba.size()) << what;
-  EXPECT_EQ(std::memcmp(parts.rgba.data(), whole.rgba.data(), whole.rgba.size() * sizeof(float)), 0)
-      << what << ": colour";
-  ASSERT_EQ(parts.depth.size(), whole.depth.size()) << what;
-  EXPECT_EQ(std::memcmp(parts.depth.data(), whole.depth.data(), whole.depth.size() * sizeof(float)), 0)
-      << what << ": depth";
+  EXPECT_TRUE(same_bits(parts.rgba, whole.rgba)) << what << ": colour";
+  EXPECT_TRUE(same_bits(parts.depth, whole.depth)) << what << ": depth";
   EXPECT_EQ(parts.splat_count, whole.splat_count) << what << ": splat counts";
-  ASSERT_EQ(parts.host_depth.size(), whole.host_depth.size()) << what;
-  EXPECT_EQ(
-      std::memcmp(parts.host_depth.data(), whole.host_depth.data(), whole.host_depth.size() * sizeof(float)),
-      0)
-      << what << ": host depth";
+  EXPECT_TRUE(same_bits(parts.host_depth, whole.host_depth)) << what << ": host depth";
 }
 
 // The 500k playbot (../shared) at 240x135 from its first training camera: a budget of 8 MiB takes
@@ -244,6 +244,19 @@ TEST(SceneParts, SceneFileInstancesMergeToTheLoadedScene) {
     EXPECT_EQ(from_instances.max[a], from_merged.max[a]) << a;
     EXPECT_EQ(from_instances.center[a], from_merged.center[a]) << a;
   }
+}
+
+// A camera with every Gaussian behind it: one empty part, the background, as the whole frame has it.
+TEST(SceneParts, NothingInFrontOfTheCameraIsTheBackground) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  const BigScene& big = big_scene();
+  Camera away = testing::axis_camera(120, 68, 100);  // looking down +z from far beyond the scene
+  away.position = {0, 0, 1e4};
+  RenderSettings settings;
+  settings.background = {0.25f, 0.5f, 0.75f};
+  expect_parts_equal_whole(big.scene, away, settings, 1, "everything behind the camera");
+  EXPECT_EQ(parts_renderer().last_frame_stats().scene_parts, 1);
+  EXPECT_EQ(parts_renderer().last_frame_stats().visible, 0u);
 }
 
 TEST(SceneParts, SceneThatFitsRendersWholeAndStaysSet) {

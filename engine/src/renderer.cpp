@@ -46,7 +46,7 @@ uint64_t Renderer::Impl::device_bytes() const {
 Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, const RenderSettings& settings,
                                                        bool depth_image, bool without_waiting,
                                                        const ScenePart& part) {
-  if (scene_in_parts && part.whole())
+  if (scene_in_parts && !rendering_parts)
     throw std::logic_error(
         "the renderer holds the last part of a scene rendered in parts (render(scene, camera, settings) "
         "under a memory budget), not a whole scene: call set_scene before render(camera, settings)");

@@ -123,6 +123,7 @@ struct Renderer::Impl {
   uint64_t scene_generation = 0;            // counts set_scene calls (and scene parts uploaded)
   bool scene_in_parts = false;              // the buffers hold a part of a scene, not a whole one
   uint64_t parts_budget = 0;                // the memory budget those parts were sized for
+  bool rendering_parts = false;             // within render_in_parts: its frames are parts
   uint64_t uploaded_bytes_reported = 0;     // vk::Context::uploaded_bytes() at the last frame's statistics
   std::optional<SubmittedFrame> submitted;  // the frame render_to_image submitted without waiting
   // Its fence and command buffer: declared last, so that it is destroyed first and waits for the

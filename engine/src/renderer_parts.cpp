@@ -89,6 +89,11 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
   if (!scene_in_parts || parts_budget != settings.memory_budget) resources.release_scene();
   scene_in_parts = true;  // from the first upload on, even if a part fails
   parts_budget = settings.memory_budget;
+  struct RenderingParts {  // begin_frame takes this frame's parts, and no other frame
+    bool& flag;
+    explicit RenderingParts(bool& f) : flag(f) { flag = true; }
+    ~RenderingParts() { flag = false; }
+  } rendering(rendering_parts);
   ++scene_generation;
   lists.reset();
   FrameStats total;
