@@ -28,14 +28,7 @@ void add_part_stats(FrameStats& total, const FrameStats& part) {
     total.scene_parts = 1;
     return;
   }
-  for (const PassTiming& pass : part.passes) {
-    auto it = std::find_if(total.passes.begin(), total.passes.end(),
-                           [&](const PassTiming& p) { return p.name == pass.name; });
-    if (it == total.passes.end())
-      total.passes.push_back(pass);
-    else
-      it->gpu_ms += pass.gpu_ms;
-  }
+  add_pass_times(total.passes, part.passes);
   total.gpu_ms += part.gpu_ms;
   total.visible += part.visible;
   total.intersections += part.intersections;

@@ -162,7 +162,7 @@ TILESPLAT_API GaussianScene load_described_scene(const SceneDescription& descrip
 /// once: the scene load_described_scene() merges, without the merged copy. Renderer::render takes it
 /// under a memory budget and places the copies part by part (docs/big-scenes.md), so that a scene of
 /// many copies needs host memory for its files only.
-struct SceneInstances {
+struct TILESPLAT_API SceneInstances {
   /// One placed copy: a file's Gaussians through a transform.
   struct Instance {
     size_t file = 0;           ///< index into `files`

@@ -124,19 +124,23 @@ RenderImage render_averaged(const Camera& camera, const RenderSettings& settings
   return mean.mean();
 }
 
+void add_pass_times(std::vector<PassTiming>& into, const std::vector<PassTiming>& from) {
+  for (const PassTiming& pass : from) {
+    auto it =
+        std::find_if(into.begin(), into.end(), [&](const PassTiming& p) { return p.name == pass.name; });
+    if (it == into.end())
+      into.push_back(pass);
+    else
+      it->gpu_ms += pass.gpu_ms;
+  }
+}
+
 void add_sample_stats(FrameStats& frame, const FrameStats& sample) {
   if (frame.samples == 0) {
     frame = sample;
     return;
   }
-  for (const PassTiming& pass : sample.passes) {
-    auto it = std::find_if(frame.passes.begin(), frame.passes.end(),
-                           [&](const PassTiming& p) { return p.name == pass.name; });
-    if (it == frame.passes.end())
-      frame.passes.push_back(pass);
-    else
-      it->gpu_ms += pass.gpu_ms;
-  }
+  add_pass_times(frame.passes, sample.passes);
   frame.gpu_ms += sample.gpu_ms;
   frame.visible = std::max(frame.visible, sample.visible);
   frame.intersections = std::max(frame.intersections, sample.intersections);

@@ -58,5 +58,7 @@ RenderImage render_averaged(const Camera& camera, const RenderSettings& settings
 // that was itself averaged brings its own count). frame.samples == 0: `sample` is the first, and becomes
 // the frame's.
 void add_sample_stats(FrameStats& frame, const FrameStats& sample);
+// Adds each pass's GPU time of `from` to the pass of that name in `into` (appended where it has none).
+void add_pass_times(std::vector<PassTiming>& into, const std::vector<PassTiming>& from);
 
 }  // namespace tilesplat
