@@ -25,6 +25,7 @@ int run(int argc, char** argv) {
   if (options.effects) return run_effects_report(options);
   if (options.formats) return run_formats_report(options);
   if (options.scaling) return run_scaling_report(options);
+  if (!options.lod_budgets.empty()) return run_lod_report(options);
   return run_frame_bench(options);
 }
 

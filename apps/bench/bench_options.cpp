@@ -132,6 +132,19 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
       "(bytes per Gaussian against PSNR) write the report",
       &options.formats);
 
+  parser.section("LOD report");
+  parser.add_value(
+      "--lod-curve", "N[,N...]",
+      "measure a LOD set (lod-meta.json, one SCENE): every level whole, then each splat budget N (the "
+      "levels each view calls for, docs/big-scenes.md); per row the Gaussians drawn, the GPU time, the "
+      "host's time to choose and gather, and PSNR and max abs against level 0; --markdown, --csv and "
+      "--plot (PSNR against Gaussians drawn) write the report",
+      [&options](const std::string& text) {
+        options.lod_budgets.clear();
+        for (const int budget : parse_int_list("--lod-curve", text, 1, std::numeric_limits<int>::max()))
+          options.lod_budgets.push_back(uint64_t(budget));
+      });
+
   parser.section("scaling report");
   parser.add_switch(
       "--scaling",
@@ -208,17 +221,21 @@ std::string write_outputs(const std::vector<std::pair<std::string, std::function
 void check_frame_options(const cli::ArgParser& parser, const BenchOptions& options) {
   for (const char* flag : {"--sort-sizes", "--key-bits"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --sort-bench");
-  if (int(options.accuracy) + int(options.effects) + int(options.formats) + int(options.scaling) > 1)
-    throw cli::UsageError("--accuracy, --effects, --formats and --scaling are separate runs");
+  const bool lod_curve = !options.lod_budgets.empty();
+  if (int(options.accuracy) + int(options.effects) + int(options.formats) + int(options.scaling) +
+          int(lod_curve) >
+      1)
+    throw cli::UsageError("--accuracy, --effects, --formats, --scaling and --lod-curve are separate runs");
   if (parser.seen("--tile-copies") && !options.scaling)
     throw cli::UsageError("--tile-copies applies only with --scaling");
   if (parser.seen("--memory-budget") &&
-      (options.accuracy || options.effects || options.formats || options.scaling))
+      (options.accuracy || options.effects || options.formats || options.scaling || lod_curve))
     throw cli::UsageError("--memory-budget applies only to the frame benchmark");
   if (!options.accuracy) {
     if (parser.seen("--path-frames")) throw cli::UsageError("--path-frames applies only with --accuracy");
-    if (parser.seen("--markdown") && !options.effects && !options.formats && !options.scaling)
-      throw cli::UsageError("--markdown applies only with --accuracy, --effects, --formats or --scaling");
+    if (parser.seen("--markdown") && !options.effects && !options.formats && !options.scaling && !lod_curve)
+      throw cli::UsageError(
+          "--markdown applies only with --accuracy, --effects, --formats, --scaling or --lod-curve");
     if (options.common.modes.size() > 1)
       throw cli::UsageError(
           "several --mode combinations are compared by --accuracy; the frame benchmark takes one");
@@ -268,6 +285,13 @@ void check_bench_flags(const cli::ArgParser& parser, const BenchOptions& options
     if (options.common.sorts.size() > 1) throw cli::UsageError("--effects measures with one --sort strategy");
     if (parser.seen("--antialiasing"))
       throw cli::UsageError("--antialiasing does not apply to --effects (it measures every mode)");
+  } else if (!options.lod_budgets.empty()) {
+    for (const char* flag : {"--resolutions", "--json", "--lod"})
+      if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --lod-curve");
+    if (options.common.scenes.size() != 1)
+      throw cli::UsageError("--lod-curve measures one SCENE, a LOD set (lod-meta.json)");
+    if (options.common.sorts.size() > 1)
+      throw cli::UsageError("--lod-curve measures with one --sort strategy");
   } else if (options.scaling) {
     for (const char* flag : {"--json", "--view", "--views", "--orbit", "--cameras", "--width", "--height"})
       if (parser.seen(flag))

@@ -41,6 +41,7 @@ struct BenchOptions {
   bool formats = false;   // --formats: what each file of a scene costs against its lossless PLY
   bool scaling = false;   // --scaling: frame time and memory against Gaussian count and image size
   int tile_copies = 0;    // --tile-copies N: with --scaling, also N copies of the largest scene
+  std::vector<uint64_t> lod_budgets;  // --lod-curve: a LOD set's levels and these splat budgets
   uint64_t memory_budget = 0;  // --memory-budget: frames under RenderSettings::memory_budget (0: none)
   std::string markdown;
   accuracy::CameraPath path = accuracy::CameraPath::kPan;

@@ -359,7 +359,8 @@ int run_frame_bench(const BenchOptions& options) {
   std::vector<Case> cases;
   for (size_t s = 0; s < options.common.scenes.size(); ++s) {
     BenchScene scene;
-    scene.loaded = cli::load_scene_file(options.common.scenes[s], options.common.strict, kProgram);
+    scene.loaded = cli::load_scene_file(options.common.scenes[s], options.common.strict, kProgram,
+                                        cli::SceneHolding::kMerged, options.common.lod);
     scene.name = scene.loaded.path.filename().string();
     scene.description = cli::describe_scene(scene.loaded.scene);
     scene.gaussians = scene.loaded.scene.size();

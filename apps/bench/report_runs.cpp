@@ -8,6 +8,7 @@
 #include "effects_report.h"
 #include "formats_report.h"
 #include "frame_bench.h"
+#include "lod_report.h"
 #include "scaling_report.h"
 
 namespace tilesplat::bench {
@@ -43,7 +44,8 @@ int run_accuracy_report(const BenchOptions& options) {
   const cli::ImageSize size{options.common.width, options.common.height};
   for (size_t s = 0; s < options.common.scenes.size(); ++s) {
     Planned p;
-    p.scene.loaded = cli::load_scene_file(options.common.scenes[s], options.common.strict, kProgram);
+    p.scene.loaded = cli::load_scene_file(options.common.scenes[s], options.common.strict, kProgram,
+                                          cli::SceneHolding::kMerged, options.common.lod);
     p.scene.name = p.scene.loaded.path.filename().string();
     p.scene.description = cli::describe_scene(p.scene.loaded.scene);
     p.scene.sh_degree = p.scene.loaded.scene.sh_degree;
@@ -129,7 +131,8 @@ int run_effects_report(const BenchOptions& options) {
   const std::string& command = options.command;
 
   BenchScene scene;
-  scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
+  scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram,
+                                      cli::SceneHolding::kMerged, options.common.lod);
   scene.name = scene.loaded.path.filename().string();
   scene.description = cli::describe_scene(scene.loaded.scene);
   scene.sh_degree = scene.loaded.scene.sh_degree;
@@ -191,7 +194,8 @@ int run_scaling_report(const BenchOptions& options) {
 
   std::vector<tilesplat::scaling::Scene> scenes;
   for (const std::string& file : options.common.scenes) {
-    cli::LoadedScene loaded = cli::load_scene_file(file, options.common.strict, kProgram);
+    cli::LoadedScene loaded = cli::load_scene_file(file, options.common.strict, kProgram,
+                                                   cli::SceneHolding::kMerged, options.common.lod);
     if (loaded.scene.empty()) throw cli::UsageError("'" + file + "' has no Gaussians to measure");
     std::printf("scene   %s: %s\n", loaded.path.filename().string().c_str(),
                 cli::describe_scene(loaded.scene).c_str());
@@ -259,7 +263,8 @@ int run_formats_report(const BenchOptions& options) {
   const std::string& command = options.command;
 
   BenchScene reference;
-  reference.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
+  reference.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram,
+                                          cli::SceneHolding::kMerged, options.common.lod);
   if (!options.common.cameras_files.empty()) reference.cameras = options.common.cameras_files.front();
   tilesplat::formats::Options format_options;
   std::string view_names;
@@ -298,6 +303,56 @@ int run_formats_report(const BenchOptions& options) {
       report.validation_messages);
   std::fprintf(stderr, "%s: format costs, %zu files against %s%s\n", kProgram, files.size(),
                report.reference_name.c_str(), written.c_str());
+  return cli::kExitOk;
+}
+
+int run_lod_report(const BenchOptions& options) {
+  check_outputs(options, scene_and_camera_inputs(options));
+  BenchScene scene;
+  scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
+  if (!scene.loaded.lod)
+    throw cli::UsageError("--lod-curve measures a LOD set (lod-meta.json); " +
+                          cli::single_quoted(scene.loaded.path.string()) + " is not one");
+  scene.name = scene.loaded.path.filename().string();
+  if (!options.common.cameras_files.empty()) scene.cameras = options.common.cameras_files.front();
+  tilesplat::lod_report::Options lod_options;
+  for (const Case& c : plan_cases(options, scene, 0, {{options.common.width, options.common.height}}))
+    lod_options.views.push_back(c.camera.camera);
+  lod_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
+  lod_options.repeat = options.repeat;
+  if (!options.common.sorts.empty()) lod_options.sort = options.common.sorts.front();
+  if (!options.common.modes.empty()) lod_options.settings.accuracy = options.common.modes.front();
+  cli::apply_training_options(options.common, lod_options.settings);
+
+  const tilesplat::LodSet& set = *scene.loaded.lod->set;
+  std::vector<tilesplat::lod_report::Row> rows = tilesplat::lod_report::plan_rows(set, options.lod_budgets);
+  std::printf("scene   %s: %s, %s, %zu views\n", scene.name.c_str(),
+              cli::describe_scene(scene.loaded).c_str(),
+              cli::format_size(lod_options.views.front().width, lod_options.views.front().height).c_str(),
+              lod_options.views.size());
+  std::fflush(stdout);
+  scene.loaded.scene = {};  // the report reads every level from the set itself
+  tilesplat::lod_report::Run run;
+  {
+    Progress progress(tilesplat::lod_report::work_units(rows, lod_options), cli::stderr_is_terminal());
+    run = tilesplat::lod_report::measure(
+        cli::renderer_options(options.common), set, rows, lod_options,
+        [&](int done, int, const std::string& what) { progress.update(done, what); });
+  }
+  std::printf("device  %s (driver %s)\n\n%s", run.device.name.c_str(), run.device.driver.c_str(),
+              tilesplat::lod_report::text_table(rows).c_str());
+  std::fflush(stdout);
+  const std::string written = write_outputs(
+      {{options.markdown,
+        [&] { return tilesplat::lod_report::markdown(rows, scene.name, run.device, options.command); }},
+       {options.csv,
+        [&] {
+          return cli::with_provenance_columns(tilesplat::lod_report::csv(rows, scene.name, run.device),
+                                              options.command);
+        }},
+       {options.plot, [&] { return tilesplat::lod_report::svg(rows, scene.name, run.device); }}},
+      run.validation_messages);
+  std::fprintf(stderr, "%s: LOD report, %zu rows%s\n", kProgram, rows.size(), written.c_str());
   return cli::kExitOk;
 }
 

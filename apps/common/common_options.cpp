@@ -132,6 +132,12 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
                    });
 
   parser.section("scene and device");
+  parser.add_value("--lod", "N",
+                   "a LOD set (splat-transform's lod-meta.json): draw its level N, 0 the finest (default 0; "
+                   "docs/big-scenes.md)",
+                   [&options](const std::string& text) {
+                     options.lod.level = parse_int("--lod", text, 0, std::numeric_limits<int>::max());
+                   });
   parser.add_switch(
       "--strict",
       "fail on the first non-finite value in the scene (default: drop such Gaussians and report "
@@ -258,6 +264,17 @@ void add_memory_budget_option(ArgParser& parser, uint64_t& budget, const std::st
       "parts that follow the depth order, into the same image bit for bit (docs/big-scenes.md; " +
           what_it_adds + "default: no budget)",
       [&budget](const std::string& text) { budget = parse_byte_size("--memory-budget", text); });
+}
+
+void add_splat_budget_option(ArgParser& parser, CommonOptions& options) {
+  parser.add_value("--splat-budget", "N",
+                   "a LOD set (lod-meta.json): draw at most N Gaussians a frame, each chunk at the level its "
+                   "size on screen calls for, chosen again for every frame's camera (docs/big-scenes.md; "
+                   "default: --lod's one level)",
+                   [&options](const std::string& text) {
+                     const int budget = parse_int("--splat-budget", text, 1, std::numeric_limits<int>::max());
+                     options.lod.splat_budget = static_cast<uint64_t>(budget);
+                   });
 }
 
 void apply_training_options(const CommonOptions& options, RenderSettings& settings) {

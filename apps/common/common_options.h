@@ -1,6 +1,7 @@
 // The options every app has: which scene, which camera, which device, which sort and accuracy modes.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,6 +11,13 @@
 #include "tilesplat/renderer.h"
 
 namespace tilesplat::cli {
+
+// How a LOD set (lod-meta.json, tilesplat/lod_set.h) is drawn: one level for every frame, or, under a
+// splat budget, the levels each frame's camera calls for (select_lod_levels).
+struct LodOptions {
+  std::optional<int> level;   // --lod N (default 0: the finest)
+  uint64_t splat_budget = 0;  // --splat-budget N: levels chosen per frame (0: none; where the app offers it)
+};
 
 struct CommonOptions {
   std::string scene;
@@ -37,6 +45,7 @@ struct CommonOptions {
   std::optional<double> max_alpha;
   // --compositor: how the splats become pixels; unset = the app's default (sorted).
   std::optional<Compositor> compositor;
+  LodOptions lod;  // --lod (every app), --splat-budget (add_splat_budget_option)
 };
 
 inline constexpr int kOrbitDefaultWidth = 1920;
@@ -78,6 +87,9 @@ void apply_training_options(const CommonOptions& options, RenderSettings& settin
 // --memory-budget SIZE (parse_byte_size) into `budget`, RenderSettings::memory_budget; `what_it_adds`
 // ends the help text with what the app does besides rendering in parts.
 void add_memory_budget_option(ArgParser& parser, uint64_t& budget, const std::string& what_it_adds);
+
+// --splat-budget N into options.lod.splat_budget, for an app that renders a LOD set frame by frame.
+void add_splat_budget_option(ArgParser& parser, CommonOptions& options);
 
 // Whether any SCENE of the options is a scene file (.json).
 bool any_scene_file(const CommonOptions& options);

@@ -46,17 +46,55 @@ double elapsed_ms(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view program,
-                            SceneHolding holding) {
+size_t LoadedScene::gaussians() const {
+  if (instances) return instances->size();
+  if (lod && lod->splat_budget > 0) return lod->set->level_size(0);
+  return scene.size();
+}
+
+Bounds LoadedScene::bounds() const {
+  if (lod) return lod->framing;
+  return instances ? compute_bounds(*instances) : compute_bounds(scene);
+}
+
+namespace {
+
+// The set's level, or nothing under a splat budget (each frame gathers its own), and its framing.
+void load_lod_set(LoadedScene& loaded, const LodOptions& options, const LoadOptions& load_options) {
+  auto set = std::make_shared<LodSet>(LodSet::open(loaded.path));
+  LoadedLodSet lod;
+  lod.level = options.level.value_or(0);
+  lod.splat_budget = options.splat_budget;
+  set->level_size(lod.level);  // a level the set does not have is an error before anything is read
+  if (lod.splat_budget == 0) loaded.scene = set->load_level(lod.level, load_options);
+  const int coarsest = set->levels() - 1;
+  lod.framing = compute_bounds(lod.splat_budget == 0 && lod.level == coarsest
+                                   ? loaded.scene
+                                   : set->load_level(coarsest, load_options));
+  loaded.report = LoadReport{.format = "lod set", .version = "1", .gaussians_in_file = set->level_size(0)};
+  lod.set = std::move(set);
+  loaded.lod = std::move(lod);
+}
+
+}  // namespace
+
+LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view program, SceneHolding holding,
+                            const LodOptions& lod) {
   LoadedScene loaded;
   loaded.path = path;
   require_input_file(loaded.path, "scene");
+  const bool lod_set = is_lod_set(loaded.path);
+  if (!lod_set && (lod.level || lod.splat_budget > 0))
+    throw UsageError(std::string(lod.level ? "--lod" : "--splat-budget") +
+                     " needs a LOD set (lod-meta.json); " + single_quoted(path.string()) + " is not one");
 
   const auto start = std::chrono::steady_clock::now();
   LoadOptions load_options;
   load_options.strict = strict;
   try {
-    if (is_scene_description(loaded.path)) {
+    if (lod_set) {
+      load_lod_set(loaded, lod, load_options);
+    } else if (is_scene_description(loaded.path)) {
       loaded.description = load_scene_description(loaded.path);
       if (holding == SceneHolding::kInstances)
         loaded.instances = load_scene_instances(*loaded.description, load_options, &loaded.report);
@@ -183,7 +221,7 @@ SceneViews camera_views(const CommonOptions& options, const LoadedScene& loaded)
 
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program,
                                   SceneHolding holding) {
-  LoadedScene loaded = load_scene_file(options.scene, options.strict, program, holding);
+  LoadedScene loaded = load_scene_file(options.scene, options.strict, program, holding, options.lod);
   const SceneViews cameras = camera_views(options, loaded);
   NamedCamera named;
   if (!cameras.views.empty()) {
@@ -212,6 +250,17 @@ std::string describe_scene(const GaussianScene& scene) {
 }
 
 std::string describe_scene(const LoadedScene& loaded) {
+  if (loaded.lod) {
+    const LodSet& set = *loaded.lod->set;
+    std::string levels;
+    for (int level = 0; level < set.levels(); ++level)
+      levels += (level ? " / " : "") + group_thousands(set.level_size(level));
+    const std::string what =
+        "LOD set of " + std::to_string(set.levels()) + " levels (" + levels + " Gaussians)";
+    if (loaded.lod->splat_budget > 0)
+      return what + ", at most " + group_thousands(loaded.lod->splat_budget) + " a frame";
+    return what + ", level " + std::to_string(loaded.lod->level) + ": " + describe_scene(loaded.scene);
+  }
   if (!loaded.instances) return describe_scene(loaded.scene);
   return group_thousands(loaded.gaussians()) + " Gaussians (SH" +
          std::to_string(loaded.instances->sh_degree) + "), " +

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -12,6 +13,7 @@
 #include "common_options.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/lens.h"
+#include "tilesplat/lod_set.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
@@ -22,6 +24,16 @@ namespace tilesplat::cli {
 // renderer under a memory budget, which places the copies part by part: docs/big-scenes.md).
 enum class SceneHolding { kMerged, kInstances };
 
+// A LOD set the SCENE names (lod-meta.json): the index, and how the run draws it.
+struct LoadedLodSet {
+  std::shared_ptr<const LodSet> set;
+  int level = 0;              // the level in LoadedScene::scene (unused under a splat budget)
+  uint64_t splat_budget = 0;  // > 0: each frame draws select_lod_levels(set, camera, splat_budget)
+  // Every level frames the same: an orbit frames the set by its coarsest level (the cheapest to read),
+  // so that renders of one orbit at different levels and budgets show the same view.
+  Bounds framing;
+};
+
 struct LoadedScene {
   std::filesystem::path path;
   GaussianScene scene;
@@ -30,8 +42,10 @@ struct LoadedScene {
   // as SceneHolding::kInstances, placed in `instances` (and `scene` is empty).
   std::optional<SceneDescription> description;
   std::optional<SceneInstances> instances;
-  size_t gaussians() const { return instances ? instances->size() : scene.size(); }
-  Bounds bounds() const { return instances ? compute_bounds(*instances) : compute_bounds(scene); }
+  // Set when the SCENE is a LOD set: `scene` holds its level lod->level, or nothing under a splat budget.
+  std::optional<LoadedLodSet> lod;
+  size_t gaussians() const;  // what a frame draws at most (under a splat budget: the finest level's size)
+  Bounds bounds() const;     // what an orbit frames
   LoadReport report;
   Camera camera;
   std::string camera_description;  // "view 0 of cams.json" or "orbit azimuth 0 elevation 20 fov 50"
@@ -50,8 +64,9 @@ LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view
 
 // The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
 // load_scene_file fills path, scene, description, report and load_ms only.
+// A LOD set is read as `lod` says; `lod` given for any other scene is a UsageError.
 LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program,
-                            SceneHolding holding = SceneHolding::kMerged);
+                            SceneHolding holding = SceneHolding::kMerged, const LodOptions& lod = {});
 
 // The views a scene file brings ("cameras") and the file that names them (the cameras.json it
 // refers to, else the scene file). No views for a .ply, or a scene file without cameras.

@@ -9,6 +9,7 @@
 
 #include "cli.h"
 #include "info_options.h"
+#include "tilesplat/lod_set.h"
 #include "tilesplat/scene.h"
 
 namespace {
@@ -25,15 +26,45 @@ struct FileInfo {
   tilesplat::SceneStatistics stats;
 };
 
-// A file's size; a folder's (an unbundled SOG's meta.json brings its images) counts them all.
-uint64_t file_bytes(const fs::path& path) {
+// A file's size; a folder's (an unbundled SOG's meta.json brings its images) counts them all, and a LOD
+// set's index its chunk files.
+uint64_t file_bytes(const fs::path& path, const tilesplat::LodSet* lod_set = nullptr) {
   std::error_code ec;
   uint64_t bytes = fs::file_size(path, ec);
   if (ec) return 0;
   if (path.filename() == "meta.json")
     for (const auto& entry : fs::directory_iterator(path.parent_path(), ec))
       if (entry.is_regular_file() && entry.path().extension() == ".webp") bytes += entry.file_size();
+  if (lod_set) {
+    std::vector<std::string> files = lod_set->files();
+    if (lod_set->environment()) files.push_back(*lod_set->environment());
+    for (const std::string& file : files) bytes += file_bytes(path.parent_path() / file);
+  }
   return bytes;
+}
+
+// Per level of a LOD set: its Gaussians, the chunks that hold some and the files they are in.
+struct LodLevel {
+  uint64_t gaussians = 0;
+  size_t chunks = 0;
+  size_t files = 0;
+};
+
+std::vector<LodLevel> lod_levels(const tilesplat::LodSet& set) {
+  std::vector<LodLevel> levels(size_t(set.levels()));
+  for (int level = 0; level < set.levels(); ++level) {
+    std::vector<bool> used(set.files().size(), false);
+    LodLevel& out = levels[size_t(level)];
+    out.gaussians = set.level_size(level);
+    for (const tilesplat::LodChunk& chunk : set.chunks()) {
+      const tilesplat::LodSlice& slice = chunk.levels[size_t(level)];
+      if (slice.count == 0) continue;
+      ++out.chunks;
+      if (!used[slice.file]) ++out.files;
+      used[slice.file] = true;
+    }
+  }
+  return levels;
 }
 
 FileInfo inspect(const std::string& file, bool strict) {
@@ -43,7 +74,7 @@ FileInfo inspect(const std::string& file, bool strict) {
   info.loaded = cli::load_scene_file(file, strict, kProgram);
   const uint64_t peak = cli::peak_memory_bytes();
   info.peak_bytes = peak > before ? peak - before : 0;
-  info.file_bytes = file_bytes(file);
+  info.file_bytes = file_bytes(file, info.loaded.lod ? info.loaded.lod->set.get() : nullptr);
   info.stats = tilesplat::compute_statistics(info.loaded.scene);
   return info;
 }
@@ -79,6 +110,19 @@ void print_text(const FileInfo& info) {
               loaded.report.gaussians_in_file, loaded.report.dropped ? ": " : "",
               loaded.report.summary().c_str());
   std::printf("  load         %.1f ms, peak memory +%.1f MB\n", loaded.load_ms, megabytes(info.peak_bytes));
+  if (!loaded.lod) return;
+  const tilesplat::LodSet& set = *loaded.lod->set;
+  std::printf("  lod set      %d levels, %zu chunks, %zu chunk files%s%s\n", set.levels(),
+              set.chunks().size(), set.files().size(), set.generator().empty() ? "" : ", made by ",
+              set.generator().c_str());
+  const std::vector<LodLevel> levels = lod_levels(set);
+  for (size_t level = 0; level < levels.size(); ++level)
+    std::printf("  level %-6zu %s Gaussians in %zu chunks, %zu files\n", level,
+                cli::group_thousands(levels[level].gaussians).c_str(), levels[level].chunks,
+                levels[level].files);
+  if (set.environment())
+    std::printf("  environment  %s, %s Gaussians, drawn with every level\n", set.environment()->c_str(),
+                cli::group_thousands(set.environment_size()).c_str());
 }
 
 nlohmann::json to_json(const FileInfo& info) {
@@ -88,26 +132,38 @@ nlohmann::json to_json(const FileInfo& info) {
   for (const auto& entry : loaded.report.dropped_by_property)
     dropped.push_back(
         {{"property", entry.property}, {"count", entry.count}, {"first_index", entry.first_index}});
-  return {{"file", loaded.path.string()},
-          {"format", loaded.report.format},
-          {"version", loaded.report.version},
-          {"gaussians", loaded.scene.size()},
-          {"gaussians_in_file", loaded.report.gaussians_in_file},
-          {"sh_degree", loaded.scene.sh_degree},
-          {"file_bytes", info.file_bytes},
-          {"bytes_per_gaussian", loaded.scene.empty() ? 0.0
-                                                      : static_cast<double>(info.file_bytes) /
-                                                            static_cast<double>(loaded.scene.size())},
-          {"box_min", triple(info.stats.min)},
-          {"box_max", triple(info.stats.max)},
-          {"robust_box_min", triple(info.stats.robust_min)},
-          {"robust_box_max", triple(info.stats.robust_max)},
-          {"opacity_range", {info.stats.opacity_min, info.stats.opacity_max}},
-          {"scale_range", {info.stats.scale_min, info.stats.scale_max}},
-          {"non_finite_dropped", loaded.report.dropped},
-          {"dropped_by_property", dropped},
-          {"load_ms", loaded.load_ms},
-          {"peak_memory_bytes", info.peak_bytes}};
+  nlohmann::json out = {
+      {"file", loaded.path.string()},
+      {"format", loaded.report.format},
+      {"version", loaded.report.version},
+      {"gaussians", loaded.scene.size()},
+      {"gaussians_in_file", loaded.report.gaussians_in_file},
+      {"sh_degree", loaded.scene.sh_degree},
+      {"file_bytes", info.file_bytes},
+      {"bytes_per_gaussian", loaded.scene.empty() ? 0.0
+                                                  : static_cast<double>(info.file_bytes) /
+                                                        static_cast<double>(loaded.scene.size())},
+      {"box_min", triple(info.stats.min)},
+      {"box_max", triple(info.stats.max)},
+      {"robust_box_min", triple(info.stats.robust_min)},
+      {"robust_box_max", triple(info.stats.robust_max)},
+      {"opacity_range", {info.stats.opacity_min, info.stats.opacity_max}},
+      {"scale_range", {info.stats.scale_min, info.stats.scale_max}},
+      {"non_finite_dropped", loaded.report.dropped},
+      {"dropped_by_property", dropped},
+      {"load_ms", loaded.load_ms},
+      {"peak_memory_bytes", info.peak_bytes}};
+  if (loaded.lod) {
+    const tilesplat::LodSet& set = *loaded.lod->set;
+    nlohmann::json levels = nlohmann::json::array();
+    for (const LodLevel& level : lod_levels(set))
+      levels.push_back({{"gaussians", level.gaussians}, {"chunks", level.chunks}, {"files", level.files}});
+    out["lod_levels"] = levels;
+    out["lod_chunks"] = set.chunks().size();
+    out["lod_files"] = set.files().size();
+    out["lod_environment"] = set.environment() ? nlohmann::json(*set.environment()) : nlohmann::json();
+  }
+  return out;
 }
 
 int run(int argc, char** argv) {

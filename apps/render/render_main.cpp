@@ -25,6 +25,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/camera_path.h"
 #include "tilesplat/image.h"
+#include "tilesplat/lod_set.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
@@ -64,8 +65,11 @@ std::string shortest_exact(Number value) {
 
 // What the EXR's renderSettings attribute records: everything that changes the image.
 std::string settings_text(const tilesplat::RenderSettings& settings, const LensFlags& lens,
-                          const ShutterFlags& shutter) {
+                          const ShutterFlags& shutter, const std::optional<cli::LoadedLodSet>& lod) {
   std::string text = "sort=" + settings.sort;
+  if (lod)
+    text += lod->splat_budget > 0 ? " lod=budget:" + std::to_string(lod->splat_budget)
+                                  : " lod=level:" + std::to_string(lod->level);
   text += " accuracy=" + tilesplat::to_string(settings.accuracy);
   text += " antialiasing=" + tilesplat::to_string(settings.antialiasing);
   if (settings.max_alpha != tilesplat::kDefaultMaxAlpha)
@@ -120,7 +124,21 @@ void print_frame_stats(const tilesplat::FrameStats& stats, const tilesplat::Devi
   print_row("peak resident memory", mib(cli::peak_memory_bytes()), "MiB");
 }
 
-
+// How many chunks the frame drew at each level, and the Gaussians it drew against its budget.
+void print_lod_selection(const tilesplat::LodSelection& selection) {
+  int levels = 0;
+  for (const int level : selection.chunk_levels) levels = std::max(levels, level + 1);
+  std::vector<int> chunks(size_t(levels), 0);
+  int culled = 0;
+  for (const int level : selection.chunk_levels) level < 0 ? ++culled : ++chunks[size_t(level)];
+  for (int level = 0; level < levels; ++level)
+    print_row("lod " + std::to_string(level) + " chunks", std::to_string(chunks[size_t(level)]), "");
+  print_row("lod chunks out of view", std::to_string(culled), "");
+  print_row("lod splats", std::to_string(selection.splats), "");
+  if (selection.over_budget)
+    print_row("lod over budget", "yes",
+              "(the coarsest levels in view need " + std::to_string(selection.coarsest_splats) + ")");
+}
 
 std::string png_settings_text(const tilesplat::PreviewOptions& preview) {
   return "exposure=" + cli::format_fixed(preview.exposure_stops, 3) +
@@ -278,6 +296,7 @@ class FrameRenderer {
   FrameRenderer(const RenderOptions& options, const cli::LoadedScene& loaded)
       : scene_(loaded.scene),
         instances_(loaded.instances ? &*loaded.instances : nullptr),
+        lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
         lens_(options.lens),
         in_parts_(options.memory_budget > 0) {
     if (lens_.enabled()) {
@@ -286,8 +305,9 @@ class FrameRenderer {
     }
     if (options.reference) return;
     renderer_ = tilesplat::Renderer::create(cli::renderer_options(options.common));
-    // Under a memory budget each frame takes the scene (in parts where it does not fit).
-    if (!in_parts_) renderer_->set_scene(scene_);
+    // Under a memory budget each frame takes the scene (in parts where it does not fit); under a splat
+    // budget each frame draws the levels its camera calls for.
+    if (!in_parts_ && !lod_) renderer_->set_scene(scene_);
   }
 
   tilesplat::RenderImage render(const tilesplat::Camera& camera,
@@ -296,15 +316,28 @@ class FrameRenderer {
     // The flags' lens, its focus following the frame's camera, over the scene file's lens for the view.
     if (lens_.enabled()) settings.lens = lens_for_frame(lens_, camera, scene_centre_);
     tilesplat::RenderImage image;
+    tilesplat::GaussianScene selected;  // the LOD set's chunks at the levels this camera calls for
+    if (lod_) {
+      lod_selection_ = tilesplat::select_lod_levels(*lod_->set, camera, lod_->splat_budget);
+      selected = lod_->set->load_selection(lod_selection_);
+      if (lod_selection_.over_budget && !warned_over_budget_) {
+        cli::print_warning(kProgram, "--splat-budget " + std::to_string(lod_->splat_budget) +
+                                         " is below what the coarsest levels in view draw (" +
+                                         std::to_string(lod_selection_.coarsest_splats) +
+                                         " Gaussians): those frames draw the coarsest levels");
+        warned_over_budget_ = true;
+      }
+    }
+    const tilesplat::GaussianScene& scene = lod_ ? selected : scene_;
     if (renderer_) {
-      image = !in_parts_   ? renderer_->render(camera, settings)
-              : instances_ ? renderer_->render(*instances_, camera, settings)
-                           : renderer_->render(scene_, camera, settings);
+      image = !in_parts_ && !lod_ ? renderer_->render(camera, settings)
+              : instances_        ? renderer_->render(*instances_, camera, settings)
+                                  : renderer_->render(scene, camera, settings);
       gpu_ms_ = renderer_->last_frame_stats().gpu_ms;
       cpu_ms_ = renderer_->last_frame_stats().cpu_ms;
     } else {
       const auto start = std::chrono::steady_clock::now();
-      image = tilesplat::render_reference(scene_, camera, settings);
+      image = tilesplat::render_reference(scene, camera, settings);
       cpu_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
       gpu_ms_ = 0;
     }
@@ -326,10 +359,15 @@ class FrameRenderer {
   double gpu_ms() const { return gpu_ms_; }
   double cpu_ms() const { return cpu_ms_; }
   tilesplat::Renderer* gpu() const { return renderer_.get(); }
+  // The levels the last frame drew, under --splat-budget (else empty).
+  const tilesplat::LodSelection& lod_selection() const { return lod_selection_; }
 
  private:
   const tilesplat::GaussianScene& scene_;
   const tilesplat::SceneInstances* instances_;  // a scene file's placed copies, held so under --memory-budget
+  const cli::LoadedLodSet* lod_;                // a LOD set drawn under --splat-budget
+  tilesplat::LodSelection lod_selection_;
+  bool warned_over_budget_ = false;
   LensFlags lens_;
   bool in_parts_ = false;                           // --memory-budget
   std::array<double, 3> scene_centre_ = {0, 0, 0};  // where the lens focuses unless --focus-distance says
@@ -462,9 +500,9 @@ int run(int argc, char** argv) {
   // Under a memory budget a scene file's models stay placed copies of their files, never merged.
   const cli::SceneHolding holding =
       options.memory_budget > 0 ? cli::SceneHolding::kInstances : cli::SceneHolding::kMerged;
-  cli::LoadedScene loaded =
-      sequence ? cli::load_scene_file(options.common.scene, options.common.strict, kProgram, holding)
-               : cli::load_scene_and_camera(options.common, kProgram, holding);
+  cli::LoadedScene loaded = sequence ? cli::load_scene_file(options.common.scene, options.common.strict,
+                                                            kProgram, holding, options.common.lod)
+                                     : cli::load_scene_and_camera(options.common, kProgram, holding);
   std::vector<Frame> frames;
   if (sequence) {
     frames = plan_sequence(parser, options, loaded);
@@ -518,7 +556,8 @@ int run(int argc, char** argv) {
   writer.exr.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
   // A scene file's lens: the view's own for one frame; for many, each frame's view has its own.
   if (!sequence) settings.lens = frames.front().lens;
-  writer.exr.attributes["renderSettings"] = settings_text(settings, options.lens, options.shutter);
+  writer.exr.attributes["renderSettings"] =
+      settings_text(settings, options.lens, options.shutter, loaded.lod);
   if (sequence && !options.lens.enabled() &&
       std::any_of(frames.begin(), frames.end(), [](const Frame& f) { return f.lens.enabled(); }))
     writer.exr.attributes["renderSettings"] += " lens=the scene file's, per view";
@@ -544,6 +583,8 @@ int run(int argc, char** argv) {
     timing = "GPU " + cli::format_fixed(stats.gpu_ms, 2) + " ms, frame " +
              cli::format_fixed(stats.cpu_ms, 2) + " ms";
     if (options.stats) print_frame_stats(stats, gpu->device_info());
+    if (options.stats && loaded.lod && loaded.lod->splat_budget > 0)
+      print_lod_selection(renderer.lod_selection());
     if (const auto messages = gpu->validation_messages(); messages > 0)
       cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
   } else {

@@ -226,6 +226,7 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                     "intersections, retries, device memory and its peak, scene parts, peak resident memory",
                     &options.stats);
   cli::add_memory_budget_option(parser, options.memory_budget, "--stats prints the parts and peaks; ");
+  cli::add_splat_budget_option(parser, options.common);
 
   parser.section("many frames (one process; -o and --png then take a frame number: out/view_%04d.exr)");
   parser.add_string(
@@ -287,6 +288,9 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
     throw cli::UsageError(
         "--memory-budget bounds the GPU renderer's device memory; the --reference renderer renders on the "
         "host");
+  if (parser.seen("--lod") && parser.seen("--splat-budget"))
+    throw cli::UsageError(
+        "--lod draws one level of a LOD set and --splat-budget chooses the levels per frame: one of them");
   if (options.reference && stochastic)
     throw cli::UsageError(
         "the stochastic compositor is the GPU's; the --reference renderer has the sorted and raster rules");

@@ -14,10 +14,10 @@ cd "$(dirname "$0")/../.."
 seconds="${1:-60}"
 build="${FUZZ_BUILD_DIR:-build-fuzz}"
 scenes="${TILESPLAT_SHARED_SCENES:-$(cd .. && pwd)/shared/scenes}"
-readers=(ply splat spz sog compressed_ply gltf cameras scene_file)
+readers=(ply splat spz sog compressed_ply gltf cameras scene_file lod_set)
 fuzz_flags=(-timeout=10 -rss_limit_mb=2048)
 max_len() {  # a SOG zip or a GLB of 64 Gaussians with SH3 is about 20 kB; the rest fit in 16 kB
-  case "$1" in sog | gltf) echo 65536 ;; *) echo 16384 ;; esac
+  case "$1" in sog | gltf | lod_set) echo 65536 ;; *) echo 16384 ;; esac
 }
 
 mkdir -p "$build"
@@ -53,6 +53,9 @@ seed spz "$scenes/train_3pts.spz" "$scenes/formats/playcanvas_test_64_sh3.v3.spz
 seed sog "$scenes/formats/playcanvas_test_64_sh3.sog"
 seed compressed_ply "$scenes/playcanvas_test_64.compressed.ply" "$scenes/formats/playcanvas_test_64_sh3.compressed.ply"
 seed gltf "$scenes/formats/playcanvas_test_64_sh3.glb"
+# LOD set indexes: splat-transform's own (its chunk files are not beside the harness's folder: the index
+# parses, its loads fail) and the valid indexes over the harness's c.ply in regressions/lod_set/.
+seed lod_set tests/data/playbot_lod_set/lod-meta.json
 # The camera readers (fuzz_cameras.cpp: the first byte picks the reader) from a COLMAP camera of each lens
 # family and a transforms.json of each nerfstudio model.
 mkdir -p "$build/seeds/cameras"

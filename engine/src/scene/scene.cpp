@@ -1,9 +1,6 @@
 // Scene-level entry points: the format chosen by content, load reports and robust scene bounds.
 #include "tilesplat/scene.h"
 
-#include "scene/scene_readers.h"
-#include "scene/scene_reading.h"
-
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -11,6 +8,10 @@
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "scene/scene_readers.h"
+#include "scene/scene_reading.h"
+#include "tilesplat/lod_set.h"
 
 namespace tilesplat {
 namespace {
@@ -58,12 +59,9 @@ Container container_of(std::span<const std::byte> data) {
 // Reads a file that `referrer` names, resolved beside it; only plain relative names are followed.
 detail::FileLoader sibling_loader(const std::filesystem::path& referrer) {
   return [referrer](const std::string& name) {
-    const std::filesystem::path relative(name);
-    const bool escapes = relative.is_absolute() ||
-                         std::any_of(relative.begin(), relative.end(), [](const auto& part) { return part == ".."; });
-    if (name.empty() || escapes)
+    if (!detail::is_path_beside(name))
       detail::fail(referrer.string(), "it names the file '" + name + "', which is not a path beside it");
-    const std::filesystem::path path = referrer.parent_path() / relative;
+    const std::filesystem::path path = referrer.parent_path() / name;
     detail::FileContents contents;
     try {
       detail::open_scene_file(path, contents);
@@ -72,6 +70,19 @@ detail::FileLoader sibling_loader(const std::filesystem::path& referrer) {
     }
     return std::vector<unsigned char>(contents.data(), contents.data() + contents.size());
   };
+}
+
+// A LOD set's finest level, the whole capture (tilesplat/lod_set.h picks other levels).
+GaussianScene read_lod_set_level0(std::string_view text, const std::filesystem::path& path,
+                                  const LoadOptions& options, LoadReport* report) {
+  const LodSet set = LodSet::parse(text, path);
+  GaussianScene scene = set.load_level(0, options);
+  if (report) {
+    *report = LoadReport{.format = "lod set (level 0 of " + std::to_string(set.levels()) + ")",
+                         .version = "1",
+                         .gaussians_in_file = scene.size()};
+  }
+  return scene;
 }
 
 GaussianScene read_any(std::span<const std::byte> data, const std::string& name, const std::filesystem::path* path,
@@ -89,6 +100,10 @@ GaussianScene read_any(std::span<const std::byte> data, const std::string& name,
       return detail::read_gltf(data, name, files, options, report);
     case Container::kJson: {
       const std::string_view text(reinterpret_cast<const char*>(data.data()), data.size());
+      if (detail::is_lod_index(text)) {
+        if (!path) detail::fail(name, "a LOD set index: its chunks are files, read it with load_scene");
+        return read_lod_set_level0(text, *path, options, report);
+      }
       if (detail::is_sog_meta(text)) {
         if (!path) detail::fail(name, "an unbundled SOG meta.json: its images are files, read it with load_scene");
         return detail::read_sog_meta(text, name, files, options, report);

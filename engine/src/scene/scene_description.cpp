@@ -485,7 +485,8 @@ bool is_scene_description(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return true;  // load_scene_description reports why it cannot be read
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return !detail::is_sog_meta(text);
+  // Nor is a LOD set's index (tilesplat/lod_set.h).
+  return !detail::is_sog_meta(text) && !detail::is_lod_index(text);
 }
 
 }  // namespace tilesplat

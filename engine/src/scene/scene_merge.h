@@ -28,8 +28,10 @@ class PositionPlacement {
 
 // `out` empty, with room for `total` Gaussians of SH degree `sh_degree` (and normals).
 void reserve_merged(GaussianScene& out, size_t total, int sh_degree, bool with_normals);
-// Appends `scene`, its SH padded with zeros or cut to out.sh_degree, its normals (zeros where it has
-// none) when `with_normals`.
+// Appends `scene` (or its Gaussians [first, first + count)), its SH padded with zeros or cut to
+// out.sh_degree, its normals (zeros where it has none) when `with_normals`.
 void append_merged(GaussianScene& out, const GaussianScene& scene, bool with_normals);
+void append_merged(GaussianScene& out, const GaussianScene& scene, bool with_normals, size_t first,
+                   size_t count);
 
 }  // namespace tilesplat::detail

@@ -42,6 +42,10 @@ bool is_sog_meta(std::string_view json_text);  // a JSON object with SOG's "mean
 GaussianScene read_sog_meta(std::string_view meta_json, std::string_view name, const FileLoader& load_image,
                             const LoadOptions& options, LoadReport* report);
 
+// splat-transform's LOD set index (lod-meta.json, tilesplat/lod_set.h): a JSON object with "lodLevels",
+// "filenames" and "tree". load_scene reads it as its level 0.
+bool is_lod_index(std::string_view json_text);
+
 // glTF 2.0 with KHR_gaussian_splatting: binary .glb, or JSON .gltf whose buffers are data: URIs or
 // files that `load_buffer` reads (nullptr: external buffers are an error).
 GaussianScene read_gltf(std::span<const std::byte> data, std::string_view name, const FileLoader& load_buffer,

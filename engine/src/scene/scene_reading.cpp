@@ -83,6 +83,12 @@ void open_scene_file(const std::filesystem::path& path, FileContents& contents) 
   if (const std::string error = contents.open(path); !error.empty()) fail(name, error);
 }
 
+bool is_path_beside(const std::string& name) {
+  const std::filesystem::path relative(name);
+  return !name.empty() && !relative.is_absolute() &&
+         std::none_of(relative.begin(), relative.end(), [](const auto& part) { return part == ".."; });
+}
+
 float to_float(double value) {
   if (std::isfinite(value) && std::fabs(value) > static_cast<double>(std::numeric_limits<float>::max()))
     return value > 0 ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();

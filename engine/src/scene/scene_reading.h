@@ -55,6 +55,10 @@ class FileContents {
 // Checks that `path` names a readable regular file and maps or reads it; throws SceneError.
 void open_scene_file(const std::filesystem::path& path, FileContents& contents);
 
+// Whether a file name that another file gives (an unbundled SOG's image, a LOD set's chunk) is a plain
+// path beside that file: not empty, not absolute, no "..". Only such names are followed.
+bool is_path_beside(const std::string& name);
+
 // Little-endian loads from unaligned bytes (every binary splat format is little-endian).
 template <typename T>
 T load_le(const unsigned char* bytes) {

@@ -191,20 +191,26 @@ void rotate_sh(GaussianScene& scene, const Matrix3& r) {
 }
 
 // Appends one scene's SH re-laid to `degree` bands (dropping or zero-filling bands).
-void append_sh(std::vector<float>& out, const GaussianScene& scene, int degree) {
+void append_sh(std::vector<float>& out, const GaussianScene& scene, int degree, size_t first, size_t count) {
   const size_t from = sh_values_per_gaussian(scene.sh_degree);
   const size_t to = sh_values_per_gaussian(degree);
   const size_t kept = std::min(from, to);
-  for (size_t i = 0; i < scene.size(); ++i) {
-    const auto first = scene.sh.begin() + static_cast<std::ptrdiff_t>(i * from);
-    out.insert(out.end(), first, first + static_cast<std::ptrdiff_t>(kept));
+  for (size_t i = first; i < first + count; ++i) {
+    const auto values = scene.sh.begin() + static_cast<std::ptrdiff_t>(i * from);
+    out.insert(out.end(), values, values + static_cast<std::ptrdiff_t>(kept));
     out.insert(out.end(), to - kept, 0.0f);
   }
 }
 
+void append_sh(std::vector<float>& out, const GaussianScene& scene, int degree) {
+  append_sh(out, scene, degree, 0, scene.size());
+}
+
+// Appends the `width` values of each of Gaussians [first, first + count).
 template <typename T>
-void append(std::vector<T>& out, const std::vector<T>& values) {
-  out.insert(out.end(), values.begin(), values.end());
+void append(std::vector<T>& out, const std::vector<T>& values, size_t first, size_t count, size_t width) {
+  const auto begin = values.begin() + static_cast<std::ptrdiff_t>(first * width);
+  out.insert(out.end(), begin, begin + static_cast<std::ptrdiff_t>(count * width));
 }
 
 }  // namespace
@@ -386,17 +392,26 @@ void reserve_merged(GaussianScene& out, size_t total, int sh_degree, bool with_n
 }
 
 void append_merged(GaussianScene& out, const GaussianScene& scene, bool with_normals) {
+  append_merged(out, scene, with_normals, 0, scene.size());
+}
+
+void append_merged(GaussianScene& out, const GaussianScene& scene, bool with_normals, size_t first,
+                   size_t count) {
   check_arrays(scene, "merge_scenes");
-  append(out.positions, scene.positions);
-  append(out.log_scales, scene.log_scales);
-  append(out.rotations, scene.rotations);
-  append(out.opacity_logits, scene.opacity_logits);
-  append_sh(out.sh, scene, out.sh_degree);
+  if (first > scene.size() || count > scene.size() - first)
+    throw std::invalid_argument("merge_scenes: Gaussians " + std::to_string(first) + " to " +
+                                std::to_string(first + count) + " of a scene of " +
+                                std::to_string(scene.size()));
+  append(out.positions, scene.positions, first, count, 3);
+  append(out.log_scales, scene.log_scales, first, count, 3);
+  append(out.rotations, scene.rotations, first, count, 4);
+  append(out.opacity_logits, scene.opacity_logits, first, count, 1);
+  append_sh(out.sh, scene, out.sh_degree, first, count);
   if (!with_normals) return;
   if (scene.has_normals())
-    append(out.normals, scene.normals);
+    append(out.normals, scene.normals, first, count, 3);
   else
-    out.normals.insert(out.normals.end(), 3 * scene.size(), 0.0f);
+    out.normals.insert(out.normals.end(), 3 * count, 0.0f);
 }
 
 }  // namespace detail
