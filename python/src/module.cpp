@@ -24,6 +24,7 @@
 #include "tilesplat/camera_sets.h"
 #include "tilesplat/image.h"
 #include "tilesplat/lens.h"
+#include "tilesplat/lod_set.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
@@ -267,6 +268,61 @@ void bind(nb::module_& m) {
       ".sog, "
       "SOG meta.json, .glb, .gltf) or a scene file (.json). strict: fail on a non-finite value instead of "
       "dropping the Gaussian.");
+
+  // --- level-of-detail sets
+  nb::class_<LodSelection>(m, "LodSelection", "The level each chunk of a LOD set is drawn at for one camera.")
+      .def_ro("chunk_levels", &LodSelection::chunk_levels, "per chunk: the level drawn, or -1 out of view")
+      .def_ro("splats", &LodSelection::splats, "Gaussians drawn")
+      .def_ro("coarsest_splats", &LodSelection::coarsest_splats,
+              "what the chunks in view cost at their coarsest")
+      .def_ro("over_budget", &LodSelection::over_budget, "the budget was below coarsest_splats")
+      .def("__repr__", [](const LodSelection& s) {
+        return "<tilesplat.LodSelection " + std::to_string(s.splats) + " splats of " +
+               std::to_string(s.chunk_levels.size()) + " chunks>";
+      });
+  nb::class_<LodSet>(
+      m, "LodSet",
+      "A level-of-detail set: splat-transform's lod-meta.json, a scene in spatial chunks held at "
+      "several levels (0 the finest). docs/big-scenes.md.")
+      .def(
+          "__init__",
+          [](LodSet* self, const std::filesystem::path& path) {
+            check_exists(path, "LOD set index");
+            new (self) LodSet(LodSet::open(path));
+          },
+          "path"_a, "Reads and checks the index (the chunk files are read when a level needs them).")
+      .def_prop_ro("levels", &LodSet::levels, "the number of levels")
+      .def_prop_ro(
+          "chunks", [](const LodSet& set) { return set.chunks().size(); }, "the number of chunks")
+      .def("level_size", &LodSet::level_size, "level"_a, "Gaussians at a level")
+      .def(
+          "load_level",
+          [](const LodSet& set, int level) {
+            nb::gil_scoped_release release;
+            return set.load_level(level);
+          },
+          "level"_a, "The scene that level draws: every chunk at it, then the environment.")
+      .def(
+          "select",
+          [](const LodSet& set, const Camera& camera, uint64_t splat_budget) {
+            return select_lod_levels(set, camera, splat_budget);
+          },
+          "camera"_a, "splat_budget"_a,
+          "The levels the camera calls for under the budget: chunks out of view left out, the rest refined "
+          "from their coarsest level where their Gaussians cover the most pixels each.")
+      .def(
+          "load_selection",
+          [](const LodSet& set, const LodSelection& selection) {
+            nb::gil_scoped_release release;
+            return set.load_selection(selection);
+          },
+          "selection"_a, "The chunks at the levels a selection chose, then the environment.")
+      .def("__repr__", [](const LodSet& set) {
+        std::string counts;
+        for (int level = 0; level < set.levels(); ++level)
+          counts += (level ? " / " : "") + std::to_string(set.level_size(level));
+        return "<tilesplat.LodSet " + std::to_string(set.levels()) + " levels (" + counts + " Gaussians)>";
+      });
 
   // --- cameras
   nb::class_<Camera>(

@@ -144,6 +144,29 @@ def test_a_scene_in_parts_under_a_memory_budget(playbot_renderer):
     assert other.validation_messages == 0
 
 
+def test_a_lod_set_by_level_and_under_a_splat_budget(playbot_renderer):
+    _, renderer = playbot_renderer
+    lods = tilesplat.LodSet(REPO / "tests" / "data" / "playbot_lod_set" / "lod-meta.json")
+    assert lods.levels == 3 and lods.chunks == 42
+    assert [lods.level_size(level) for level in range(3)] == [31000, 7750, 1550]
+    finest = lods.load_level(0)
+    assert finest.size == 31000 and finest.sh_degree == 2
+    camera = tilesplat.Camera.orbit(finest, 160, 90, azimuth_deg=30)
+    everything = lods.select(camera, splat_budget=10**6)
+    assert everything.splats == 31000 and set(everything.chunk_levels) == {0}
+    some = lods.select(camera, splat_budget=5000)
+    assert some.splats <= 5000 and not some.over_budget and len(some.chunk_levels) == 42
+    chosen = lods.load_selection(some)
+    assert chosen.size == some.splats
+    whole = renderer.render(camera, scene=finest)
+    budget = renderer.render(camera, scene=chosen)
+    assert 15 < tilesplat.compare_images(whole, budget)["psnr_db"] < 100
+    assert lods.select(camera, splat_budget=10).over_budget
+    with pytest.raises(ValueError, match="there is no level 3"):
+        lods.load_level(3)
+    assert renderer.validation_messages == 0
+
+
 def test_raster_compositor(playbot_renderer):
     scene, renderer = playbot_renderer
     camera = tilesplat.Camera.orbit(scene, 96, 54)
