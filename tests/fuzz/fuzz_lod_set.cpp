@@ -6,6 +6,7 @@
 // See tests/fuzz/README.md.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -80,8 +81,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       for (const uint64_t budget : {uint64_t(1), uint64_t(10), uint64_t(1000)}) {
         const tilesplat::LodSelection selection = tilesplat::select_lod_levels(set, camera, budget);
         FUZZ_CHECK(selection.chunk_levels.size() == set.chunks().size());
-        FUZZ_CHECK(selection.over_budget ? selection.splats == selection.coarsest_splats
-                                         : selection.splats <= budget);
+        FUZZ_CHECK(selection.over_budget == (selection.splats > budget));
+        FUZZ_CHECK(selection.splats <= std::max(budget, selection.coarsest_splats));
         FUZZ_CHECK(set.load_selection(selection).size() == selection.splats);
       }
     } catch (const tilesplat::SceneError& error) {

@@ -42,7 +42,8 @@ struct LodSelection {
   std::vector<int> chunk_levels;
   uint64_t splats = 0;           ///< Gaussians drawn: the chosen slices' counts plus the environment's
   uint64_t coarsest_splats = 0;  ///< what the chunks in view cost at their coarsest, plus the environment
-  bool over_budget = false;      ///< the budget was below coarsest_splats: everything in view at its coarsest
+  /// The Gaussians drawn exceed the budget: it is below what the chunks in view need at their coarsest.
+  bool over_budget = false;
 };
 
 /// An opened lod-meta.json: the index, read and checked in full; the chunk files are read when a level or

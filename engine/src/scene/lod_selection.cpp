@@ -79,7 +79,6 @@ LodSelection select_lod_levels(const LodSet& set, const Camera& camera, uint64_t
     pixels[c] = projected_pixels(camera, chunks[c]);
   }
   selection.coarsest_splats = selection.splats;
-  selection.over_budget = selection.splats > splat_budget;
 
   const auto need = [&](size_t c) {
     const uint64_t drawn = chunks[c].levels[size_t(selection.chunk_levels[c])].count;
@@ -100,6 +99,9 @@ LodSelection select_lod_levels(const LodSet& set, const Camera& camera, uint64_t
     selection.splats = total;
     if (level - 1 > 0) queue.push(need(c));
   }
+  // Over only where the coarsest levels were (a finer level of fewer Gaussians than a coarser one, which
+  // an index may hold, is taken whatever the budget: it only lowers the count).
+  selection.over_budget = selection.splats > splat_budget;
   return selection;
 }
 
