@@ -296,6 +296,16 @@ void bind(nb::module_& m) {
           "chunks", [](const LodSet& set) { return set.chunks().size(); }, "the number of chunks")
       .def("level_size", &LodSet::level_size, "level"_a, "Gaussians at a level")
       .def(
+          "chunk_sizes",
+          [](const LodSet& set, int level) {
+            set.level_size(level);  // raises for a level the set does not have
+            std::vector<uint64_t> sizes;
+            for (const LodChunk& chunk : set.chunks()) sizes.push_back(chunk.levels[size_t(level)].count);
+            return sizes;
+          },
+          "level"_a,
+          "Gaussians of each chunk at a level, in the order load_level and load_selection put them")
+      .def(
           "load_level",
           [](const LodSet& set, int level) {
             nb::gil_scoped_release release;

@@ -149,6 +149,7 @@ def test_a_lod_set_by_level_and_under_a_splat_budget(playbot_renderer):
     lods = tilesplat.LodSet(REPO / "tests" / "data" / "playbot_lod_set" / "lod-meta.json")
     assert lods.levels == 3 and lods.chunks == 42
     assert [lods.level_size(level) for level in range(3)] == [31000, 7750, 1550]
+    assert [sum(lods.chunk_sizes(level)) for level in range(3)] == [31000, 7750, 1550]
     finest = lods.load_level(0)
     assert finest.size == 31000 and finest.sh_degree == 2
     camera = tilesplat.Camera.orbit(finest, 160, 90, azimuth_deg=30)
