@@ -14,6 +14,7 @@
 #include <limits>
 #include <optional>
 #include <random>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -338,6 +339,49 @@ TEST(PlyLoader, LoadsBundledPlaybot) {
   EXPECT_EQ(report.dropped, 0u);
   EXPECT_TRUE(report.ignored_properties.empty());
   EXPECT_EQ(report.summary(), "");
+}
+
+// A file of more than one block of rows (the reader decodes 64 MiB of rows at a time and lets go of each
+// block's pages): every Gaussian lands in its slot across the blocks' seams, the non-finite ones dropped
+// with their indices in the file, and the file read from memory (parse_ply, no pages let go of) agrees.
+TEST(PlyLoader, AFileOfManyBlocksLoadsEveryRowInOrder) {
+  constexpr size_t kCount = 1300000;  // 14 floats a row: 72.8 MB, two blocks and a part
+  constexpr size_t kFloats = 14;
+  std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(kCount) + "\n";
+  for (const char* name : {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1",
+                           "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
+    ply += std::string("property float ") + name + "\n";
+  ply += "end_header\n";
+  const size_t header = ply.size();
+  ply.resize(header + kCount * kFloats * sizeof(float));
+  const auto is_dropped = [](size_t i) { return i % 100003 == 7; };  // a NaN opacity in these
+  for (size_t i = 0; i < kCount; ++i) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float row[kFloats] = {float(i), 0,  1,  0.1f, 0.2f, 0.3f, is_dropped(i) ? nan : 0.5f,
+                                -3,       -3, -3, 1,    0,    0,    0};
+    std::memcpy(ply.data() + header + i * sizeof(row), row, sizeof(row));
+  }
+  const std::filesystem::path path = write_file("many_blocks.ply", ply);
+  LoadReport report;
+  const GaussianScene scene = load_ply(path, {}, &report);
+  size_t dropped = 0;
+  for (size_t i = 0; i < kCount; ++i) dropped += is_dropped(i) ? 1 : 0;
+  ASSERT_EQ(scene.size(), kCount - dropped);
+  EXPECT_EQ(report.dropped, dropped);
+  ASSERT_EQ(report.dropped_by_property.size(), 1u);
+  EXPECT_EQ(report.dropped_by_property[0].first_index, 7u);
+  size_t slot = 0;
+  for (size_t i = 0; i < kCount; ++i) {
+    if (is_dropped(i)) continue;
+    ASSERT_EQ(scene.positions[3 * slot], float(i)) << "slot " << slot;
+    ASSERT_EQ(scene.opacity_logits[slot], 0.5f) << "slot " << slot;
+    ++slot;
+  }
+  const GaussianScene in_memory =
+      parse_ply(std::as_bytes(std::span(ply.data(), ply.size())), "many_blocks.ply");
+  EXPECT_EQ(in_memory.positions, scene.positions);
+  EXPECT_EQ(in_memory.sh, scene.sh);
+  std::filesystem::remove(path);
 }
 
 TEST(PlyLoader, LoadsBundledSh3Scene) {

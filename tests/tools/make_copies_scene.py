@@ -8,6 +8,10 @@ named "overview" looks at the whole grid from above the front edge.
       --spacing 2.5 -o /tmp/big/playbot_x216.json
 
 tilesplat reads the capture once however many copies name it (docs/big-scenes.md).
+
+With --merged-ply FILE.ply it also writes the placed copies as one PLY of distinct Gaussians at SH degree 0 (the
+scene file's merge, its colour bands dropped): a big single file, for measuring what reading one costs. That
+needs the tilesplat Python module (python/README.md) and numpy.
 """
 
 import argparse
@@ -25,6 +29,7 @@ def main():
     parser.add_argument("--width", type=int, default=1920, help="the overview camera's width (default 1920)")
     parser.add_argument("--height", type=int, default=1080, help="its height (default 1080)")
     parser.add_argument("-o", "--output", required=True, help="the scene file to write (.json)")
+    parser.add_argument("--merged-ply", help="also write the merged copies as one SH0 binary PLY")
     args = parser.parse_args()
     if not 1 <= args.copies <= 100000:
         sys.exit(f"make_copies_scene: --copies must be 1 to 100000, got {args.copies}")
@@ -61,6 +66,30 @@ def main():
         json.dump(scene, f, indent=1)
         f.write("\n")
     print(f"make_copies_scene: {args.copies} copies of {args.model} on a {side}x{side} grid -> {args.output}")
+    if args.merged_ply:
+        write_merged_ply(args.output, args.merged_ply)
+
+
+def write_merged_ply(scene_file, path):
+    """The scene file's copies, merged by tilesplat, as one binary little-endian PLY at SH degree 0."""
+    import numpy as np
+    import tilesplat
+
+    scene = tilesplat.load_scene(scene_file)
+    n = scene.size
+    names = ["x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
+             "rot_0", "rot_1", "rot_2", "rot_3"]
+    columns = [scene.positions, scene.sh[:, 0, :], scene.opacity_logits[:, None], scene.log_scales,
+               scene.rotations]
+    header = f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\n"
+    header += "".join(f"property float {name}\n" for name in names) + "end_header\n"
+    with open(path, "wb") as f:
+        f.write(header.encode("ascii"))
+        step = 1 << 22  # a few million Gaussians at a time: the whole table at once would double the memory
+        for first in range(0, n, step):
+            rows = np.concatenate([np.asarray(c[first:first + step], np.float32) for c in columns], axis=1)
+            f.write(np.ascontiguousarray(rows, "<f4").tobytes())
+    print(f"make_copies_scene: {n:,} Gaussians (SH0) -> {path}")
 
 
 if __name__ == "__main__":

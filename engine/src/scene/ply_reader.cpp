@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -28,6 +29,11 @@ namespace {
 
 using namespace detail;
 
+// How many bytes of vertex rows are decoded before the reader lets go of them.
+constexpr size_t kReleaseBlockBytes = size_t(64) << 20;
+
+using ConsumedBytes = std::function<void(size_t end)>;
+
 // One output slot per used property: where its value goes for Gaussian 0, and the distance in
 // floats between consecutive Gaussians.
 struct Column {
@@ -42,12 +48,15 @@ struct Column {
 // Decodes a PLY held in memory. `name` (the file's path, for load_ply) prefixes every error.
 class PlyReader {
  public:
-  PlyReader(std::string_view name, const unsigned char* bytes, size_t size, const LoadOptions& options)
+  // `done_with(end)`, where given, is told that bytes [0, end) of the file will not be read again.
+  PlyReader(std::string_view name, const unsigned char* bytes, size_t size, const LoadOptions& options,
+            ConsumedBytes done_with = {})
       : name_(name),
         options_(options),
         ply_(name, bytes, size),
         bytes_(bytes),
         size_(size),
+        done_with_(std::move(done_with)),
         non_finite_(name, options) {}
 
   GaussianScene read(LoadReport* report) {
@@ -295,23 +304,29 @@ class PlyReader {
     allocate(scene, count);
     const std::vector<Column> columns = make_columns(scene);
     const unsigned char* rows = bytes_ + vertex_offset;
-    if constexpr (!kSwap) {
-      const bool all_float = std::all_of(columns.begin(), columns.end(),
-                                         [](const Column& c) { return c.type == ScalarType::kFloat32; });
-      if (all_float) {
-        shrink(scene, decode_rows<true, false>(rows, row_size, count, columns));
-        return;
-      }
+    bool all_float = false;
+    if constexpr (!kSwap)
+      all_float = std::all_of(columns.begin(), columns.end(),
+                              [](const Column& c) { return c.type == ScalarType::kFloat32; });
+    // In blocks of rows, each let go of once decoded: the file's pages and the decoded arrays are never
+    // both whole in memory (a mapped file's pages count as resident while mapped).
+    const size_t block = std::max<size_t>(1, kReleaseBlockBytes / row_size);
+    size_t kept = 0;
+    for (size_t first = 0; first < count; first += block) {
+      const size_t end = std::min(count, first + block);
+      kept = all_float ? decode_rows<true, false>(rows, row_size, first, end, kept, columns)
+                       : decode_rows<false, kSwap>(rows, row_size, first, end, kept, columns);
+      if (done_with_) done_with_(vertex_offset + end * row_size);
     }
-    shrink(scene, decode_rows<false, kSwap>(rows, row_size, count, columns));
+    shrink(scene, kept);
   }
 
+  // Rows [first, end) into the scene from slot `kept` on; returns the slots filled after them.
   // kFloatOnly: every used property is a native-endian float32, so a value is one memcpy.
   template <bool kFloatOnly, bool kSwap>
-  size_t decode_rows(const unsigned char* rows, size_t row_size, size_t count,
+  size_t decode_rows(const unsigned char* rows, size_t row_size, size_t first, size_t end, size_t kept,
                      const std::vector<Column>& columns) {
-    size_t kept = 0;
-    for (size_t i = 0; i < count; ++i) {
+    for (size_t i = first; i < end; ++i) {
       const unsigned char* row = rows + i * row_size;
       bool finite = true;
       for (const Column& column : columns) {
@@ -434,6 +449,7 @@ class PlyReader {
   PlyBytes ply_;
   const unsigned char* bytes_ = nullptr;
   size_t size_ = 0;
+  ConsumedBytes done_with_;
   PlyHeader header_;
   std::vector<ColumnTarget> targets_;  // one per vertex property
   int sh_degree_ = 0;
@@ -450,10 +466,21 @@ GaussianScene parse_ply(std::span<const std::byte> data, std::string_view name, 
   return reader.read(report);
 }
 
+namespace detail {
+
+GaussianScene read_ply_file(FileContents& contents, std::string_view name, const LoadOptions& options,
+                            LoadReport* report) {
+  PlyReader reader(name, contents.data(), contents.size(), options,
+                   [&contents](size_t end) { contents.release_before(end); });
+  return reader.read(report);
+}
+
+}  // namespace detail
+
 GaussianScene load_ply(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report) {
   detail::FileContents contents;
   detail::open_scene_file(path, contents);
-  return parse_ply(contents.bytes(), path.string(), options, report);
+  return detail::read_ply_file(contents, path.string(), options, report);
 }
 
 }  // namespace tilesplat

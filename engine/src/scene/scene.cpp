@@ -85,13 +85,22 @@ GaussianScene read_lod_set_level0(std::string_view text, const std::filesystem::
   return scene;
 }
 
-GaussianScene read_any(std::span<const std::byte> data, const std::string& name, const std::filesystem::path* path,
+// `file`: where `data` came from when it is a file on disk (its path, and its contents, which a reader may
+// let go of as it decodes them); nullptr for bytes in memory.
+struct OpenFile {
+  const std::filesystem::path& path;
+  detail::FileContents& contents;
+};
+
+GaussianScene read_any(std::span<const std::byte> data, const std::string& name, const OpenFile* file,
                        const LoadOptions& options, LoadReport* report) {
+  const std::filesystem::path* path = file ? &file->path : nullptr;
   const detail::FileLoader no_files;
   const detail::FileLoader files = path ? sibling_loader(*path) : no_files;
   switch (container_of(data)) {
     case Container::kPly:
-      return parse_ply(data, name, options, report);
+      return file ? detail::read_ply_file(file->contents, name, options, report)
+                  : parse_ply(data, name, options, report);
     case Container::kSpz:
       return detail::read_spz(data, name, options, report);
     case Container::kZip:
@@ -126,7 +135,8 @@ GaussianScene read_any(std::span<const std::byte> data, const std::string& name,
 GaussianScene load_scene(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report) {
   detail::FileContents contents;
   detail::open_scene_file(path, contents);
-  return read_any(contents.bytes(), path.string(), &path, options, report);
+  const OpenFile file{path, contents};
+  return read_any(contents.bytes(), path.string(), &file, options, report);
 }
 
 GaussianScene parse_scene(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,

@@ -20,6 +20,13 @@ namespace tilesplat::detail {
 // name as written there; throws SceneError when it cannot.
 using FileLoader = std::function<std::vector<unsigned char>(const std::string& name)>;
 
+class FileContents;  // scene/scene_reading.h
+
+// A 3DGS PLY from an open file: parse_ply, letting go of the file's pages as the vertex rows are decoded
+// (FileContents::release_before), so that a big file and its decoded arrays are never both resident.
+GaussianScene read_ply_file(FileContents& contents, std::string_view name, const LoadOptions& options,
+                            LoadReport* report);
+
 // PlayCanvas compressed PLY: a 'chunk' element of per-256-splat bounds, a 'vertex' element of
 // packed_* uint32 fields and an optional 'sh' element of uint8 coefficients.
 bool is_compressed_ply(const PlyHeader& header);

@@ -71,6 +71,20 @@ std::string FileContents::open(const std::filesystem::path& path) {
   return {};
 }
 
+void FileContents::release_before(size_t end) {
+#if TILESPLAT_HAS_MMAP
+  if (!mapping_) return;
+  const size_t page = static_cast<size_t>(sysconf(_SC_PAGESIZE));
+  const size_t whole_pages = std::min(end, size_) / page * page;
+  if (whole_pages <= released_) return;
+  // A private read-only file mapping: dropped pages come back from the file if touched again.
+  madvise(static_cast<unsigned char*>(mapping_) + released_, whole_pages - released_, MADV_DONTNEED);
+  released_ = whole_pages;
+#else
+  (void)end;
+#endif
+}
+
 void open_scene_file(const std::filesystem::path& path, FileContents& contents) {
   const std::string name = path.string();
   std::error_code ec;

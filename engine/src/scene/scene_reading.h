@@ -41,6 +41,11 @@ class FileContents {
   // Returns an error message, empty on success.
   std::string open(const std::filesystem::path& path);
 
+  // Lets go of bytes [0, end) of a mapped file (rounded down to whole pages): they stop counting as the
+  // process's resident memory, and are read from the file again if touched. Nothing for a file read
+  // into memory.
+  void release_before(size_t end);
+
   const unsigned char* data() const { return data_; }
   size_t size() const { return size_; }
   std::span<const std::byte> bytes() const { return std::as_bytes(std::span(data_, size_)); }
@@ -49,6 +54,7 @@ class FileContents {
   const unsigned char* data_ = nullptr;
   size_t size_ = 0;
   void* mapping_ = nullptr;
+  size_t released_ = 0;  // bytes at the mapping's start let go of (release_before)
   std::unique_ptr<unsigned char[]> buffer_;
 };
 
