@@ -20,6 +20,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
 #include "tilesplat/lod_set.h"
+#include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 
 namespace {
@@ -192,6 +193,30 @@ TEST(LodSet, ASplatBudgetRefinesTheChunksThatCoverMostPixelsFirst) {
   EXPECT_TRUE(
       std::all_of(none.chunk_levels.begin(), none.chunk_levels.end(), [](int level) { return level == -1; }));
   EXPECT_TRUE(set.load_selection(none).empty());
+}
+
+// The renderer's own entry point draws what select_lod_levels and load_selection give, and level 0 whole
+// without a budget; under a memory budget too (in parts, the same image).
+TEST(LodSet, TheRendererDrawsTheLevelsTheBudgetChooses) {
+  const LodSet set = LodSet::open(lod_index());
+  const tilesplat::Camera camera = whole_view();
+  tilesplat::Renderer& renderer = tilesplat::testing::validated_renderer();
+  tilesplat::RenderSettings settings;
+  settings.splat_budget = 6000;
+  const tilesplat::RenderImage through_renderer = renderer.render(set, camera, settings);
+  EXPECT_EQ(renderer.last_frame_stats().gaussians, tilesplat::select_lod_levels(set, camera, 6000).splats);
+  const tilesplat::RenderImage by_hand =
+      renderer.render(set.load_selection(tilesplat::select_lod_levels(set, camera, 6000)), camera, settings);
+  EXPECT_EQ(through_renderer.rgba, by_hand.rgba);
+  settings.memory_budget = 3 << 20;
+  const tilesplat::RenderImage in_parts = renderer.render(set, camera, settings);
+  EXPECT_GT(renderer.last_frame_stats().scene_parts, 1);
+  EXPECT_EQ(in_parts.rgba, by_hand.rgba);
+
+  const tilesplat::RenderImage finest = renderer.render(set, camera, tilesplat::RenderSettings{});
+  EXPECT_EQ(renderer.last_frame_stats().gaussians, 31000u);
+  EXPECT_EQ(finest.rgba, renderer.render(set.load_level(0), camera, tilesplat::RenderSettings{}).rgba);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
 TEST(LodSet, KeepsDecodedChunkFilesWithinTheCacheLimit) {

@@ -12,6 +12,7 @@
 #include "frame/averaged_frames.h"
 #include "frame/scene_parts.h"
 #include "renderer_impl.h"
+#include "tilesplat/lod_set.h"
 #include "tilesplat/scene_description.h"
 
 namespace tilesplat {
@@ -154,6 +155,13 @@ RenderImage Renderer::render(const SceneInstances& scene, const Camera& camera,
                              const RenderSettings& settings) {
   return impl_->render_scene(
       PartSource(scene), [&] { set_scene(merge_instances(scene)); }, camera, settings, *this);
+}
+
+RenderImage Renderer::render(const LodSet& set, const Camera& camera, const RenderSettings& settings) {
+  const GaussianScene scene = settings.splat_budget > 0
+                                  ? set.load_selection(select_lod_levels(set, camera, settings.splat_budget))
+                                  : set.load_level(0);
+  return render(scene, camera, settings);
 }
 
 }  // namespace tilesplat

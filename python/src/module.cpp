@@ -628,11 +628,17 @@ void bind(nb::module_& m) {
              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
              const std::array<float, 3>& background, bool reuse_lists, double near_plane, double max_alpha,
              const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter,
-             const GaussianScene* scene, uint64_t memory_budget) {
-            const RenderSettings settings = make_settings(
+             const GaussianScene* scene, uint64_t memory_budget, const LodSet* lod_set,
+             uint64_t splat_budget) {
+            RenderSettings settings = make_settings(
                 sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames, seed,
                 background, reuse_lists, near_plane, max_alpha, lens, shutter, memory_budget);
+            if (scene && lod_set) throw std::invalid_argument("render takes a scene or a lod_set, not both");
+            if (splat_budget > 0 && !lod_set)
+              throw std::invalid_argument("splat_budget applies to a lod_set");
+            settings.splat_budget = splat_budget;
             nb::gil_scoped_release release;
+            if (lod_set) return self.renderer->render(*lod_set, camera, settings);
             return scene ? self.renderer->render(*scene, camera, settings)
                          : self.renderer->render(camera, settings);
           },
@@ -640,10 +646,12 @@ void bind(nb::module_& m) {
           "antialiasing"_a = "classic", "compositor"_a = "sorted", "stochastic_frames"_a = 16, "seed"_a = 1,
           "background"_a = std::array<float, 3>{0, 0, 0}, "reuse_lists"_a = true,
           "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
-          "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0,
+          "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0, "lod_set"_a = nb::none(),
+          "splat_budget"_a = 0,
           "Renders the scene from `camera`: the one set_scene uploaded, or `scene`, which replaces it and is "
           "rendered within memory_budget bytes of device memory (0: none), in depth-ordered parts into the "
-          "same image where the whole frame would need more (docs/big-scenes.md). "
+          "same image where the whole frame would need more (docs/big-scenes.md), or a LodSet `lod_set`: "
+          "level 0, or under splat_budget the levels this camera calls for (LodSet.select). "
           "Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted', 'stochastic' or 'raster' (the depth-sorted splats drawn as quads by the "

@@ -163,6 +163,12 @@ def test_a_lod_set_by_level_and_under_a_splat_budget(playbot_renderer):
     budget = renderer.render(camera, scene=chosen)
     assert 15 < tilesplat.compare_images(whole, budget)["psnr_db"] < 100
     assert lods.select(camera, splat_budget=10).over_budget
+    direct = renderer.render(camera, lod_set=lods, splat_budget=5000)
+    assert np.array_equal(direct.rgba, budget.rgba)
+    assert renderer.last_frame_stats["gaussians"] == some.splats
+    assert np.array_equal(renderer.render(camera, lod_set=lods).rgba, whole.rgba)
+    with pytest.raises(ValueError, match="splat_budget applies to a lod_set"):
+        renderer.render(camera, scene=finest, splat_budget=5000)
     with pytest.raises(ValueError, match="there is no level 3"):
         lods.load_level(3)
     assert renderer.validation_messages == 0

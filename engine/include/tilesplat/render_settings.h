@@ -217,6 +217,10 @@ struct RenderSettings {
   /// the budget, into the same image bit for bit (docs/big-scenes.md). 0 (the default): no budget, the
   /// scene is rendered whole. render(camera, settings) on a scene set_scene uploaded ignores it.
   uint64_t memory_budget = 0;
+  /// For Renderer::render(const LodSet&, ...): the most Gaussians the frame draws, each chunk of the set at
+  /// the level the camera calls for (select_lod_levels, docs/big-scenes.md). 0 (the default): level 0,
+  /// every chunk. Other scenes ignore it.
+  uint64_t splat_budget = 0;
 };
 
 }  // namespace tilesplat

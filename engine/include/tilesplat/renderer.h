@@ -102,6 +102,7 @@ struct DeviceInfo {
 };
 
 struct SceneInstances;        // tilesplat/scene_description.h
+class LodSet;                 // tilesplat/lod_set.h
 struct ExternalVulkanDevice;  // tilesplat/vulkan_interop.h
 struct ExternalImage;
 struct ExternalDepthImage;
@@ -164,6 +165,10 @@ class TILESPLAT_API Renderer {
   /// The same for a scene file's placed copies (load_scene_instances): in parts, each part's Gaussians are
   /// placed as they are drawn, so the merged scene is never held; whole, it is merged and set.
   RenderImage render(const SceneInstances& scene, const Camera& camera, const RenderSettings& settings = {});
+  /// A level-of-detail set from this camera: under RenderSettings::splat_budget the levels select_lod_levels
+  /// chooses for it, else level 0 whole; then as render(scene, camera, settings), in parts under a memory
+  /// budget. FrameStats::gaussians is what it drew. Throws SceneError for a chunk file it cannot read.
+  RenderImage render(const LodSet& set, const Camera& camera, const RenderSettings& settings = {});
 
   /// What the last render() (or render_to_image()) did and cost. The reference is valid until the
   /// next frame. A frame render_to_image submitted without waiting (HostFrameSync) is described once
