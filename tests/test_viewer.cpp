@@ -96,6 +96,33 @@ TEST(Viewer, ScreenshotIsTheRenderOfTheSameView) {
   EXPECT_EQ(shown.splat_count, rendered.splat_count);
 }
 
+// A LOD set under a splat budget: the viewer chooses the levels for its camera as tilesplat-render does
+// for the same view, and says how many Gaussians it draws.
+TEST(Viewer, ASplatBudgetDrawsWhatTheRendererDraws) {
+  REQUIRE_VIEWER();
+  const std::optional<std::string> prefix = display_prefix();
+  if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
+  const fs::path out = fresh_output_dir();
+  const fs::path lod_set =
+      fs::path(TILESPLAT_SOURCE_DIR) / "tests" / "data" / "playbot_lod_set" / "lod-meta.json";
+  std::vector<std::string> viewer_args = view_args(lod_set, bundled_playbot_cameras(), 2);
+  viewer_args.insert(viewer_args.end(), {"--splat-budget", "6000"});
+  std::vector<std::string> render_args = viewer_args;
+  viewer_args.insert(viewer_args.end(),
+                     {"--validation", "--frames", "2", "--screenshot", (out / "viewer.exr").string()});
+  render_args.insert(render_args.end(), {"-o", (out / "render.exr").string()});
+
+  const ProcessResult viewer = run_process(*prefix, kViewerExe, viewer_args);
+  ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
+  EXPECT_NE(viewer.err.find("at most 6,000 a frame"), std::string::npos) << viewer.err;
+  EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
+  const ProcessResult render = run_process("", kRenderExe, render_args);
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  const tilesplat::ImageDifference difference = tilesplat::compare_images(
+      tilesplat::read_exr(out / "viewer.exr"), tilesplat::read_exr(out / "render.exr"));
+  EXPECT_GE(difference.psnr_db, 100.0) << "max abs " << difference.max_abs;
+}
+
 // The window shows the trained colours as a PNG preview holds them (docs/colour.md): the bytes of the
 // window's image equal tilesplat-render's --png of the same view within one level (the blit's float to
 // 8-bit rounding against the preview's). Both kinds of window format: a _UNORM one, which the viewer

@@ -25,6 +25,7 @@
 #include "swapchain.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
+#include "tilesplat/lod_set.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
@@ -93,11 +94,12 @@ class Viewer {
         device_(device),
         renderer_(renderer),
         swapchain_(device),
-        bounds_(tilesplat::compute_bounds(loaded.scene)),
+        bounds_(loaded.bounds()),
         controller_(loaded.camera, bounds_),
         mesh_(!options.no_mesh),
         depth_out_(!options.no_depth_out),
         scene_name_(loaded.path.filename().string()),
+        lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
         views_(std::move(views)),
         view_(options.common.view),
         sorts_(sort_cycle()) {
@@ -302,6 +304,7 @@ class Viewer {
   }
 
   void render() {
+    if (lod_) choose_lod_levels();
     tilesplat::RenderSettings frame = settings();
     frame.depth = frame.splat_count = false;  // the window shows colour alone
     // Submitted without waiting (HostFrameSync): the presentation's blit is queued behind it.
@@ -313,6 +316,16 @@ class Viewer {
     needs_render_ = false;
     needs_present_ = true;
     ++frames_;
+  }
+
+  // Under --splat-budget: the levels this frame's camera calls for, uploaded when they changed.
+  void choose_lod_levels() {
+    tilesplat::LodSelection selection =
+        tilesplat::select_lod_levels(*lod_->set, controller_.camera(), lod_->splat_budget);
+    lod_splats_ = selection.splats;
+    if (selection.chunk_levels == lod_levels_) return;
+    renderer_.set_scene(lod_->set->load_selection(selection));
+    lod_levels_ = std::move(selection.chunk_levels);
   }
 
   bool present() {
@@ -331,7 +344,8 @@ class Viewer {
     const std::string& ran = renderer_.last_frame_stats().sort_strategy;
     const std::string sort = sorts_[sort_] == "auto" && !ran.empty() ? "auto (" + ran + ")" : sorts_[sort_];
     title += " | " + tilesplat::to_string(modes_[mode_]) + " | " + sort + " | " +
-             tilesplat::to_string(kCompositorCycle[compositor_]) + " | GPU " +
+             tilesplat::to_string(kCompositorCycle[compositor_]) +
+             (lod_ ? " | " + cli::group_thousands(lod_splats_) + " splats (LOD)" : "") + " | GPU " +
              cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
              cli::format_fixed(frame_ms, 1) + " ms (" +
              cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps)";
@@ -356,6 +370,9 @@ class Viewer {
   bool mesh_;       // draw the box and the grid (not --no-mesh)
   bool depth_out_;  // the splats write their depth for the grid (D toggles)
   std::string scene_name_;
+  const cli::LoadedLodSet* lod_;  // a LOD set drawn under --splat-budget, else null
+  std::vector<int> lod_levels_;   // the levels the scene on the device has, per chunk
+  uint64_t lod_splats_ = 0;
   std::vector<tilesplat::CameraView> views_;  // of --cameras or the scene file; N and P step through them
   int view_ = 0;
   std::vector<tilesplat::AccuracyModes> modes_;
@@ -424,7 +441,7 @@ int run(int argc, char** argv) {
   if (!window) throw std::runtime_error("cannot open a window: " + last_glfw_error);
   const WindowDevice device(window.get(), options.common.validation, options.common.device);
   const auto renderer = tilesplat::create_renderer(device.external());
-  renderer->set_scene(loaded.scene);
+  if (!loaded.lod || loaded.lod->splat_budget == 0) renderer->set_scene(loaded.scene);  // else per frame
 
   Viewer viewer(window.get(), device, *renderer, options, loaded, std::move(views));
   viewer.run(options.frames);
@@ -439,7 +456,7 @@ int run(int argc, char** argv) {
 
   const tilesplat::Camera& camera = viewer.camera();
   std::string summary = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
-                        cli::describe_scene(loaded.scene) + ", " + std::to_string(viewer.frames()) +
+                        cli::describe_scene(loaded) + ", " + std::to_string(viewer.frames()) +
                         (viewer.frames() == 1 ? " frame on " : " frames on ") + device.name() + " in a " +
                         tilesplat::viewer::format_name(viewer.window_format()) + " window, the last " +
                         cli::format_size(camera.width, camera.height) + " in " +

@@ -6,6 +6,7 @@ namespace cli = tilesplat::cli;
 
 void add_viewer_options(cli::ArgParser& parser, ViewerOptions& options) {
   cli::add_common_options(parser, options.common, cli::SortChoice::kOne);
+  cli::add_splat_budget_option(parser, options.common);
   parser.section("scripting");
   parser.add_int("--frames", "N", "render N frames, then exit (default: run until the window is closed)",
                  &options.frames, 1, 1000000);
@@ -22,6 +23,9 @@ void add_viewer_options(cli::ArgParser& parser, ViewerOptions& options) {
 
 void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& options) {
   cli::check_common_options(parser, options.common);
+  if (parser.seen("--lod") && parser.seen("--splat-budget"))
+    throw cli::UsageError(
+        "--lod draws one level of a LOD set and --splat-budget chooses the levels per frame: one of them");
   // The compositors the window shows (key C), checked before a window opens.
   if (options.common.compositor == Compositor::kStochastic)
     throw cli::UsageError("the viewer shows the sorted or the raster compositor, not the stochastic one");
