@@ -74,18 +74,46 @@ TEST(CliBench, HelpListsEveryFlag) {
   const auto result = run_exe(kBenchExe, {"--help"});
   EXPECT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(contains(result.out, "usage: tilesplat-bench")) << result.out;
-  for (const char* flag : {"--warmup",       "--repeat",     "--csv",
-                           "--json",         "--plot",       "--cameras",
-                           "--view",         "--views",      "--orbit",
-                           "--resolutions",  "--width",      "--height",
-                           "--azimuth",      "--elevation",  "--fov",
-                           "--distance",     "--strict",     "--device",
-                           "--list-devices", "--sort",       "--validation",
-                           "--help",         "SCENE.ply...", "--sort-bench",
-                           "--sort-sizes",   "--key-bits",   "--effects",
-                           "--antialiasing", "--accuracy",   "--path",
-                           "--path-frames",  "--path-step",  "--consistency-angle",
-                           "--scaling",      "--tile-copies"})
+  for (const char* flag : {"--warmup",
+                           "--repeat",
+                           "--csv",
+                           "--json",
+                           "--plot",
+                           "--cameras",
+                           "--view",
+                           "--views",
+                           "--orbit",
+                           "--resolutions",
+                           "--width",
+                           "--height",
+                           "--azimuth",
+                           "--elevation",
+                           "--fov",
+                           "--distance",
+                           "--strict",
+                           "--device",
+                           "--list-devices",
+                           "--sort",
+                           "--validation",
+                           "--help",
+                           "SCENE.ply...",
+                           "--sort-bench",
+                           "--sort-sizes",
+                           "--key-bits",
+                           "--effects",
+                           "--antialiasing",
+                           "--accuracy",
+                           "--path",
+                           "--path-frames",
+                           "--path-step",
+                           "--consistency-angle",
+                           "--scaling",
+                           "--tile-copies",
+                           "--fisheye",
+                           "--orthographic",
+                           "--equirectangular",
+                           "--lod-curve",
+                           "--lod"})
     EXPECT_TRUE(contains(result.out, flag)) << "--help does not mention " << flag << "\n" << result.out;
 }
 
@@ -675,6 +703,27 @@ TEST(CliBench, PrintsTableAndWritesCsvAndJson) {
   EXPECT_TRUE(contains(json_text, "\"projection\"")) << json_text;
   EXPECT_EQ(entries(out), (std::vector<std::string>{"c.csv", "j.json"}));
   EXPECT_FALSE(contains(result.err, "validation messages")) << result.err;
+}
+
+// The camera-model flags tilesplat-render has: each case's view through the model, named in the table and
+// the CSV; one model at a time, and not for the reports that measure pinhole views.
+TEST(CliBench, CameraModelFlagsTimeTheViewsThroughAnotherLens) {
+  const auto out = fresh_output_dir();
+  const fs::path csv = out / "fisheye.csv";
+  const auto fisheye =
+      run_exe(kBenchExe, {bundled_sh3().string(), "--width", "64", "--height", "36", "--warmup", "0",
+                          "--repeat", "1", "--fisheye", "180", "--csv", csv.string()});
+  ASSERT_EQ(fisheye.exit_code, 0) << fisheye.err;
+  EXPECT_TRUE(contains(fisheye.out, "fov 50.0, fisheye ==")) << fisheye.out;
+  EXPECT_TRUE(contains(read_file(csv), "azimuth 0.0 fisheye")) << read_file(csv);
+  const auto two = run_exe(kBenchExe, {bundled_sh3().string(), "--fisheye", "180", "--equirectangular"});
+  EXPECT_EQ(two.exit_code, 2);
+  EXPECT_TRUE(contains(two.err, "are camera models: one of them")) << two.err;
+  const auto effects = run_exe(kBenchExe, {bundled_sh3().string(), "--effects", "--orthographic", "2"});
+  EXPECT_EQ(effects.exit_code, 2);
+  EXPECT_TRUE(contains(effects.err, "--effects measures pinhole views")) << effects.err;
+  const auto sort_bench = run_exe(kBenchExe, {"--sort-bench", "--equirectangular"});
+  EXPECT_EQ(sort_bench.exit_code, 2);
 }
 
 // Every output says which build and command made it: the CSV in four columns of every record, the

@@ -41,6 +41,8 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
                      options.resolutions = cli::parse_resolutions("--resolutions", text);
                    });
 
+  cli::add_camera_model_options(parser, options.camera_model);
+
   parser.section("benchmark");
   parser.add_int("--warmup", "N",
                  "frames rendered and discarded before measuring, per camera and sort (default 2)",
@@ -268,11 +270,19 @@ void check_bench_flags(const cli::ArgParser& parser, const BenchOptions& options
     if (!options.common.scenes.empty())
       throw cli::UsageError("--sort-bench sorts random keys and takes no SCENE");
     for (const char* flag : {"--cameras", "--view", "--views", "--orbit", "--width", "--height",
-                             "--resolutions", "--azimuth", "--elevation", "--fov", "--distance", "--strict"})
+                             "--resolutions", "--azimuth", "--elevation", "--fov", "--distance", "--strict",
+                             "--fisheye", "--orthographic", "--equirectangular"})
       if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --sort-bench");
     return;
   }
   check_frame_options(parser, options);
+  cli::check_camera_model_options(options.camera_model);
+  if (options.camera_model.enabled() && (options.effects || options.scaling))
+    throw cli::UsageError(
+        std::string(options.effects ? "--effects" : "--scaling") +
+        " measures pinhole views (--effects times every camera model itself); "
+        "--fisheye, --orthographic and --equirectangular apply to the frame benchmark and the "
+        "other reports");
   if (options.accuracy) {
     for (const char* flag : {"--resolutions", "--orbit", "--json"})
       if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");

@@ -35,6 +35,7 @@ struct BenchOptions {
   std::vector<int> views;  // --views; empty: --view alone (or every view, with all_views)
   bool all_views = false;
   int orbit = 0;  // --orbit N: N orbit cameras; 0: the one at --azimuth
+  tilesplat::cli::CameraModelFlags camera_model;  // --fisheye, --orthographic, --equirectangular
   bool sort_bench = false;
   bool accuracy = false;  // --accuracy: the error/time report
   bool effects = false;   // --effects: the per-effect cost table

@@ -297,7 +297,13 @@ std::string make_frame_svg(const std::vector<Group>& groups, const std::vector<B
 std::vector<Case> plan_cases(const BenchOptions& options, const BenchScene& scene, size_t scene_index,
                              const std::vector<cli::ImageSize>& sizes) {
   std::vector<Case> cases;
+  // Each view through --fisheye, --orthographic or --equirectangular where one is given, named so.
   auto add = [&](size_t size_index, std::string label, cli::NamedCamera camera) {
+    if (options.camera_model.enabled()) {
+      camera.camera = cli::camera_for_frame(options.camera_model, camera.camera);
+      label += std::string(" ") + tilesplat::camera_model_name(camera.camera.model);
+      camera.description += std::string(", ") + tilesplat::camera_model_name(camera.camera.model);
+    }
     cases.push_back({scene_index, size_index, std::move(label), std::move(camera), {}});
   };
   const cli::SceneViews own = cli::scene_views(scene.loaded);

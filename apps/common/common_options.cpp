@@ -1,6 +1,7 @@
 #include "common_options.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 
@@ -264,6 +265,43 @@ void add_memory_budget_option(ArgParser& parser, uint64_t& budget, const std::st
       "parts that follow the depth order, into the same image bit for bit (docs/big-scenes.md; " +
           what_it_adds + "default: no budget)",
       [&budget](const std::string& text) { budget = parse_byte_size("--memory-budget", text); });
+}
+
+void add_camera_model_options(ArgParser& parser, CameraModelFlags& flags) {
+  parser.section("camera model (every frame's camera, its pose and size kept, through another lens)");
+  parser.add_value("--fisheye", "DEG",
+                   "an equidistant fisheye whose field of view spans DEG degrees across the image's shorter "
+                   "side (up to 360: a circular fisheye, past 180 it sees behind)",
+                   [&flags](const std::string& text) {
+                     const double degrees = parse_double("--fisheye", text);
+                     if (!(degrees > 0 && degrees <= 360))
+                       throw UsageError("--fisheye must be in (0, 360] degrees, got " + single_quoted(text));
+                     flags.fisheye_fov_deg = degrees;
+                   });
+  parser.add_value(
+      "--orthographic", "H", "an orthographic view H world units tall (parallel rays)",
+      [&flags](const std::string& text) {
+        const double height = parse_double("--orthographic", text);
+        if (!(height > 0 && std::isfinite(height)))
+          throw UsageError("--orthographic must be a positive number, got " + single_quoted(text));
+        flags.view_height = height;
+      });
+  parser.add_switch(
+      "--equirectangular",
+      "the 360x180 panorama around the camera (give a 2:1 size, e.g. --width 2048 --height 1024)",
+      &flags.equirectangular);
+}
+
+void check_camera_model_options(const CameraModelFlags& flags) {
+  if (flags.given() > 1)
+    throw UsageError("--fisheye, --orthographic and --equirectangular are camera models: one of them");
+}
+
+Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera) {
+  if (flags.fisheye_fov_deg) return fisheye_camera(camera, *flags.fisheye_fov_deg);
+  if (flags.view_height) return orthographic_camera(camera, *flags.view_height);
+  if (flags.equirectangular) return equirectangular_camera(camera);
+  return camera;
 }
 
 void add_splat_budget_option(ArgParser& parser, CommonOptions& options) {

@@ -88,6 +88,22 @@ void apply_training_options(const CommonOptions& options, RenderSettings& settin
 // ends the help text with what the app does besides rendering in parts.
 void add_memory_budget_option(ArgParser& parser, uint64_t& budget, const std::string& what_it_adds);
 
+// --fisheye, --orthographic and --equirectangular: every frame's camera (its pose, size and principal point)
+// through another model. Off: the cameras as given, whatever model they have.
+struct CameraModelFlags {
+  std::optional<double> fisheye_fov_deg;  // --fisheye DEG: equidistant, DEG across the shorter side
+  std::optional<double> view_height;      // --orthographic H: H world units tall
+  bool equirectangular = false;           // --equirectangular: the 360x180 panorama
+  int given() const { return fisheye_fov_deg.has_value() + view_height.has_value() + equirectangular; }
+  bool enabled() const { return given() > 0; }
+};
+// Declares the three flags, in a section of their own.
+void add_camera_model_options(ArgParser& parser, CameraModelFlags& flags);
+// Throws UsageError for more than one of them.
+void check_camera_model_options(const CameraModelFlags& flags);
+// The frame's camera through the flags' model (fisheye_camera, orthographic_camera), or as it is.
+Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera);
+
 // --splat-budget N into options.lod.splat_budget, for an app that renders a LOD set frame by frame.
 void add_splat_budget_option(ArgParser& parser, CommonOptions& options);
 

@@ -519,8 +519,9 @@ int run(int argc, char** argv) {
                       loaded.lens});
   }
   for (Frame& frame : frames) {
-    frame.camera = camera_for_frame(options.camera_model, frame.camera);
-    if (frame.next_camera) frame.next_camera = camera_for_frame(options.camera_model, *frame.next_camera);
+    frame.camera = cli::camera_for_frame(options.camera_model, frame.camera);
+    if (frame.next_camera)
+      frame.next_camera = cli::camera_for_frame(options.camera_model, *frame.next_camera);
   }
 
   tilesplat::RenderSettings settings;

@@ -202,25 +202,7 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                            "alone");
                    });
 
-  parser.section("camera model (every frame's camera, its pose and size kept, through another lens)");
-  parser.add_value(
-      "--fisheye", "DEG",
-      "an equidistant fisheye whose field of view spans DEG degrees across the image's shorter "
-      "side (up to 360: a circular fisheye, past 180 it sees behind)",
-      [&options](const std::string& text) {
-        const double degrees = cli::parse_double("--fisheye", text);
-        if (!(degrees > 0 && degrees <= 360))
-          throw cli::UsageError("--fisheye must be in (0, 360] degrees, got " + single_quoted(text));
-        options.camera_model.fisheye_fov_deg = degrees;
-      });
-  parser.add_value("--orthographic", "H", "an orthographic view H world units tall (parallel rays)",
-                   [&options, positive](const std::string& text) {
-                     options.camera_model.view_height = positive("--orthographic", text);
-                   });
-  parser.add_switch(
-      "--equirectangular",
-      "the 360x180 panorama around the camera (give a 2:1 size, e.g. --width 2048 --height 1024)",
-      &options.camera_model.equirectangular);
+  cli::add_camera_model_options(parser, options.camera_model);
   parser.add_switch("--stats",
                     "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
                     "intersections, retries, device memory and its peak, scene parts, peak resident memory",
@@ -299,8 +281,7 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
     throw cli::UsageError(
         "--stochastic N is the stochastic compositor; it cannot be combined with --compositor " +
         tilesplat::to_string(*options.common.compositor));
-  if (options.camera_model.given() > 1)
-    throw cli::UsageError("--fisheye, --orthographic and --equirectangular are camera models: one of them");
+  cli::check_camera_model_options(options.camera_model);
   if (options.camera_model.enabled() && options.lens.enabled())
     throw cli::UsageError("depth of field (--aperture, --f-stop) needs a pinhole camera, not " +
                           std::string(options.camera_model.fisheye_fov_deg ? "--fisheye"
@@ -355,13 +336,6 @@ std::string shutter_text(const ShutterFlags& flags) {
   std::string text = std::string(angle, end) + "deg:samples:" + std::to_string(flags.samples);
   if (flags.scan != ShutterScan::kGlobal) text += std::string(":rolling:") + shutter_scan_name(flags.scan);
   return text;
-}
-
-Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera) {
-  if (flags.fisheye_fov_deg) return fisheye_camera(camera, *flags.fisheye_fov_deg);
-  if (flags.view_height) return orthographic_camera(camera, *flags.view_height);
-  if (flags.equirectangular) return equirectangular_camera(camera);
-  return camera;
 }
 
 ThinLens lens_for_frame(const LensFlags& flags, const Camera& camera,

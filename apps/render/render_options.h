@@ -47,18 +47,6 @@ ThinLens lens_for_frame(const LensFlags& flags, const Camera& camera,
 // renderSettings; empty when off.
 std::string lens_text(const LensFlags& flags);
 
-// --fisheye, --orthographic and --equirectangular: every frame's camera (its pose, size and principal point)
-// through another model. Off: the cameras as given, whatever model they have.
-struct CameraModelFlags {
-  std::optional<double> fisheye_fov_deg;  // --fisheye DEG: equidistant, DEG across the shorter side
-  std::optional<double> view_height;      // --orthographic H: H world units tall
-  bool equirectangular = false;           // --equirectangular: the 360x180 panorama
-  int given() const { return fisheye_fov_deg.has_value() + view_height.has_value() + equirectangular; }
-  bool enabled() const { return given() > 0; }
-};
-// The frame's camera through the flags' model (fisheye_camera, orthographic_camera), or as it is.
-Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera);
-
 // --shutter and --shutter-samples: motion blur over a sequence's camera motion. The shutter opens at a
 // frame's time and stays open for DEG/360 of the interval to the next frame (a film camera's shutter
 // angle: 180 is half the interval).
@@ -88,7 +76,7 @@ struct RenderOptions {
   bool reference = false;
   int stochastic_frames = 0;  // --stochastic N: the sort-free compositor averaging N frames; 0 = sorted
   LensFlags lens;
-  CameraModelFlags camera_model;
+  cli::CameraModelFlags camera_model;  // --fisheye, --orthographic, --equirectangular
   ShutterFlags shutter;
   bool stats = false;
   uint64_t memory_budget = 0;  // --memory-budget: RenderSettings::memory_budget (0: none)
