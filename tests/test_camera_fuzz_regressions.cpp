@@ -5,35 +5,17 @@
 // invariant aborts the process, which fails the test.
 #include <gtest/gtest.h>
 
-#include <algorithm>
+#include <cstddef>
 #include <cstdint>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <string>
-#include <vector>
+
+#include "test_support.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
 namespace {
 
-namespace fs = std::filesystem;
-
 TEST(CameraFuzzRegressions, EveryInputPassesTheFuzzersInvariants) {
-  const fs::path dir = fs::path(TILESPLAT_SOURCE_DIR) / "tests" / "fuzz" / "regressions" / "cameras";
-  std::vector<fs::path> inputs;
-  for (const auto& entry : fs::directory_iterator(dir))
-    if (entry.is_regular_file()) inputs.push_back(entry.path());
-  std::sort(inputs.begin(), inputs.end());
-  ASSERT_GE(inputs.size(), 10u) << "the camera regressions in " << dir << " are missing";
-  for (const fs::path& input : inputs) {
-    SCOPED_TRACE(input.filename().string());
-    std::ifstream file(input, std::ios::binary);
-    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)),
-                                     std::istreambuf_iterator<char>());
-    ASSERT_FALSE(bytes.empty());
-    EXPECT_EQ(LLVMFuzzerTestOneInput(bytes.data(), bytes.size()), 0);
-  }
+  tilesplat::testing::replay_fuzz_regressions("cameras", 10, LLVMFuzzerTestOneInput);
 }
 
 }  // namespace

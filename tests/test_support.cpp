@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -145,6 +147,25 @@ DecodedPng read_png_rgb(const std::filesystem::path& path) {
     throw std::runtime_error(message);
   }
   return decoded;
+}
+
+void replay_fuzz_regressions(const std::string& reader, size_t at_least,
+                             int (*harness)(const uint8_t*, size_t)) {
+  const std::filesystem::path dir =
+      std::filesystem::path(TILESPLAT_SOURCE_DIR) / "tests" / "fuzz" / "regressions" / reader;
+  std::vector<std::filesystem::path> inputs;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    if (entry.is_regular_file()) inputs.push_back(entry.path());
+  std::sort(inputs.begin(), inputs.end());
+  ASSERT_GE(inputs.size(), at_least) << "the " << reader << " regressions in " << dir << " are missing";
+  for (const std::filesystem::path& input : inputs) {
+    SCOPED_TRACE(input.filename().string());
+    std::ifstream file(input, std::ios::binary);
+    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)),
+                                     std::istreambuf_iterator<char>());
+    ASSERT_FALSE(bytes.empty());
+    EXPECT_EQ(harness(bytes.data(), bytes.size()), 0);
+  }
 }
 
 }  // namespace tilesplat::testing

@@ -33,6 +33,12 @@ bool skips_forbidden();
 // pixels of focal length `focal`, the principal point at the image centre.
 Camera axis_camera(int width, int height, double focal);
 
+// Replays the regression inputs of one fuzzer (tests/fuzz/regressions/READER/), each once and whole,
+// through `harness`, the fuzzer's own LLVMFuzzerTestOneInput linked into the test (a broken invariant
+// aborts the process, which fails the test); expects at least `at_least` of them.
+void replay_fuzz_regressions(const std::string& reader, size_t at_least,
+                             int (*harness)(const uint8_t*, size_t));
+
 // A directory unique to the running test for temporary files (removed by the OS, not by tests).
 std::filesystem::path temp_dir();
 

@@ -126,6 +126,14 @@ int run_accuracy_report(const BenchOptions& options) {
   return cli::kExitOk;
 }
 
+// The cameras of a report of one scene: its cases at --width and --height.
+std::vector<tilesplat::Camera> report_views(const BenchOptions& options, const BenchScene& scene) {
+  std::vector<tilesplat::Camera> views;
+  for (const Case& c : plan_cases(options, scene, 0, {{options.common.width, options.common.height}}))
+    views.push_back(c.camera.camera);
+  return views;
+}
+
 int run_effects_report(const BenchOptions& options) {
   check_outputs(options, {{"SCENE", options.common.scenes.front()}});
   const std::string& command = options.command;
@@ -138,8 +146,7 @@ int run_effects_report(const BenchOptions& options) {
   scene.sh_degree = scene.loaded.scene.sh_degree;
   if (!options.common.cameras_files.empty()) scene.cameras = options.common.cameras_files.front();
   tilesplat::effects::Options effect_options;
-  for (const Case& c : plan_cases(options, scene, 0, {{options.common.width, options.common.height}}))
-    effect_options.views.push_back(c.camera.camera);
+  effect_options.views = report_views(options, scene);
   effect_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
   effect_options.repeat = options.repeat;
   if (!options.common.sorts.empty()) effect_options.sort = options.common.sorts.front();
@@ -316,8 +323,7 @@ int run_lod_report(const BenchOptions& options) {
   scene.name = scene.loaded.path.filename().string();
   if (!options.common.cameras_files.empty()) scene.cameras = options.common.cameras_files.front();
   tilesplat::lod_report::Options lod_options;
-  for (const Case& c : plan_cases(options, scene, 0, {{options.common.width, options.common.height}}))
-    lod_options.views.push_back(c.camera.camera);
+  lod_options.views = report_views(options, scene);
   lod_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
   lod_options.repeat = options.repeat;
   if (!options.common.sorts.empty()) lod_options.sort = options.common.sorts.front();
