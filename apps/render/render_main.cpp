@@ -18,6 +18,7 @@
 
 #include "cli.h"
 #include "frame_manifest.h"
+#include "frame_renderer.h"
 #include "frame_sequence.h"
 #include "progress.h"
 #include "render_options.h"
@@ -288,91 +289,6 @@ struct FrameWriter {
       throw std::runtime_error(write_failure(frame.png, error));
     }
   }
-};
-
-// Renders one camera with the GPU renderer or the float64 reference; `gpu_ms` gets the frame's time.
-class FrameRenderer {
- public:
-  FrameRenderer(const RenderOptions& options, const cli::LoadedScene& loaded)
-      : scene_(loaded.scene),
-        instances_(loaded.instances ? &*loaded.instances : nullptr),
-        lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
-        lens_(options.lens),
-        in_parts_(options.memory_budget > 0) {
-    if (lens_.enabled()) {
-      const tilesplat::Bounds bounds = loaded.bounds();
-      scene_centre_ = {bounds.center[0], bounds.center[1], bounds.center[2]};
-    }
-    if (options.reference) return;
-    renderer_ = tilesplat::Renderer::create(cli::renderer_options(options.common));
-    // Under a memory budget each frame takes the scene (in parts where it does not fit); under a splat
-    // budget each frame draws the levels its camera calls for.
-    if (!in_parts_ && !lod_) renderer_->set_scene(scene_);
-  }
-
-  tilesplat::RenderImage render(const tilesplat::Camera& camera,
-                                const tilesplat::RenderSettings& base_settings) {
-    tilesplat::RenderSettings settings = base_settings;
-    // The flags' lens, its focus following the frame's camera, over the scene file's lens for the view.
-    if (lens_.enabled()) settings.lens = lens_for_frame(lens_, camera, scene_centre_);
-    tilesplat::RenderImage image;
-    tilesplat::GaussianScene selected;  // the LOD set's chunks at the levels this camera calls for
-    if (lod_) {
-      lod_selection_ = tilesplat::select_lod_levels(*lod_->set, camera, lod_->splat_budget);
-      selected = lod_->set->load_selection(lod_selection_);
-      if (lod_selection_.over_budget && !warned_over_budget_) {
-        cli::print_warning(kProgram, "--splat-budget " + std::to_string(lod_->splat_budget) +
-                                         " is below what the coarsest levels in view draw (" +
-                                         std::to_string(lod_selection_.coarsest_splats) +
-                                         " Gaussians): those frames draw the coarsest levels");
-        warned_over_budget_ = true;
-      }
-    }
-    const tilesplat::GaussianScene& scene = lod_ ? selected : scene_;
-    if (renderer_) {
-      image = !in_parts_ && !lod_ ? renderer_->render(camera, settings)
-              : instances_        ? renderer_->render(*instances_, camera, settings)
-                                  : renderer_->render(scene, camera, settings);
-      gpu_ms_ = renderer_->last_frame_stats().gpu_ms;
-      cpu_ms_ = renderer_->last_frame_stats().cpu_ms;
-    } else {
-      const auto start = std::chrono::steady_clock::now();
-      image = tilesplat::render_reference(scene, camera, settings);
-      cpu_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-      gpu_ms_ = 0;
-    }
-    if (image.width != camera.width || image.height != camera.height ||
-        image.rgba.size() != image.pixels() * 4)
-      throw std::runtime_error("the renderer returned a " + std::to_string(image.width) + "x" +
-                               std::to_string(image.height) + " image for a " + std::to_string(camera.width) +
-                               "x" + std::to_string(camera.height) + " camera");
-    if (!settings.depth) image.depth.clear();
-    if (!settings.splat_count) image.splat_count.clear();
-    return image;
-  }
-
-  // The strategy the frames sort with ("auto" resolved on the device), for the EXR's provenance.
-  std::string sort_strategy(const tilesplat::RenderSettings& settings) const {
-    return renderer_ ? renderer_->sort_strategy_for(settings.sort) : "none (float64 CPU reference)";
-  }
-
-  double gpu_ms() const { return gpu_ms_; }
-  double cpu_ms() const { return cpu_ms_; }
-  tilesplat::Renderer* gpu() const { return renderer_.get(); }
-  // The levels the last frame drew, under --splat-budget (else empty).
-  const tilesplat::LodSelection& lod_selection() const { return lod_selection_; }
-
- private:
-  const tilesplat::GaussianScene& scene_;
-  const tilesplat::SceneInstances* instances_;  // a scene file's placed copies, held so under --memory-budget
-  const cli::LoadedLodSet* lod_;                // a LOD set drawn under --splat-budget
-  tilesplat::LodSelection lod_selection_;
-  bool warned_over_budget_ = false;
-  LensFlags lens_;
-  bool in_parts_ = false;                           // --memory-budget
-  std::array<double, 3> scene_centre_ = {0, 0, 0};  // where the lens focuses unless --focus-distance says
-  std::unique_ptr<tilesplat::Renderer> renderer_;
-  double gpu_ms_ = 0, cpu_ms_ = 0;
 };
 
 cli::FrameProgress::Style progress_style(bool quiet) {

@@ -1,0 +1,70 @@
+#include "frame_renderer.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "tilesplat/reference.h"
+
+namespace tilesplat::render_app {
+
+FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScene& loaded)
+    : scene_(loaded.scene),
+      instances_(loaded.instances ? &*loaded.instances : nullptr),
+      lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
+      lens_(options.lens),
+      in_parts_(options.memory_budget > 0) {
+  if (lens_.enabled()) {
+    const Bounds bounds = loaded.bounds();
+    scene_centre_ = {bounds.center[0], bounds.center[1], bounds.center[2]};
+  }
+  if (options.reference) return;
+  renderer_ = Renderer::create(cli::renderer_options(options.common));
+  // Under a memory budget each frame takes the scene (in parts where it does not fit); under a splat
+  // budget each frame draws the levels its camera calls for.
+  if (!in_parts_ && !lod_) renderer_->set_scene(scene_);
+}
+
+RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& base_settings) {
+  RenderSettings settings = base_settings;
+  // The flags' lens, its focus following the frame's camera, over the scene file's lens for the view.
+  if (lens_.enabled()) settings.lens = lens_for_frame(lens_, camera, scene_centre_);
+  GaussianScene selected;  // the LOD set's chunks at the levels this camera calls for
+  if (lod_) {
+    lod_selection_ = select_lod_levels(*lod_->set, camera, lod_->splat_budget);
+    selected = lod_->set->load_selection(lod_selection_);
+    if (lod_selection_.over_budget && !warned_over_budget_) {
+      cli::print_warning(kProgram, "--splat-budget " + std::to_string(lod_->splat_budget) +
+                                       " is below what the coarsest levels in view draw (" +
+                                       std::to_string(lod_selection_.coarsest_splats) +
+                                       " Gaussians): those frames draw the coarsest levels");
+      warned_over_budget_ = true;
+    }
+  }
+  const GaussianScene& scene = lod_ ? selected : scene_;
+  RenderImage image;
+  if (renderer_) {
+    image = !in_parts_ && !lod_ ? renderer_->render(camera, settings)
+            : instances_        ? renderer_->render(*instances_, camera, settings)
+                                : renderer_->render(scene, camera, settings);
+    gpu_ms_ = renderer_->last_frame_stats().gpu_ms;
+    cpu_ms_ = renderer_->last_frame_stats().cpu_ms;
+  } else {
+    const auto start = std::chrono::steady_clock::now();
+    image = render_reference(scene, camera, settings);
+    cpu_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    gpu_ms_ = 0;
+  }
+  if (image.width != camera.width || image.height != camera.height || image.rgba.size() != image.pixels() * 4)
+    throw std::runtime_error("the renderer returned a " + std::to_string(image.width) + "x" +
+                             std::to_string(image.height) + " image for a " + std::to_string(camera.width) +
+                             "x" + std::to_string(camera.height) + " camera");
+  if (!settings.depth) image.depth.clear();
+  if (!settings.splat_count) image.splat_count.clear();
+  return image;
+}
+
+std::string FrameRenderer::sort_strategy(const RenderSettings& settings) const {
+  return renderer_ ? renderer_->sort_strategy_for(settings.sort) : "none (float64 CPU reference)";
+}
+
+}  // namespace tilesplat::render_app

@@ -1,0 +1,48 @@
+// tilesplat-render's frame: one camera rendered with the GPU renderer (whole, in parts under a memory
+// budget, or a LOD set's levels under a splat budget) or the float64 reference, with the flags' lens.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+
+#include "cli.h"
+#include "render_options.h"
+#include "tilesplat/camera.h"
+#include "tilesplat/image.h"
+#include "tilesplat/lod_set.h"
+#include "tilesplat/renderer.h"
+#include "tilesplat/scene.h"
+
+namespace tilesplat::render_app {
+
+// Renders one camera at a time; gpu_ms() and cpu_ms() give the last frame's time.
+class FrameRenderer {
+ public:
+  FrameRenderer(const RenderOptions& options, const cli::LoadedScene& loaded);
+
+  RenderImage render(const Camera& camera, const RenderSettings& base_settings);
+
+  // The strategy the frames sort with ("auto" resolved on the device), for the EXR's provenance.
+  std::string sort_strategy(const RenderSettings& settings) const;
+
+  double gpu_ms() const { return gpu_ms_; }
+  double cpu_ms() const { return cpu_ms_; }
+  Renderer* gpu() const { return renderer_.get(); }
+  // The levels the last frame drew, under --splat-budget (else empty).
+  const LodSelection& lod_selection() const { return lod_selection_; }
+
+ private:
+  const GaussianScene& scene_;
+  const SceneInstances* instances_;  // a scene file's placed copies, held so under --memory-budget
+  const cli::LoadedLodSet* lod_;     // a LOD set drawn under --splat-budget
+  LodSelection lod_selection_;
+  bool warned_over_budget_ = false;
+  LensFlags lens_;
+  bool in_parts_ = false;                           // --memory-budget
+  std::array<double, 3> scene_centre_ = {0, 0, 0};  // where the lens focuses unless --focus-distance says
+  std::unique_ptr<Renderer> renderer_;
+  double gpu_ms_ = 0, cpu_ms_ = 0;
+};
+
+}  // namespace tilesplat::render_app
