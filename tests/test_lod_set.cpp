@@ -219,6 +219,48 @@ TEST(LodSet, TheRendererDrawsTheLevelsTheBudgetChooses) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// splat-transform's environment (the Gaussians it tags level -1) is drawn with every level and counts against
+// the budget: a set whose environment is the shared playbot at its coarsest (1,873 Gaussians).
+TEST(LodSet, TheEnvironmentIsDrawnWithEveryLevel) {
+  const fs::path index =
+      fs::path(TILESPLAT_SOURCE_DIR) / "tests" / "data" / "lod_set_with_environment" / "lod-meta.json";
+  const LodSet set = LodSet::open(index);
+  EXPECT_EQ(set.levels(), 2);
+  EXPECT_EQ(set.level_size(0), 64u);
+  EXPECT_EQ(set.level_size(1), 32u);
+  ASSERT_TRUE(set.environment().has_value());
+  EXPECT_EQ(*set.environment(), "env/meta.json");
+  EXPECT_EQ(set.environment_size(), 1873u);
+  const tilesplat::GaussianScene environment =
+      tilesplat::load_scene(index.parent_path() / "env" / "meta.json");
+  for (int level = 0; level < 2; ++level) {
+    const tilesplat::GaussianScene scene = set.load_level(level);
+    ASSERT_EQ(scene.size(), set.level_size(level) + 1873u);
+    // The environment comes last, as its file holds it (SH padded to the chunks' degree 3).
+    const size_t first = set.level_size(level);
+    EXPECT_TRUE(std::equal(environment.positions.begin(), environment.positions.end(),
+                           scene.positions.begin() + std::ptrdiff_t(3 * first)));
+    EXPECT_EQ(scene.sh_degree, 3);
+  }
+  // Framing the one chunk (the environment is elsewhere, and may be out of this view).
+  ASSERT_EQ(set.chunks().size(), 1u);
+  tilesplat::Bounds chunk;
+  for (size_t a = 0; a < 3; ++a) {
+    chunk.min[a] = set.chunks()[0].min[a];
+    chunk.max[a] = set.chunks()[0].max[a];
+    chunk.center[a] = 0.5 * (chunk.min[a] + chunk.max[a]);
+    chunk.radius = std::max(chunk.radius, 0.5 * (chunk.max[a] - chunk.min[a]));
+  }
+  const tilesplat::Camera camera = tilesplat::orbit_camera(chunk, 160, 90);
+  const LodSelection small = tilesplat::select_lod_levels(set, camera, 1000);
+  EXPECT_TRUE(small.over_budget);  // the environment alone is 1,873
+  EXPECT_EQ(small.splats, 32u + 1873u);
+  const LodSelection large = tilesplat::select_lod_levels(set, camera, 5000);
+  EXPECT_FALSE(large.over_budget);
+  EXPECT_EQ(large.splats, 64u + 1873u);
+  EXPECT_EQ(set.load_selection(large).size(), large.splats);
+}
+
 TEST(LodSet, KeepsDecodedChunkFilesWithinTheCacheLimit) {
   LodSet set = LodSet::open(lod_index());
   EXPECT_EQ(set.cached_bytes(), 0u);
