@@ -391,6 +391,31 @@ TEST(CliBench, EffectsTableMeasuresEachEffectBesideItsNeverHadItRow) {
 
 // --memory-budget: the same EXR in parts (docs/big-scenes.md), the parts and peaks in --stats, sizes
 // with units, and what cannot work refused before anything is written.
+TEST(CliRender, AFrameLargerThanTheDeviceRendersInPartsWithoutABudget) {
+  const auto out = fresh_output_dir();
+  auto render = [&](const std::string& prefix, const std::string& name) {
+    return tilesplat::testing::run_process(prefix, kRenderExe,
+                                           {bundled_playbot().string(), "--width", "160", "--height", "90",
+                                            "--stats", "-o", (out / name).string()});
+  };
+  const auto whole = render("", "whole.exr");
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  EXPECT_TRUE(contains(whole.out, "scene parts                         1\n")) << whole.out;
+  // On a device whose largest allocation (1 MiB) is below the scene's spherical harmonics (3.3 MB).
+  const auto parts = render("env TILESPLAT_MAX_ALLOCATION=1M ", "parts.exr");
+  ASSERT_EQ(parts.exit_code, 0) << parts.err;
+  EXPECT_FALSE(contains(parts.out, "scene parts                         1\n")) << parts.out;
+  const tilesplat::RenderImage expected = tilesplat::read_exr(out / "whole.exr");
+  const tilesplat::RenderImage in_parts = tilesplat::read_exr(out / "parts.exr");
+  EXPECT_EQ(in_parts.rgba, expected.rgba);
+  EXPECT_EQ(in_parts.depth, expected.depth);
+  // A frame whose images alone pass it cannot be split: a clear error, and no file.
+  const auto images = render("env TILESPLAT_MAX_ALLOCATION=256K ", "images.exr");
+  EXPECT_NE(images.exit_code, 0);
+  EXPECT_TRUE(contains(images.err, "more than the device's largest allocation (262144 bytes)")) << images.err;
+  EXPECT_FALSE(fs::exists(out / "images.exr"));
+}
+
 TEST(CliRender, MemoryBudgetRendersTheSameImageInParts) {
   const auto out = fresh_output_dir();
   auto render = [&](const std::vector<std::string>& extra, const std::string& name) {

@@ -110,6 +110,47 @@ TEST(PartSizing, CapacityIsTheBudgetOverTheCostsOrAClearError) {
   EXPECT_NE(error.find("150 bytes per Gaussian"), std::string::npos) << error;
 }
 
+TEST(PartSizing, NoBufferOfAPartPassesTheLargestAllocation) {
+  PartCosts costs{1000, 100, 10};
+  costs.largest_per_gaussian = 64;
+  costs.largest_per_pair = 4;
+  costs.invocations_per_gaussian = 2;
+  const DeviceCapacity device{6400, UINT64_MAX, 1};
+  EXPECT_EQ(part_capacity(1ull << 40, costs, 0, 4.0, device), 100u);  // 6400 / 64
+  EXPECT_EQ(part_capacity(1ull << 40, costs, 0, 40.0, device), 39u);  // (6400 / 4 - 1) / 40
+  EXPECT_EQ(part_capacity(1000 + 1500, costs, 0, 5.0, device), 10u);  // the budget's 10 are fewer
+  EXPECT_EQ(part_capacity(1ull << 40, costs, 0, 4.0, {1 << 20, UINT64_MAX, 1}), 128u);  // 256 / 2 a dispatch
+  const std::string error = testing::error_of<std::invalid_argument>([&] {
+    part_capacity(1ull << 40, costs, 0, 4.0, {32, UINT64_MAX, 1});
+  });
+  EXPECT_NE(error.find("largest allocation (32 bytes) cannot hold the buffers of one Gaussian"),
+            std::string::npos)
+      << error;
+}
+
+TEST(PartSizing, AWholeFrameFitsTheDeviceOrIsSplit) {
+  PartCosts costs{1000, 100, 10};
+  costs.largest_per_gaussian = 64;
+  costs.largest_per_pair = 4;
+  costs.invocations_per_gaussian = 1;
+  const DeviceCapacity roomy{1ull << 30, 1ull << 34};
+  EXPECT_TRUE(whole_frame_fits(costs, 1000, 4.0, roomy));
+  EXPECT_EQ(device_frame_budget(roomy), 3ull << 32);
+  // The largest per-Gaussian buffer: 64 bytes each.
+  EXPECT_TRUE(whole_frame_fits(costs, 1000, 4.0, {64000, 1ull << 34}));
+  EXPECT_FALSE(whole_frame_fits(costs, 1001, 4.0, {64000, 1ull << 34}));
+  // The key buffers: 4,000 pairs with a quarter's headroom make 8,192, at 4 bytes each.
+  costs.largest_per_gaussian = 16;
+  EXPECT_TRUE(whole_frame_fits(costs, 1000, 4.0, {32768, 1ull << 34}));
+  EXPECT_FALSE(whole_frame_fits(costs, 1000, 4.0, {32767, 1ull << 34}));
+  // Each dispatch within the device's workgroups: 1000 invocations are 4 workgroups of 256.
+  EXPECT_TRUE(whole_frame_fits(costs, 1000, 4.0, {1ull << 30, 1ull << 34, 4}));
+  EXPECT_FALSE(whole_frame_fits(costs, 1000, 4.0, {1ull << 30, 1ull << 34, 3}));
+  // All of it within 3/4 of the device's memory: 1000 + 1000 * (100 + 4 * 10) = 141,000 bytes.
+  EXPECT_TRUE(whole_frame_fits(costs, 1000, 4.0, {1ull << 30, 188000}));
+  EXPECT_FALSE(whole_frame_fits(costs, 1000, 4.0, {1ull << 30, 187999}));
+}
+
 TEST(PartSizing, CostsFollowTheFrame) {
   const GaussianScene scene = on_axis({1, 2});
   const Camera camera = testing::axis_camera(32, 16, 50);
@@ -123,6 +164,14 @@ TEST(PartSizing, CostsFollowTheFrame) {
   const PartCosts seams = part_costs(PartSource(scene), camera, settings, 2, true);
   EXPECT_GT(seams.per_gaussian, plain.per_gaussian);
   EXPECT_GT(seams.per_pair, plain.per_pair);
+  // The largest buffers: the projected splats (64 bytes a record, two records a Gaussian with seam
+  // copies), and a key buffer (wide keys: 8 bytes a pair).
+  EXPECT_EQ(plain.largest_per_gaussian, 64u);
+  EXPECT_EQ(plain.largest_per_pair, 4u);
+  EXPECT_EQ(seams.largest_per_gaussian, 128u);
+  EXPECT_EQ(seams.largest_per_pair, 8u);
+  EXPECT_EQ(plain.invocations_per_gaussian, 1u);
+  EXPECT_EQ(seams.invocations_per_gaussian, 2u);
 }
 
 }  // namespace

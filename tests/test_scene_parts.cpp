@@ -4,6 +4,7 @@
 // cannot render so is a clear error.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -271,6 +272,89 @@ TEST(SceneParts, SceneThatFitsRendersWholeAndStaysSet) {
   EXPECT_EQ(renderer.last_frame_stats().peak_device_bytes, renderer.last_frame_stats().device_bytes);
   // Whole: the scene is set, and render(camera) draws it again.
   expect_bit_identical(renderer.render(camera, settings), first, "the scene set by render(scene, ...)");
+}
+
+// A renderer on a device that pretends to be smaller (TILESPLAT_MAX_ALLOCATION, TILESPLAT_DEVICE_MEMORY:
+// read when the renderer is made, and only lowering the device's own limits).
+std::unique_ptr<Renderer> renderer_with_limits(const char* variable, const char* bytes) {
+  ::setenv(variable, bytes, 1);
+  RendererOptions options;
+  options.validation = true;
+  std::unique_ptr<Renderer> renderer;
+  try {
+    renderer = Renderer::create(options);
+  } catch (...) {
+    ::unsetenv(variable);
+    throw;
+  }
+  ::unsetenv(variable);
+  return renderer;
+}
+
+struct BundledView {
+  GaussianScene scene = load_ply(testing::bundled_playbot());
+  Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras())[0].camera, 160, 90);
+};
+
+TEST(SceneParts, AFrameThatFitsTheDeviceRendersWhole) {
+  const BundledView view;
+  Renderer& renderer = testing::validated_renderer();
+  const DeviceInfo device = renderer.device_info();
+  EXPECT_GE(device.max_allocation_size, 1ull << 27);
+  EXPECT_GE(device.device_memory, device.max_allocation_size);
+  EXPECT_FALSE(renderer.renders_in_parts(view.scene, view.camera));
+  renderer.render(view.scene, view.camera);
+  EXPECT_EQ(renderer.last_frame_stats().scene_parts, 1);
+}
+
+TEST(SceneParts, WithoutABudgetABufferPastTheLargestAllocationSplitsTheFrame) {
+  const BundledView view;  // 31,000 Gaussians of SH2: 108 bytes each of spherical harmonics
+  Renderer& whole_renderer = testing::validated_renderer();
+  whole_renderer.set_scene(view.scene);
+  const RenderImage whole = whole_renderer.render(view.camera);
+  const std::unique_ptr<Renderer> small = renderer_with_limits("TILESPLAT_MAX_ALLOCATION", "1M");
+  EXPECT_EQ(small->device_info().max_allocation_size, 1u << 20);
+  // Whole, the scene's spherical harmonics alone are a 3.3 MB buffer.
+  const std::string error = testing::error_of<std::runtime_error>([&] { small->set_scene(view.scene); });
+  EXPECT_NE(error.find("more than the device's largest allocation (1048576 bytes)"), std::string::npos)
+      << error;
+  EXPECT_TRUE(small->renders_in_parts(view.scene, view.camera));
+  const RenderImage parts = small->render(view.scene, view.camera);
+  EXPECT_GE(small->last_frame_stats().scene_parts, 4);  // 1 MiB holds 9,709 Gaussians' harmonics
+  expect_bit_identical(parts, whole, "parts sized by the largest allocation");
+  // A budget of the caller's keeps each buffer within the allocation too.
+  RenderSettings budget;
+  budget.memory_budget = 1ull << 30;
+  expect_bit_identical(small->render(view.scene, view.camera, budget), whole, "under a budget of 1 GiB");
+  EXPECT_GE(small->last_frame_stats().scene_parts, 4);
+  EXPECT_EQ(small->validation_messages(), 0u);
+}
+
+TEST(SceneParts, WithoutABudgetAFramePastTheDevicesMemorySplits) {
+  const BundledView view;
+  Renderer& whole_renderer = testing::validated_renderer();
+  whole_renderer.set_scene(view.scene);
+  const RenderImage whole = whole_renderer.render(view.camera);
+  const std::unique_ptr<Renderer> small = renderer_with_limits("TILESPLAT_DEVICE_MEMORY", "8M");
+  EXPECT_EQ(small->device_info().device_memory, 8u << 20);
+  ASSERT_TRUE(small->renders_in_parts(view.scene, view.camera));
+  const RenderImage parts = small->render(view.scene, view.camera);
+  const FrameStats& stats = small->last_frame_stats();
+  EXPECT_GE(stats.scene_parts, 2);
+  // Within 3/4 of the device's memory, but for what the first part's guess missed.
+  EXPECT_LE(stats.peak_device_bytes, (6u << 20) + (6u << 20) / 100) << stats.peak_device_bytes;
+  expect_bit_identical(parts, whole, "parts sized by the device's memory");
+  EXPECT_EQ(small->validation_messages(), 0u);
+}
+
+TEST(SceneParts, ALimitFromTheEnvironmentThatIsNoSizeIsAClearError) {
+  for (const char* bytes : {"lots", "0", "12Q", "-5", "99999999999999999999G"}) {
+    const std::string error = testing::error_of<std::runtime_error>(
+        [&] { renderer_with_limits("TILESPLAT_MAX_ALLOCATION", bytes); });
+    EXPECT_NE(error.find("TILESPLAT_MAX_ALLOCATION='" + std::string(bytes) + "': expected a positive size"),
+              std::string::npos)
+        << error;
+  }
 }
 
 TEST(SceneParts, AfterPartsTheRendererNeedsASceneAgain) {

@@ -20,8 +20,16 @@ FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScen
   if (options.reference) return;
   renderer_ = Renderer::create(cli::renderer_options(options.common));
   // Under a memory budget each frame takes the scene (in parts where it does not fit); under a splat
-  // budget each frame draws the levels its camera calls for.
-  if (!in_parts_ && !lod_) renderer_->set_scene(scene_);
+  // budget each frame draws the levels its camera calls for. Otherwise the first frame decides: a scene
+  // whose frame fits the device is set once, one that does not is rendered in parts every frame.
+}
+
+void FrameRenderer::decide_holding(const Camera& camera, const RenderSettings& settings) {
+  if (decided_) return;
+  decided_ = true;
+  if (in_parts_ || lod_) return;  // a scene file's copies are held as such under --memory-budget alone
+  in_parts_ = renderer_->renders_in_parts(scene_, camera, settings);
+  if (!in_parts_) renderer_->set_scene(scene_);
 }
 
 RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& base_settings) {
@@ -43,6 +51,7 @@ RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& ba
   const GaussianScene& scene = lod_ ? selected : scene_;
   RenderImage image;
   if (renderer_) {
+    decide_holding(camera, settings);
     image = !in_parts_ && !lod_ ? renderer_->render(camera, settings)
             : instances_        ? renderer_->render(*instances_, camera, settings)
                                 : renderer_->render(scene, camera, settings);

@@ -39,7 +39,11 @@ class FrameRenderer {
   LodSelection lod_selection_;
   bool warned_over_budget_ = false;
   LensFlags lens_;
-  bool in_parts_ = false;                           // --memory-budget
+  // The first frame's choice: the scene set once, or taken by each frame (in parts where it does not fit).
+  void decide_holding(const Camera& camera, const RenderSettings& settings);
+
+  bool in_parts_ = false;  // --memory-budget, or a frame that does not fit the device
+  bool decided_ = false;
   std::array<double, 3> scene_centre_ = {0, 0, 0};  // where the lens focuses unless --focus-distance says
   std::unique_ptr<Renderer> renderer_;
   double gpu_ms_ = 0, cpu_ms_ = 0;

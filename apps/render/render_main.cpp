@@ -107,8 +107,10 @@ void print_row(const std::string& name, const std::string& value, const std::str
 }
 
 void print_frame_stats(const tilesplat::FrameStats& stats, const tilesplat::DeviceInfo& device) {
-  std::printf("device: %s (driver %s), subgroup size %u\n", device.name.c_str(), device.driver.c_str(),
-              device.subgroup_size);
+  std::printf("device: %s (driver %s), subgroup size %u, largest allocation %s MiB, memory %s MiB\n",
+              device.name.c_str(), device.driver.c_str(), device.subgroup_size,
+              cli::format_fixed(double(device.max_allocation_size) / (1024.0 * 1024.0), 0).c_str(),
+              cli::format_fixed(double(device.device_memory) / (1024.0 * 1024.0), 0).c_str());
   for (const auto& pass : stats.passes) print_row(pass.name, cli::format_fixed(pass.gpu_ms, 3), "ms");
   print_row("gpu frame", cli::format_fixed(stats.gpu_ms, 3), "ms");
   print_row("cpu frame", cli::format_fixed(stats.cpu_ms, 3), "ms");

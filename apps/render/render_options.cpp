@@ -207,7 +207,10 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                     "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
                     "intersections, retries, device memory and its peak, scene parts, peak resident memory",
                     &options.stats);
-  cli::add_memory_budget_option(parser, options.memory_budget, "--stats prints the parts and peaks; ");
+  cli::add_memory_budget_option(
+      parser, options.memory_budget,
+      "--stats prints the parts and peaks; without a budget, a frame past the device's limits still renders "
+      "in parts; ");
   cli::add_splat_budget_option(parser, options.common);
 
   parser.section("many frames (one process; -o and --png then take a frame number: out/view_%04d.exr)");

@@ -79,7 +79,7 @@ struct RenderOptions {
   cli::CameraModelFlags camera_model;  // --fisheye, --orthographic, --equirectangular
   ShutterFlags shutter;
   bool stats = false;
-  uint64_t memory_budget = 0;  // --memory-budget: RenderSettings::memory_budget (0: none)
+  uint64_t memory_budget = 0;  // --memory-budget: RenderSettings::memory_budget (0: the device's limits)
   // Many frames in one run.
   std::string views;      // --views: a selection of the camera set's views
   int orbit_frames = 0;   // --orbit N

@@ -272,9 +272,12 @@ Renderer::SortRun Renderer::sort_keys(const std::string& strategy, const std::ve
 
 DeviceInfo Renderer::device_info() const {
   const auto& l = impl_->ctx.limits();
-  return {impl_->ctx.device_name(),   impl_->ctx.driver_name(),   l.subgroup_size,
-          l.max_storage_buffer_range, l.max_shared_memory,        l.timestamp_period_ns,
-          l.max_image_dimension_2d,   impl_->ctx.is_cpu_device(), impl_->ctx.vendor_id()};
+  return {impl_->ctx.device_name(), impl_->ctx.driver_name(),
+          l.subgroup_size,          l.max_storage_buffer_range,
+          l.max_shared_memory,      l.timestamp_period_ns,
+          l.max_image_dimension_2d, impl_->ctx.is_cpu_device(),
+          impl_->ctx.vendor_id(),   l.max_allocation_size,
+          l.device_memory};
 }
 
 uint64_t Renderer::validation_messages() const { return impl_->ctx.validation_messages(); }

@@ -68,9 +68,12 @@ struct Renderer::Impl {
   RenderImage average_samples(const Camera& camera, const RenderSettings& settings,
                               const SampleRenderer& render_sample);
   // A scene within a memory budget (renderer_parts.cpp): whether its frame would exceed
-  // settings.memory_budget, and the rendering in depth-ordered parts that leaves the image in the
-  // outputs and the parts' statistics.
+  // settings.memory_budget (or without one, the device: whole_frame_fits), and the rendering in depth-ordered
+  // parts that leaves the image in the outputs and the parts' statistics.
   bool needs_parts(const PartSource& scene, const Camera& camera, const RenderSettings& settings);
+  DeviceCapacity device_capacity() const;
+  // settings.memory_budget, or without one the share of the device's memory a frame may take.
+  uint64_t parts_memory_budget(const RenderSettings& settings) const;
   void render_in_parts(const PartSource& scene, const Camera& camera, const RenderSettings& settings);
   PartCosts part_costs_for(const PartSource& scene, const Camera& camera, const RenderSettings& settings,
                            const std::string& sort_name);

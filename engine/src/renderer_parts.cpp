@@ -1,5 +1,6 @@
-// A scene rendered within a memory budget (Renderer::render(scene, camera, settings)): whole, as set_scene
-// and render(camera, settings) do, when its frame fits; else in depth-ordered parts (frame/scene_parts.h).
+// A scene rendered within a memory budget (Renderer::render(scene, camera, settings)), the caller's or,
+// without one, the device's: whole, as set_scene and render(camera, settings) do, when its frame fits;
+// else in depth-ordered parts (frame/scene_parts.h).
 // Each part's Gaussians go into the same scene buffers and render as one frame of the usual plan, its
 // composite carrying every pixel's state to the next part (ScenePart); the parts are sized to the budget
 // from what the frame holds before any Gaussian, the bytes per Gaussian and per pair, the pairs each
@@ -55,15 +56,29 @@ PartCosts Renderer::Impl::part_costs_for(const PartSource& scene, const Camera& 
   return part_costs(scene, camera, settings, seam_copies, wide_keys);
 }
 
+DeviceCapacity Renderer::Impl::device_capacity() const {
+  return {ctx.limits().max_allocation_size, ctx.limits().device_memory, ctx.limits().max_workgroup_count_x};
+}
+
+uint64_t Renderer::Impl::parts_memory_budget(const RenderSettings& settings) const {
+  return settings.memory_budget > 0 ? settings.memory_budget : device_frame_budget(device_capacity());
+}
+
 bool Renderer::Impl::needs_parts(const PartSource& scene, const Camera& camera,
                                  const RenderSettings& settings) {
-  if (settings.memory_budget == 0) return false;
   const std::string sort_name = choose_sort_strategy(settings.sort, device_caps(), /*without_waiting=*/false);
   const PartCosts costs = part_costs_for(scene, camera, settings, sort_name);
+  // Without a budget, the device's: whole where the frame fits it, as every frame did before budgets.
+  if (settings.memory_budget == 0)
+    return !whole_frame_fits(costs, scene.size(), kFirstPairsPerGaussian, device_capacity());
   const double whole_bytes =
       double(costs.fixed) +
       double(scene.size()) * (double(costs.per_gaussian) + kFirstPairsPerGaussian * double(costs.per_pair));
-  return whole_bytes > double(settings.memory_budget);
+  // Under any budget, no buffer past the device's largest allocation and no dispatch past its limit.
+  DeviceCapacity buffers_only = device_capacity();
+  buffers_only.total = UINT64_MAX;
+  return whole_bytes > double(settings.memory_budget) ||
+         !whole_frame_fits(costs, scene.size(), kFirstPairsPerGaussian, buffers_only);
 }
 
 void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& camera,
@@ -73,16 +88,18 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
   const PartCosts costs = part_costs_for(scene, camera, settings, sort_name);
   const bool wide_keys = sort(sort_name).frame_plan() == FrameSortPlan::kTileDepthPairs;
   validate_scene_parts(settings, sort_name);
+  const uint64_t budget = parts_memory_budget(settings);
+  const DeviceCapacity device = device_capacity();
   double pairs_per_gaussian = kFirstPairsPerGaussian;
-  size_t capacity = part_capacity(settings.memory_budget, costs, 0, pairs_per_gaussian);  // or a clear error
+  size_t capacity = part_capacity(budget, costs, 0, pairs_per_gaussian, device);  // or a clear error
   const DepthOrder order(scene, camera, settings.near_plane, settings.accuracy.depth_key_bits,
                          ctx.features().shader_float64 ? kDepthMarginFloat64 : kDepthMarginFloat32);
 
   // A whole scene's buffers go: the parts size their own, which the next frame under the same budget
   // reuses.
-  if (!scene_in_parts || parts_budget != settings.memory_budget) resources.release_scene();
+  if (!scene_in_parts || parts_budget != budget) resources.release_scene();
   scene_in_parts = true;  // from the first upload on, even if a part fails
-  parts_budget = settings.memory_budget;
+  parts_budget = budget;
   struct RenderingParts {  // begin_frame takes this frame's parts, and no other frame
     bool& flag;
     explicit RenderingParts(bool& f) : flag(f) { flag = true; }
@@ -119,7 +136,7 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
         costs.fixed + uint64_t(largest_part) * costs.per_gaussian + resources.keys.bytes();
     const uint64_t overhead = stats.device_bytes > estimated ? stats.device_bytes - estimated : 0;
     // Never larger than a part before: the scene buffers keep the largest part's size.
-    capacity = std::min(capacity, part_capacity(settings.memory_budget, costs, overhead, pairs_per_gaussian));
+    capacity = std::min(capacity, part_capacity(budget, costs, overhead, pairs_per_gaussian, device));
     begin = end;
   }
   total.gaussians = scene.size();
@@ -155,6 +172,16 @@ RenderImage Renderer::render(const SceneInstances& scene, const Camera& camera,
                              const RenderSettings& settings) {
   return impl_->render_scene(
       PartSource(scene), [&] { set_scene(merge_instances(scene)); }, camera, settings, *this);
+}
+
+bool Renderer::renders_in_parts(const GaussianScene& scene, const Camera& camera,
+                                const RenderSettings& settings) {
+  return impl_->needs_parts(PartSource(scene), camera, settings);
+}
+
+bool Renderer::renders_in_parts(const SceneInstances& scene, const Camera& camera,
+                                const RenderSettings& settings) {
+  return impl_->needs_parts(PartSource(scene), camera, settings);
 }
 
 RenderImage Renderer::render(const LodSet& set, const Camera& camera, const RenderSettings& settings) {

@@ -170,6 +170,8 @@ nb::dict device_dict(const DeviceInfo& device) {
   out["cpu"] = device.cpu;
   out["vendor_id"] = device.vendor_id;
   out["max_image_dimension"] = device.max_image_dimension;
+  out["max_allocation_size"] = device.max_allocation_size;
+  out["device_memory"] = device.device_memory;
   return out;
 }
 
@@ -649,8 +651,10 @@ void bind(nb::module_& m) {
           "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0, "lod_set"_a = nb::none(),
           "splat_budget"_a = 0,
           "Renders the scene from `camera`: the one set_scene uploaded, or `scene`, which replaces it and is "
-          "rendered within memory_budget bytes of device memory (0: none), in depth-ordered parts into the "
-          "same image where the whole frame would need more (docs/big-scenes.md), or a LodSet `lod_set`: "
+          "rendered within memory_budget bytes of device memory (0: the device's own limits), in "
+          "depth-ordered "
+          "parts into the same image where the whole frame would need more (docs/big-scenes.md), or a LodSet "
+          "`lod_set`: "
           "level 0, or under splat_budget the levels this camera calls for (LodSet.select). "
           "Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "

@@ -144,6 +144,24 @@ def test_a_scene_in_parts_under_a_memory_budget(playbot_renderer):
     assert other.validation_messages == 0
 
 
+def test_a_scene_past_the_device_renders_in_parts_without_a_budget(playbot_renderer, monkeypatch):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 160, 90, azimuth_deg=30)
+    whole = renderer.render(camera)
+    assert renderer.device_info["max_allocation_size"] >= 1 << 27
+    assert renderer.device_info["device_memory"] >= renderer.device_info["max_allocation_size"]
+    # A device whose largest allocation (1 MiB) is below the scene's spherical harmonics (3.3 MB).
+    monkeypatch.setenv("TILESPLAT_MAX_ALLOCATION", "1M")
+    small = tilesplat.Renderer(validation=True)
+    monkeypatch.delenv("TILESPLAT_MAX_ALLOCATION")
+    assert small.device_info["max_allocation_size"] == 1 << 20
+    parts = small.render(camera, scene=scene)
+    assert small.last_frame_stats["scene_parts"] >= 4
+    assert np.array_equal(parts.rgba, whole.rgba)
+    assert np.array_equal(parts.depth, whole.depth)
+    assert small.validation_messages == 0
+
+
 def test_a_lod_set_by_level_and_under_a_splat_budget(playbot_renderer):
     _, renderer = playbot_renderer
     lods = tilesplat.LodSet(REPO / "tests" / "data" / "playbot_lod_set" / "lod-meta.json")

@@ -214,8 +214,11 @@ struct RenderSettings {
   Shutter shutter;
   /// Device memory, in bytes, that Renderer::render(scene, camera, settings) may hold for a frame: a
   /// scene whose frame would need more is rendered in parts that follow the depth order, each within
-  /// the budget, into the same image bit for bit (docs/big-scenes.md). 0 (the default): no budget, the
-  /// scene is rendered whole. render(camera, settings) on a scene set_scene uploaded ignores it.
+  /// the budget, into the same image bit for bit (docs/big-scenes.md). 0 (the default): the device's,
+  /// the scene rendered whole where its frame fits the device (each buffer within its largest allocation,
+  /// all within 3/4 of its memory: DeviceInfo), else in parts under that share. Every buffer of a part
+  /// stays within the largest allocation under any budget. render(camera, settings) on a scene set_scene
+  /// uploaded ignores it.
   uint64_t memory_budget = 0;
   /// For Renderer::render(const LodSet&, ...): the most Gaussians the frame draws, each chunk of the set at
   /// the level the camera calls for (select_lod_levels, docs/big-scenes.md). 0 (the default): level 0,

@@ -99,6 +99,13 @@ struct DeviceInfo {
   bool cpu = false;
   uint32_t vendor_id =
       0;  ///< VkPhysicalDeviceProperties::vendorID, the PCI vendor (0x10DE NVIDIA, 0x1002 AMD, ...)
+  /// The largest buffer the device allocates, in bytes (maxMemoryAllocationSize): a frame whose
+  /// largest buffer would be larger is rendered in parts (Renderer::render(scene, camera, settings)).
+  uint64_t max_allocation_size = 0;
+  /// The memory device buffers draw on, in bytes: VK_EXT_memory_budget's budget for this process where
+  /// the driver has it, else the device-local heap's size (the host's physical memory for a CPU driver,
+  /// whose device memory is the host's). A frame without a memory budget takes at most 3/4 of it.
+  uint64_t device_memory = 0;
 };
 
 struct SceneInstances;        // tilesplat/scene_description.h
@@ -152,9 +159,9 @@ class TILESPLAT_API Renderer {
   /// lights, compositor) or an unknown sort strategy. The renderer stays usable after either.
   RenderImage render(const Camera& camera, const RenderSettings& settings = {});
 
-  /// Renders one frame of `scene`, which replaces the scene last set, within settings.memory_budget:
-  /// whole (as set_scene and render(camera, settings)) when its frame fits the budget or there is none;
-  /// else in parts that follow the frame's depth order (docs/big-scenes.md), each part's Gaussians
+  /// Renders one frame of `scene`, which replaces the scene last set, within settings.memory_budget or,
+  /// without one, the device's memory: whole (as set_scene and render(camera, settings)) when its frame
+  /// fits; else in parts that follow the frame's depth order (docs/big-scenes.md), each part's Gaussians
   /// uploaded, sorted and composited in turn with every pixel's state carried to the next, into the
   /// image the whole scene renders, bit for bit. The scene is read during the call only. After a frame
   /// in parts the renderer holds no whole scene: render(camera, settings) needs a set_scene first.
@@ -165,6 +172,17 @@ class TILESPLAT_API Renderer {
   /// The same for a scene file's placed copies (load_scene_instances): in parts, each part's Gaussians are
   /// placed as they are drawn, so the merged scene is never held; whole, it is merged and set.
   RenderImage render(const SceneInstances& scene, const Camera& camera, const RenderSettings& settings = {});
+  /// Whether render(scene, camera, settings) renders this frame in parts: with settings.memory_budget,
+  /// when the whole frame would need more; without one, when it would not fit the device (a buffer
+  /// larger than DeviceInfo::max_allocation_size, or all of them more than 3/4 of
+  /// DeviceInfo::device_memory). An application that renders a scene that fits many times sets it once
+  /// (set_scene) and renders it with render(camera, settings) instead. Throws as render does for an
+  /// unknown sort strategy.
+  bool renders_in_parts(const GaussianScene& scene, const Camera& camera,
+                        const RenderSettings& settings = {});
+  /// The same for a scene file's placed copies, measured as their merged scene.
+  bool renders_in_parts(const SceneInstances& scene, const Camera& camera,
+                        const RenderSettings& settings = {});
   /// A level-of-detail set from this camera: under RenderSettings::splat_budget the levels select_lod_levels
   /// chooses for it, else level 0 whole; then as render(scene, camera, settings), in parts under a memory
   /// budget. FrameStats::gaussians is what it drew. Throws SceneError for a chunk file it cannot read.

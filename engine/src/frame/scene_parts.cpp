@@ -200,12 +200,37 @@ PartCosts part_costs(const PartSource& scene, const Camera& camera, const Render
   // Per projected record: the splat, its tile rect, four counts and offsets, the depth sort's pairs.
   costs.per_gaussian += uint64_t(seam_copies) * (kSplatRecordBytes + 8 + 4 * 4 + 16);
   costs.per_pair = wide_keys ? 2 * (8 + 4) : 2 * (4 + 4);  // keys and values, and their ping-pong copies
+  // The largest single buffers: the spherical harmonics (or their normals, rotations), the projected
+  // splats (kSplatRecordBytes a record); a key buffer.
+  costs.largest_per_gaussian = std::max<uint64_t>({4 * 3 * k, 16, uint64_t(seam_copies) * kSplatRecordBytes});
+  costs.largest_per_pair = wide_keys ? 8 : 4;
+  // The projection's dispatch, or the packing of half-precision harmonics (two values an invocation).
+  costs.invocations_per_gaussian = std::max<uint64_t>(seam_copies, modes.fp16_sh ? (3 * k + 1) / 2 : 1);
   return costs;
 }
 
-size_t part_capacity(uint64_t budget, const PartCosts& costs, uint64_t overhead, double pairs_per_gaussian) {
+size_t part_capacity(uint64_t budget, const PartCosts& costs, uint64_t overhead, double pairs_per_gaussian,
+                     const DeviceCapacity& device) {
+  const uint64_t largest_allocation = device.largest_allocation;
   const double per_gaussian = double(costs.per_gaussian) + pairs_per_gaussian * double(costs.per_pair);
   const uint64_t before = costs.fixed + overhead;
+  // Each buffer within the device's largest allocation: the largest per-Gaussian buffer, and the key
+  // buffers reserved for the part's pairs (FrameResources::reserve_pairs).
+  double most_by_buffers = double(SIZE_MAX);
+  if (costs.largest_per_gaussian > 0)
+    most_by_buffers = std::floor(double(largest_allocation) / double(costs.largest_per_gaussian));
+  if (costs.largest_per_pair > 0)
+    most_by_buffers = std::min(
+        most_by_buffers,
+        std::floor((double(largest_allocation) / double(costs.largest_per_pair) - 1) / pairs_per_gaussian));
+  if (most_by_buffers < 1)
+    throw std::invalid_argument("the device's largest allocation (" + std::to_string(largest_allocation) +
+                                " bytes) cannot hold the buffers of one Gaussian");
+  // And each dispatch within the device's workgroup count.
+  if (costs.invocations_per_gaussian > 0 && device.max_workgroups < UINT64_MAX)
+    most_by_buffers =
+        std::min(most_by_buffers, std::floor(double(device.max_workgroups) * double(kWorkgroupSize) /
+                                             double(costs.invocations_per_gaussian)));
   if (budget <= before || double(budget - before) < per_gaussian) {
     auto mib = [](uint64_t bytes) {
       char text[32];
@@ -219,7 +244,25 @@ size_t part_capacity(uint64_t budget, const PartCosts& costs, uint64_t overhead,
         std::to_string(uint64_t(per_gaussian)) +
         " bytes per Gaussian: raise the budget or render a smaller image");
   }
-  return size_t(double(budget - before) / per_gaussian);
+  return size_t(std::min(double(budget - before) / per_gaussian, most_by_buffers));
+}
+
+uint64_t device_frame_budget(const DeviceCapacity& device) {
+  return uint64_t(kDeviceMemoryShare * double(device.total));
+}
+
+bool whole_frame_fits(const PartCosts& costs, size_t gaussians, double pairs_per_gaussian,
+                      const DeviceCapacity& device) {
+  const double n = double(gaussians);
+  const double pairs = pairs_per_gaussian * n;
+  // The whole frame's key buffers hold a power of two of pairs with a quarter's headroom (set_scene).
+  const double key_capacity = double(std::bit_ceil(uint64_t(std::max(1.0, 1.25 * pairs))));
+  const double bytes = double(costs.fixed) + n * double(costs.per_gaussian) + pairs * double(costs.per_pair);
+  return n * double(costs.largest_per_gaussian) <= double(device.largest_allocation) &&
+         n * double(costs.invocations_per_gaussian) <=
+             double(device.max_workgroups) * double(kWorkgroupSize) &&
+         key_capacity * double(costs.largest_per_pair) <= double(device.largest_allocation) &&
+         bytes <= double(device_frame_budget(device));
 }
 
 }  // namespace tilesplat

@@ -87,18 +87,49 @@ GaussianScene gather_gaussians(const GaussianScene& scene, std::span<const uint3
 // What a part holds on the device, for sizing parts under a memory budget: the frame's buffers that do
 // not depend on the part (outputs, the carried state, tile ranges, a host's depth), and the bytes per
 // Gaussian (attributes and projected records) and per (tile, Gaussian) pair (key buffers). The sort
-// strategy's own buffers are measured as the parts run (renderer_parts.cpp).
+// strategy's own buffers are measured as the parts run (renderer_parts.cpp). A device also caps each
+// buffer (its largest allocation): the largest buffer that grows with the Gaussians takes
+// largest_per_gaussian bytes for each (their spherical harmonics, or their projected records), the
+// largest that grows with the pairs largest_per_pair (0: no such cap is reckoned). And it caps a
+// dispatch's workgroups: the largest dispatch over the Gaussians has invocations_per_gaussian for each
+// (their records, or the half-precision harmonics' pairs of values), kWorkgroupSize to a workgroup.
 struct PartCosts {
   uint64_t fixed = 0;
   uint64_t per_gaussian = 0;
   uint64_t per_pair = 0;
+  uint64_t largest_per_gaussian = 0;
+  uint64_t largest_per_pair = 0;
+  uint64_t invocations_per_gaussian = 0;
 };
+// The workgroup size of the passes that run an invocation per record (projection, key emission, ...).
+constexpr uint64_t kWorkgroupSize = 256;
 PartCosts part_costs(const PartSource& scene, const Camera& camera, const RenderSettings& settings,
                      uint32_t seam_copies, bool wide_keys);
 
+// What a device holds at most: its largest allocation (VkPhysicalDeviceMaintenance3Properties), its
+// memory (vk::DeviceLimits::device_memory), and the workgroups of one dispatch (maxComputeWorkGroupCount).
+struct DeviceCapacity {
+  uint64_t largest_allocation = UINT64_MAX;
+  uint64_t total = UINT64_MAX;
+  uint64_t max_workgroups = UINT64_MAX;
+};
+
 // The most Gaussians a part may hold when `budget` bytes are to cover costs.fixed, `overhead` bytes
-// measured besides, and each Gaussian with `pairs_per_gaussian` pairs. Throws std::invalid_argument
-// when not even one fits, naming the budget and what the frame needs before any Gaussian.
-size_t part_capacity(uint64_t budget, const PartCosts& costs, uint64_t overhead, double pairs_per_gaussian);
+// measured besides, and each Gaussian with `pairs_per_gaussian` pairs, no buffer being larger than the
+// device's largest allocation and no dispatch larger than its workgroup count (device.total is not
+// read: the budget stands for it). Throws std::invalid_argument when not even one fits, naming the
+// budget and what the frame needs before any Gaussian.
+size_t part_capacity(uint64_t budget, const PartCosts& costs, uint64_t overhead, double pairs_per_gaussian,
+                     const DeviceCapacity& device = {});
+// The share of the device's memory a frame without a budget may take: the rest is left to the host
+// application, the pipelines, and (on a CPU driver, whose device memory is the host's) the scene itself.
+constexpr double kDeviceMemoryShare = 0.75;
+uint64_t device_frame_budget(const DeviceCapacity& device);
+// Whether a whole frame of `gaussians` (with `pairs_per_gaussian` pairs each, and the key buffers' growth
+// headroom) fits the device: each buffer within its largest allocation, each dispatch within its
+// workgroup count, and all of the buffers within device_frame_budget. A frame that does not is rendered
+// in parts under that budget.
+bool whole_frame_fits(const PartCosts& costs, size_t gaussians, double pairs_per_gaussian,
+                      const DeviceCapacity& device);
 
 }  // namespace tilesplat

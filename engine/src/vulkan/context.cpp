@@ -1,11 +1,14 @@
 #include "vulkan/context.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string_view>
+#include <vector>
 
 #include "vulkan/device_selection.h"
 #include "vulkan/vk_check.h"
@@ -36,6 +39,60 @@ namespace {
 bool env_flag(const char* name) {
   const char* v = std::getenv(name);
   return v && *v && std::string_view(v) != "0";
+}
+
+// A size in bytes from the environment, as "1048576", "512K", "64M" or "2G" (powers of 1024); 0 when unset.
+// Throws std::runtime_error naming the variable for anything else.
+uint64_t env_bytes(const char* name) {
+  const char* v = std::getenv(name);
+  if (!v || !*v) return 0;
+  const std::string_view text(v);
+  size_t digits = 0;
+  uint64_t value = 0;
+  while (digits < text.size() && std::isdigit(static_cast<unsigned char>(text[digits]))) {
+    if (value > (UINT64_MAX - 9) / 10) digits = text.size() + 1;  // too large: refused below
+    value = value * 10 + uint64_t(text[digits] - '0');
+    ++digits;
+  }
+  int shift = -1;
+  if (digits == text.size()) shift = 0;
+  if (digits + 1 == text.size()) {
+    const char unit = char(std::toupper(static_cast<unsigned char>(text[digits])));
+    shift = unit == 'K' ? 10 : unit == 'M' ? 20 : unit == 'G' ? 30 : unit == 'T' ? 40 : -1;
+  }
+  if (digits == 0 || shift < 0 || value == 0 || value > (UINT64_MAX >> shift))
+    throw std::runtime_error(std::string(name) + "='" + std::string(text) +
+                             "': expected a positive size in bytes, optionally with K, M, G or T");
+  return value << shift;
+}
+
+// The bytes of memory the device's memory type for device buffers draws on. With VK_EXT_memory_budget,
+// the budget the driver gives this process; without it, the heap's size, except on a CPU driver, whose
+// device memory is the host's (Mesa 22's lavapipe reports a 2 GiB heap and allocates past it): there,
+// the host's physical memory.
+uint64_t device_memory(VkPhysicalDevice physical_device, bool cpu,
+                       const std::vector<VkExtensionProperties>& available) {
+  const bool has_budget = std::any_of(available.begin(), available.end(), [](const VkExtensionProperties& e) {
+    return std::string_view(e.extensionName) == VK_EXT_MEMORY_BUDGET_EXTENSION_NAME;
+  });
+  VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
+  VkPhysicalDeviceMemoryProperties2 memory{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2};
+  if (has_budget) memory.pNext = &budget;
+  vkGetPhysicalDeviceMemoryProperties2(physical_device, &memory);
+  const VkPhysicalDeviceMemoryProperties& properties = memory.memoryProperties;
+  uint64_t largest = 0;  // the largest device-local heap (the one device buffers come from)
+  for (uint32_t heap = 0; heap < properties.memoryHeapCount; ++heap) {
+    if (!(properties.memoryHeaps[heap].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)) continue;
+    const uint64_t bytes = has_budget && budget.heapBudget[heap] > 0 ? budget.heapBudget[heap]
+                                                                     : properties.memoryHeaps[heap].size;
+    largest = std::max(largest, bytes);
+  }
+  if (cpu && !has_budget) {
+    const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
+    if (pages > 0 && page_size > 0) largest = std::max(largest, uint64_t(pages) * uint64_t(page_size));
+  }
+  return largest;
 }
 
 }  // namespace
@@ -186,6 +243,17 @@ void Context::read_device_properties() {
   p2.pNext = &maint3;
   vkGetPhysicalDeviceProperties2(physical_device_, &p2);
   limits_.max_allocation_size = maint3.maxMemoryAllocationSize;
+  uint32_t extension_count = 0;
+  vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &extension_count, nullptr);
+  std::vector<VkExtensionProperties> available(extension_count);
+  vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &extension_count, available.data());
+  limits_.device_memory = device_memory(physical_device_, is_cpu_, available);
+  // A smaller device, for seeing and testing how frames split (docs/big-scenes.md): these only lower
+  // the device's own limits.
+  if (const uint64_t bytes = env_bytes("TILESPLAT_MAX_ALLOCATION"))
+    limits_.max_allocation_size = std::min<uint64_t>(limits_.max_allocation_size, bytes);
+  if (const uint64_t bytes = env_bytes("TILESPLAT_DEVICE_MEMORY"))
+    limits_.device_memory = std::min(limits_.device_memory, bytes);
 
   VkPhysicalDeviceVulkan12Features has12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};

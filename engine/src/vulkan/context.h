@@ -27,6 +27,10 @@ struct DeviceLimits {
   uint32_t max_workgroup_count_x = 0;
   uint32_t max_image_dimension_2d = 0;
   uint64_t max_allocation_size = 0;
+  // The memory device buffers draw on: VK_EXT_memory_budget's budget, else the device-local heap (the
+  // host's physical memory for a CPU driver without the extension). TILESPLAT_MAX_ALLOCATION and
+  // TILESPLAT_DEVICE_MEMORY lower this and max_allocation_size.
+  uint64_t device_memory = 0;
   uint32_t max_texel_buffer_elements = 0;
   double timestamp_period_ns = 0;
   uint32_t timestamp_valid_bits = 0;
