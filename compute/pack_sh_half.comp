@@ -8,10 +8,14 @@
 
 layout(local_size_x = 256) in;
 
+// A scene has more words than a dispatch has invocations (3 of them a Gaussian at SH degree 1, 24 at
+// degree 3, against the 65,535 workgroups of 256 that lavapipe dispatches): each invocation strides
+// through the words by the dispatch's size.
 void main() {
-  uint w = gl_GlobalInvocationID.x;
-  if (2 * w >= pc.values) return;
-  float lo = pc.sh.v[2 * w];
-  float hi = 2 * w + 1 < pc.values ? pc.sh.v[2 * w + 1] : 0.0;
-  pc.sh_half.v[w] = packHalf2x16(vec2(lo, hi));
+  const uint stride = gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  for (uint w = gl_GlobalInvocationID.x; 2 * w < pc.values; w += stride) {
+    float lo = pc.sh.v[2 * w];
+    float hi = 2 * w + 1 < pc.values ? pc.sh.v[2 * w + 1] : 0.0;
+    pc.sh_half.v[w] = packHalf2x16(vec2(lo, hi));
+  }
 }

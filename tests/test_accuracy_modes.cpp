@@ -3,6 +3,7 @@
 // lossless ones change no pixel, and that the per-pixel re-sorting orders by ray depth.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -209,6 +210,38 @@ TEST(AccuracyModes, ShCapsAndHalfPrecisionBehave) {
   for (size_t i = 0; i < scene.size(); ++i)
     for (int c = 0; c < 3; ++c) cut.sh.push_back(scene.sh[i * 16 * 3 + size_t(c)]);
   EXPECT_GT(compare_images(dc_only, render_reference(cut, camera)).psnr_db, 60.0);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// The half-precision harmonics are packed by one dispatch that strides: a scene of SH degree 3 has 24
+// words a Gaussian to pack, and past 699,050 Gaussians more than lavapipe's 65,535 workgroups of 256
+// (which stopped the mode before). 720,000 Gaussians behind the camera come first, so that the 64 it
+// sees are packed by the stride's second round; their values are exact in fp16, so the image is the
+// full-precision one.
+TEST(AccuracyModes, HalfPrecisionHarmonicsOfAnyCountArePacked) {
+  constexpr size_t kHidden = 720000, kSeen = 64;
+  GaussianScene scene;
+  scene.sh_degree = 3;
+  for (size_t i = 0; i < kHidden + kSeen; ++i) {
+    const bool seen = i >= kHidden;
+    const float x = seen ? float(i % 8) * 0.25f - 0.875f : 0.0f,
+                y = seen ? float(i / 8 % 8) * 0.25f - 0.875f : 0.0f;
+    scene.positions.insert(scene.positions.end(), {x, y, seen ? 3.0f + float(i % 5) * 0.1f : -5.0f});
+    scene.log_scales.insert(scene.log_scales.end(), {-2.5f, -2.5f, -2.5f});
+    scene.rotations.insert(scene.rotations.end(), {1.0f, 0.0f, 0.0f, 0.0f});
+    scene.opacity_logits.push_back(1.0f);
+    for (int c = 0; c < 48; ++c) scene.sh.push_back(float(int((i * 7 + size_t(c) * 13) % 41) - 20) / 64.0f);
+  }
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(scene);
+  const Camera camera = testing::axis_camera(64, 48, 40);
+  RenderSettings settings;
+  const RenderImage full = renderer.render(camera, settings);
+  ASSERT_EQ(renderer.last_frame_stats().visible, kSeen);
+  settings.accuracy.fp16_sh = true;
+  const RenderImage half = renderer.render(camera, settings);
+  EXPECT_EQ(half.rgba, full.rgba);
+  EXPECT_GT(*std::max_element(full.rgba.begin(), full.rgba.end()), 0.1f);
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 

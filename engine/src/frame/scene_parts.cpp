@@ -204,8 +204,8 @@ PartCosts part_costs(const PartSource& scene, const Camera& camera, const Render
   // splats (kSplatRecordBytes a record); a key buffer.
   costs.largest_per_gaussian = std::max<uint64_t>({4 * 3 * k, 16, uint64_t(seam_copies) * kSplatRecordBytes});
   costs.largest_per_pair = wide_keys ? 8 : 4;
-  // The projection's dispatch, or the packing of half-precision harmonics (two values an invocation).
-  costs.invocations_per_gaussian = std::max<uint64_t>(seam_copies, modes.fp16_sh ? (3 * k + 1) / 2 : 1);
+  // The projection's dispatch and those after it: a record an invocation.
+  costs.invocations_per_gaussian = seam_copies;
   return costs;
 }
 

@@ -91,8 +91,8 @@ GaussianScene gather_gaussians(const GaussianScene& scene, std::span<const uint3
 // buffer (its largest allocation): the largest buffer that grows with the Gaussians takes
 // largest_per_gaussian bytes for each (their spherical harmonics, or their projected records), the
 // largest that grows with the pairs largest_per_pair (0: no such cap is reckoned). And it caps a
-// dispatch's workgroups: the largest dispatch over the Gaussians has invocations_per_gaussian for each
-// (their records, or the half-precision harmonics' pairs of values), kWorkgroupSize to a workgroup.
+// dispatch's workgroups: the dispatches over the Gaussians have invocations_per_gaussian for each (their
+// projected records), kWorkgroupSize to a workgroup.
 struct PartCosts {
   uint64_t fixed = 0;
   uint64_t per_gaussian = 0;

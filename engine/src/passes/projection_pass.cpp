@@ -137,7 +137,8 @@ void ProjectionPass::prepare(SceneBuffers& scene, const ProjectionVariant& varia
   ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
     if (pack_sh && sh_values > 0) {
       pack_sh_half_.bind(cmd, PackShPush{scene.sh.address(), scene.sh_half.address(), sh_values});
-      pack_sh_half_.dispatch(cmd, vk::div_ceil(vk::div_ceil(sh_values, 2), 256));
+      pack_sh_half_.dispatch(cmd, std::min(vk::div_ceil(vk::div_ceil(sh_values, 2), 256),
+                                           ctx_.limits().max_workgroup_count_x));  // it strides past them
     }
     if (pack_covariance && scene.count > 0) {
       pack_covariance_half_.bind(cmd,
