@@ -556,6 +556,101 @@ TEST(SceneDescription, CamerasHaveLenses) {
             std::string::npos);
 }
 
+TEST(SceneDescription, ModelsMoveAndCamerasHaveShutters) {
+  const fs::path dir = temp_dir();
+  const std::string text = replace_all(R"({"models": [
+      {"path": "$PLY"},
+      {"path": "$PLY", "translation": [1, 0, 0], "rotation_deg": [0, 30, 0], "scale": 2,
+       "motion": {"translation": [-1, 0, 0.5]}},
+      {"path": "$PLY", "z_up": true, "motion": {"rotation_deg": [0, 90, 0], "scale": 3}}],
+    "cameras": [
+      {"width": 64, "height": 48, "look_at": {"eye": [0, 0, -4], "target": [0, 0, 0]},
+       "shutter": {"close": 0.5, "samples": 8, "end": {"look_at": {"eye": [1, 0, -4], "target": [0, 0, 0]}}}},
+      {"width": 64, "height": 48, "fx": 50, "fy": 50, "position": [0, 0, -3],
+       "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+       "shutter": {"open": 0.25, "close": 1, "scan": "bottom-to-top",
+                   "end": {"position": [0, 0.5, -3], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}}},
+      {"width": 64, "height": 48, "look_at": {"eye": [0, 0, -4], "target": [0, 0, 0]},
+       "shutter": {"close": 1}},
+      {"width": 64, "height": 48, "look_at": {"eye": [0, 0, -4], "target": [0, 0, 0]}}]})",
+                                       "$PLY", bundled_sh3().string());
+  const SceneDescription d = load_scene_description(write_text(dir / "moving.json", text));
+  ASSERT_EQ(d.models.size(), 3u);
+  EXPECT_FALSE(d.models[0].motion.has_value());
+  ASSERT_TRUE(d.models[1].motion.has_value());
+  // Each key the model's own where the motion leaves it out.
+  EXPECT_EQ(d.models[1].motion->translation, (std::array<double, 3>{-1, 0, 0.5}));
+  EXPECT_EQ(d.models[1].motion->rotation, d.models[1].transform.rotation);
+  EXPECT_EQ(d.models[1].motion->scale, d.models[1].transform.scale);
+  ASSERT_TRUE(d.models[2].motion.has_value());
+  EXPECT_TRUE(d.models[2].motion->z_up);
+  EXPECT_EQ(d.models[2].motion->rotation, quaternion_from_euler_xyz_deg({0, 90, 0}));
+  EXPECT_EQ(d.models[2].motion->scale, (std::array<double, 3>{3, 3, 3}));
+  const SceneInstances instances = load_scene_instances(d);
+  EXPECT_TRUE(instances.moves());
+  EXPECT_EQ(instances.instances[1].at(1).translation, d.models[1].motion->translation);
+  // At time 0 the models are where the file places them: load_described_scene's scene.
+  EXPECT_EQ(merge_instances(instances, 0).positions, load_described_scene(d).positions);
+
+  ASSERT_EQ(d.shutters.size(), 4u);
+  EXPECT_EQ(d.shutters[0].open, 0.0);
+  EXPECT_EQ(d.shutters[0].close, 0.5);
+  EXPECT_EQ(d.shutters[0].samples, 8);
+  ASSERT_TRUE(d.shutters[0].end_camera.has_value());
+  EXPECT_EQ(d.shutters[0].end_camera->fx, d.cameras[0].camera.fx);  // the same camera, moved
+  EXPECT_EQ(d.shutters[0].end_camera->position, (std::array<double, 3>{1, 0, -4}));
+  EXPECT_TRUE(d.shutters[0].enabled());
+  EXPECT_EQ(d.shutters[1].open, 0.25);
+  EXPECT_EQ(d.shutters[1].scan, ShutterScan::kBottomToTop);
+  EXPECT_EQ(d.shutters[1].end_camera->position, (std::array<double, 3>{0, 0.5, -3}));
+  EXPECT_EQ(d.shutters[1].samples, Shutter{}.samples);
+  // Open over a still camera: it blurs the moving models alone.
+  EXPECT_EQ(d.shutters[2].close, 1.0);
+  EXPECT_FALSE(d.shutters[2].end_camera.has_value());
+  EXPECT_EQ(d.shutters[3], Shutter{});
+
+  const std::string camera =
+      R"("width": 64, "height": 48, "look_at": {"eye": [0, 0, -4], "target": [0, 0, 0]})";
+  const std::vector<std::pair<std::string, std::string>> mistakes = {
+      {R"("shutter": {"open": 0.5})", "cameras[0].shutter: missing 'close'"},
+      {R"("shutter": {"open": 0.5, "close": 0.5})", "cameras[0].shutter.close: must be after 'open' (0.5)"},
+      {R"("shutter": {"close": 1.5})", "cameras[0].shutter.close"},
+      {R"("shutter": {"close": 1, "samples": 0})", "cameras[0].shutter.samples"},
+      {R"("shutter": {"close": 1, "scan": "sideways"})", "cameras[0].shutter.scan"},
+      {R"("shutter": {"close": 1, "angle": 180})", "unknown key"},
+      {R"("shutter": {"close": 1, "end": {"position": [0, 0, 1]}})",
+       "cameras[0].shutter.end: missing 'rotation'"},
+      {R"("shutter": {"close": 1, "end": {"look_at": {"eye": [0, 0, -4], "target": [0, 0, 0], "fov_deg": 30}}})",
+       "the end camera keeps the camera's intrinsics"},
+      {R"("shutter": {"close": 1, "end": {"look_at": {"eye": [0, 0, 0], "target": [0, 0, 0]}}})",
+       "cameras[0].shutter.end.look_at.target: must differ from 'eye'"},
+      {R"("shutter": {"close": 1, "end": {"position": [0, 0, 1], "rotation": [[1, 0, 0], [0, 1, 0], [0, 0, -1]]}})",
+       "is a reflection"},
+  };
+  for (const auto& [shutter, phrase] : mistakes) {
+    const std::string bad =
+        replace_all(R"({"models": [{"path": "$PLY"}], "cameras": [{)" + camera + ", " + shutter + "}]}",
+                    "$PLY", bundled_sh3().string());
+    const std::string message =
+        tilesplat::testing::error_of([&] { load_scene_description(write_text(dir / "bad.json", bad)); });
+    EXPECT_NE(message.find(phrase), std::string::npos) << shutter << ": " << message;
+  }
+  const std::vector<std::pair<std::string, std::string>> motions = {
+      {R"("motion": {"scale": [1, 2, 1]})", "models[0].motion.scale"},
+      {R"("motion": {"z_up": true})", "unknown key"},
+      {R"("motion": {"rotation_deg": [0, 1, 0], "quaternion": [1, 0, 0, 0]})", "not both"},
+      {R"("motion": {"translation": [0, 0, 1e12]})", "models[0].motion.translation"},
+      {R"("motion": [0, 0, 1])", "models[0].motion"},
+  };
+  for (const auto& [motion, phrase] : motions) {
+    const std::string bad =
+        replace_all(R"({"models": [{"path": "$PLY", )" + motion + "}]}", "$PLY", bundled_sh3().string());
+    const std::string message =
+        tilesplat::testing::error_of([&] { load_scene_description(write_text(dir / "bad.json", bad)); });
+    EXPECT_NE(message.find(phrase), std::string::npos) << motion << ": " << message;
+  }
+}
+
 TEST(SceneDescription, MalformedJsonGivesLineAndColumn) {
   const fs::path dir = temp_dir();
   auto message_of = [&](const std::string& text) {

@@ -177,16 +177,18 @@ void Renderer::set_scene(const GaussianScene& scene) {
 }
 
 RenderImage Renderer::Impl::average_samples(const Camera& camera, const RenderSettings& settings,
-                                            const SampleRenderer& render_sample) {
+                                            const TimedSampleRenderer& render_sample) {
   const auto start = std::chrono::steady_clock::now();
   FrameStats frame;
   frame.samples = 0;
-  RenderImage image = render_averaged(
-      camera, settings, [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
-        RenderImage sample = render_sample(sample_camera, sample_settings);
-        add_sample_stats(frame, stats);
-        return sample;
-      });
+  RenderImage image =
+      render_averaged(camera, settings,
+                      TimedSampleRenderer([&](const Camera& sample_camera,
+                                              const RenderSettings& sample_settings, double time) {
+                        RenderImage sample = render_sample(sample_camera, sample_settings, time);
+                        add_sample_stats(frame, stats);
+                        return sample;
+                      }));
   stats = frame;
   stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return image;
@@ -196,7 +198,7 @@ RenderImage Renderer::render(const Camera& camera, const RenderSettings& setting
   Impl& r = *impl_;
   if (averages_samples(settings))  // depth of field, motion blur
     return r.average_samples(camera, settings,
-                             [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
+                             [&](const Camera& sample_camera, const RenderSettings& sample_settings, double) {
                                return render(sample_camera, sample_settings);
                              });
   const auto start = std::chrono::steady_clock::now();

@@ -66,7 +66,7 @@ struct Renderer::Impl {
   // Depth of field, motion blur: the sample frames averaged (frame/averaged_frames.h), each rendered by
   // render_sample; the frame's statistics are the samples' summed.
   RenderImage average_samples(const Camera& camera, const RenderSettings& settings,
-                              const SampleRenderer& render_sample);
+                              const TimedSampleRenderer& render_sample);
   // A scene within a memory budget (renderer_parts.cpp): whether its frame would exceed
   // settings.memory_budget (or without one, the device: whole_frame_fits), and the rendering in depth-ordered
   // parts that leaves the image in the outputs and the parts' statistics.

@@ -152,7 +152,7 @@ RenderImage Renderer::Impl::render_scene(const PartSource& scene, const std::fun
   }
   if (averages_samples(settings))  // depth of field, motion blur: every sample frame in parts
     return average_samples(camera, settings,
-                           [&](const Camera& sample_camera, const RenderSettings& sample_settings) {
+                           [&](const Camera& sample_camera, const RenderSettings& sample_settings, double) {
                              return render_scene(scene, set_whole, sample_camera, sample_settings, renderer);
                            });
   const auto start = std::chrono::steady_clock::now();
@@ -170,6 +170,19 @@ RenderImage Renderer::render(const GaussianScene& scene, const Camera& camera,
 
 RenderImage Renderer::render(const SceneInstances& scene, const Camera& camera,
                              const RenderSettings& settings) {
+  const Shutter& shutter = settings.shutter;
+  if (scene.moves() && shutter.close > shutter.open) {
+    // Moving models under an open shutter: each time sample renders the copies where they are then (and
+    // the camera where it is then: still without an end camera), whole or in parts as any frame.
+    RenderSettings moving = settings;
+    if (!moving.shutter.end_camera) moving.shutter.end_camera = camera;
+    return impl_->average_samples(
+        camera, moving, [&](const Camera& sample_camera, const RenderSettings& sample_settings, double time) {
+          return impl_->render_scene(
+              PartSource(scene, time), [&] { set_scene(merge_instances(scene, time)); }, sample_camera,
+              sample_settings, *this);
+        });
+  }
   return impl_->render_scene(
       PartSource(scene), [&] { set_scene(merge_instances(scene)); }, camera, settings, *this);
 }

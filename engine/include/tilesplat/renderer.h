@@ -170,7 +170,11 @@ class TILESPLAT_API Renderer {
   /// Gaussian); otherwise it throws as set_scene and render do.
   RenderImage render(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings = {});
   /// The same for a scene file's placed copies (load_scene_instances): in parts, each part's Gaussians are
-  /// placed as they are drawn, so the merged scene is never held; whole, it is merged and set.
+  /// placed as they are drawn, so the merged scene is never held; whole, it is merged and set. Copies that
+  /// move (SceneInstances::moves) under an open shutter (settings.shutter: close > open, with or without
+  /// an end camera) blur: the frame is the linear mean (a rolling shutter's bands, the stitch) of the
+  /// frames at the shutter's times, each with every copy where it is then (merge_instances(scene, t)) seen
+  /// from the camera then. A closed shutter renders the copies where they are at time 0.
   RenderImage render(const SceneInstances& scene, const Camera& camera, const RenderSettings& settings = {});
   /// Whether render(scene, camera, settings) renders this frame in parts: with settings.memory_budget,
   /// when the whole frame would need more; without one, when it would not fit the device (a buffer

@@ -17,6 +17,7 @@
 #include "tilesplat/lens.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/shutter.h"
 
 namespace tilesplat {
 
@@ -36,6 +37,14 @@ struct TILESPLAT_API ModelTransform {
   /// Whether the transform changes nothing: no translation, rotation, scale or z_up.
   bool is_identity() const;
 };
+
+/// The transform at time `t` in [0, 1] of a model that moves from `start` (time 0) to `end` (time 1) while
+/// a frame's shutter is open (RenderSettings::shutter, docs/effects.md "Moving models"): translation and
+/// scale blended linearly, the rotation by the shortest-arc slerp, z_up start's. Exactly `start` at 0 and
+/// `end` at 1. Throws std::invalid_argument for t outside [0, 1], an invalid transform (validate) or an
+/// `end` whose z_up differs.
+TILESPLAT_API ModelTransform transform_between(const ModelTransform& start, const ModelTransform& end,
+                                               double t);
 
 /// The rotation z_up applies: +90 degrees about +X, as a w x y z quaternion.
 TILESPLAT_API std::array<double, 4> z_up_rotation();
@@ -91,7 +100,10 @@ TILESPLAT_API GaussianScene merge_scenes(std::span<const GaussianScene> scenes);
 /// One splat file of a scene description and where it is placed.
 struct SceneModel {
   std::filesystem::path path;  ///< resolved: relative paths in the file are relative to its directory
-  ModelTransform transform;    ///< where the file's Gaussians go in the scene
+  ModelTransform transform;    ///< where the file's Gaussians go in the scene (at time 0)
+  /// Where they are at time 1, the model's "motion" in the file: it moves between the two while a
+  /// camera's shutter is open (transform_between). None: it stays at `transform`.
+  std::optional<ModelTransform> motion;
 };
 
 /// A light of a scene description's relighting effect, as the file gives it (tilesplat::Light has the model).
@@ -136,6 +148,10 @@ struct SceneDescription {
   /// The lens each camera looks through (a camera's "lens": depth of field, tilesplat/lens.h): one per
   /// camera, off (aperture 0) where a camera has none; empty when the cameras come from a cameras.json.
   std::vector<ThinLens> lenses;
+  /// The shutter each camera exposes through (a camera's "shutter": motion blur, tilesplat/shutter.h): one
+  /// per camera, closed where a camera has none; empty when the cameras come from a cameras.json. Its
+  /// end_camera is unset for a camera that stays still (the moving models still blur).
+  std::vector<Shutter> shutters;
   std::filesystem::path cameras_file;  ///< resolved cameras.json when "cameras" names one, else empty
   std::array<float, 3> background = {0, 0, 0};  ///< RGB behind the splats, display values like theirs
   SceneEffects effects;                         ///< what to simulate; each off unless the file asks
@@ -164,9 +180,13 @@ TILESPLAT_API GaussianScene load_described_scene(const SceneDescription& descrip
 /// many copies needs host memory for its files only.
 struct TILESPLAT_API SceneInstances {
   /// One placed copy: a file's Gaussians through a transform.
-  struct Instance {
+  struct TILESPLAT_API Instance {
     size_t file = 0;           ///< index into `files`
-    ModelTransform transform;  ///< where the copy goes (transform_scene)
+    ModelTransform transform;  ///< where the copy goes (transform_scene), at time 0
+    /// Where it goes at time 1 (SceneModel::motion); none for a copy that stays put.
+    std::optional<ModelTransform> end_transform;
+    /// Its transform at time `t` in [0, 1]: `transform`, or transform_between it and end_transform.
+    ModelTransform at(double t) const;
   };
   std::vector<GaussianScene> files;  ///< each file the description names, once, as load_scene read it
   std::vector<Instance> instances;   ///< the models in the description's order: the merged scene's order
@@ -175,6 +195,9 @@ struct TILESPLAT_API SceneInstances {
 
   /// The merged scene's Gaussians: the sum over the instances.
   size_t size() const;
+  /// Whether any instance moves (has an end_transform): then Renderer::render blurs its motion over an
+  /// open shutter (RenderSettings::shutter), the camera still or moving.
+  bool moves() const;
 };
 
 /// Loads every file the description names once and places its models as instances (what
@@ -185,6 +208,9 @@ TILESPLAT_API SceneInstances load_scene_instances(const SceneDescription& descri
 
 /// The instances transformed and merged, in order: load_described_scene's scene, bit for bit.
 TILESPLAT_API GaussianScene merge_instances(const SceneInstances& scene);
+/// The same with each instance where it is at time `t` in [0, 1] (Instance::at): at 0,
+/// merge_instances(scene).
+TILESPLAT_API GaussianScene merge_instances(const SceneInstances& scene, double t);
 
 /// The bounds of the merged scene (compute_bounds of merge_instances(scene)), from the placed positions
 /// alone.

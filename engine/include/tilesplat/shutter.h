@@ -33,7 +33,8 @@ TILESPLAT_API ShutterScan parse_shutter_scan(const std::string& name);
 /// where it is `end_camera`; between them camera_between() moves it. The shutter is open from `open` to
 /// `close`, and the frame is the mean, in linear light (as a ThinLens frame's: tilesplat/lens.h), of
 /// `samples` pinhole frames at shutter_times(open, close, samples). Off (the frame it always was) unless the
-/// shutter opens for a while (close > open) over a camera that moves (end_camera set). A rolling shutter
+/// shutter opens for a while (close > open) over a camera that moves (end_camera set), or over a scene
+/// file's models that move (Renderer::render(const SceneInstances&, ...)). A rolling shutter
 /// (`scan` other than ShutterScan::kGlobal) stitches its bands' frames instead of averaging them.
 struct Shutter {
   double open = 0;                   ///< when the shutter opens, in [0, 1]

@@ -77,7 +77,8 @@ Camera camera_between(const Camera& start, const Camera& end, double t) {
   camera.cx = blend(start.cx, end.cx);
   camera.cy = blend(start.cy, end.cy);
   for (size_t k = 0; k < 3; ++k) camera.position[k] = blend(start.position[k], end.position[k]);
-  if (t > 0)
+  // A camera that turns; one that does not keeps its rotation to the bit (a still camera over moving models).
+  if (t > 0 && start.rotation != end.rotation)
     camera.rotation = matrix_of(slerp(quaternion_of(start.rotation), quaternion_of(end.rotation), t));
   return camera;
 }

@@ -66,7 +66,7 @@ namespace {
 // of the shutter's times. Each sample frame is rendered whole (a band's pixels are then exactly the whole
 // frame's), so the frame costs `bands` frames, as a global shutter of as many samples does.
 RenderImage render_rolling(const Camera& camera, const RenderSettings& settings,
-                           const SampleRenderer& render_sample) {
+                           const TimedSampleRenderer& render_sample) {
   const Shutter& shutter = settings.shutter;
   const bool rows = shutter.scan == ShutterScan::kTopToBottom || shutter.scan == ShutterScan::kBottomToTop;
   const bool reversed =
@@ -78,8 +78,8 @@ RenderImage render_rolling(const Camera& camera, const RenderSettings& settings,
   RenderImage image;
   const std::vector<double> times = shutter_times(shutter.open, shutter.close, bands);
   for (int k = 0; k < bands; ++k) {
-    const RenderImage frame =
-        render_sample(camera_between(camera, *shutter.end_camera, times[size_t(k)]), sample_settings);
+    const RenderImage frame = render_sample(camera_between(camera, *shutter.end_camera, times[size_t(k)]),
+                                            sample_settings, times[size_t(k)]);
     if (k == 0) image = frame;  // sizes and outputs; every pixel is overwritten by its band below
     // Band k in scan order covers [first, last) along the scan's axis, counted from where the scan starts.
     const int first = int(int64_t(k) * extent / bands), last = int(int64_t(k + 1) * extent / bands);
@@ -102,6 +102,15 @@ RenderImage render_rolling(const Camera& camera, const RenderSettings& settings,
 
 RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
                             const SampleRenderer& render_sample) {
+  return render_averaged(
+      camera, settings,
+      TimedSampleRenderer([&](const Camera& sample_camera, const RenderSettings& sample_settings, double) {
+        return render_sample(sample_camera, sample_settings);
+      }));
+}
+
+RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
+                            const TimedSampleRenderer& render_sample) {
   LinearFrameMean mean(settings.background != std::array<float, 3>{0, 0, 0});
   RenderSettings sample_settings = settings;
   if (settings.shutter.enabled() && settings.shutter.scan != ShutterScan::kGlobal) {
@@ -113,13 +122,13 @@ RenderImage render_averaged(const Camera& camera, const RenderSettings& settings
     const Shutter& shutter = settings.shutter;
     sample_settings.shutter = {};
     for (const double t : shutter_times(shutter.open, shutter.close, shutter.samples))
-      mean.add(render_sample(camera_between(camera, *shutter.end_camera, t), sample_settings));
+      mean.add(render_sample(camera_between(camera, *shutter.end_camera, t), sample_settings, t));
   } else {
     check_lens(settings, camera);
     const ThinLens& lens = settings.lens;
     sample_settings.lens = {};
     for (const auto& sample : lens_samples(lens.samples))
-      mean.add(render_sample(lens_sample_camera(camera, lens, sample), sample_settings));
+      mean.add(render_sample(lens_sample_camera(camera, lens, sample), sample_settings, 0.0));
   }
   return mean.mean();
 }

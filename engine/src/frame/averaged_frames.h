@@ -41,6 +41,9 @@ bool averages_samples(const RenderSettings& settings);
 
 // Renders one sample frame: a camera and the settings without the effect being averaged.
 using SampleRenderer = std::function<RenderImage(const Camera&, const RenderSettings&)>;
+// The same, told the sample's time in the frame (a shutter's time; 0 for the lens samples of a frame
+// without one): for scenes whose models move (SceneInstances::moves).
+using TimedSampleRenderer = std::function<RenderImage(const Camera&, const RenderSettings&, double time)>;
 
 // The averaged frame of `camera` (averages_samples(settings)), checked first (check_shutter, check_lens).
 // With an enabled shutter: the linear mean (LinearFrameMean, over settings.background) of
@@ -52,6 +55,8 @@ using SampleRenderer = std::function<RenderImage(const Camera&, const RenderSett
 // shutter_times(open, close, bands)[k]), settings without the shutter). Samples are rendered in that order.
 RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
                             const SampleRenderer& render_sample);
+RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
+                            const TimedSampleRenderer& render_sample);
 
 // Adds a sample frame's statistics to those of the frame it is part of: GPU times summed (pass by pass),
 // the largest visible and intersection counts, retries and submissions summed; samples summed (a sample

@@ -34,11 +34,12 @@ uint32_t depth_key(double depth, int key_bits) {
 
 PartSource::PartSource(const GaussianScene& scene) : scene_(&scene), size_(scene.size()) {}
 
-PartSource::PartSource(const SceneInstances& scene) : instances_(&scene) {
+PartSource::PartSource(const SceneInstances& scene, double time) : instances_(&scene) {
   for (const SceneInstances::Instance& instance : scene.instances) {
     first_.push_back(size_);
     size_ += scene.files.at(instance.file).size();
-    placements_.emplace_back(instance.transform);
+    transforms_.push_back(instance.at(time));
+    placements_.emplace_back(transforms_.back());
   }
   first_.push_back(size_);
 }
@@ -73,7 +74,7 @@ GaussianScene PartSource::gather(std::span<const uint32_t> indices) const {
       local.push_back(uint32_t(indices[next] - first_[k]));
     const SceneInstances::Instance& instance = instances_->instances[k];
     detail::append_merged(
-        part, transform_scene(gather_gaussians(instances_->files[instance.file], local), instance.transform),
+        part, transform_scene(gather_gaussians(instances_->files[instance.file], local), transforms_[k]),
         instances_->normals);
   }
   return part;

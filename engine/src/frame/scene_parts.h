@@ -34,11 +34,12 @@ constexpr double kDepthMarginFloat32 = 2e-6;
 
 // The Gaussians a scene in parts draws from: one GaussianScene, or the placed copies of a
 // SceneInstances, numbered as in their merged scene (merge_instances), whose parts it places one
-// Gaussian at a time (so that a scene of many copies is never held whole).
+// Gaussian at a time (so that a scene of many copies is never held whole), each copy where it is at
+// `time` (SceneInstances::Instance::at).
 class PartSource {
  public:
   explicit PartSource(const GaussianScene& scene);
-  explicit PartSource(const SceneInstances& scene);
+  explicit PartSource(const SceneInstances& scene, double time = 0);
 
   size_t size() const { return size_; }
   int sh_degree() const;
@@ -53,6 +54,7 @@ class PartSource {
   const SceneInstances* instances_ = nullptr;
   std::vector<size_t>
       first_;  // instances: each instance's first Gaussian in the merged scene, then the total
+  std::vector<ModelTransform> transforms_;  // instances: each one's at the time
   std::vector<detail::PositionPlacement> placements_;
   size_t size_ = 0;
 };

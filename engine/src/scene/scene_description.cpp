@@ -19,6 +19,7 @@
 
 #include "scene/json_reader.h"
 #include "scene/scene_readers.h"
+#include "tilesplat/shutter.h"
 
 namespace tilesplat {
 namespace {
@@ -39,11 +40,17 @@ constexpr int kFormatVersion = 1;
 
 constexpr auto kTopKeys = std::to_array<std::string_view>({"$schema", "version", "models", "cameras",
                                                       "background", "effects", "outputs"});
-constexpr auto kModelKeys = std::to_array<std::string_view>({"path", "translation", "rotation_deg",
-                                                        "quaternion", "scale", "z_up"});
-constexpr auto kCameraKeys =
-    std::to_array<std::string_view>({"name", "width", "height", "fx", "fy", "cx", "cy", "position",
-                                     "rotation", "look_at", "model", "distortion", "view_height", "lens"});
+constexpr auto kModelKeys = std::to_array<std::string_view>(
+    {"path", "translation", "rotation_deg", "quaternion", "scale", "z_up", "motion"});
+constexpr auto kMotionKeys =
+    std::to_array<std::string_view>({"translation", "rotation_deg", "quaternion", "scale"});
+constexpr auto kCameraKeys = std::to_array<std::string_view>(
+    {"name", "width", "height", "fx", "fy", "cx", "cy", "position", "rotation", "look_at", "model",
+     "distortion", "view_height", "lens", "shutter"});
+constexpr auto kShutterKeys = std::to_array<std::string_view>({"open", "close", "samples", "scan", "end"});
+constexpr auto kShutterEndKeys = std::to_array<std::string_view>({"position", "rotation", "look_at"});
+constexpr auto kShutterScans = std::to_array<std::string_view>(
+    {"global", "top-to-bottom", "bottom-to-top", "left-to-right", "right-to-left"});
 constexpr auto kLensKeys = std::to_array<std::string_view>(
     {"aperture", "f_stop", "sensor_width_mm", "units_per_metre", "focus_distance", "samples"});
 constexpr auto kLookAtKeys = std::to_array<std::string_view>({"eye", "target", "up", "fov_deg"});
@@ -98,15 +105,26 @@ std::array<double, 3> read_scale(const Reader& reader, const Node& node) {
   return scale;
 }
 
+// A placement's translation, rotation and scale over `base` (a model's, or where its motion ends).
+ModelTransform read_placement(const Reader& reader, const Node& node, ModelTransform base) {
+  if (const auto t = reader.optional_child(node, "translation"))
+    base.translation = reader.numbers<3>(*t, -kMaxCoordinate, kMaxCoordinate);
+  base = read_rotation(reader, node, base);
+  if (const auto s = reader.optional_child(node, "scale")) base.scale = read_scale(reader, *s);
+  return base;
+}
+
 SceneModel read_model(const Reader& reader, const Node& model) {
   reader.expect_object(model, kModelKeys);
   SceneModel out;
   out.path = reader.existing_file(reader.required_child(model, "path", "the splat file (.ply) to load"), "splat file");
-  if (const auto t = reader.optional_child(model, "translation"))
-    out.transform.translation = reader.numbers<3>(*t, -kMaxCoordinate, kMaxCoordinate);
-  out.transform = read_rotation(reader, model, out.transform);
-  if (const auto s = reader.optional_child(model, "scale")) out.transform.scale = read_scale(reader, *s);
+  out.transform = read_placement(reader, model, out.transform);
   if (const auto z_up = reader.optional_child(model, "z_up")) out.transform.z_up = reader.boolean(*z_up);
+  // "motion": where the model is at time 1, each key over the model's own (and its z_up).
+  if (const auto motion = reader.optional_child(model, "motion")) {
+    reader.expect_object(*motion, kMotionKeys);
+    out.motion = read_placement(reader, *motion, out.transform);
+  }
   return out;
 }
 
@@ -297,7 +315,49 @@ ThinLens read_lens(const Reader& reader, const Node& node, const Camera& camera,
   return lens;
 }
 
-CameraView read_camera(const Reader& reader, const Node& node, size_t index, ThinLens& lens) {
+// A camera's "shutter": open and close times in [0, 1] of the frame's time, the samples (or a rolling
+// shutter's bands), the scan, and "end", the camera at time 1: the same camera (size, intrinsics, model)
+// at another pose, given as "position" and "rotation" or as "look_at" (eye, target, up). Without "end"
+// the camera stays still, and the shutter blurs the models that move.
+Shutter read_shutter(const Reader& reader, const Node& node, const Camera& camera) {
+  reader.expect_object(node, kShutterKeys);
+  Shutter shutter;
+  if (const auto open = reader.optional_child(node, "open")) shutter.open = reader.number(*open, 0, 1);
+  const Node close = reader.required_child(node, "close", "when the shutter closes, in (open, 1]");
+  shutter.close = reader.number(close, 0, 1);
+  if (!(shutter.close > shutter.open))
+    reader.fail(close.path, "must be after 'open' (" + format_number(shutter.open) + "), got " +
+                                format_number(shutter.close));
+  if (const auto samples = reader.optional_child(node, "samples"))
+    shutter.samples = reader.integer(*samples, 1, kMaxShutterSamples);
+  if (const auto scan = reader.optional_child(node, "scan"))
+    shutter.scan = parse_shutter_scan(std::string(reader.choice(*scan, kShutterScans)));
+  if (const auto end = reader.optional_child(node, "end")) {
+    reader.expect_object(*end, kShutterEndKeys);
+    Camera moved = camera;
+    if (const auto look_at = reader.optional_child(*end, "look_at")) {
+      for (const char* key : {"position", "rotation"})
+        if (const auto conflict = reader.optional_child(*end, key))
+          reader.fail(conflict->path, "not allowed with 'look_at', which sets the pose");
+      if (const auto fov = reader.optional_child(*look_at, "fov_deg"))
+        reader.fail(fov->path, "the end camera keeps the camera's intrinsics: give its pose only");
+      const Camera aimed = read_look_at(reader, *look_at, camera.width, camera.height, false).camera;
+      moved.position = aimed.position;
+      moved.rotation = aimed.rotation;
+    } else {
+      moved.position =
+          reader.numbers<3>(reader.required_child(*end, "position", "the camera centre at time 1"),
+                            -kMaxCoordinate, kMaxCoordinate);
+      moved.rotation = read_camera_rotation(
+          reader, reader.required_child(*end, "rotation", "the world-to-camera rotation at time 1, 3 rows"));
+    }
+    shutter.end_camera = moved;
+  }
+  return shutter;
+}
+
+CameraView read_camera(const Reader& reader, const Node& node, size_t index, ThinLens& lens,
+                       Shutter& shutter) {
   reader.expect_object(node, kCameraKeys);
   CameraView view;
   view.id = static_cast<int>(index);
@@ -323,6 +383,8 @@ CameraView read_camera(const Reader& reader, const Node& node, size_t index, Thi
   read_model(reader, node, model, look_at.has_value(), fisheye_fov, view.camera);
   if (const auto lens_node = reader.optional_child(node, "lens"))
     lens = read_lens(reader, *lens_node, view.camera, target_distance);
+  if (const auto shutter_node = reader.optional_child(node, "shutter"))
+    shutter = read_shutter(reader, *shutter_node, view.camera);
   return view;
 }
 
@@ -339,8 +401,10 @@ void read_cameras(const Reader& reader, const Node& node, SceneDescription& out)
   const json& list = reader.array(node, "a cameras.json path or a list of cameras");
   if (list.empty()) reader.fail(node.path, "must list at least one camera (leave 'cameras' out for none)");
   out.lenses.resize(list.size());
+  out.shutters.resize(list.size());
   for (size_t i = 0; i < list.size(); ++i)
-    out.cameras.push_back(read_camera(reader, Node{list[i], element_path(node.path, i)}, i, out.lenses[i]));
+    out.cameras.push_back(
+        read_camera(reader, Node{list[i], element_path(node.path, i)}, i, out.lenses[i], out.shutters[i]));
 }
 
 // --- effects and outputs

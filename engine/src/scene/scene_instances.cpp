@@ -34,6 +34,15 @@ void add_report(LoadReport& total, const LoadReport& part, const fs::path& file)
 
 }  // namespace
 
+ModelTransform SceneInstances::Instance::at(double t) const {
+  return end_transform ? transform_between(transform, *end_transform, t) : transform;
+}
+
+bool SceneInstances::moves() const {
+  return std::any_of(instances.begin(), instances.end(),
+                     [](const Instance& instance) { return instance.end_transform.has_value(); });
+}
+
 size_t SceneInstances::size() const {
   size_t total = 0;
   for (const Instance& instance : instances) total += files.at(instance.file).size();
@@ -65,10 +74,11 @@ SceneInstances load_scene_instances(const SceneDescription& description, const L
     }
     try {
       validate(model.transform);
+      if (model.motion) transform_between(model.transform, *model.motion, 1);  // validates the end
     } catch (const std::invalid_argument& error) {
       throw SceneError(where + model.path.string() + ": transform_scene: " + error.what());
     }
-    out.instances.push_back({found->second, model.transform});
+    out.instances.push_back({found->second, model.transform, model.motion});
     add_report(total, file_reports[found->second], model.path);
     const GaussianScene& file = out.files[found->second];
     out.sh_degree = std::max(out.sh_degree, file.sh_degree);
@@ -82,12 +92,16 @@ SceneInstances load_scene_instances(const SceneDescription& description, const L
 }
 
 GaussianScene merge_instances(const SceneInstances& scene) {
+  return merge_instances(scene, 0);
+}
+
+GaussianScene merge_instances(const SceneInstances& scene, double t) {
   // One transformed copy at a time into the merged scene: at most one copy exists besides the files and
   // the result.
   GaussianScene merged;
   detail::reserve_merged(merged, scene.size(), scene.sh_degree, scene.normals);
   for (const SceneInstances::Instance& instance : scene.instances)
-    detail::append_merged(merged, transform_scene(scene.files.at(instance.file), instance.transform),
+    detail::append_merged(merged, transform_scene(scene.files.at(instance.file), instance.at(t)),
                           scene.normals);
   return merged;
 }

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "camera/rotation_interpolation.h"
 #include "scene/scene_merge.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/scene_description.h"
@@ -244,6 +245,28 @@ std::array<double, 9> rotation_matrix(const std::array<double, 4>& quaternion) {
 std::array<double, 4> total_rotation(const ModelTransform& transform) {
   if (!transform.z_up) return transform.rotation;
   return normalized(multiply(normalized(transform.rotation), z_up_rotation()));
+}
+
+ModelTransform transform_between(const ModelTransform& start, const ModelTransform& end, double t) {
+  if (!(t >= 0 && t <= 1))
+    throw std::invalid_argument("transform_between: t must be in [0, 1], got " + std::to_string(t));
+  validate(start);
+  validate(end);
+  if (start.z_up != end.z_up)
+    throw std::invalid_argument("transform_between: the end transform's z_up differs from the start's");
+  if (t == 0) return start;
+  if (t == 1) return end;
+  const auto blend = [t](double a, double b) { return a + (b - a) * t; };
+  ModelTransform between = start;
+  for (size_t k = 0; k < 3; ++k) {
+    between.translation[k] = blend(start.translation[k], end.translation[k]);
+    between.scale[k] = blend(start.scale[k], end.scale[k]);
+  }
+  // The quaternions as written (normalised, so that the slerp's result is one too): a still rotation stays
+  // bit-identical.
+  if (start.rotation != end.rotation)
+    between.rotation = slerp(normalized(start.rotation), normalized(end.rotation), t);
+  return between;
 }
 
 void validate(const ModelTransform& transform) {
