@@ -1048,6 +1048,54 @@ fs::path write_scene_file(const std::string& effects = "") {
   return path;
 }
 
+// The bundled moving_playbots.json: its second model moves while each camera's shutter is open (view 0
+// still, view 1 panning, view 2 a rolling shutter).
+TEST(CliRender, ASceneFilesMovingModelsBlurUnderItsCamerasShutter) {
+  const auto out = fresh_output_dir();
+  const fs::path moving = tilesplat::testing::bundled_scene_dir() / "moving_playbots.json";
+  // The same scene with nothing moving: the file with its "motion" left out, the model path made absolute.
+  std::string text = tilesplat::testing::read_file(moving);
+  const std::string motion = R"(, "motion": {"translation": [0.75, 0, 0.55], "rotation_deg": [0, -30, 0]})";
+  ASSERT_NE(text.find(motion), std::string::npos);
+  text.replace(text.find(motion), motion.size(), "");
+  const std::string ply = (tilesplat::testing::bundled_scene_dir() / "playbot_lod3").string() + "/";
+  for (size_t at = text.find("playbot_lod3/"); at != std::string::npos;
+       at = text.find("playbot_lod3/", at + ply.size()))
+    text.replace(at, std::string("playbot_lod3/").size(), ply);
+  const fs::path still_file = out / "still_models.json";
+  std::ofstream(still_file, std::ios::binary) << text;
+  auto render = [&](const fs::path& scene, const std::vector<std::string>& extra, const std::string& name) {
+    std::vector<std::string> args = {scene.string(), "--width", "160", "-o", (out / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_exe(kRenderExe, args);
+  };
+  const auto blurred = render(moving, {"--view", "0"}, "blurred.exr");
+  ASSERT_EQ(blurred.exit_code, 0) << blurred.err;
+  EXPECT_TRUE(contains(blurred.err, "2 placed copies of 1 file")) << blurred.err;
+  ASSERT_EQ(render(still_file, {"--view", "0"}, "still.exr").exit_code, 0);
+  const std::string recorded =
+      tilesplat::read_exr_string_attributes(out / "blurred.exr").at("renderSettings");
+  EXPECT_TRUE(contains(recorded, "shutter=open:0,close:1,samples:24,scan:global,camera:still")) << recorded;
+  const tilesplat::RenderImage a = tilesplat::read_exr(out / "blurred.exr");
+  const tilesplat::RenderImage b = tilesplat::read_exr(out / "still.exr");
+  const tilesplat::ImageDifference difference = tilesplat::compare_images(a, b);
+  EXPECT_LT(difference.psnr_db, 35.0);  // the moving model is smeared
+  EXPECT_GT(difference.psnr_db, 12.0);  // and the other one is where it was
+
+  // A sequence of its views records that each has its own shutter.
+  fs::create_directories(out / "views");
+  const auto views = run_exe(kRenderExe, {moving.string(), "--views", "1,2", "--width", "96", "-o",
+                                          (out / "views" / "frame_%04d.exr").string(), "--quiet"});
+  ASSERT_EQ(views.exit_code, 0) << views.err;
+  EXPECT_TRUE(
+      contains(tilesplat::read_exr_string_attributes(out / "views" / "frame_0002.exr").at("renderSettings"),
+               "shutter=the scene file's, per view"));
+  const auto reference = render(moving, {"--reference"}, "reference.exr");
+  EXPECT_EQ(reference.exit_code, 2) << reference.err;
+  EXPECT_TRUE(contains(reference.err, "--reference renders still scenes")) << reference.err;
+  EXPECT_FALSE(fs::exists(out / "reference.exr"));
+}
+
 TEST(CliRender, RendersSceneFileToExr) {
   const auto out = fresh_output_dir();
   const fs::path scene_file = write_scene_file();

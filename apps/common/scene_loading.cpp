@@ -96,7 +96,9 @@ LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view 
       load_lod_set(loaded, lod, load_options);
     } else if (is_scene_description(loaded.path)) {
       loaded.description = load_scene_description(loaded.path);
-      if (holding == SceneHolding::kInstances)
+      const bool moving = std::any_of(loaded.description->models.begin(), loaded.description->models.end(),
+                                      [](const SceneModel& model) { return model.motion.has_value(); });
+      if (holding == SceneHolding::kInstances || (holding == SceneHolding::kInstancesIfMoving && moving))
         loaded.instances = load_scene_instances(*loaded.description, load_options, &loaded.report);
       else
         loaded.scene = load_described_scene(*loaded.description, load_options, &loaded.report);
@@ -124,7 +126,14 @@ SceneViews scene_views(const LoadedScene& loaded) {
   out.views = loaded.description->cameras;
   out.file = loaded.description->cameras_file.empty() ? loaded.path : loaded.description->cameras_file;
   out.lenses = loaded.description->lenses;
+  out.shutters = loaded.description->shutters;
   return out;
+}
+
+Shutter shutter_at_size(const Shutter& shutter, const Camera& camera) {
+  Shutter sized = shutter;
+  if (sized.end_camera) sized.end_camera = resize_camera(*sized.end_camera, camera.width, camera.height);
+  return sized;
 }
 
 Lighting scene_lighting(const SceneEffects& effects) {
@@ -233,6 +242,8 @@ LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view
     loaded.view_index = options.view;
     loaded.view_name = cameras.views[size_t(options.view)].name;  // in range: view_camera checked it
     if (!cameras.lenses.empty()) loaded.lens = cameras.lenses[size_t(options.view)];
+    if (!cameras.shutters.empty())
+      loaded.shutter = shutter_at_size(cameras.shutters[size_t(options.view)], named.camera);
   } else {
     if (options.view_given)
       throw UsageError(

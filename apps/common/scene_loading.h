@@ -21,8 +21,10 @@
 namespace tilesplat::cli {
 
 // How a scene file's models are held: merged into one scene, or as placed copies of their files (for a
-// renderer under a memory budget, which places the copies part by part: docs/big-scenes.md).
-enum class SceneHolding { kMerged, kInstances };
+// renderer under a memory budget, which places the copies part by part: docs/big-scenes.md), or so only
+// when some of them move (a merged scene is where they are at time 0: the renderer places moving copies
+// at each time of a shutter, docs/effects.md).
+enum class SceneHolding { kMerged, kInstances, kInstancesIfMoving };
 
 // A LOD set the SCENE names (lod-meta.json): the index, and how the run draws it.
 struct LoadedLodSet {
@@ -52,6 +54,8 @@ struct LoadedScene {
   std::optional<int> view_index;   // the view's index in its cameras, when the camera is a view
   std::string view_name;           // its img_name (may be empty); empty for the orbit camera
   ThinLens lens;                   // the scene file's lens for that view (SceneDescription::lenses); off else
+  Shutter shutter;  // the scene file's shutter for that view (SceneDescription::shutters), its end camera
+                    // at the view's size; closed else
   double load_ms = 0;
 };
 
@@ -74,7 +78,11 @@ struct SceneViews {
   std::vector<CameraView> views;
   std::filesystem::path file;
   std::vector<ThinLens> lenses;  // the scene file's, one per view; empty for --cameras and cameras.json
+  std::vector<Shutter> shutters;  // likewise
 };
+// A view's shutter (SceneViews::shutters) for its camera at another size (view_camera): the end camera
+// resized the same way.
+Shutter shutter_at_size(const Shutter& shutter, const Camera& camera);
 SceneViews scene_views(const LoadedScene& loaded);
 // The views a run picks from: those of --cameras (loaded) when given, else the scene file's own.
 // No views when neither has any.

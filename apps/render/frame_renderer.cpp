@@ -27,7 +27,8 @@ FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScen
 void FrameRenderer::decide_holding(const Camera& camera, const RenderSettings& settings) {
   if (decided_) return;
   decided_ = true;
-  if (in_parts_ || lod_) return;  // a scene file's copies are held as such under --memory-budget alone
+  // A scene file's copies, held as such under --memory-budget or when some move, are taken every frame.
+  if (in_parts_ || lod_ || instances_) return;
   in_parts_ = renderer_->renders_in_parts(scene_, camera, settings);
   if (!in_parts_) renderer_->set_scene(scene_);
 }
@@ -52,9 +53,9 @@ RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& ba
   RenderImage image;
   if (renderer_) {
     decide_holding(camera, settings);
-    image = !in_parts_ && !lod_ ? renderer_->render(camera, settings)
-            : instances_        ? renderer_->render(*instances_, camera, settings)
-                                : renderer_->render(scene, camera, settings);
+    image = instances_            ? renderer_->render(*instances_, camera, settings)
+            : !in_parts_ && !lod_ ? renderer_->render(camera, settings)
+                                  : renderer_->render(scene, camera, settings);
     gpu_ms_ = renderer_->last_frame_stats().gpu_ms;
     cpu_ms_ = renderer_->last_frame_stats().cpu_ms;
   } else {

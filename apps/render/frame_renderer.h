@@ -34,7 +34,7 @@ class FrameRenderer {
 
  private:
   const GaussianScene& scene_;
-  const SceneInstances* instances_;  // a scene file's placed copies, held so under --memory-budget
+  const SceneInstances* instances_;  // a scene file's placed copies: under --memory-budget, or moving
   const cli::LoadedLodSet* lod_;     // a LOD set drawn under --splat-budget
   LodSelection lod_selection_;
   bool warned_over_budget_ = false;

@@ -53,6 +53,7 @@ struct Frame {
   // (none after its last); none for the views of a camera set, which do not move from one to the next.
   std::optional<tilesplat::Camera> next_camera;
   tilesplat::ThinLens lens;  // the scene file's lens for this view (off unless it has one)
+  tilesplat::Shutter shutter;  // the scene file's shutter for this view (closed unless it has one)
 };
 
 using cli::single_quoted;
@@ -88,7 +89,15 @@ std::string settings_text(const tilesplat::RenderSettings& settings, const LensF
     text += " lens=aperture:" + shortest_exact(settings.lens.aperture_diameter) +
             ",focus:" + shortest_exact(settings.lens.focus_distance) +
             ",samples:" + std::to_string(settings.lens.samples);
-  if (shutter.enabled()) text += " shutter=" + shutter_text(shutter);
+  if (shutter.enabled()) {
+    text += " shutter=" + shutter_text(shutter);
+  } else if (settings.shutter.close > settings.shutter.open) {  // a scene file's shutter for the view
+    text += " shutter=open:" + shortest_exact(settings.shutter.open) +
+            ",close:" + shortest_exact(settings.shutter.close) +
+            ",samples:" + std::to_string(settings.shutter.samples) +
+            ",scan:" + tilesplat::shutter_scan_name(settings.shutter.scan) +
+            (settings.shutter.end_camera ? ",camera:moving" : ",camera:still");
+  }
   return text;
 }
 
@@ -173,7 +182,10 @@ std::vector<Frame> plan_sequence(const cli::ArgParser& parser, const RenderOptio
                         {},
                         {},
                         {},
-                        cameras.lenses.empty() ? tilesplat::ThinLens{} : cameras.lenses[size_t(view)]});
+                        cameras.lenses.empty() ? tilesplat::ThinLens{} : cameras.lenses[size_t(view)],
+                        cameras.shutters.empty()
+                            ? tilesplat::Shutter{}
+                            : cli::shutter_at_size(cameras.shutters[size_t(view)], named.camera)});
     }
   } else {
     const cli::ImageSize size = cli::orbit_image_size(common.width, common.height);
@@ -346,7 +358,8 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
     std::future<void> writing;
     for (const Frame* frame : to_render) {
       tilesplat::RenderSettings frame_settings = settings;
-      frame_settings.shutter = shutter_for_frame(options.shutter, frame->next_camera);
+      frame_settings.shutter =
+          options.shutter.enabled() ? shutter_for_frame(options.shutter, frame->next_camera) : frame->shutter;
       frame_settings.lens = frame->lens;
       tilesplat::RenderImage image = renderer.render(frame->camera, frame_settings);
       cli::ManifestEntry entry = manifest_entry(*frame, frame_count, folder, settings_line);
@@ -415,9 +428,10 @@ int run(int argc, char** argv) {
   if (!options.png.empty())
     cli::check_output_path(sequence ? cli::frame_file("--png", options.png, 0) : options.png, "--png");
 
-  // Under a memory budget a scene file's models stay placed copies of their files, never merged.
+  // Under a memory budget a scene file's models stay placed copies of their files, never merged; so do
+  // they when some of them move (each time of a shutter places them anew).
   const cli::SceneHolding holding =
-      options.memory_budget > 0 ? cli::SceneHolding::kInstances : cli::SceneHolding::kMerged;
+      options.memory_budget > 0 ? cli::SceneHolding::kInstances : cli::SceneHolding::kInstancesIfMoving;
   cli::LoadedScene loaded = sequence ? cli::load_scene_file(options.common.scene, options.common.strict,
                                                             kProgram, holding, options.common.lod)
                                      : cli::load_scene_and_camera(options.common, kProgram, holding);
@@ -434,12 +448,18 @@ int run(int argc, char** argv) {
                       options.output,
                       options.png,
                       {},
-                      loaded.lens});
+                      loaded.lens,
+                      loaded.shutter});
   }
+  if (options.reference && loaded.instances && loaded.instances->moves())
+    throw cli::UsageError("--reference renders still scenes, and " + single_quoted(loaded.path.string()) +
+                          " has models that move (their 'motion'): render it on the GPU");
   for (Frame& frame : frames) {
     frame.camera = cli::camera_for_frame(options.camera_model, frame.camera);
     if (frame.next_camera)
       frame.next_camera = cli::camera_for_frame(options.camera_model, *frame.next_camera);
+    if (frame.shutter.end_camera)
+      frame.shutter.end_camera = cli::camera_for_frame(options.camera_model, *frame.shutter.end_camera);
   }
 
   tilesplat::RenderSettings settings;
@@ -473,13 +493,20 @@ int run(int argc, char** argv) {
   writer.exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
   writer.exr.attributes["scene"] = loaded.path.string();
   writer.exr.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
-  // A scene file's lens: the view's own for one frame; for many, each frame's view has its own.
-  if (!sequence) settings.lens = frames.front().lens;
+  // A scene file's lens and shutter: the view's own for one frame; for many, each frame's view has its own.
+  if (!sequence) {
+    settings.lens = frames.front().lens;
+    settings.shutter = frames.front().shutter;
+  }
   writer.exr.attributes["renderSettings"] =
       settings_text(settings, options.lens, options.shutter, loaded.lod);
   if (sequence && !options.lens.enabled() &&
       std::any_of(frames.begin(), frames.end(), [](const Frame& f) { return f.lens.enabled(); }))
     writer.exr.attributes["renderSettings"] += " lens=the scene file's, per view";
+  if (sequence && !options.shutter.enabled() && std::any_of(frames.begin(), frames.end(), [](const Frame& f) {
+        return f.shutter.close > f.shutter.open;
+      }))
+    writer.exr.attributes["renderSettings"] += " shutter=the scene file's, per view";
 
   if (sequence) {
     // Everything besides the camera that makes two runs' files differ, for the manifest.

@@ -1,7 +1,8 @@
 // libFuzzer harness for scene files (docs/scene-format.md): the input is the JSON of a scene file in a
 // folder that holds one splat file, m.ply, for "models" to name (the parser checks that a model exists;
 // it does not read it). Every input must parse into a description whose cameras, lenses and lights a
-// renderer accepts, or throw a SceneError that names the file; see tests/fuzz/README.md.
+// renderer accepts (and shutters and motions too), or throw a SceneError that names the file; see
+// tests/fuzz/README.md.
 #include <unistd.h>
 
 #include <cmath>
@@ -48,6 +49,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         FUZZ_CHECK(std::isfinite((*pixel)[0]) && std::isfinite((*pixel)[1]));
     }
     for (const tilesplat::ThinLens& lens : description.lenses) tilesplat::validate(lens);
+    FUZZ_CHECK(description.shutters.size() == description.lenses.size());
+    for (size_t i = 0; i < description.shutters.size(); ++i) {
+      const tilesplat::Shutter& shutter = description.shutters[i];
+      FUZZ_CHECK(shutter.close > shutter.open || shutter == tilesplat::Shutter{});
+      if (shutter.end_camera) {  // the same camera, moved
+        tilesplat::validate(shutter);
+        FUZZ_CHECK(shutter.end_camera->width == description.cameras[i].camera.width);
+      }
+    }
+    // A moving model's path is valid all the way (throws std::invalid_argument otherwise).
+    for (const tilesplat::SceneModel& model : description.models)
+      if (model.motion) tilesplat::transform_between(model.transform, *model.motion, 0.5);
   } catch (const tilesplat::SceneError& error) {
     FUZZ_CHECK(std::string(error.what()).starts_with(file.string()));
   }
