@@ -271,6 +271,32 @@ void bind(nb::module_& m) {
       "SOG meta.json, .glb, .gltf) or a scene file (.json). strict: fail on a non-finite value instead of "
       "dropping the Gaussian.");
 
+  // --- a scene file's models as placed copies, some of which may move
+  nb::class_<SceneInstances>(
+      m, "SceneInstances",
+      "A scene file's models as placed copies of their files (each file held once), where some may move "
+      "(a model's \"motion\"): Renderer.render(camera, instances=..., shutter=...) blurs them while the "
+      "shutter is open (docs/effects.md, \"Moving models\").")
+      .def(
+          "__init__",
+          [](SceneInstances* self, const std::filesystem::path& path, bool strict) {
+            check_exists(path, "scene file");
+            LoadOptions options;
+            options.strict = strict;
+            nb::gil_scoped_release release;
+            new (self) SceneInstances(load_scene_instances(load_scene_description(path), options));
+          },
+          "path"_a, "strict"_a = false, "Reads a scene file (.json) and the splat files it names.")
+      .def_prop_ro("size", &SceneInstances::size, "the Gaussians of the merged scene")
+      .def_prop_ro("moves", &SceneInstances::moves, "whether any model moves")
+      .def(
+          "scene_at",
+          [](const SceneInstances& scene, double t) {
+            nb::gil_scoped_release release;
+            return merge_instances(scene, t);
+          },
+          "t"_a = 0.0, "The merged scene with every model where it is at time t in [0, 1].");
+
   // --- level-of-detail sets
   nb::class_<LodSelection>(m, "LodSelection", "The level each chunk of a LOD set is drawn at for one camera.")
       .def_ro("chunk_levels", &LodSelection::chunk_levels, "per chunk: the level drawn, or -1 out of view")
@@ -630,17 +656,19 @@ void bind(nb::module_& m) {
              const std::string& compositor, uint32_t stochastic_frames, uint32_t seed,
              const std::array<float, 3>& background, bool reuse_lists, double near_plane, double max_alpha,
              const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter,
-             const GaussianScene* scene, uint64_t memory_budget, const LodSet* lod_set,
-             uint64_t splat_budget) {
+             const GaussianScene* scene, uint64_t memory_budget, const LodSet* lod_set, uint64_t splat_budget,
+             const SceneInstances* instances) {
             RenderSettings settings = make_settings(
                 sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames, seed,
                 background, reuse_lists, near_plane, max_alpha, lens, shutter, memory_budget);
-            if (scene && lod_set) throw std::invalid_argument("render takes a scene or a lod_set, not both");
+            if (int(scene != nullptr) + int(lod_set != nullptr) + int(instances != nullptr) > 1)
+              throw std::invalid_argument("render takes one of scene, lod_set and instances");
             if (splat_budget > 0 && !lod_set)
               throw std::invalid_argument("splat_budget applies to a lod_set");
             settings.splat_budget = splat_budget;
             nb::gil_scoped_release release;
             if (lod_set) return self.renderer->render(*lod_set, camera, settings);
+            if (instances) return self.renderer->render(*instances, camera, settings);
             return scene ? self.renderer->render(*scene, camera, settings)
                          : self.renderer->render(camera, settings);
           },
@@ -649,13 +677,13 @@ void bind(nb::module_& m) {
           "background"_a = std::array<float, 3>{0, 0, 0}, "reuse_lists"_a = true,
           "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
           "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0, "lod_set"_a = nb::none(),
-          "splat_budget"_a = 0,
+          "splat_budget"_a = 0, "instances"_a = nb::none(),
           "Renders the scene from `camera`: the one set_scene uploaded, or `scene`, which replaces it and is "
-          "rendered within memory_budget bytes of device memory (0: the device's own limits), in "
-          "depth-ordered "
-          "parts into the same image where the whole frame would need more (docs/big-scenes.md), or a LodSet "
-          "`lod_set`: "
-          "level 0, or under splat_budget the levels this camera calls for (LodSet.select). "
+          "rendered within memory_budget bytes of device memory (0: the device's own limits), "
+          "in depth-ordered parts into the same image where the whole frame would need more "
+          "(docs/big-scenes.md); a LodSet `lod_set`: level 0, or under splat_budget the levels this camera "
+          "calls for (LodSet.select); or SceneInstances `instances`, whose moving models blur under an open "
+          "shutter (with or without its end_camera). "
           "Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted', 'stochastic' or 'raster' (the depth-sorted splats drawn as quads by the "

@@ -162,6 +162,46 @@ def test_a_scene_past_the_device_renders_in_parts_without_a_budget(playbot_rende
     assert small.validation_messages == 0
 
 
+def test_a_scene_files_moving_models_blur_under_an_open_shutter(playbot_renderer):
+    _, renderer = playbot_renderer
+    instances = tilesplat.SceneInstances(REPO / "scenes" / "moving_playbots.json")
+    assert instances.moves and instances.size == 62000
+    camera = tilesplat.Camera.orbit(instances.scene_at(0), 96, 54, azimuth_deg=0)
+    # Closed: the scene where it is at time 0.
+    renderer.set_scene(instances.scene_at(0))
+    still = renderer.render(camera)
+    assert np.array_equal(renderer.render(camera, instances=instances).rgba, still.rgba)
+    # Open over a still camera: the linear mean of the frames of the scene at the shutter's times.
+    shutter = tilesplat.Shutter(open=0.0, close=1.0, samples=3)
+    blurred = renderer.render(camera, instances=instances, shutter=shutter)
+    assert renderer.last_frame_stats["samples"] == 3
+    frames = []
+    for t in tilesplat.shutter_times(0.0, 1.0, 3):
+        renderer.set_scene(instances.scene_at(t))
+        frames.append(renderer.render(camera))
+    assert tilesplat.compare_images(blurred, frames[1])["psnr_db"] < 40
+
+    # The mean in linear light (docs/effects.md): each premultiplied display colour decoded as A decode(C / A).
+    def decode(v):
+        return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+
+    def encode(v):
+        return np.where(v <= 0.0031308, v * 12.92, 1.055 * np.power(np.maximum(v, 0), 1 / 2.4) - 0.055)
+
+    linear, alpha = 0, 0
+    for frame in frames:
+        a = frame.rgba[..., 3:].astype(np.float64)
+        c = frame.rgba[..., :3].astype(np.float64)
+        linear = linear + a * decode(np.divide(c, a, out=np.zeros_like(c), where=a > 0))
+        alpha = alpha + a
+    linear, alpha = linear / len(frames), alpha / len(frames)
+    mean = alpha * encode(np.divide(linear, alpha, out=np.zeros_like(linear), where=alpha > 0))
+    assert np.abs(mean - blurred.rgba[..., :3]).max() <= 1e-5
+    assert np.abs(alpha[..., 0] - blurred.rgba[..., 3]).max() <= 1e-6
+    with pytest.raises(ValueError, match="one of scene, lod_set and instances"):
+        renderer.render(camera, instances=instances, scene=instances.scene_at(0))
+
+
 def test_a_lod_set_by_level_and_under_a_splat_budget(playbot_renderer):
     _, renderer = playbot_renderer
     lods = tilesplat.LodSet(REPO / "tests" / "data" / "playbot_lod_set" / "lod-meta.json")
