@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "tilesplat/reference.h"
+#include "tilesplat/scene_description.h"
 
 namespace tilesplat::render_app {
 
@@ -60,7 +61,8 @@ RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& ba
     cpu_ms_ = renderer_->last_frame_stats().cpu_ms;
   } else {
     const auto start = std::chrono::steady_clock::now();
-    image = render_reference(scene, camera, settings);
+    image = instances_ ? render_reference(*instances_, camera, settings)
+                       : render_reference(scene, camera, settings);
     cpu_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     gpu_ms_ = 0;
   }

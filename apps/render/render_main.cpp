@@ -451,9 +451,6 @@ int run(int argc, char** argv) {
                       loaded.lens,
                       loaded.shutter});
   }
-  if (options.reference && loaded.instances && loaded.instances->moves())
-    throw cli::UsageError("--reference renders still scenes, and " + single_quoted(loaded.path.string()) +
-                          " has models that move (their 'motion'): render it on the GPU");
   for (Frame& frame : frames) {
     frame.camera = cli::camera_for_frame(options.camera_model, frame.camera);
     if (frame.next_camera)

@@ -170,14 +170,12 @@ RenderImage Renderer::render(const GaussianScene& scene, const Camera& camera,
 
 RenderImage Renderer::render(const SceneInstances& scene, const Camera& camera,
                              const RenderSettings& settings) {
-  const Shutter& shutter = settings.shutter;
-  if (scene.moves() && shutter.close > shutter.open) {
+  if (blurs_moving_models(scene, settings)) {
     // Moving models under an open shutter: each time sample renders the copies where they are then (and
     // the camera where it is then: still without an end camera), whole or in parts as any frame.
-    RenderSettings moving = settings;
-    if (!moving.shutter.end_camera) moving.shutter.end_camera = camera;
     return impl_->average_samples(
-        camera, moving, [&](const Camera& sample_camera, const RenderSettings& sample_settings, double time) {
+        camera, shutter_over_moving_models(settings, camera),
+        [&](const Camera& sample_camera, const RenderSettings& sample_settings, double time) {
           return impl_->render_scene(
               PartSource(scene, time), [&] { set_scene(merge_instances(scene, time)); }, sample_camera,
               sample_settings, *this);

@@ -54,6 +54,15 @@ TILESPLAT_API std::array<double, 9> covariance3d(const float log_scale[3], const
 TILESPLAT_API RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
                                            const RenderSettings& settings = {});
 
+struct SceneInstances;  // tilesplat/scene_description.h
+
+/// A scene file's placed copies in float64: their merged scene (merge_instances); where copies move under
+/// an open shutter (settings.shutter: close > open), the linear mean of the frames at the shutter's times,
+/// each of the copies where they are then from the camera then, as Renderer::render(instances, ...)
+/// makes it (docs/effects.md, "Moving models").
+TILESPLAT_API RenderImage render_reference(const SceneInstances& scene, const Camera& camera,
+                                           const RenderSettings& settings = {});
+
 /// The order in which each pixel of render_reference blends its splats.
 enum class ReferenceOrder {
   kSettings,  ///< as the settings say: the tile's centre-depth list, or the re-sorting mode's window

@@ -133,6 +133,16 @@ RenderImage render_averaged(const Camera& camera, const RenderSettings& settings
   return mean.mean();
 }
 
+bool blurs_moving_models(const SceneInstances& scene, const RenderSettings& settings) {
+  return scene.moves() && settings.shutter.close > settings.shutter.open;
+}
+
+RenderSettings shutter_over_moving_models(const RenderSettings& settings, const Camera& camera) {
+  RenderSettings moving = settings;
+  if (!moving.shutter.end_camera) moving.shutter.end_camera = camera;
+  return moving;
+}
+
 void add_pass_times(std::vector<PassTiming>& into, const std::vector<PassTiming>& from) {
   for (const PassTiming& pass : from) {
     auto it =

@@ -11,6 +11,7 @@
 #include "tilesplat/lens.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/renderer.h"
+#include "tilesplat/scene_description.h"
 #include "tilesplat/shutter.h"
 
 namespace tilesplat {
@@ -57,6 +58,13 @@ RenderImage render_averaged(const Camera& camera, const RenderSettings& settings
                             const SampleRenderer& render_sample);
 RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
                             const TimedSampleRenderer& render_sample);
+
+// Whether a scene file's copies that move (SceneInstances::moves) blur in this frame: an open shutter
+// (close > open), whether the camera moves or not.
+bool blurs_moving_models(const SceneInstances& scene, const RenderSettings& settings);
+// The settings such a frame averages under: the shutter's end camera the camera itself where it has none
+// (a still camera), so that render_averaged takes the shutter's times.
+RenderSettings shutter_over_moving_models(const RenderSettings& settings, const Camera& camera);
 
 // Adds a sample frame's statistics to those of the frame it is part of: GPU times summed (pass by pass),
 // the largest visible and intersection counts, retries and submissions summed; samples summed (a sample

@@ -20,6 +20,7 @@
 #include "reference/reference_projection.h"
 #include "settings_checks.h"
 #include "tilesplat/reference.h"
+#include "tilesplat/scene_description.h"
 
 namespace tilesplat {
 namespace {
@@ -113,6 +114,19 @@ PixelRule pixel_rule(const RenderSettings& settings, ReferenceOrder order) {
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
                              const RenderSettings& settings) {
   return render_reference(scene, camera, settings, ReferenceOrder::kSettings);
+}
+
+RenderImage render_reference(const SceneInstances& scene, const Camera& camera,
+                             const RenderSettings& settings) {
+  if (!blurs_moving_models(scene, settings))
+    return render_reference(merge_instances(scene), camera, settings);
+  // Each time sample of the scene where it is then, as Renderer::render(instances, ...) samples them.
+  return render_averaged(
+      camera, shutter_over_moving_models(settings, camera),
+      TimedSampleRenderer(
+          [&](const Camera& sample_camera, const RenderSettings& sample_settings, double time) {
+            return render_reference(merge_instances(scene, time), sample_camera, sample_settings);
+          }));
 }
 
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
