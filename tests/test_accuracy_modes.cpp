@@ -213,6 +213,34 @@ TEST(AccuracyModes, ShCapsAndHalfPrecisionBehave) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// compositor_draws is the rule render() refuses by: each compositor against modes it draws and not.
+TEST(AccuracyModes, CompositorDrawsIsTheRuleRenderHolds) {
+  Renderer& renderer = testing::validated_renderer();
+  const GaussianScene scene = load_scene(testing::bundled_sh3());
+  renderer.set_scene(scene);
+  const Camera camera = orbit_camera(scene, 32, 24);
+  for (const Compositor compositor : {Compositor::kSorted, Compositor::kStochastic, Compositor::kRaster})
+    for (const char* name : {"reference", "depth16", "depth24", "resort4", "fp16-sh+opacity-extent"}) {
+      RenderSettings settings;
+      settings.compositor = compositor;
+      settings.stochastic.frames = 1;
+      settings.accuracy = parse_accuracy_modes(name);
+      bool rendered = true;
+      try {
+        renderer.render(camera, settings);
+      } catch (const std::invalid_argument&) {
+        rendered = false;
+      }
+      EXPECT_EQ(compositor_draws(compositor, settings.accuracy), rendered)
+          << to_string(compositor) << " " << name;
+    }
+  EXPECT_TRUE(compositor_draws(Compositor::kSorted, parse_accuracy_modes("resort4")));
+  EXPECT_FALSE(compositor_draws(Compositor::kRaster, parse_accuracy_modes("resort4")));
+  EXPECT_TRUE(compositor_draws(Compositor::kRaster, parse_accuracy_modes("depth16")));
+  EXPECT_FALSE(compositor_draws(Compositor::kStochastic, parse_accuracy_modes("depth16")));
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 // The half-precision harmonics are packed by one dispatch that strides: a scene of SH degree 3 has 24
 // words a Gaussian to pack, and past 699,050 Gaussians more than lavapipe's 65,535 workgroups of 256
 // (which stopped the mode before). 720,000 Gaussians behind the camera come first, so that the 64 it

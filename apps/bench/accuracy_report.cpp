@@ -102,15 +102,10 @@ std::vector<Camera> camera_path(CameraPath kind, const Camera& start, const std:
 
 std::vector<Row> report_rows(const Options& options, int scene_sh_degree) {
   const auto modes = options.modes.empty() ? default_modes() : options.modes;
-  auto draws = [](Compositor compositor, const AccuracyModes& m) {
-    if (compositor == Compositor::kSorted) return true;
-    if (compositor == Compositor::kRaster) return m.resort_window == 0;
-    return m.resort_window == 0 && m.depth_key_bits == 32;
-  };
   std::vector<Row> rows;
   const Compositor first = options.compositor.value_or(Compositor::kSorted);
   for (const AccuracyModes& m : modes)
-    if (applies_to(m, scene_sh_degree) && draws(first, m)) rows.push_back({m, first});
+    if (applies_to(m, scene_sh_degree) && compositor_draws(first, m)) rows.push_back({m, first});
   // The default report: the raster compositor beside the sorted one, on the reference modes. (Modes
   // given by name are measured as given, by the compositor given.)
   if (options.modes.empty() && !options.compositor) rows.push_back({AccuracyModes{}, Compositor::kRaster});

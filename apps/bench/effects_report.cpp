@@ -150,7 +150,7 @@ std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& bas
   add("+depth +splat count", SceneVariant::kScene, [](RenderSettings& s) { s.depth = s.splat_count = true; });
   // Not an effect but the other side of the sort's cost: no depth sort, one hashed sample per pixel.
   // (The modes that reorder by depth have no stochastic form.)
-  if (base.accuracy.depth_key_bits == 32 && base.accuracy.resort_window == 0) {
+  if (compositor_draws(Compositor::kStochastic, base.accuracy)) {
     add("stochastic, 1 frame", SceneVariant::kScene, [](RenderSettings& s) {
       s.compositor = Compositor::kStochastic;
       s.stochastic.frames = 1;

@@ -51,10 +51,6 @@ constexpr const char* kModeCycle[] = {"reference", "depth16", "resort8", "depth1
 // resort8 while it is on).
 constexpr std::array<tilesplat::Compositor, 2> kCompositorCycle = {tilesplat::Compositor::kSorted,
                                                                    tilesplat::Compositor::kRaster};
-bool draws(tilesplat::Compositor compositor, const tilesplat::AccuracyModes& modes) {
-  return compositor != tilesplat::Compositor::kRaster || modes.resort_window == 0;
-}
-
 bool validation_from_environment() {
   const char* value = std::getenv("TILESPLAT_VALIDATION");
   return value && *value && std::string_view(value) != "0";
@@ -223,7 +219,8 @@ class Viewer {
       case GLFW_KEY_S: viewer.sort_ = (viewer.sort_ + 1) % viewer.sorts_.size(); break;
       case GLFW_KEY_C:
         viewer.compositor_ = (viewer.compositor_ + 1) % kCompositorCycle.size();
-        if (!draws(kCompositorCycle[viewer.compositor_], viewer.modes_[viewer.mode_])) viewer.next_mode();
+        if (!tilesplat::compositor_draws(kCompositorCycle[viewer.compositor_], viewer.modes_[viewer.mode_]))
+          viewer.next_mode();
         break;
       case GLFW_KEY_D:
         viewer.depth_out_ = !viewer.depth_out_;
@@ -270,7 +267,7 @@ class Viewer {
   void next_mode() {
     do {
       mode_ = (mode_ + 1) % modes_.size();
-    } while (!draws(kCompositorCycle[compositor_], modes_[mode_]));
+    } while (!tilesplat::compositor_draws(kCompositorCycle[compositor_], modes_[mode_]));
   }
 
   void step_view(int step) {

@@ -30,7 +30,7 @@ void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& optio
   if (options.common.compositor == Compositor::kStochastic)
     throw cli::UsageError("the viewer shows the sorted or the raster compositor, not the stochastic one");
   if (options.common.compositor == Compositor::kRaster && !options.common.modes.empty() &&
-      options.common.modes.front().resort_window > 0)
+      !compositor_draws(Compositor::kRaster, options.common.modes.front()))
     throw cli::UsageError("the raster compositor does not re-sort per pixel (--mode " +
                           to_string(options.common.modes.front()) + ")");
   if (!options.screenshot.empty()) {

@@ -128,6 +128,11 @@ enum class Compositor {
 TILESPLAT_API std::string to_string(Compositor compositor);  ///< "sorted", "stochastic", "raster"
 /// The compositor of a name to_string gives; throws std::invalid_argument listing the names.
 TILESPLAT_API Compositor parse_compositor(const std::string& name);
+/// Whether `compositor` draws frames in the accuracy `modes`: the sorted compositor every mode, the raster
+/// one all but per-pixel re-sorting (it draws no tile lists), the stochastic one neither re-sorting nor
+/// depth keys below 32 bits (it sorts nothing). Renderer::render throws std::invalid_argument, saying
+/// why, for the others.
+TILESPLAT_API bool compositor_draws(Compositor compositor, const AccuracyModes& modes);
 /// The stochastic compositor draws, per pixel and frame, each splat of its tile with probability
 /// alpha (the sorted composite's alpha and cut-off) from a hash of (pixel, splat index, frame, seed)
 /// and shows the nearest drawn splat (by view depth, then index), or the background. Its expectation

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "camera/camera_models.h"
@@ -46,37 +47,46 @@ void check_camera(const Camera& camera, const DeviceCaps& device) {
          std::to_string(device.max_allocation_size >> 20) + " MiB)");
 }
 
-// Settings the raster compositor cannot honour: it blends in the Gaussians' depth order, each splat
-// over whole pixels.
-void validate_raster(const RenderSettings& settings) {
-  if (settings.accuracy.resort_window > 0)
-    throw std::invalid_argument(
-        "raster compositor: per-pixel re-sorting (resort" + std::to_string(settings.accuracy.resort_window) +
-        ") re-orders each tile's list, and this compositor draws no tile lists: use the "
-        "sorted compositor");
+// Why `compositor` cannot draw in `modes`, or nothing: the one rule of compositor_draws and
+// validate_compositor. The raster compositor blends in the Gaussians' depth order, each splat over whole
+// pixels; the stochastic one sorts nothing.
+std::optional<std::string> modes_refusal(Compositor compositor, const AccuracyModes& modes) {
+  if (compositor == Compositor::kSorted) return std::nullopt;
+  const std::string resort = "per-pixel re-sorting (resort" + std::to_string(modes.resort_window) + ")";
+  if (compositor == Compositor::kRaster) {
+    if (modes.resort_window > 0)
+      return "raster compositor: " + resort +
+             " re-orders each tile's list, and this compositor draws no tile lists: use the sorted "
+             "compositor";
+    return std::nullopt;
+  }
+  if (modes.resort_window > 0)
+    return "stochastic compositor: " + resort +
+           " re-orders depth-sorted lists, and this compositor sorts nothing: use the sorted compositor";
+  if (modes.depth_key_bits != 32)
+    return "stochastic compositor: " + std::to_string(modes.depth_key_bits) +
+           "-bit depth keys approximate the depth sort, which this compositor does not run (it compares full "
+           "view depths): use 32-bit depth keys";
+  return std::nullopt;
 }
 
-// Settings the stochastic compositor cannot honour.
+// Settings the compositors cannot honour.
 constexpr uint32_t kMaxStochasticFrames = 4096;
 void validate_compositor(const RenderSettings& settings) {
-  if (settings.compositor == Compositor::kRaster) validate_raster(settings);
+  if (const auto why = modes_refusal(settings.compositor, settings.accuracy))
+    throw std::invalid_argument(*why);
   if (settings.compositor != Compositor::kStochastic) return;
   auto fail = [](const std::string& why) { throw std::invalid_argument("stochastic compositor: " + why); };
-  const AccuracyModes& modes = settings.accuracy;
-  if (modes.resort_window > 0)
-    fail("per-pixel re-sorting (resort" + std::to_string(modes.resort_window) +
-         ") re-orders depth-sorted lists, and this compositor sorts nothing: use the sorted compositor");
-  if (modes.depth_key_bits != 32)
-    fail(std::to_string(modes.depth_key_bits) +
-         "-bit depth keys approximate the depth sort, which this compositor does not run (it compares full "
-         "view "
-         "depths): use 32-bit depth keys");
   if (settings.stochastic.frames < 1 || settings.stochastic.frames > kMaxStochasticFrames)
     fail("stochastic.frames must be 1 to " + std::to_string(kMaxStochasticFrames) + ", not " +
          std::to_string(settings.stochastic.frames));
 }
 
 }  // namespace
+
+bool compositor_draws(Compositor compositor, const AccuracyModes& modes) {
+  return !modes_refusal(compositor, modes).has_value();
+}
 
 // Each part's lists are exact only for an order every part agrees on.
 void validate_scene_parts(const RenderSettings& settings, const std::string& sort_name) {
