@@ -123,6 +123,43 @@ TEST(Viewer, ASplatBudgetDrawsWhatTheRendererDraws) {
   EXPECT_GE(difference.psnr_db, 100.0) << "max abs " << difference.max_abs;
 }
 
+// --fisheye, --equirectangular (and key L's cycle) show the splats through another lens: the screenshot
+// is tilesplat-render's frame through the same lens. They need --no-mesh (the box and the grid are drawn
+// through a pinhole), and per-pixel re-sorting needs the pinhole: usage errors before any window.
+TEST(Viewer, AnotherLensShowsWhatTheRendererDrawsThroughIt) {
+  REQUIRE_VIEWER();
+  const fs::path out = fresh_output_dir();
+  std::vector<std::string> mesh_args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
+  mesh_args.insert(mesh_args.end(), {"--fisheye", "200"});
+  const ProcessResult with_mesh = run_process("env -u DISPLAY ", kViewerExe, mesh_args);
+  EXPECT_EQ(with_mesh.exit_code, 2) << with_mesh.err;
+  EXPECT_NE(with_mesh.err.find("add --no-mesh"), std::string::npos) << with_mesh.err;
+  mesh_args.insert(mesh_args.end(), {"--no-mesh", "--mode", "resort4"});
+  const ProcessResult resort = run_process("env -u DISPLAY ", kViewerExe, mesh_args);
+  EXPECT_EQ(resort.exit_code, 2) << resort.err;
+  EXPECT_NE(resort.err.find("needs the pinhole camera"), std::string::npos) << resort.err;
+
+  const std::optional<std::string> prefix = display_prefix();
+  if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
+  for (const std::vector<std::string>& lens :
+       {std::vector<std::string>{"--fisheye", "200"}, std::vector<std::string>{"--equirectangular"}}) {
+    std::vector<std::string> viewer_args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
+    viewer_args.insert(viewer_args.end(), lens.begin(), lens.end());
+    std::vector<std::string> render_args = viewer_args;
+    viewer_args.insert(viewer_args.end(), {"--no-mesh", "--validation", "--frames", "2", "--screenshot",
+                                           (out / "viewer.exr").string()});
+    render_args.insert(render_args.end(), {"-o", (out / "render.exr").string()});
+    const ProcessResult viewer = run_process(*prefix, kViewerExe, viewer_args);
+    ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
+    EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
+    const ProcessResult render = run_process("", kRenderExe, render_args);
+    ASSERT_EQ(render.exit_code, 0) << render.err;
+    const tilesplat::ImageDifference difference = tilesplat::compare_images(
+        tilesplat::read_exr(out / "viewer.exr"), tilesplat::read_exr(out / "render.exr"));
+    EXPECT_GE(difference.psnr_db, 100.0) << lens.front() << ": max abs " << difference.max_abs;
+  }
+}
+
 // The window shows the trained colours as a PNG preview holds them (docs/colour.md): the bytes of the
 // window's image equal tilesplat-render's --png of the same view within one level (the blit's float to
 // 8-bit rounding against the preview's). Both kinds of window format: a _UNORM one, which the viewer

@@ -96,6 +96,7 @@ struct CameraModelFlags {
   bool equirectangular = false;           // --equirectangular: the 360x180 panorama
   int given() const { return fisheye_fov_deg.has_value() + view_height.has_value() + equirectangular; }
   bool enabled() const { return given() > 0; }
+  bool operator==(const CameraModelFlags&) const = default;
 };
 // Declares the three flags, in a section of their own.
 void add_camera_model_options(ArgParser& parser, CameraModelFlags& flags);

@@ -108,6 +108,14 @@ class Viewer {
     // file sets no compositor).
     compositor_ =
         base_settings_.compositor == tilesplat::Compositor::kRaster ? 1 : 0;  // kCompositorCycle order
+    // Key L's lenses, without the box and the grid (drawn through a pinhole): the pinhole, a fisheye of
+    // 180 degrees, the panorama, and --fisheye, --orthographic or --equirectangular where given.
+    lenses_.push_back({});
+    if (!mesh_) {
+      lenses_.push_back({.fisheye_fov_deg = 180.0});
+      lenses_.push_back({.equirectangular = true});
+      if (options.camera_model.enabled()) lens_ = find_or_append(lenses_, options.camera_model);
+    }
 
     glfwSetWindowUserPointer(window_, this);
     glfwSetKeyCallback(window_, on_key);
@@ -154,7 +162,7 @@ class Viewer {
 
   // The camera and settings of the last frame, for a screenshot. The settings have the depth and
   // count outputs the scene asks for, which the window's frames leave out.
-  const tilesplat::Camera& camera() const { return controller_.camera(); }
+  tilesplat::Camera camera() const { return cli::camera_for_frame(lenses_[lens_], controller_.camera()); }
   tilesplat::RenderSettings settings() const {
     tilesplat::RenderSettings settings = base_settings_;
     settings.sort = sorts_[sort_];
@@ -219,11 +227,14 @@ class Viewer {
       case GLFW_KEY_S: viewer.sort_ = (viewer.sort_ + 1) % viewer.sorts_.size(); break;
       case GLFW_KEY_C:
         viewer.compositor_ = (viewer.compositor_ + 1) % kCompositorCycle.size();
-        if (!tilesplat::compositor_draws(kCompositorCycle[viewer.compositor_], viewer.modes_[viewer.mode_]))
-          viewer.next_mode();
+        if (!viewer.draws(viewer.modes_[viewer.mode_])) viewer.next_mode();
         break;
       case GLFW_KEY_D:
         viewer.depth_out_ = !viewer.depth_out_;
+        break;
+      case GLFW_KEY_L:
+        viewer.lens_ = (viewer.lens_ + 1) % viewer.lenses_.size();
+        if (!viewer.draws(viewer.modes_[viewer.mode_])) viewer.next_mode();
         break;
       default: return;
     }
@@ -263,11 +274,18 @@ class Viewer {
     self(window).needs_render_ = true;
   }
 
-  // The next accuracy mode the compositor draws (the reference always is one).
+  // Whether the frame draws in `modes`: the compositor's rule, and per-pixel re-sorting through the
+  // pinhole alone.
+  bool draws(const tilesplat::AccuracyModes& modes) const {
+    return tilesplat::compositor_draws(kCompositorCycle[compositor_], modes) &&
+           (modes.resort_window == 0 || !lenses_[lens_].enabled());
+  }
+
+  // The next accuracy mode the frame draws (the reference always is one).
   void next_mode() {
     do {
       mode_ = (mode_ + 1) % modes_.size();
-    } while (!tilesplat::compositor_draws(kCompositorCycle[compositor_], modes_[mode_]));
+    } while (!draws(modes_[mode_]));
   }
 
   void step_view(int step) {
@@ -308,7 +326,7 @@ class Viewer {
     if (mesh_layer_)
       mesh_layer_->draw(renderer_, controller_.camera(), frame, depth_out_);
     else
-      tilesplat::render_to_image(renderer_, controller_.camera(), frame, image_->target(), nullptr,
+      tilesplat::render_to_image(renderer_, camera(), frame, image_->target(), nullptr,
                                  tilesplat::HostFrameSync{});
     needs_render_ = false;
     needs_present_ = true;
@@ -318,7 +336,7 @@ class Viewer {
   // Under --splat-budget: the levels this frame's camera calls for, uploaded when they changed.
   void choose_lod_levels() {
     tilesplat::LodSelection selection =
-        tilesplat::select_lod_levels(*lod_->set, controller_.camera(), lod_->splat_budget);
+        tilesplat::select_lod_levels(*lod_->set, camera(), lod_->splat_budget);
     lod_splats_ = selection.splats;
     if (selection.chunk_levels == lod_levels_) return;
     renderer_.set_scene(lod_->set->load_selection(selection));
@@ -332,6 +350,13 @@ class Viewer {
   }
 
   // The GPU time is the previous frame's: a frame's statistics come once it has been waited for.
+  std::string lens_name() const {
+    const cli::CameraModelFlags& lens = lenses_[lens_];
+    if (lens.fisheye_fov_deg) return "fisheye " + cli::format_fixed(*lens.fisheye_fov_deg, 0) + " deg";
+    if (lens.view_height) return "orthographic " + cli::format_fixed(*lens.view_height, 2) + " tall";
+    return lens.equirectangular ? "panorama" : "pinhole";
+  }
+
   void show_title(double frame_ms) {
     std::string title = scene_name_;
     if (!views_.empty()) {
@@ -340,7 +365,7 @@ class Viewer {
     }
     const std::string& ran = renderer_.last_frame_stats().sort_strategy;
     const std::string sort = sorts_[sort_] == "auto" && !ran.empty() ? "auto (" + ran + ")" : sorts_[sort_];
-    title += " | " + tilesplat::to_string(modes_[mode_]) + " | " + sort + " | " +
+    title += " | " + lens_name() + " | " + tilesplat::to_string(modes_[mode_]) + " | " + sort + " | " +
              tilesplat::to_string(kCompositorCycle[compositor_]) +
              (lod_ ? " | " + cli::group_thousands(lod_splats_) + " splats (LOD)" : "") + " | GPU " +
              cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
@@ -376,6 +401,8 @@ class Viewer {
   size_t mode_ = 0;
   std::vector<std::string> sorts_;
   size_t sort_ = 0;
+  std::vector<cli::CameraModelFlags> lenses_;  // key L's cycle
+  size_t lens_ = 0;
   size_t compositor_ = 0;                    // in kCompositorCycle (C cycles)
   tilesplat::RenderSettings base_settings_;  // the scene file's background, effects and outputs
 

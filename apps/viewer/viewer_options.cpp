@@ -7,6 +7,7 @@ namespace cli = tilesplat::cli;
 void add_viewer_options(cli::ArgParser& parser, ViewerOptions& options) {
   cli::add_common_options(parser, options.common, cli::SortChoice::kOne);
   cli::add_splat_budget_option(parser, options.common);
+  cli::add_camera_model_options(parser, options.camera_model);
   parser.section("scripting");
   parser.add_int("--frames", "N", "render N frames, then exit (default: run until the window is closed)",
                  &options.frames, 1, 1000000);
@@ -33,6 +34,16 @@ void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& optio
       !compositor_draws(Compositor::kRaster, options.common.modes.front()))
     throw cli::UsageError("the raster compositor does not re-sort per pixel (--mode " +
                           to_string(options.common.modes.front()) + ")");
+  cli::check_camera_model_options(options.camera_model);
+  // The box and the grid are drawn through a pinhole, and the splats test against their depth.
+  if (options.camera_model.enabled() && !options.no_mesh)
+    throw cli::UsageError(
+        "--fisheye, --orthographic and --equirectangular show the splats alone: add --no-mesh (the box "
+        "and the grid are drawn through a pinhole)");
+  if (options.camera_model.enabled() && !options.common.modes.empty() &&
+      options.common.modes.front().resort_window > 0)
+    throw cli::UsageError("per-pixel re-sorting (--mode " + to_string(options.common.modes.front()) +
+                          ") needs the pinhole camera");
   if (!options.screenshot.empty()) {
     if (!cli::has_extension(options.screenshot, ".exr") && !cli::has_extension(options.screenshot, ".png"))
       throw cli::UsageError("--screenshot expects an .exr or .png file, got '" + options.screenshot + "'");

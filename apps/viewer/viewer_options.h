@@ -16,7 +16,8 @@ inline constexpr const char* kDescription =
     "middle-drag pans, the wheel zooms; N and P (or the arrow keys) step through the "
     "views of --cameras or the "
     "scene file, M cycles accuracy modes, S cycles sort strategies, C switches between the sorted and the "
-    "raster compositor, D turns the splats' "
+    "raster compositor, L steps through the lenses (the pinhole, a 180-degree fisheye, the 360x180 "
+    "panorama; --no-mesh), D turns the splats' "
     "depth out off and on, "
     "Esc or Q quits. The window starts at --width x --height (default 960 wide, the "
     "view's aspect) and the image "
@@ -31,6 +32,7 @@ struct ViewerOptions {
   std::string screenshot;
   bool no_mesh = false;       // the splats alone, straight into the float image
   bool no_depth_out = false;  // the splats write no depth: the grid is drawn over them
+  tilesplat::cli::CameraModelFlags camera_model;  // --fisheye, --orthographic, --equirectangular (key L)
 };
 
 // Declares every flag of tilesplat-viewer.
