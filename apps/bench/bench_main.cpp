@@ -26,6 +26,7 @@ int run(int argc, char** argv) {
   if (options.formats) return run_formats_report(options);
   if (options.scaling) return run_scaling_report(options);
   if (!options.lod_budgets.empty()) return run_lod_report(options);
+  if (options.sample_curve) return run_sample_curve(options);
   return run_frame_bench(options);
 }
 

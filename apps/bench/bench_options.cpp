@@ -147,6 +147,29 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
           options.lod_budgets.push_back(uint64_t(budget));
       });
 
+  parser.section("sample curve");
+  parser.add_value(
+      "--sample-curve", "EFFECT[:N,...]",
+      "measure an averaged effect's sample count against error and time on one SCENE: 'lens' (depth of "
+      "field, aperture 0.05 of the view depth of the scene's centre, focused there) or 'time' (motion blur "
+      "while the camera turns 5 degrees about the centre), with N samples (default 1,2,4,...,128); per "
+      "row the GPU time, the time per sample, and PSNR and max abs against 1,024 samples of the same "
+      "effect (docs/effects.md); --markdown, --csv and --plot (PSNR against samples) write the report",
+      [&options](const std::string& text) {
+        const size_t colon = text.find(':');
+        const std::string name = text.substr(0, colon);
+        if (name == "lens")
+          options.sample_curve = tilesplat::sample_curve::Effect::kLens;
+        else if (name == "time")
+          options.sample_curve = tilesplat::sample_curve::Effect::kTime;
+        else
+          throw cli::UsageError("--sample-curve takes 'lens' or 'time', optionally with ':N,N,...', got " +
+                                cli::single_quoted(text));
+        if (colon != std::string::npos)
+          options.sample_counts =
+              parse_int_list("--sample-curve", text.substr(colon + 1), 1, tilesplat::kMaxLensSamples);
+      });
+
   parser.section("scaling report");
   parser.add_switch(
       "--scaling",
@@ -224,20 +247,24 @@ void check_frame_options(const cli::ArgParser& parser, const BenchOptions& optio
   for (const char* flag : {"--sort-sizes", "--key-bits"})
     if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " applies only with --sort-bench");
   const bool lod_curve = !options.lod_budgets.empty();
+  const bool sample_curve = options.sample_curve.has_value();
   if (int(options.accuracy) + int(options.effects) + int(options.formats) + int(options.scaling) +
-          int(lod_curve) >
+          int(lod_curve) + int(sample_curve) >
       1)
-    throw cli::UsageError("--accuracy, --effects, --formats, --scaling and --lod-curve are separate runs");
+    throw cli::UsageError(
+        "--accuracy, --effects, --formats, --scaling, --lod-curve and --sample-curve are separate runs");
   if (parser.seen("--tile-copies") && !options.scaling)
     throw cli::UsageError("--tile-copies applies only with --scaling");
-  if (parser.seen("--memory-budget") &&
-      (options.accuracy || options.effects || options.formats || options.scaling || lod_curve))
+  if (parser.seen("--memory-budget") && (options.accuracy || options.effects || options.formats ||
+                                         options.scaling || lod_curve || sample_curve))
     throw cli::UsageError("--memory-budget applies only to the frame benchmark");
   if (!options.accuracy) {
     if (parser.seen("--path-frames")) throw cli::UsageError("--path-frames applies only with --accuracy");
-    if (parser.seen("--markdown") && !options.effects && !options.formats && !options.scaling && !lod_curve)
+    if (parser.seen("--markdown") && !options.effects && !options.formats && !options.scaling && !lod_curve &&
+        !sample_curve)
       throw cli::UsageError(
-          "--markdown applies only with --accuracy, --effects, --formats, --scaling or --lod-curve");
+          "--markdown applies only with --accuracy, --effects, --formats, --scaling, --lod-curve or "
+          "--sample-curve");
     if (options.common.modes.size() > 1)
       throw cli::UsageError(
           "several --mode combinations are compared by --accuracy; the frame benchmark takes one");
@@ -295,6 +322,12 @@ void check_bench_flags(const cli::ArgParser& parser, const BenchOptions& options
     if (options.common.sorts.size() > 1) throw cli::UsageError("--effects measures with one --sort strategy");
     if (parser.seen("--antialiasing"))
       throw cli::UsageError("--antialiasing does not apply to --effects (it measures every mode)");
+  } else if (options.sample_curve) {
+    for (const char* flag : {"--resolutions", "--json", "--fisheye", "--orthographic", "--equirectangular"})
+      if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --sample-curve");
+    if (options.common.scenes.size() != 1) throw cli::UsageError("--sample-curve measures one SCENE");
+    if (options.common.sorts.size() > 1)
+      throw cli::UsageError("--sample-curve measures with one --sort strategy");
   } else if (!options.lod_budgets.empty()) {
     for (const char* flag : {"--resolutions", "--json", "--lod"})
       if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --lod-curve");

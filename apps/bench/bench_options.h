@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -11,6 +12,7 @@
 
 #include "accuracy_report.h"
 #include "cli.h"
+#include "sample_curve.h"
 
 namespace tilesplat::bench {
 
@@ -43,6 +45,9 @@ struct BenchOptions {
   bool scaling = false;   // --scaling: frame time and memory against Gaussian count and image size
   int tile_copies = 0;    // --tile-copies N: with --scaling, also N copies of the largest scene
   std::vector<uint64_t> lod_budgets;  // --lod-curve: a LOD set's levels and these splat budgets
+  // --sample-curve EFFECT[:N,...]: an averaged effect's sample counts against error and time
+  std::optional<tilesplat::sample_curve::Effect> sample_curve;
+  std::vector<int> sample_counts = tilesplat::sample_curve::kDefaultCounts;
   uint64_t memory_budget = 0;  // --memory-budget: frames under RenderSettings::memory_budget (0: none)
   std::string markdown;
   accuracy::CameraPath path = accuracy::CameraPath::kPan;

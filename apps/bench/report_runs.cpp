@@ -9,6 +9,7 @@
 #include "formats_report.h"
 #include "frame_bench.h"
 #include "lod_report.h"
+#include "sample_curve.h"
 #include "scaling_report.h"
 
 namespace tilesplat::bench {
@@ -310,6 +311,56 @@ int run_formats_report(const BenchOptions& options) {
       report.validation_messages);
   std::fprintf(stderr, "%s: format costs, %zu files against %s%s\n", kProgram, files.size(),
                report.reference_name.c_str(), written.c_str());
+  return cli::kExitOk;
+}
+
+int run_sample_curve(const BenchOptions& options) {
+  check_outputs(options, scene_and_camera_inputs(options));
+  BenchScene scene;
+  scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram,
+                                      cli::SceneHolding::kMerged, options.common.lod);
+  scene.name = scene.loaded.path.filename().string();
+  if (!options.common.cameras_files.empty()) scene.cameras = options.common.cameras_files.front();
+  namespace curve = tilesplat::sample_curve;
+  curve::Options curve_options;
+  curve_options.effect = *options.sample_curve;
+  curve_options.counts = options.sample_counts;
+  curve_options.views = report_views(options, scene);
+  const tilesplat::Bounds bounds = scene.loaded.bounds();
+  curve_options.centre = {bounds.center[0], bounds.center[1], bounds.center[2]};
+  curve_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
+  curve_options.repeat = options.repeat;
+  if (!options.common.sorts.empty()) curve_options.sort = options.common.sorts.front();
+  if (!options.common.modes.empty()) curve_options.settings.accuracy = options.common.modes.front();
+  cli::apply_scene_settings(scene.loaded, curve_options.settings);
+  cli::apply_training_options(options.common, curve_options.settings);
+  std::printf("scene   %s: %s, %s, %zu views, %s samples\n", scene.name.c_str(),
+              cli::describe_scene(scene.loaded).c_str(),
+              cli::format_size(curve_options.views.front().width, curve_options.views.front().height).c_str(),
+              curve_options.views.size(), curve::effect_name(curve_options.effect).c_str());
+  std::fflush(stdout);
+  std::vector<curve::Row> rows;
+  curve::Run run;
+  {
+    Progress progress(curve::work_units(curve_options), cli::stderr_is_terminal());
+    run = curve::measure(cli::renderer_options(options.common), scene.loaded.scene, curve_options, rows,
+                         [&](int done, int, const std::string& what) { progress.update(done, what); });
+  }
+  std::printf("device  %s (driver %s)\n\n%s", run.device.name.c_str(), run.device.driver.c_str(),
+              curve::text_table(rows).c_str());
+  std::fflush(stdout);
+  const curve::Effect effect = curve_options.effect;
+  const std::string written =
+      write_outputs({{options.markdown,
+                      [&] { return curve::markdown(rows, effect, scene.name, run.device, options.command); }},
+                     {options.csv,
+                      [&] {
+                        return cli::with_provenance_columns(curve::csv(rows, effect, scene.name, run.device),
+                                                            options.command);
+                      }},
+                     {options.plot, [&] { return curve::svg(rows, effect, scene.name, run.device); }}},
+                    run.validation_messages);
+  std::fprintf(stderr, "%s: sample curve, %zu rows%s\n", kProgram, rows.size(), written.c_str());
   return cli::kExitOk;
 }
 
