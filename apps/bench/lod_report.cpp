@@ -7,6 +7,7 @@
 
 #include "bench_plot.h"
 #include "cli.h"
+#include "text_tables.h"
 #include "tilesplat/image.h"
 
 namespace tilesplat::lod_report {
@@ -35,6 +36,12 @@ std::vector<std::string> cells(const Row& row) {
 }
 
 const std::vector<std::string> kColumns = {"row", "splats", "GPU ms", "select ms", "PSNR dB", "max abs"};
+
+std::vector<std::vector<std::string>> table_rows(const std::vector<Row>& rows) {
+  std::vector<std::vector<std::string>> out;
+  for (const Row& row : rows) out.push_back(cells(row));
+  return out;
+}
 
 }  // namespace
 
@@ -118,23 +125,7 @@ Run measure(const RendererOptions& renderer_options, const LodSet& set, std::vec
 }
 
 std::string text_table(const std::vector<Row>& rows) {
-  std::vector<size_t> widths;
-  for (const std::string& column : kColumns) widths.push_back(column.size());
-  for (const Row& row : rows) {
-    const std::vector<std::string> line = cells(row);
-    for (size_t c = 0; c < line.size(); ++c) widths[c] = std::max(widths[c], line[c].size());
-  }
-  const auto format = [&widths](const std::vector<std::string>& line) {
-    std::string out;
-    for (size_t c = 0; c < line.size(); ++c) {
-      const std::string pad(widths[c] - line[c].size(), ' ');
-      out += c == 0 ? line[c] + pad : "  " + pad + line[c];
-    }
-    return out + "\n";
-  };
-  std::string out = format(kColumns);
-  for (const Row& row : rows) out += format(cells(row));
-  return out;
+  return bench::aligned_table(kColumns, table_rows(rows), /*label_column=*/true);
 }
 
 std::string markdown(const std::vector<Row>& rows, const std::string& scene, const DeviceInfo& device,
@@ -144,19 +135,8 @@ std::string markdown(const std::vector<Row>& rows, const std::string& scene, con
   out +=
       "Splats: Gaussians drawn (mean over the views). GPU ms: median over repeats, then views. Select ms: "
       "choosing the levels and gathering the chunks on the host. PSNR and max abs: against level 0 from "
-      "the same view.\n\n|";
-  for (const std::string& column : kColumns) out += " " + column + " |";
-  out += "\n|---|---:|---:|---:|---:|---:|\n";
-  for (const Row& row : rows) {
-    out += "|";
-    for (const std::string& cell : cells(row)) {
-      out += ' ';
-      out += cell;
-      out += " |";
-    }
-    out += '\n';
-  }
-  return out;
+      "the same view.\n\n";
+  return out + bench::markdown_table(kColumns, table_rows(rows), "|---|---:|---:|---:|---:|---:|");
 }
 
 std::string csv(const std::vector<Row>& rows, const std::string& scene, const DeviceInfo& device) {

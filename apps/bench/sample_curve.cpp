@@ -7,6 +7,7 @@
 
 #include "bench_plot.h"
 #include "cli.h"
+#include "text_tables.h"
 #include "tilesplat/image.h"
 #include "tilesplat/lens.h"
 #include "tilesplat/shutter.h"
@@ -29,6 +30,12 @@ const std::vector<std::string> kColumns = {"samples", "GPU ms", "GPU ms per samp
 std::vector<std::string> cells(const Row& row) {
   return {std::to_string(row.samples), fixed(row.gpu_ms, 3), fixed(row.gpu_ms / row.samples, 3),
           psnr_text(row.psnr_db), fixed(row.max_abs, 4)};
+}
+
+std::vector<std::vector<std::string>> table_rows(const std::vector<Row>& rows) {
+  std::vector<std::vector<std::string>> out;
+  for (const Row& row : rows) out.push_back(cells(row));
+  return out;
 }
 
 std::string what_is_averaged(Effect effect) {
@@ -115,21 +122,7 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
 }
 
 std::string text_table(const std::vector<Row>& rows) {
-  std::vector<size_t> widths;
-  for (const std::string& column : kColumns) widths.push_back(column.size());
-  for (const Row& row : rows) {
-    const std::vector<std::string> line = cells(row);
-    for (size_t c = 0; c < line.size(); ++c) widths[c] = std::max(widths[c], line[c].size());
-  }
-  const auto format = [&widths](const std::vector<std::string>& line) {
-    std::string out;
-    for (size_t c = 0; c < line.size(); ++c)
-      out += (c == 0 ? "" : "  ") + std::string(widths[c] - line[c].size(), ' ') + line[c];
-    return out + "\n";
-  };
-  std::string out = format(kColumns);
-  for (const Row& row : rows) out += format(cells(row));
-  return out;
+  return bench::aligned_table(kColumns, table_rows(rows), /*label_column=*/false);
 }
 
 std::string markdown(const std::vector<Row>& rows, Effect effect, const std::string& scene,
@@ -139,15 +132,8 @@ std::string markdown(const std::vector<Row>& rows, Effect effect, const std::str
   out += "The effect: " + what_is_averaged(effect) +
          ". GPU ms: median over repeats, then views. PSNR and max abs: "
          "against the frame of " +
-         std::to_string(kReferenceSamples) + " samples from the same view.\n\n|";
-  for (const std::string& column : kColumns) out += " " + column + " |";
-  out += "\n|---:|---:|---:|---:|---:|\n";
-  for (const Row& row : rows) {
-    out += "|";
-    for (const std::string& cell : cells(row)) out += " " + cell + " |";
-    out += '\n';
-  }
-  return out;
+         std::to_string(kReferenceSamples) + " samples from the same view.\n\n";
+  return out + bench::markdown_table(kColumns, table_rows(rows), "|---:|---:|---:|---:|---:|");
 }
 
 std::string csv(const std::vector<Row>& rows, Effect effect, const std::string& scene,
