@@ -20,19 +20,18 @@ std::string fixed(double value, int decimals) {
   return cli::format_fixed(value, decimals);
 }
 
-std::string psnr_text(double psnr) {
-  return std::isinf(psnr) ? "inf" : fixed(psnr, 2);
-}
-
 double elapsed_ms(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 // The cells of a row, in the tables' column order.
 std::vector<std::string> cells(const Row& row) {
-  return {row_label(row),         cli::group_thousands(uint64_t(std::llround(row.splats))),
-          fixed(row.gpu_ms, 3),   row.level < 0 ? fixed(row.select_ms, 2) : "-",
-          psnr_text(row.psnr_db), fixed(row.max_abs, 4)};
+  return {row_label(row),
+          cli::group_thousands(uint64_t(std::llround(row.splats))),
+          fixed(row.gpu_ms, 3),
+          row.level < 0 ? fixed(row.select_ms, 2) : "-",
+          bench::psnr_cell(row.psnr_db),
+          fixed(row.max_abs, 4)};
 }
 
 const std::vector<std::string> kColumns = {"row", "splats", "GPU ms", "select ms", "PSNR dB", "max abs"};

@@ -21,15 +21,12 @@ namespace cli = tilesplat::cli;
 std::string fixed(double value, int decimals) {
   return cli::format_fixed(value, decimals);
 }
-std::string psnr_text(double psnr) {
-  return std::isinf(psnr) ? "inf" : fixed(psnr, 2);
-}
 
 const std::vector<std::string> kColumns = {"samples", "GPU ms", "GPU ms per sample", "PSNR dB", "max abs"};
 
 std::vector<std::string> cells(const Row& row) {
   return {std::to_string(row.samples), fixed(row.gpu_ms, 3), fixed(row.gpu_ms / row.samples, 3),
-          psnr_text(row.psnr_db), fixed(row.max_abs, 4)};
+          bench::psnr_cell(row.psnr_db), fixed(row.max_abs, 4)};
 }
 
 std::vector<std::vector<std::string>> table_rows(const std::vector<Row>& rows) {

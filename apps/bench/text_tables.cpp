@@ -1,6 +1,9 @@
 #include "text_tables.h"
 
 #include <algorithm>
+#include <cmath>
+
+#include "text.h"
 
 namespace tilesplat::bench {
 
@@ -22,6 +25,10 @@ std::string aligned_table(const std::vector<std::string>& header,
   std::string out = format(header);
   for (const std::vector<std::string>& row : rows) out += format(row);
   return out;
+}
+
+std::string psnr_cell(double psnr_db) {
+  return std::isinf(psnr_db) ? "inf" : cli::format_fixed(psnr_db, 2);
 }
 
 std::string markdown_table(const std::vector<std::string>& header,

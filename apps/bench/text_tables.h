@@ -12,6 +12,9 @@ namespace tilesplat::bench {
 std::string aligned_table(const std::vector<std::string>& header,
                           const std::vector<std::vector<std::string>>& rows, bool label_column);
 
+// A PSNR in dB with two decimals, "inf" for identical images.
+std::string psnr_cell(double psnr_db);
+
 // A Markdown table: the header, `separator` (e.g. "|---|---:|"), a line per row.
 std::string markdown_table(const std::vector<std::string>& header,
                            const std::vector<std::vector<std::string>>& rows, const std::string& separator);
