@@ -217,20 +217,20 @@ size_t part_capacity(uint64_t budget, const PartCosts& costs, uint64_t overhead,
   const uint64_t before = costs.fixed + overhead;
   // Each buffer within the device's largest allocation: the largest per-Gaussian buffer, and the key
   // buffers reserved for the part's pairs (FrameResources::reserve_pairs).
-  double most_by_buffers = double(SIZE_MAX);
+  double most_by_device = double(SIZE_MAX);
   if (costs.largest_per_gaussian > 0)
-    most_by_buffers = std::floor(double(largest_allocation) / double(costs.largest_per_gaussian));
+    most_by_device = std::floor(double(largest_allocation) / double(costs.largest_per_gaussian));
   if (costs.largest_per_pair > 0)
-    most_by_buffers = std::min(
-        most_by_buffers,
+    most_by_device = std::min(
+        most_by_device,
         std::floor((double(largest_allocation) / double(costs.largest_per_pair) - 1) / pairs_per_gaussian));
-  if (most_by_buffers < 1)
+  if (most_by_device < 1)
     throw std::invalid_argument("the device's largest allocation (" + std::to_string(largest_allocation) +
                                 " bytes) cannot hold the buffers of one Gaussian");
   // And each dispatch within the device's workgroup count.
   if (costs.invocations_per_gaussian > 0 && device.max_workgroups < UINT64_MAX)
-    most_by_buffers =
-        std::min(most_by_buffers, std::floor(double(device.max_workgroups) * double(kWorkgroupSize) /
+    most_by_device =
+        std::min(most_by_device, std::floor(double(device.max_workgroups) * double(kWorkgroupSize) /
                                              double(costs.invocations_per_gaussian)));
   if (budget <= before || double(budget - before) < per_gaussian) {
     auto mib = [](uint64_t bytes) {
@@ -245,7 +245,7 @@ size_t part_capacity(uint64_t budget, const PartCosts& costs, uint64_t overhead,
         std::to_string(uint64_t(per_gaussian)) +
         " bytes per Gaussian: raise the budget or render a smaller image");
   }
-  return size_t(std::min(double(budget - before) / per_gaussian, most_by_buffers));
+  return size_t(std::min(double(budget - before) / per_gaussian, most_by_device));
 }
 
 uint64_t device_frame_budget(const DeviceCapacity& device) {
