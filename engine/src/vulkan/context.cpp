@@ -49,10 +49,13 @@ uint64_t env_bytes(const char* name) {
   const std::string_view text(v);
   size_t digits = 0;
   uint64_t value = 0;
-  while (digits < text.size() && std::isdigit(static_cast<unsigned char>(text[digits]))) {
-    if (value > (UINT64_MAX - 9) / 10) digits = text.size() + 1;  // too large: refused below
+  bool too_large = false;
+  for (; digits < text.size() && std::isdigit(static_cast<unsigned char>(text[digits])); ++digits) {
+    if (value > (UINT64_MAX - 9) / 10) {
+      too_large = true;
+      break;
+    }
     value = value * 10 + uint64_t(text[digits] - '0');
-    ++digits;
   }
   int shift = -1;
   if (digits == text.size()) shift = 0;
@@ -60,7 +63,7 @@ uint64_t env_bytes(const char* name) {
     const char unit = char(std::toupper(static_cast<unsigned char>(text[digits])));
     shift = unit == 'K' ? 10 : unit == 'M' ? 20 : unit == 'G' ? 30 : unit == 'T' ? 40 : -1;
   }
-  if (digits == 0 || shift < 0 || value == 0 || value > (UINT64_MAX >> shift))
+  if (too_large || digits == 0 || shift < 0 || value == 0 || value > (UINT64_MAX >> shift))
     throw std::runtime_error(std::string(name) + "='" + std::string(text) +
                              "': expected a positive size in bytes, optionally with K, M, G or T");
   return value << shift;
