@@ -22,3 +22,8 @@ const float FLT_MIN = 1.175494351e-38;  // the smallest normal float
 
 // Popcount of a subgroup ballot, valid for any subgroup size up to 128.
 uint ballot_count(uvec4 b) { return bitCount(b.x) + bitCount(b.y) + bitCount(b.z) + bitCount(b.w); }
+
+// A push constant's first tile of the frame in the camera's tile grid, x | y << 16 (the host's
+// pack_first_tile): (0, 0) for the whole image, else the first tile a RenderSettings::region meets.
+// Pixels and tile rects stay in the camera's coordinates, so a region's pixels are the whole frame's.
+uvec2 first_tile_of(uint packed) { return uvec2(packed & 0xffffu, packed >> 16); }

@@ -185,16 +185,18 @@ uint blend_splat(uint entry, vec2 tile_origin, uint local_x, uint local_y0, uint
 }
 
 void main() {
-  uvec2 tile = gl_WorkGroupID.xy;
+  uvec2 tile = first_tile_of(pc.first_tile) + gl_WorkGroupID.xy;  // in the camera's grid
   uint thread = gl_LocalInvocationIndex;
   uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
   uint local_x = gl_LocalInvocationID.x;
   uint local_y0 = gl_LocalInvocationID.y * P;  // first row of this invocation in the tile
   vec2 tile_origin = vec2(tile * TILE_SIZE);
-  uint px = tile.x * TILE_SIZE + local_x;
-  uint py0 = tile.y * TILE_SIZE + local_y0;
+  // The outputs' pixel (out_x, out_y0 + p), counted from their first tile's corner: the whole image's,
+  // or a region's. Splats are evaluated at the camera's pixel (tile_origin + local), as in the whole frame.
+  uint out_x = gl_WorkGroupID.x * TILE_SIZE + local_x;
+  uint out_y0 = gl_WorkGroupID.y * TILE_SIZE + local_y0;
 
-  uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
+  uvec2 range = pc.ranges.v[gl_WorkGroupID.y * pc.tiles_x + gl_WorkGroupID.x];
   uint list_length = range.y - range.x;
   if (CHUNKED && pc.chunk_start > 0 && list_length <= pc.chunk_start) return;  // an earlier chunk finished this tile
   if (pc.chunk_start == 0 && list_length > pc.chunk_size && thread == 0)
@@ -212,16 +214,16 @@ void main() {
   bool write_outputs = !CHUNKED || ((pc.flags & COMPOSITE_CARRY_OUT) == 0 && tile_done);
 
   for (uint p = 0; p < P; ++p) {
-    bool outside = px >= pc.width || py0 + p >= pc.height;
+    bool outside = out_x >= pc.width || out_y0 + p >= pc.height;
     T[p] = outside ? -1.0 : 1.0;
     colour[p] = vec3(0.0);
     depth_sum[p] = 0.0;
     weight_sum[p] = 0.0;
     blended[p] = 0;
     surface[p] = 0.0;
-    if (HOST_DEPTH) host_z[p] = outside ? 0.0 : pc.host_z.v[(py0 + p) * pc.width + px];
+    if (HOST_DEPTH) host_z[p] = outside ? 0.0 : pc.host_z.v[(out_y0 + p) * pc.width + out_x];
     if (resume && !outside) {
-      uint i = (py0 + p) * pc.width + px;
+      uint i = (out_y0 + p) * pc.width + out_x;
       vec4 colour_T = pc.state.v[state_in + 2 * i];
       vec4 sums = pc.state.v[state_in + 2 * i + 1];
       colour[p] = colour_T.rgb;
@@ -306,9 +308,9 @@ void main() {
   }
 
   for (uint p = 0; p < P; ++p) {
-    uint py = py0 + p;
-    if (px >= pc.width || py >= pc.height) continue;
-    uint i = py * pc.width + px;
+    uint out_y = out_y0 + p;
+    if (out_x >= pc.width || out_y >= pc.height) continue;
+    uint i = out_y * pc.width + out_x;
     if (!write_outputs) {
       pc.state.v[state_out + 2 * i] = vec4(colour[p], T[p]);
       pc.state.v[state_out + 2 * i + 1] = vec4(depth_sum[p], weight_sum[p], uintBitsToFloat(blended[p]), surface[p]);

@@ -117,18 +117,21 @@ float ray_depth(uint j, vec2 pixel) {
 }
 
 void main() {
-  uvec2 tile = gl_WorkGroupID.xy;
+  uvec2 tile = first_tile_of(pc.first_tile) + gl_WorkGroupID.xy;  // in the camera's grid
   uint thread = gl_LocalInvocationIndex;
   uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
   uint local_x = gl_LocalInvocationID.x;
   uint local_y0 = gl_LocalInvocationID.y * P;
   vec2 tile_origin = vec2(tile * TILE_SIZE);
-  uint px = tile.x * TILE_SIZE + local_x;
+  uint px = tile.x * TILE_SIZE + local_x;  // the camera's pixel (px, py0 + p)
   uint py0 = tile.y * TILE_SIZE + local_y0;
+  // and the outputs' (out_x, out_y0 + p): the whole image's, or a region's (composite.comp)
+  uint out_x = gl_WorkGroupID.x * TILE_SIZE + local_x;
+  uint out_y0 = gl_WorkGroupID.y * TILE_SIZE + local_y0;
 
   uint my_done = 0;
   for (uint p = 0; p < P; ++p) {
-    bool outside = px >= pc.width || py0 + p >= pc.height;
+    bool outside = out_x >= pc.width || out_y0 + p >= pc.height;
     T[p] = outside ? -1.0 : 1.0;
     colour[p] = vec3(0.0);
     depth_sum[p] = 0.0;
@@ -142,7 +145,7 @@ void main() {
   if (my_done > 0) atomicAdd(s_done_pixels, my_done);
   uint published_done = my_done;
 
-  uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
+  uvec2 range = pc.ranges.v[gl_WorkGroupID.y * pc.tiles_x + gl_WorkGroupID.x];
   if (range.y - range.x > pc.max_splats && thread == 0) atomicMax(pc.counters.v[COUNTER_MAX_TILE_PAIRS], range.y - range.x);
   for (uint batch_start = range.x; batch_start < range.y; batch_start += BATCH) {
     barrier();
@@ -186,9 +189,9 @@ void main() {
     for (uint k = 0; k < pending[p]; ++k) blend(p, w_alpha[p * WINDOW + k], w_colour_depth[p * WINDOW + k]);
 
   for (uint p = 0; p < P; ++p) {
-    uint py = py0 + p;
-    if (px >= pc.width || py >= pc.height) continue;
-    uint i = py * pc.width + px;
+    uint out_y = out_y0 + p;
+    if (out_x >= pc.width || out_y >= pc.height) continue;
+    uint i = out_y * pc.width + out_x;
     float transmittance = abs(T[p]);
     pc.out_rgba.v[i] = vec4(colour[p] + transmittance * pc.background.rgb, 1.0 - transmittance);
     if (WRITE_DEPTH) pc.out_depth.v[i] = weight_sum[p] > 0.0 ? depth_sum[p] / weight_sum[p] : 0.0;

@@ -105,16 +105,19 @@ void test_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
 }
 
 void main() {
-  uvec2 tile = gl_WorkGroupID.xy;
+  uvec2 tile = first_tile_of(pc.first_tile) + gl_WorkGroupID.xy;  // in the camera's grid
   uint thread = gl_LocalInvocationIndex;
   uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
   uint local_x = gl_LocalInvocationID.x;
   uint local_y0 = gl_LocalInvocationID.y * P;
   vec2 tile_origin = vec2(tile * TILE_SIZE);
-  uint px = tile.x * TILE_SIZE + local_x;
+  uint px = tile.x * TILE_SIZE + local_x;  // the camera's pixel (px, py0 + p)
   uint py0 = tile.y * TILE_SIZE + local_y0;
+  // and the outputs' (out_x, out_y0 + p): the whole image's, or a region's (composite.comp)
+  uint out_x = gl_WorkGroupID.x * TILE_SIZE + local_x;
+  uint out_y0 = gl_WorkGroupID.y * TILE_SIZE + local_y0;
 
-  uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
+  uvec2 range = pc.ranges.v[gl_WorkGroupID.y * pc.tiles_x + gl_WorkGroupID.x];
   uint list_length = range.y - range.x;
   bool resume = pc.chunk_start > 0;
   if (resume && list_length <= pc.chunk_start) return;  // an earlier chunk finished this tile's sample
@@ -129,7 +132,8 @@ void main() {
   for (uint p = 0; p < P; ++p) {
     pixel_hash[p] = hash32(hash32(sample_hash ^ px) ^ (py0 + p));
     best[p] = NONE;
-    if (resume && px < pc.width && py0 + p < pc.height) best[p] = carried.v[4 * ((py0 + p) * pc.width + px) + 3];
+    if (resume && out_x < pc.width && out_y0 + p < pc.height)
+      best[p] = carried.v[4 * ((out_y0 + p) * pc.width + out_x) + 3];
   }
 
   uint my_bits = my_reach_bits(local_x, local_y0, P);
@@ -179,9 +183,9 @@ void main() {
   bool first_sample = pc.sample_index == 0;
   bool last_sample = pc.sample_index + 1 >= pc.samples;
   for (uint p = 0; p < P; ++p) {
-    uint py = py0 + p;
-    if (px >= pc.width || py >= pc.height) continue;
-    uint i = py * pc.width + px;
+    uint out_y = out_y0 + p;
+    if (out_x >= pc.width || out_y >= pc.height) continue;
+    uint i = out_y * pc.width + out_x;
     if (!finish_sample) {  // a later chunk goes on with this sample
       carried.v[4 * i + 3] = best[p];
       continue;

@@ -75,10 +75,12 @@ void main() {
   float tau = coverage_tau(mdo.w, ALPHA_INV);
   uint end = offset + n;
   uint64_t depth_bits = WIDE_KEYS ? uint64_t(pc.depth_keys.v[i]) : uint64_t(0);
+  uvec2 first = first_tile_of(pc.first_tile);  // the rect is in the camera's grid, tile ids the frame's
   for (uint ty = lo.y; ty < hi.y; ++ty) {
     uvec2 span = SQUARE_TILES ? uvec2(lo.x, hi.x) : row_span(mdo.xy, cov_det, tau, ty, lo, hi);
     for (uint tx = span.x; tx < span.y && offset < end; ++tx) {
-      write_pair(offset, uint64_t(ty * pc.tiles_x + tx) << (WIDE_KEYS ? 32 : 0) | depth_bits, i);
+      uint tile = (ty - first.y) * pc.tiles_x + (tx - first.x);
+      write_pair(offset, uint64_t(tile) << (WIDE_KEYS ? 32 : 0) | depth_bits, i);
       ++offset;
     }
   }

@@ -31,6 +31,7 @@ void main() {
   vec4 cov_det = pc.splats.v[SPLAT_VEC4S * i + 3];
   float tau = coverage_tau(mdo.w, ALPHA_INV);
   uint64_t depth_bits = WIDE_KEYS ? uint64_t(pc.depth_keys.v[i]) : uint64_t(0);
+  uvec2 first = first_tile_of(pc.first_tile);
   // Rows follow the scan's (subgroup, lane) order, so each row's pairs start where the scan says.
   uint linear = gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
   uint row_base = offset;  // where this round's first row starts
@@ -40,7 +41,8 @@ void main() {
     uint round_pairs;
     uint at = row_base + workgroup_exclusive_scan(span.y - span.x, round_pairs);
     for (uint tx = span.x; tx < span.y && at < end; ++tx, ++at) {
-      store_key(pc.keys, at, uint64_t(ty * pc.tiles_x + tx) << (WIDE_KEYS ? 32 : 0) | depth_bits);
+      uint tile = (ty - first.y) * pc.tiles_x + (tx - first.x);  // as key_emission.comp
+      store_key(pc.keys, at, uint64_t(tile) << (WIDE_KEYS ? 32 : 0) | depth_bits);
       pc.values.v[at] = i;
     }
     row_base += round_pairs;

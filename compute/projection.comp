@@ -447,10 +447,11 @@ uint project(uint i, uint seam_copy, out vec4 record[SPLAT_VEC4S], out uvec2 rec
   real sigmas = OPACITY_EXTENT ? real(min(sqrt(max(2.0 * log(ALPHA_INV * opacity), 0.0)), 3.33)) : 3.0;
   real radius = ceil(sigmas * sqrt(lambda));
   if (!is_finite(radius)) return 0;
-  real2 grid = real2(camera_word(CAMERA_GRID));
+  // The frame's tiles in the camera's grid: the image's, or a region's (RenderSettings::region).
+  real2 first_tile = real2(camera_word(CAMERA_TILES)), end_tile = real2(camera_word(CAMERA_TILES + 1));
   // Clamp before converting: a huge radius must not overflow the integer rect.
-  real2 rect_min = clamp(floor((mean - radius) / real(TILE_SIZE)), real2(0.0), grid);
-  real2 rect_max = clamp(floor((mean + radius + real(TILE_SIZE - 1)) / real(TILE_SIZE)), real2(0.0), grid);
+  real2 rect_min = clamp(floor((mean - radius) / real(TILE_SIZE)), first_tile, end_tile);
+  real2 rect_max = clamp(floor((mean + radius + real(TILE_SIZE - 1)) / real(TILE_SIZE)), first_tile, end_tile);
   uvec2 lo = uvec2(rect_min);
   uvec2 hi = uvec2(rect_max);
   if ((hi.x - lo.x) * (hi.y - lo.y) == 0) return 0;

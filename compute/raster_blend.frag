@@ -22,7 +22,8 @@ layout(location = 2) out float out_count;      // 1, added
 
 void main() {
   // The pixel's offset from the mean as composite.comp forms it: relative to the pixel's tile.
-  uvec2 pixel = uvec2(gl_FragCoord.xy);
+  // The camera's pixel: the attachments start at their first tile's corner (a region's, or the image's).
+  uvec2 pixel = uvec2(gl_FragCoord.xy) + first_tile_of(pc.first_tile) * TILE_SIZE;
   uvec2 local = pixel % TILE_SIZE;
   vec2 tile_origin = vec2(pixel - local);
   vec4 mdo = mean_depth_opacity;

@@ -64,5 +64,7 @@ RasterQuad raster_quad(uint position) {
 
 vec4 raster_corner(RasterQuad q, uint corner) {
   vec2 pixel = q.centre + QUAD_CORNERS[corner].x * q.axis_x + QUAD_CORNERS[corner].y * q.axis_y;
+  // The camera's pixel in the attachments, which start at their first tile's corner (a region's).
+  pixel -= vec2(first_tile_of(pc.first_tile) * TILE_SIZE);
   return vec4(pixel / vec2(pc.width, pc.height) * 2.0 - 1.0, q.depth, 1.0);
 }

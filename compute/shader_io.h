@@ -118,6 +118,7 @@ TS_PUSH_CONSTANTS(CompositePush) {
   uint chunk_size;   // splats per tile this dispatch blends at most
   uint flags;        // COMPOSITE_LAST_CHUNK, COMPOSITE_CARRY_IN, COMPOSITE_CARRY_OUT, COMPOSITE_STATE_HIGH
   float surface_alpha;
+  uint first_tile;  // the outputs' first tile in the camera's grid, x | y << 16 (first_tile_of)
 }
 TS_PUSH_INSTANCE;
 #endif
@@ -139,6 +140,7 @@ TS_PUSH_CONSTANTS(CompositeResortPush) {
   uint tiles_x;
   uint max_splats;             // the longest list a tile may have (llvmpipe's loop limit; see composite.comp)
   TS_REF(UintArray) counters;  // COUNTER_MAX_TILE_PAIRS: a longer list, which the host reports as an error
+  uint first_tile;             // the outputs' first tile in the camera's grid (first_tile_of)
 }
 TS_PUSH_INSTANCE;
 #endif
@@ -167,6 +169,7 @@ TS_PUSH_CONSTANTS(StochasticCompositePush) {
   uint sample_index;  // this dispatch's sample, 0 .. samples - 1
   uint samples;       // samples averaged: the last one writes the outputs
   uint seed;
+  uint first_tile;  // the outputs' first tile in the camera's grid (first_tile_of)
 }
 TS_PUSH_INSTANCE;
 #endif
@@ -178,8 +181,9 @@ TS_PUSH_CONSTANTS(RasterPush) {
   TS_REF(Vec4Array) splats;
   TS_REF(UintArray) depth_order;  // the depth sort's result: record indices, visible ones first
   TS_REF(UintArray) counters;     // COUNTER_VISIBLE: how many of them the mesh stage draws
-  uint width;
+  uint width;                     // of the attachments: the image's, or a region's tiles'
   uint height;
+  uint first_tile;  // the attachments' first tile in the camera's grid (first_tile_of)
 }
 TS_PUSH_INSTANCE;
 #endif
@@ -256,11 +260,13 @@ TS_BUFFER(CameraParams) {
   // plane, the model's reach (camera_models::ModelLimits): the reference compares in double, and a
   // float 0.2 would cull a splat on the plane that the reference keeps.
   TS_F64 clip[4];
-  uvec4 grid;  // tiles x, tiles y, width, height
+  // The frame's tiles in the camera's grid, [first x, first y] to [end x, end y): the image's, or those a
+  // region meets (RenderSettings::region). A splat's tile rect is clamped to them.
+  uvec4 tiles;
   TS_F64 distortion[8];  // Camera::distortion (CAMERA_MODEL other than the pinhole)
 };
 // The same as uvec2 words (projection.comp's camera_word): where each field starts.
-TS_CONST uint CAMERA_ROTATION = 0, CAMERA_CENTRE = 9, CAMERA_FOCAL = 12, CAMERA_CLIP = 16, CAMERA_GRID = 20,
+TS_CONST uint CAMERA_ROTATION = 0, CAMERA_CENTRE = 9, CAMERA_FOCAL = 12, CAMERA_CLIP = 16, CAMERA_TILES = 20,
               CAMERA_DISTORTION = 22;
 
 // The frame's lights, written by the host (ProjectionPass::set_lighting) in float64 from the same
@@ -367,9 +373,10 @@ TS_PUSH_CONSTANTS(KeyEmissionPush) {
   TS_REF(UintArray) big_splats;  // Gaussians with more than BIG_SPLAT_PAIRS pairs, for key_emission_big.comp
   TS_REF(UintArray) counters;
   uint count;
-  uint tiles_x;
+  uint tiles_x;  // of the frame's tiles: a region's (RenderSettings::region) or the image's
   uint capacity;
   uint tiles;
+  uint first_tile;  // the frame's first tile in the camera's grid (first_tile_of): tile ids count from it
 }
 TS_PUSH_INSTANCE;
 #endif
@@ -579,7 +586,7 @@ TS_PUSH_INSTANCE;
 // What the C++ compiler can check of the layouts: the blocks' sizes (std430 lays the members out as
 // C++ does here: scalars, 8-byte addresses and doubles, 16-byte vec4) and the 128 bytes of push
 // constants that every Vulkan device accepts (maxPushConstantsSize).
-static_assert(sizeof(CameraParams) == 240 && CAMERA_GRID * sizeof(uvec2) == 160 &&
+static_assert(sizeof(CameraParams) == 240 && CAMERA_TILES * sizeof(uvec2) == 160 &&
               CAMERA_DISTORTION * sizeof(uvec2) == 176);
 static_assert(sizeof(LightRecord) == 56 && sizeof(LightParams) == 40);
 static_assert(sizeof(CompositePush) <= 128 && sizeof(CompositeResortPush) <= 128 &&

@@ -330,6 +330,47 @@ TEST(SceneParts, WithoutABudgetABufferPastTheLargestAllocationSplitsTheFrame) {
   EXPECT_EQ(small->validation_messages(), 0u);
 }
 
+TEST(SceneParts, AnImagePastTheLargestAllocationRendersInBands) {
+  const BundledView view;  // 160x90
+  Renderer& whole_renderer = testing::validated_renderer();
+  whole_renderer.set_scene(view.scene);
+  const RenderImage whole = whole_renderer.render(view.camera);
+  EXPECT_EQ(whole_renderer.last_frame_stats().image_bands, 1);
+  // 256 KiB holds the 64-byte composite state of 4,096 pixels: bands of one row of tiles (of 160 + 32
+  // columns at most), 6 of them, each in parts (the harmonics pass the allocation too).
+  const std::unique_ptr<Renderer> small = renderer_with_limits("TILESPLAT_MAX_ALLOCATION", "256K");
+  const RenderImage banded = small->render(view.scene, view.camera);
+  EXPECT_EQ(small->last_frame_stats().image_bands, 6);
+  EXPECT_GE(small->last_frame_stats().scene_parts, 4);
+  expect_bit_identical(banded, whole, "in bands of 256 KiB");
+  EXPECT_EQ(small->last_frame_stats().intersections, whole_renderer.last_frame_stats().intersections);
+  // A region in bands, from a band that starts inside a tile.
+  RenderSettings region;
+  region.region = {3, 21, 150, 60};
+  const RenderImage banded_region = small->render(view.scene, view.camera, region);
+  EXPECT_GE(small->last_frame_stats().image_bands, 4);
+  EXPECT_EQ(banded_region.width, 150);
+  EXPECT_EQ(banded_region.height, 60);
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 150; ++x)
+      for (size_t c = 0; c < 4; ++c)
+        ASSERT_EQ(banded_region.rgba[4 * (size_t(y) * 150 + size_t(x)) + c],
+                  whole.rgba[4 * (size_t(y + 21) * 160 + size_t(x + 3)) + c])
+            << x << "," << y;
+  // A scene that fits, set once: render(camera) bands the image by itself too.
+  const std::unique_ptr<Renderer> small_images = renderer_with_limits("TILESPLAT_MAX_ALLOCATION", "4M");
+  small_images->set_scene(view.scene);
+  RenderSettings big;
+  const Camera wide = resize_camera(view.camera, 1024, 576);  // 64 bytes a pixel: 36 MiB of state
+  big.reuse_lists = false;
+  const RenderImage big_whole = whole_renderer.render(wide, big);
+  const RenderImage big_banded = small_images->render(wide, big);
+  EXPECT_GE(small_images->last_frame_stats().image_bands, 9);
+  expect_bit_identical(big_banded, big_whole, "1024x576 in bands of 4 MiB");
+  EXPECT_EQ(small->validation_messages(), 0u);
+  EXPECT_EQ(small_images->validation_messages(), 0u);
+}
+
 TEST(SceneParts, WithoutABudgetAFramePastTheDevicesMemorySplits) {
   const BundledView view;
   Renderer& whole_renderer = testing::validated_renderer();

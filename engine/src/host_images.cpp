@@ -68,6 +68,10 @@ void check_depth_image(const ExternalDepthImage& depth, const ExternalImage& tar
 void check_images(const ExternalImage& target, const ExternalDepthImage* depth, const Camera& camera,
                   const RenderSettings& settings) {
   check_colour_target(target, camera);
+  if (!settings.region.whole())
+    throw std::invalid_argument("render_to_image: RenderSettings::region " + to_string(settings.region) +
+                                ": the frame fills the host's image, of the camera's size; render a region "
+                                "with Renderer::render");
   if (depth)
     check_depth_image(*depth, target, settings);
   else if (settings.host && settings.host->write_depth)

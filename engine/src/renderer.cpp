@@ -16,6 +16,7 @@
 #include <string>
 
 #include "frame/averaged_frames.h"
+#include "frame/image_regions.h"
 #include "host_depth.h"
 #include "passes/frame_counters.h"
 #include "renderer_impl.h"
@@ -63,7 +64,8 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
   lists.reset();  // valid again once this frame's lists are complete (not if it throws)
   // Reused lists were built with an equal camera and equal (validated) lights, which are in their
   // buffers still: nothing to upload.
-  if (start.plan.build_lists) recorder.set_frame_inputs(camera, settings, resources.scene);
+  if (start.plan.build_lists)
+    recorder.set_frame_inputs(camera, settings, start.plan.culling_tiles, resources.scene);
   start.fallbacks_before = start.sorter->stall_fallbacks();
   return start;
 }
@@ -201,6 +203,9 @@ RenderImage Renderer::render(const Camera& camera, const RenderSettings& setting
                              [&](const Camera& sample_camera, const RenderSettings& sample_settings, double) {
                                return render(sample_camera, sample_settings);
                              });
+  if (const std::vector<PixelRegion> bands = r.image_bands(camera, settings); bands.size() > 1)
+    return r.render_bands(camera, settings, bands,
+                          [&](const RenderSettings& band) { return render(camera, band); });
   const auto start = std::chrono::steady_clock::now();
   r.render_frame(camera, settings);
   RenderImage image = r.read_image(camera, settings);
@@ -209,15 +214,64 @@ RenderImage Renderer::render(const Camera& camera, const RenderSettings& setting
   return image;
 }
 
+// The frame's outputs: the whole image, or the pixels of the region's tiles, of which the region's are
+// kept (frame/image_regions.h).
 RenderImage Renderer::Impl::read_image(const Camera& camera, const RenderSettings& settings) {
   RenderImage image;
-  image.width = camera.width;
-  image.height = camera.height;
+  image.width = int(resources.outputs.width);
+  image.height = int(resources.outputs.height);
   const size_t pixels = image.pixels();
   read_output(resources.outputs.rgba, image.rgba, pixels * 4);
   if (settings.depth) read_output(resources.outputs.depth, image.depth, pixels);
   if (settings.splat_count) read_output(resources.outputs.count, image.splat_count, pixels);
   if (settings.host && settings.host->write_depth) read_host_depth(*settings.host, image.host_depth, pixels);
+  return crop(image, tile_aligned(settings.region, camera.width, camera.height),
+              resolved_region(settings.region, camera.width, camera.height));
+}
+
+std::vector<PixelRegion> Renderer::Impl::image_bands(const Camera& camera,
+                                                     const RenderSettings& settings) const {
+  validate(settings.region, camera.width, camera.height);
+  const PixelRegion region = resolved_region(settings.region, camera.width, camera.height);
+  // The image comes back whole on the host: it must fit the machine.
+  const uint64_t image_bytes = uint64_t(std::max(region.width, 0)) * uint64_t(std::max(region.height, 0)) *
+                               image_bytes_per_pixel(settings);
+  if (const uint64_t host = host_physical_memory(); host > 0 && image_bytes > host)
+    throw std::runtime_error(
+        "invalid camera: image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+        (settings.region.whole() ? std::string() : " (region " + to_string(settings.region) + ")") +
+        " needs " + std::to_string(image_bytes >> 20) +
+        " MiB of host memory for its images, more than this machine's " + std::to_string(host >> 20) +
+        " MiB");
+  // A host's depth is the whole image's: such a frame is not split (a region refuses it).
+  if (settings.host) return {region};
+  const DeviceCapacity device = device_capacity();
+  const uint64_t pixels = std::min(device.largest_allocation / kLargestBytesPerPixel,
+                                   device.total / 4 / frame_bytes_per_pixel(settings));
+  return bands_within(region, 1, pixels);
+}
+
+RenderImage Renderer::Impl::render_bands(
+    const Camera& camera, const RenderSettings& settings, const std::vector<PixelRegion>& bands,
+    const std::function<RenderImage(const RenderSettings&)>& render_band) {
+  const auto start = std::chrono::steady_clock::now();
+  const PixelRegion whole = resolved_region(settings.region, camera.width, camera.height);
+  RenderImage image;
+  image.width = whole.width;
+  image.height = whole.height;
+  image.rgba.resize(4 * image.pixels());
+  if (settings.depth) image.depth.resize(image.pixels());
+  if (settings.splat_count) image.splat_count.resize(image.pixels());
+  FrameStats frame;
+  frame.image_bands = 0;
+  RenderSettings band_settings = settings;
+  for (const PixelRegion& band : bands) {
+    band_settings.region = band;
+    paste(image, whole, render_band(band_settings), band);
+    add_band_stats(frame, stats);
+  }
+  stats = frame;
+  stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return image;
 }
 

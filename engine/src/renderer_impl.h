@@ -67,6 +67,13 @@ struct Renderer::Impl {
   // render_sample; the frame's statistics are the samples' summed.
   RenderImage average_samples(const Camera& camera, const RenderSettings& settings,
                               const TimedSampleRenderer& render_sample);
+  // An image past the device (frame/image_regions.h): the bands of rows it is rendered in, each within
+  // the device's largest allocation and a quarter of its memory (one band: the region itself), and the
+  // bands rendered by render_band into one image, with their statistics combined.
+  std::vector<PixelRegion> image_bands(const Camera& camera, const RenderSettings& settings) const;
+  RenderImage render_bands(const Camera& camera, const RenderSettings& settings,
+                           const std::vector<PixelRegion>& bands,
+                           const std::function<RenderImage(const RenderSettings&)>& render_band);
   // A scene within a memory budget (renderer_parts.cpp): whether its frame would exceed
   // settings.memory_budget (or without one, the device: whole_frame_fits), and the rendering in depth-ordered
   // parts that leaves the image in the outputs and the parts' statistics.

@@ -155,6 +155,10 @@ RenderImage Renderer::Impl::render_scene(const PartSource& scene, const std::fun
                            [&](const Camera& sample_camera, const RenderSettings& sample_settings, double) {
                              return render_scene(scene, set_whole, sample_camera, sample_settings, renderer);
                            });
+  if (const std::vector<PixelRegion> bands = image_bands(camera, settings); bands.size() > 1)
+    return render_bands(camera, settings, bands, [&](const RenderSettings& band) {
+      return render_scene(scene, set_whole, camera, band, renderer);
+    });
   const auto start = std::chrono::steady_clock::now();
   render_in_parts(scene, camera, settings);
   RenderImage image = read_image(camera, settings);

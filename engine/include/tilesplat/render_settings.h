@@ -176,6 +176,26 @@ inline constexpr double kDefaultNearPlane = 0.2;
 /// The default RenderSettings::max_alpha: the cap the 3DGS trainer and its rasterizer put on a splat's alpha.
 inline constexpr double kDefaultMaxAlpha = 0.99;
 
+/// A rectangle of a camera's pixels: columns [x, x + width) and rows [y, y + height). The default,
+/// 0 x 0, is the whole image.
+struct PixelRegion {
+  int x = 0;       ///< the first column
+  int y = 0;       ///< the first row
+  int width = 0;   ///< columns; 0 (with height 0): the whole image
+  int height = 0;  ///< rows; 0 (with width 0): the whole image
+  /// The default, 0 x 0: the whole image.
+  bool whole() const { return width == 0 && height == 0; }
+  /// Every field equal.
+  bool operator==(const PixelRegion&) const = default;
+};
+/// Throws std::invalid_argument ("RenderSettings::region: ...", naming the values) unless the region is
+/// whole or has a positive size and lies within an image of image_width x image_height pixels.
+TILESPLAT_API void validate(const PixelRegion& region, int image_width, int image_height);
+/// "x,y,widthxheight", e.g. "0,540,1920x64"; "whole" for the whole image.
+TILESPLAT_API std::string to_string(const PixelRegion& region);
+/// The inverse of to_string, also "x,y,width,height". Throws std::invalid_argument naming the text.
+TILESPLAT_API PixelRegion parse_pixel_region(const std::string& text);
+
 /// Everything that changes how one frame is rendered.
 struct RenderSettings {
   std::array<float, 3> background = {
@@ -229,6 +249,15 @@ struct RenderSettings {
   /// the level the camera calls for (select_lod_levels, docs/big-scenes.md). 0 (the default): level 0,
   /// every chunk. Other scenes ignore it.
   uint64_t splat_budget = 0;
+  /// Render only these pixels of the camera's image (docs/big-scenes.md, "Image regions"): the image
+  /// returned is region.width x region.height, each pixel bit for bit the whole frame's. The tiles keep
+  /// the camera's grid and only those the region meets are binned, sorted and composited, so a band of
+  /// rows costs the projection of every Gaussian and its share of the rest. Renderer::render and
+  /// render_reference take it with every compositor, a lens and a shutter (each sample renders the
+  /// region); render_to_image, the frames submitted without waiting and a host's depth refuse it. Where a
+  /// frame's depth keys are quantized over its visible depth range (depth16, the approximate sort
+  /// strategies), a region's range is its own. The whole image (the default) is what it always was.
+  PixelRegion region;
 };
 
 }  // namespace tilesplat

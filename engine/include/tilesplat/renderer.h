@@ -80,6 +80,11 @@ struct FrameStats {
   /// RenderSettings::memory_budget): 1 for a whole scene. Over several, gpu_ms, passes, visible,
   /// intersections, retries, submissions and uploaded_bytes are the sums over the parts.
   int scene_parts = 1;
+  /// Bands of rows the image was rendered in, one after another (each a RenderSettings::region): 1, or
+  /// more for an image whose per-pixel buffers would pass the device's largest allocation or a quarter
+  /// of its memory (docs/big-scenes.md, "Images past the device"). Over several, gpu_ms, passes,
+  /// intersections, retries, submissions and uploaded_bytes are the sums over the bands.
+  int image_bands = 1;
   /// The most device memory the renderer's buffers held at the end of any part (device_bytes is the
   /// last part's); the same as device_bytes for a whole scene.
   uint64_t peak_device_bytes = 0;

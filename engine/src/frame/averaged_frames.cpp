@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "frame/image_regions.h"
 #include "settings_checks.h"
 
 namespace tilesplat {
@@ -62,9 +63,10 @@ bool averages_samples(const RenderSettings& settings) {
 
 namespace {
 
-// A rolling shutter's frame: band k of the image (in the scan's order) copied from the frame at the k-th
-// of the shutter's times. Each sample frame is rendered whole (a band's pixels are then exactly the whole
-// frame's), so the frame costs `bands` frames, as a global shutter of as many samples does.
+// A rolling shutter's frame: band k of the image (in the scan's order) rendered at the k-th of the
+// shutter's times, each band a region of the camera's image (RenderSettings::region: its pixels are the
+// whole frame's at that time, and it costs the projection and its own share of the rest). With a
+// region of the caller's, each band's part of it.
 RenderImage render_rolling(const Camera& camera, const RenderSettings& settings,
                            const TimedSampleRenderer& render_sample) {
   const Shutter& shutter = settings.shutter;
@@ -73,27 +75,30 @@ RenderImage render_rolling(const Camera& camera, const RenderSettings& settings,
       shutter.scan == ShutterScan::kBottomToTop || shutter.scan == ShutterScan::kRightToLeft;
   const int extent = rows ? camera.height : camera.width;
   const int bands = std::min(shutter.samples, extent);
+  const PixelRegion wanted = resolved_region(settings.region, camera.width, camera.height);
   RenderSettings sample_settings = settings;
   sample_settings.shutter = {};
   RenderImage image;
+  image.width = wanted.width;
+  image.height = wanted.height;
+  image.rgba.resize(4 * image.pixels());
+  if (settings.depth) image.depth.resize(image.pixels());
+  if (settings.splat_count) image.splat_count.resize(image.pixels());
   const std::vector<double> times = shutter_times(shutter.open, shutter.close, bands);
   for (int k = 0; k < bands; ++k) {
-    const RenderImage frame = render_sample(camera_between(camera, *shutter.end_camera, times[size_t(k)]),
-                                            sample_settings, times[size_t(k)]);
-    if (k == 0) image = frame;  // sizes and outputs; every pixel is overwritten by its band below
     // Band k in scan order covers [first, last) along the scan's axis, counted from where the scan starts.
     const int first = int(int64_t(k) * extent / bands), last = int(int64_t(k + 1) * extent / bands);
-    for (int along = first; along < last; ++along) {
-      const int line = reversed ? extent - 1 - along : along;  // the row or column exposed
-      const int across = rows ? camera.width : camera.height;
-      for (int i = 0; i < across; ++i) {
-        const size_t p = rows ? size_t(line) * size_t(camera.width) + size_t(i)
-                              : size_t(i) * size_t(camera.width) + size_t(line);
-        for (size_t c = 0; c < 4; ++c) image.rgba[4 * p + c] = frame.rgba[4 * p + c];
-        if (!image.depth.empty()) image.depth[p] = frame.depth[p];
-        if (!image.splat_count.empty()) image.splat_count[p] = frame.splat_count[p];
-      }
-    }
+    const int begin = reversed ? extent - last : first, end = reversed ? extent - first : last;
+    const PixelRegion band = rows ? PixelRegion{0, begin, camera.width, end - begin}
+                                  : PixelRegion{begin, 0, end - begin, camera.height};
+    // The band's part of the wanted pixels, if any.
+    const int x0 = std::max(band.x, wanted.x), x1 = std::min(band.x + band.width, wanted.x + wanted.width);
+    const int y0 = std::max(band.y, wanted.y), y1 = std::min(band.y + band.height, wanted.y + wanted.height);
+    if (x1 <= x0 || y1 <= y0) continue;
+    sample_settings.region = {x0, y0, x1 - x0, y1 - y0};
+    const RenderImage frame = render_sample(camera_between(camera, *shutter.end_camera, times[size_t(k)]),
+                                            sample_settings, times[size_t(k)]);
+    paste(image, wanted, frame, sample_settings.region);
   }
   return image;
 }
@@ -111,6 +116,7 @@ RenderImage render_averaged(const Camera& camera, const RenderSettings& settings
 
 RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
                             const TimedSampleRenderer& render_sample) {
+  validate(settings.region, camera.width, camera.height);
   LinearFrameMean mean(settings.background != std::array<float, 3>{0, 0, 0});
   RenderSettings sample_settings = settings;
   if (settings.shutter.enabled() && settings.shutter.scan != ShutterScan::kGlobal) {

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "camera/camera_models.h"
+#include "frame/image_regions.h"
 #include "host_depth.h"
 #include "passes/stochastic_composite_pass.h"
 #include "passes/tile_coverage.h"
@@ -22,7 +23,7 @@ namespace {
 
 // A camera this device cannot render is a runtime_error (render() documents it so), bad settings an
 // invalid_argument.
-void check_camera(const Camera& camera, const DeviceCaps& device) {
+void check_camera(const Camera& camera, const PixelRegion& region, const DeviceCaps& device) {
   try {
     validate(camera);  // size, intrinsics, pose; then what this device can hold
   } catch (const std::invalid_argument& e) {
@@ -39,9 +40,13 @@ void check_camera(const Camera& camera, const DeviceCaps& device) {
   if (tiles_x > max_tiles || tiles_y > std::min<uint64_t>(max_tiles, 0xffff))
     fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
          " exceeds the renderer's limit of " + std::to_string(max_tiles) + " tiles (of 16 pixels) per axis");
-  const uint64_t rgba_bytes = uint64_t(camera.width) * uint64_t(camera.height) * 16;
+  validate(region, camera.width, camera.height);
+  // Renderer::render splits such an image into regions by itself (render_in_bands).
+  const PixelRegion tiles = tile_aligned(region, camera.width, camera.height);
+  const uint64_t rgba_bytes = uint64_t(tiles.width) * uint64_t(tiles.height) * 16;
   if (rgba_bytes > device.max_allocation_size)
-    fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) + " needs " +
+    fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+         (region.whole() ? std::string() : " (region " + to_string(region) + ")") + " needs " +
          std::to_string(rgba_bytes >> 20) +
          " MiB for its colour buffer, more than the device's largest allocation (" +
          std::to_string(device.max_allocation_size >> 20) + " MiB)");
@@ -110,10 +115,13 @@ void validate_scene_parts(const RenderSettings& settings, const std::string& sor
 
 namespace {
 
-TileGrid tile_grid(const Camera& camera) {
+TileGrid tile_grid(const Camera& camera, const PixelRegion& region) {
+  const PixelRegion tiles = tile_aligned(region, camera.width, camera.height);
   TileGrid grid;
-  grid.width = uint32_t(camera.width);
-  grid.height = uint32_t(camera.height);
+  grid.width = uint32_t(tiles.width);
+  grid.height = uint32_t(tiles.height);
+  grid.first_x = uint32_t(tiles.x / kTileSize);
+  grid.first_y = uint32_t(tiles.y / kTileSize);
   grid.tiles_x = (grid.width + kTileSize - 1) / kTileSize;
   grid.tiles_y = (grid.height + kTileSize - 1) / kTileSize;
   grid.count = grid.tiles_x * grid.tiles_y;
@@ -248,7 +256,11 @@ ProjectionVariant projection_variant(const RenderSettings& settings, const Scene
 }
 
 FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const FrameContext& context) {
-  check_camera(camera, context.device);
+  check_camera(camera, settings.region, context.device);
+  if (settings.host && !settings.region.whole())
+    throw std::invalid_argument("RenderSettings::region " + to_string(settings.region) +
+                                ": a region cannot be combined with a host's depth (RenderSettings::host), "
+                                "which is the whole image's");
   validate(settings.accuracy);
   validate_compositor(settings);
   validate_host_depth(settings, camera);
@@ -263,14 +275,16 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
   plan.lists = {context.scene.generation, camera,
                 context.sort.name,        settings.accuracy,
                 settings.antialiasing,    settings.lighting,
-                settings.compositor,      settings.near_plane};
+                settings.compositor,      settings.near_plane,
+                settings.region};
   plan.part = context.part;
   // A part's lists are never whole-scene lists: always built, and never reused (renderer_parts.cpp).
   plan.build_lists =
       !(settings.reuse_lists && context.part.whole() && context.lists && *context.lists == plan.lists);
   plan.projection = projection_variant(settings, context.scene, camera_models::drawn_model(camera));
   plan.splat_records = context.scene.count * plan.projection.seam_copies();
-  plan.tiles = tile_grid(camera);
+  plan.tiles = tile_grid(camera, settings.region);
+  plan.culling_tiles = settings.compositor == Compositor::kRaster ? tile_grid(camera, {}) : plan.tiles;
   plan.compositor = settings.compositor;
   plan.depth_key_bits = uint32_t(settings.accuracy.depth_key_bits);
   const bool stochastic = settings.compositor == Compositor::kStochastic;

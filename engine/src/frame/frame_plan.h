@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "passes/projection_pass.h"
+#include "passes/tile_grid.h"
 #include "sort/sort_strategy.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/render_settings.h"
@@ -90,16 +91,9 @@ struct ListKey {
   Lighting lighting;
   Compositor compositor = Compositor::kSorted;  // sorted and binned-only lists differ
   double near_plane = kDefaultNearPlane;
+  PixelRegion region;  // the tiles listed
 
   bool operator==(const ListKey&) const = default;
-};
-
-// The frame's 16x16 tiles. Tile ids run to `count` inclusive (the key emission's padding uses that
-// id), hence tile_bits = bit_width(count).
-struct TileGrid {
-  uint32_t width = 0, height = 0;  // pixels
-  uint32_t tiles_x = 0, tiles_y = 0, count = 0;
-  uint32_t tile_bits = 0;
 };
 
 // One part of a scene rendered in depth-ordered parts (Renderer::render(scene, camera, settings) under
@@ -131,6 +125,10 @@ struct FramePlan {
   ProjectionVariant projection;
   uint32_t splat_records = 0;  // projected records: the scene's count times projection.seam_copies()
   TileGrid tiles;
+  // The tiles a splat must meet to be drawn (the projection's clamp): the frame's, except for the raster
+  // frame of a region, whose quads reach past a splat's tile rect (the rect's 3 sigmas against the
+  // quad's opacity-aware extent): there the whole image's, so that a region draws the whole frame's splats.
+  TileGrid culling_tiles;
   // Keys: the per-Gaussian depth key's bits (AccuracyModes::depth_key_bits); whether the pairs are
   // 64-bit (tile, depth) keys, for a strategy that sorts those itself; and the bits the frame's sorts
   // order by (FrameStats::sort_bits: depth + tile bits, or the tile bits alone for the stochastic

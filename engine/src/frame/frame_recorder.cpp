@@ -24,9 +24,9 @@ FrameRecorder::FrameRecorder(vk::Context& ctx, vk::GpuTimer& timer)
       pack_colour_(ctx) {}
 
 void FrameRecorder::set_frame_inputs(const Camera& camera, const RenderSettings& settings,
-                                     SceneBuffers& scene) {
+                                     const TileGrid& tiles, SceneBuffers& scene) {
   projection_.set_lighting(settings.lighting, scene);  // validates the lights; uploads normals on first use
-  projection_.set_camera(camera, settings.near_plane);
+  projection_.set_camera(camera, settings.near_plane, tiles);
 }
 
 uint32_t FrameRecorder::chunks_for(Compositor compositor, uint64_t longest_tile_list) const {
@@ -125,9 +125,8 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
                            res.counters.address());
       return;
     case FramePass::kKeyEmission:
-      key_emission_.record(cmd, res.projected, r.depth_order, res.keys, n, plan.tiles.tiles_x,
-                           plan.tiles.count, res.counters, plan.projection.square_tiles,
-                           plan.projection.alpha_inv);
+      key_emission_.record(cmd, res.projected, r.depth_order, res.keys, n, plan.tiles, res.counters,
+                           plan.projection.square_tiles, plan.projection.alpha_inv);
       vk::barrier(cmd);
       return;
     case FramePass::kTileSort:

@@ -32,7 +32,8 @@ class FrameRecorder {
   // Writes what the projection reads from the host: the lights (validating them; uploading the
   // scene's normals on its first lit frame) and the camera. Outside any command buffer; not needed for
   // a frame on reused lists, whose camera and lights are those in the buffers.
-  void set_frame_inputs(const Camera& camera, const RenderSettings& settings, SceneBuffers& scene);
+  void set_frame_inputs(const Camera& camera, const RenderSettings& settings, const TileGrid& tiles,
+                        SceneBuffers& scene);
   // Sizes the buffers, attachments and scratch the plan's passes use (the outputs the settings ask
   // for). Outside any command buffer, before record().
   void prepare(const FramePlan& plan, const RenderSettings& settings, FrameResources& resources,

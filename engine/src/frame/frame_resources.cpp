@@ -138,6 +138,7 @@ void FrameResources::prepare_outputs(const FramePlan& plan, const RenderSettings
     outputs.height = height;
     ranges = vk::Buffer(ctx_, VkDeviceSize(plan.tiles.count) * 8, vk::MemoryUse::Device, "tile ranges");
   }
+  outputs.first_tile = plan.tiles.packed_first();
   if (!settings.depth)
     outputs.depth.reset();
   else if (outputs.depth.size() == 0)

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "camera/camera_models.h"
+#include "frame/image_regions.h"
 #include "passes/projection_pass.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/sort.h"
@@ -185,9 +186,11 @@ GaussianScene gather_gaussians(const GaussianScene& scene, std::span<const uint3
 
 PartCosts part_costs(const PartSource& scene, const Camera& camera, const RenderSettings& settings,
                      uint32_t seam_copies, bool wide_keys) {
-  const uint64_t pixels = uint64_t(camera.width) * uint64_t(camera.height);
-  const uint64_t tiles = ((uint64_t(camera.width) + kTileSize - 1) / kTileSize) *
-                         ((uint64_t(camera.height) + kTileSize - 1) / kTileSize);
+  // The outputs: the image's, or the tiles' of a region (RenderSettings::region).
+  const PixelRegion outputs = tile_aligned(settings.region, camera.width, camera.height);
+  const uint64_t pixels = uint64_t(outputs.width) * uint64_t(outputs.height);
+  const uint64_t tiles = ((uint64_t(outputs.width) + kTileSize - 1) / kTileSize) *
+                         ((uint64_t(outputs.height) + kTileSize - 1) / kTileSize);
   PartCosts costs;
   // Colour, depth and counts out; the composite state's two halves of 32 bytes; the tile ranges.
   costs.fixed = pixels * (16 + (settings.depth ? 4 : 0) + (settings.splat_count ? 4 : 0) + 64) + tiles * 8;

@@ -139,7 +139,8 @@ void CompositePass::record(VkCommandBuffer cmd, const CompositeInputs& in, const
                        chunk * chunk_splats_,
                        chunk_splats_,
                        flags,
-                       host.surface_alpha};
+                       host.surface_alpha,
+                       out.first_tile};
     it->second.bind(cmd, push);
     if (variant.texel_buffers) it->second.push_texel_views(cmd, views);
     it->second.dispatch(cmd, tiles_x, tiles_y);

@@ -17,6 +17,9 @@ struct OutputBuffers {
   vk::Buffer depth;  // float per pixel (only when requested)
   vk::Buffer count;  // uint per pixel (only when requested)
   uint32_t width = 0, height = 0;
+  // Where the images start in the camera's tile grid, x | y << 16 (TileGrid::packed_first): 0 for the
+  // whole image, else a RenderSettings::region's first tile.
+  uint32_t first_tile = 0;
 };
 
 // Shared by the composites that stage splats per tile (composite.comp, composite_stochastic.comp):

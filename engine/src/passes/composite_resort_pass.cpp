@@ -51,7 +51,8 @@ void CompositeResortPass::record(VkCommandBuffer cmd, const CompositeInputs& in,
                            {float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy)},
                            tiles_x,
                            max_tile_splats(),
-                           counters};
+                           counters,
+                           out.first_tile};
   it->second.bind(cmd, push);
   it->second.dispatch(cmd, tiles_x, tiles_y);
 }

@@ -36,9 +36,10 @@ KeyEmissionPass::KeyEmissionPass(vk::Context& ctx)
                            VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER});
 }
 
-void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer* depth_order,
-                             KeyBuffers& keys, uint32_t gaussians, uint32_t tiles_x, uint32_t tiles,
-                             const vk::Buffer& counters_buffer, bool square_tiles, float alpha_inv) {
+void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projected,
+                             const vk::Buffer* depth_order, KeyBuffers& keys, uint32_t gaussians,
+                             const TileGrid& tiles, const vk::Buffer& counters_buffer, bool square_tiles,
+                             float alpha_inv) {
   const VkDeviceAddress counters = counters_buffer.address();
   frame_setup_.bind(cmd, SetupPush{counters, keys.capacity});
   frame_setup_.dispatch(cmd, 1);
@@ -86,10 +87,20 @@ void KeyEmissionPass::record(VkCommandBuffer cmd, const ProjectedBuffers& projec
              .first;
   }
   const auto& [emit_keys, emit_big_splat_keys] = it->second;
-  const EmitPush push{projected.splats.address(), projected.rects.address(), projected.tile_counts.address(),
-                      projected.offsets.address(), keys.keys.address(), keys.values.address(),
-                      projected.depth_order.keys.address(), projected.big_splats.address(), counters,
-                      gaussians, tiles_x, keys.capacity, tiles};
+  const EmitPush push{projected.splats.address(),
+                      projected.rects.address(),
+                      projected.tile_counts.address(),
+                      projected.offsets.address(),
+                      keys.keys.address(),
+                      keys.values.address(),
+                      projected.depth_order.keys.address(),
+                      projected.big_splats.address(),
+                      counters,
+                      gaussians,
+                      tiles.tiles_x,
+                      keys.capacity,
+                      tiles.count,
+                      tiles.packed_first()};
   emit_keys.bind(cmd, push);
   if (texel) emit_keys.push_texel_views(cmd, views);
   emit_keys.dispatch(cmd, vk::div_ceil(gaussians, 256));

@@ -10,6 +10,7 @@
 
 #include "passes/key_buffers.h"
 #include "passes/projection_pass.h"
+#include "passes/tile_grid.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
 
@@ -22,9 +23,9 @@ class KeyEmissionPass {
   // projected.depth_offsets the prefix sum of the tile counts taken in that order; or null, with
   // projected.offsets the prefix sum in Gaussian order and keys.wide_keys.
   // square_tiles and alpha_inv must be the projection's (ProjectionVariant): both count the same tiles.
-  void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer* depth_order, KeyBuffers& keys,
-              uint32_t gaussians, uint32_t tiles_x, uint32_t tiles, const vk::Buffer& counters, bool square_tiles,
-              float alpha_inv);
+  void record(VkCommandBuffer cmd, const ProjectedBuffers& projected, const vk::Buffer* depth_order,
+              KeyBuffers& keys, uint32_t gaussians, const TileGrid& tiles, const vk::Buffer& counters,
+              bool square_tiles, float alpha_inv);
 
  private:
   vk::Context& ctx_;

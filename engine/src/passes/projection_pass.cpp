@@ -34,7 +34,7 @@ using PackCovariancePush = shader_io::PackCovarianceHalfPush;
 
 // The words projection.comp reads the camera block by (camera_word) must be where C++ writes its fields.
 static_assert(offsetof(CameraParams, clip) == shader_io::CAMERA_CLIP * 8);
-static_assert(offsetof(CameraParams, grid) == shader_io::CAMERA_GRID * 8);
+static_assert(offsetof(CameraParams, tiles) == shader_io::CAMERA_TILES * 8);
 static_assert(offsetof(CameraParams, distortion) == shader_io::CAMERA_DISTORTION * 8);
 
 }  // namespace
@@ -46,7 +46,7 @@ ProjectionPass::ProjectionPass(vk::Context& ctx)
       pack_covariance_half_(ctx, "pack_covariance_half", sizeof(PackCovariancePush)),
       texel_buffers_(vk::texel_buffers_wanted(ctx) && ctx.features().shader_float64) {}
 
-void ProjectionPass::set_camera(const Camera& camera, double near_plane) {
+void ProjectionPass::set_camera(const Camera& camera, double near_plane, const TileGrid& tiles) {
   CameraParams p{};
   std::copy(camera.rotation.begin(), camera.rotation.end(), p.rotation);
   std::copy(camera.position.begin(), camera.position.end(), p.centre);
@@ -60,9 +60,7 @@ void ProjectionPass::set_camera(const Camera& camera, double near_plane) {
   p.clip[2] = near_plane;
   p.clip[3] = limits.reach;
   std::copy(camera.distortion.begin(), camera.distortion.end(), p.distortion);
-  p.grid = {uint32_t((camera.width + kTileSize - 1) / kTileSize),
-            uint32_t((camera.height + kTileSize - 1) / kTileSize), uint32_t(camera.width),
-            uint32_t(camera.height)};
+  p.tiles = {tiles.first_x, tiles.first_y, tiles.first_x + tiles.tiles_x, tiles.first_y + tiles.tiles_y};
   vk::upload(ctx_, camera_params_, &p, sizeof(p));
 }
 

@@ -8,6 +8,7 @@
 
 #include "camera/camera_models.h"
 #include "passes/key_buffers.h"
+#include "passes/tile_grid.h"
 #include "shader_io.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
@@ -76,8 +77,9 @@ constexpr uint32_t kRayDepthBytes = shader_io::RAY_DEPTH_VEC4S * 16;
 class ProjectionPass {
  public:
   explicit ProjectionPass(vk::Context& ctx);
-  // Writes this frame's camera; must be called before record(), outside the command buffer.
-  void set_camera(const Camera& camera, double near_plane);
+  // Writes this frame's camera and its tiles (the image's, or a region's); must be called before
+  // record(), outside the command buffer.
+  void set_camera(const Camera& camera, double near_plane, const TileGrid& tiles);
   // Validates this frame's lights (tilesplat::validate) and, when there are any, writes them and
   // uploads the scene's pending normals (once per scene). Must be called before record(), outside the
   // command buffer; record() of a lit variant reads what the last call wrote.

@@ -233,6 +233,7 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   push.counters = in.counters.address();
   push.width = shape.width;
   push.height = shape.height;
+  push.first_tile = in.out.first_tile;
   drawing.bind(cmd, push, shape.width, shape.height);
   if (mesh_)
     ctx_.cmd_draw_mesh_tasks_indirect()(cmd, draw_args_.handle(), 0, 1,

@@ -64,23 +64,24 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
       // Each dispatch reads what the previous one left in the state buffer.
       if (sample > 0 || chunk > 0) vk::barrier(stream.cmd());
       StochasticCompositePush push{in.splats.address(),
-                          in.tile_lists.address(),
-                          in.ranges.address(),
-                          out.rgba.address(),
-                          in.write_depth ? out.depth.address() : 0,
-                          in.write_count ? out.count.address() : 0,
-                          with_state ? chunks.state.address() : 0,
-                          chunks.counters,
-                          {in.background[0], in.background[1], in.background[2], 0.0f},
-                          out.width,
-                          out.height,
-                          tiles_x,
-                          chunk * chunk_splats_,
-                          chunk_splats_,
-                          chunk + 1 == chunks.count ? 1u : 0u,
-                          sample,
-                          samples.count,
-                          samples.seed};
+                                   in.tile_lists.address(),
+                                   in.ranges.address(),
+                                   out.rgba.address(),
+                                   in.write_depth ? out.depth.address() : 0,
+                                   in.write_count ? out.count.address() : 0,
+                                   with_state ? chunks.state.address() : 0,
+                                   chunks.counters,
+                                   {in.background[0], in.background[1], in.background[2], 0.0f},
+                                   out.width,
+                                   out.height,
+                                   tiles_x,
+                                   chunk * chunk_splats_,
+                                   chunk_splats_,
+                                   chunk + 1 == chunks.count ? 1u : 0u,
+                                   sample,
+                                   samples.count,
+                                   samples.seed,
+                                   out.first_tile};
       it->second.bind(stream.cmd(), push);
       if (variant.texel_buffers) it->second.push_texel_views(stream.cmd(), views);
       it->second.dispatch(stream.cmd(), tiles_x, tiles_y);

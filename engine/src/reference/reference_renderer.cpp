@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "frame/averaged_frames.h"
+#include "frame/image_regions.h"
 #include "host_depth.h"
 #include "lighting.h"
 #include "reference/pixel_order.h"
@@ -140,6 +141,11 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
   }
   const PixelRule rule = pixel_rule(settings, reference_order);
   validate(camera);
+  validate(settings.region, camera.width, camera.height);
+  if (settings.host && !settings.region.whole())
+    throw std::invalid_argument("RenderSettings::region " + to_string(settings.region) +
+                                ": a region cannot be combined with a host's depth (RenderSettings::host), "
+                                "which is the whole image's");
   check_scene(scene);
   validate_host_depth(settings, camera);
   check_near_plane(settings.near_plane);
@@ -230,9 +236,11 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
   projected.clear();
   projected.shrink_to_fit();
 
+  // The pixels composited: the whole image's, or a region's (the tiles' lists are the whole image's).
+  const PixelRegion region = resolved_region(settings.region, camera.width, camera.height);
   RenderImage image;
-  image.width = camera.width;
-  image.height = camera.height;
+  image.width = region.width;
+  image.height = region.height;
   image.rgba.assign(image.pixels() * 4, 0.0f);
   if (settings.depth) image.depth.assign(image.pixels(), 0.0f);
   if (settings.splat_count) image.splat_count.assign(image.pixels(), 0);
@@ -240,16 +248,18 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
 
   const double background[3] = {settings.background[0], settings.background[1], settings.background[2]};
   const size_t width = size_t(camera.width);
+  const size_t x0 = size_t(region.x), y0 = size_t(region.y);
+  const size_t x1 = x0 + size_t(region.width), y1 = y0 + size_t(region.height);
   parallel_chunks(size_t(grid_y), 1, [&](size_t row_begin, size_t row_end) {
-    for (size_t ty = row_begin; ty < row_end; ++ty)
-      for (size_t tx = 0; tx < size_t(grid_x); ++tx) {
+    for (size_t ty = std::max(row_begin, y0 / kTileSize); ty < row_end && ty * kTileSize < y1; ++ty)
+      for (size_t tx = x0 / kTileSize; tx * kTileSize < x1; ++tx) {
         const size_t tile = ty * size_t(grid_x) + tx;
         const uint32_t* list_begin = tile_splats.data() + tile_offsets[tile];
         const uint32_t* list_end = tile_splats.data() + tile_offsets[tile + 1];
-        const size_t y_end = std::min(size_t(camera.height), (ty + 1) * kTileSize);
-        const size_t x_end = std::min(width, (tx + 1) * kTileSize);
-        for (size_t py = ty * kTileSize; py < y_end; ++py)
-          for (size_t px = tx * kTileSize; px < x_end; ++px) {
+        const size_t y_end = std::min(y1, (ty + 1) * kTileSize);
+        const size_t x_end = std::min(x1, (tx + 1) * kTileSize);
+        for (size_t py = std::max(y0, ty * kTileSize); py < y_end; ++py)
+          for (size_t px = std::max(x0, tx * kTileSize); px < x_end; ++px) {
             const double pixel_x = double(px) + 0.5, pixel_y = double(py) + 0.5;
             double transmittance = 1.0;
             double color[3] = {0, 0, 0};
@@ -303,7 +313,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
               }
               queue.flush(release);
             }
-            const size_t pixel = py * width + px;
+            const size_t pixel = (py - y0) * size_t(region.width) + (px - x0);
             for (size_t ch = 0; ch < 3; ++ch)
               image.rgba[pixel * 4 + ch] = static_cast<float>(color[ch] + transmittance * background[ch]);
             image.rgba[pixel * 4 + 3] = static_cast<float>(1.0 - transmittance);

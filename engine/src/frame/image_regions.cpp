@@ -1,0 +1,178 @@
+#include "frame/image_regions.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "frame/averaged_frames.h"  // add_pass_times
+#include "tilesplat/reference.h"    // kTileSize
+
+namespace tilesplat {
+
+void validate(const PixelRegion& region, int image_width, int image_height) {
+  if (region.whole()) return;
+  auto fail = [&](const std::string& why) {
+    throw std::invalid_argument("RenderSettings::region " + to_string(region) + ": " + why);
+  };
+  if (region.width <= 0 || region.height <= 0) fail("its width and height must be positive");
+  if (region.x < 0 || region.y < 0) fail("its first column and row must not be negative");
+  if (int64_t(region.x) + region.width > image_width || int64_t(region.y) + region.height > image_height)
+    fail("it reaches past the " + std::to_string(image_width) + "x" + std::to_string(image_height) +
+         " image");
+}
+
+std::string to_string(const PixelRegion& region) {
+  if (region.whole()) return "whole";
+  return std::to_string(region.x) + "," + std::to_string(region.y) + "," + std::to_string(region.width) +
+         "x" + std::to_string(region.height);
+}
+
+PixelRegion parse_pixel_region(const std::string& text) {
+  if (text == "whole") return {};
+  // x,y,WxH or x,y,W,H: four non-negative integers.
+  std::vector<std::string> fields;
+  size_t start = 0;
+  for (size_t at = 0; at <= text.size(); ++at)
+    if (at == text.size() || text[at] == ',') {
+      fields.push_back(text.substr(start, at - start));
+      start = at + 1;
+    }
+  if (fields.size() == 3) {
+    const size_t times = fields[2].find('x');
+    if (times != std::string::npos) {
+      fields.push_back(fields[2].substr(times + 1));
+      fields[2].resize(times);
+    }
+  }
+  auto number = [](const std::string& field) {
+    const bool digits = !field.empty() && field.size() <= 9 &&
+                        std::all_of(field.begin(), field.end(), [](char c) { return c >= '0' && c <= '9'; });
+    return digits ? std::stoi(field) : -1;
+  };
+  int values[4] = {-1, -1, -1, -1};
+  if (fields.size() == 4)
+    for (int k = 0; k < 4; ++k) values[k] = number(fields[size_t(k)]);
+  if (std::any_of(values, values + 4, [](int v) { return v < 0; }))
+    throw std::invalid_argument(
+        "region '" + text +
+        "': expected x,y,WIDTHxHEIGHT (e.g. 0,540,1920x64) or x,y,WIDTH,HEIGHT in pixels");
+  return {values[0], values[1], values[2], values[3]};
+}
+
+PixelRegion resolved_region(const PixelRegion& region, int image_width, int image_height) {
+  return region.whole() ? PixelRegion{0, 0, image_width, image_height} : region;
+}
+
+PixelRegion tile_aligned(const PixelRegion& region, int image_width, int image_height) {
+  const PixelRegion r = resolved_region(region, image_width, image_height);
+  const int x0 = r.x / kTileSize * kTileSize, y0 = r.y / kTileSize * kTileSize;
+  const int x1 = std::min(image_width, (r.x + r.width + kTileSize - 1) / kTileSize * kTileSize);
+  const int y1 = std::min(image_height, (r.y + r.height + kTileSize - 1) / kTileSize * kTileSize);
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+namespace {
+
+// Copies rows of `width` pixels from `from` (pixels starting at from_origin) at (x, y) into `to` (pixels
+// starting at to_origin), for every output `from` and `to` both hold.
+void copy_pixels(const RenderImage& from, const PixelRegion& from_origin, RenderImage& to,
+                 const PixelRegion& to_origin, const PixelRegion& pixels) {
+  for (int row = pixels.y; row < pixels.y + pixels.height; ++row) {
+    const size_t source = size_t(row - from_origin.y) * size_t(from.width) + size_t(pixels.x - from_origin.x);
+    const size_t target = size_t(row - to_origin.y) * size_t(to.width) + size_t(pixels.x - to_origin.x);
+    const size_t n = size_t(pixels.width);
+    std::copy_n(from.rgba.begin() + ptrdiff_t(4 * source), 4 * n, to.rgba.begin() + ptrdiff_t(4 * target));
+    if (!from.depth.empty() && !to.depth.empty())
+      std::copy_n(from.depth.begin() + ptrdiff_t(source), n, to.depth.begin() + ptrdiff_t(target));
+    if (!from.splat_count.empty() && !to.splat_count.empty())
+      std::copy_n(from.splat_count.begin() + ptrdiff_t(source), n,
+                  to.splat_count.begin() + ptrdiff_t(target));
+    if (!from.host_depth.empty() && !to.host_depth.empty())
+      std::copy_n(from.host_depth.begin() + ptrdiff_t(source), n, to.host_depth.begin() + ptrdiff_t(target));
+  }
+}
+
+}  // namespace
+
+RenderImage crop(const RenderImage& image, const PixelRegion& held, const PixelRegion& within) {
+  if (held == within) return image;
+  RenderImage out;
+  out.width = within.width;
+  out.height = within.height;
+  const size_t pixels = out.pixels();
+  out.rgba.resize(4 * pixels);
+  if (!image.depth.empty()) out.depth.resize(pixels);
+  if (!image.splat_count.empty()) out.splat_count.resize(pixels);
+  if (!image.host_depth.empty()) out.host_depth.resize(pixels);
+  copy_pixels(image, held, out, within, within);
+  return out;
+}
+
+void paste(RenderImage& into, const PixelRegion& into_origin, const RenderImage& part,
+           const PixelRegion& at) {
+  copy_pixels(part, at, into, into_origin, at);
+}
+
+std::vector<PixelRegion> bands_within(const PixelRegion& region, uint64_t bytes_per_pixel,
+                                      uint64_t bytes_per_band) {
+  // The band's outputs are its tiles' pixels: up to a tile more on either side.
+  const uint64_t row_bytes = (uint64_t(region.width) + 2 * kTileSize) * bytes_per_pixel;
+  if (uint64_t(region.height) * row_bytes <= bytes_per_band) return {region};
+  // Whole rows of tiles a band, so that no tile is rendered twice.
+  const uint64_t tile_rows = std::max<uint64_t>(1, bytes_per_band / (row_bytes * kTileSize));
+  const int band_rows = int(std::min<uint64_t>(tile_rows * kTileSize, uint64_t(region.height)));
+  std::vector<PixelRegion> bands;
+  // The first band ends on a tile row of the image, so that every band after it starts on one.
+  int y = region.y;
+  const int end = region.y + region.height;
+  int next = std::min(end, (y / kTileSize) * kTileSize + band_rows);
+  while (y < end) {
+    bands.push_back({region.x, y, region.width, next - y});
+    y = next;
+    next = std::min(end, y + band_rows);
+  }
+  return bands;
+}
+
+uint64_t frame_bytes_per_pixel(const RenderSettings& settings) {
+  uint64_t bytes = 16 + (settings.depth ? 4 : 0) + (settings.splat_count ? 4 : 0) + kLargestBytesPerPixel;
+  if (settings.host) bytes += 4 * (settings.host->write_depth ? 2 : 1);
+  return bytes;
+}
+
+uint64_t image_bytes_per_pixel(const RenderSettings& settings) {
+  return 16 + (settings.depth ? 4 : 0) + (settings.splat_count ? 4 : 0) +
+         (settings.host && settings.host->write_depth ? 4 : 0);
+}
+
+uint64_t host_physical_memory() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page_size > 0 ? uint64_t(pages) * uint64_t(page_size) : 0;
+}
+
+void add_band_stats(FrameStats& frame, const FrameStats& band) {
+  if (frame.image_bands == 0) {
+    frame = band;
+    frame.image_bands = 1;
+    return;
+  }
+  add_pass_times(frame.passes, band.passes);
+  frame.gpu_ms += band.gpu_ms;
+  frame.visible = std::max(frame.visible, band.visible);
+  frame.intersections += band.intersections;
+  frame.sort_bits = std::max(frame.sort_bits, band.sort_bits);
+  frame.retries += band.retries;
+  frame.submissions += band.submissions;
+  frame.sort_fallbacks += band.sort_fallbacks;
+  frame.device_bytes = std::max(frame.device_bytes, band.device_bytes);
+  frame.peak_device_bytes = std::max(frame.peak_device_bytes, band.peak_device_bytes);
+  frame.scene_parts = std::max(frame.scene_parts, band.scene_parts);
+  frame.uploaded_bytes += band.uploaded_bytes;
+  frame.reused_sorted_lists = frame.reused_sorted_lists && band.reused_sorted_lists;
+  frame.complete = frame.complete && band.complete;
+  ++frame.image_bands;
+}
+
+}  // namespace tilesplat
