@@ -419,7 +419,8 @@ TEST(CliBench, EffectsTableMeasuresEachEffectBesideItsNeverHadItRow) {
                           "camera: orthographic",
                           "camera: equirectangular",
                           "depth of field, 8 lens samples",
-                          "motion blur, 8 time samples"})
+                          "motion blur, 8 time samples",
+                          "rolling shutter, 8 bands"})
     EXPECT_TRUE(contains(result.out, row)) << row << "\n" << result.out;
   // Every row is a whole frame: the projection and both sorts are measured, never skipped.
   for (const char* pass : {"projection", "depth_sort", "tile_sort", "composite"})
@@ -457,11 +458,56 @@ TEST(CliRender, AFrameLargerThanTheDeviceRendersInPartsWithoutABudget) {
   const tilesplat::RenderImage in_parts = tilesplat::read_exr(out / "parts.exr");
   EXPECT_EQ(in_parts.rgba, expected.rgba);
   EXPECT_EQ(in_parts.depth, expected.depth);
-  // A frame whose images alone pass it cannot be split: a clear error, and no file.
+  // A frame whose per-pixel buffers pass it renders in bands of rows, each in parts.
   const auto images = render("env TILESPLAT_MAX_ALLOCATION=256K ", "images.exr");
-  EXPECT_NE(images.exit_code, 0);
-  EXPECT_TRUE(contains(images.err, "more than the device's largest allocation (262144 bytes)")) << images.err;
-  EXPECT_FALSE(fs::exists(out / "images.exr"));
+  ASSERT_EQ(images.exit_code, 0) << images.err;
+  EXPECT_TRUE(contains(images.out, "image bands                         6\n")) << images.out;
+  const tilesplat::RenderImage in_bands = tilesplat::read_exr(out / "images.exr");
+  EXPECT_EQ(in_bands.rgba, expected.rgba);
+  EXPECT_EQ(in_bands.depth, expected.depth);
+  // One whose one row of tiles passes it cannot be split further: a clear error, and no file.
+  const auto tiny = render("env TILESPLAT_MAX_ALLOCATION=64K ", "tiny.exr");
+  EXPECT_NE(tiny.exit_code, 0);
+  EXPECT_TRUE(contains(tiny.err, "more than the device's largest allocation (65536 bytes)")) << tiny.err;
+  EXPECT_FALSE(fs::exists(out / "tiny.exr"));
+}
+
+// --region: the whole frame's pixels, written as the EXR's data window; recorded in renderSettings; bad
+// regions refused before anything is written.
+TEST(CliRender, RegionRendersTheWholeFramesPixels) {
+  const auto out = fresh_output_dir();
+  auto render = [&](std::vector<std::string> extra, const std::string& name) {
+    std::vector<std::string> args = {bundled_playbot().string(), "--width", "160", "--height", "90", "-o",
+                                     (out / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_exe(kRenderExe, args);
+  };
+  ASSERT_EQ(render({}, "whole.exr").exit_code, 0);
+  const auto region =
+      render({"--region", "10,20,100x30", "--png", (out / "region.png").string()}, "region.exr");
+  ASSERT_EQ(region.exit_code, 0) << region.err;
+  EXPECT_TRUE(contains(region.err, "160x90 (region 10,20,100x30)")) << region.err;
+  const tilesplat::RenderImage whole = tilesplat::read_exr(out / "whole.exr");
+  const tilesplat::RenderImage part = tilesplat::read_exr(out / "region.exr");
+  ASSERT_EQ(part.width, 100);
+  ASSERT_EQ(part.height, 30);
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 100; ++x)
+      for (size_t c = 0; c < 4; ++c)
+        ASSERT_EQ(part.rgba[4 * (size_t(y) * 100 + size_t(x)) + c],
+                  whole.rgba[4 * (size_t(y + 20) * 160 + size_t(x + 10)) + c]);
+  EXPECT_TRUE(contains(tilesplat::read_exr_string_attributes(out / "region.exr").at("renderSettings"),
+                       " region=10,20,100x30"));
+  EXPECT_EQ(tilesplat::testing::read_png_rgb(out / "region.png").width, 100u);
+  const auto past = render({"--region", "100,0,100x10"}, "past.exr");
+  EXPECT_EQ(past.exit_code, 2);
+  EXPECT_TRUE(contains(past.err, "--region 100,0,100x10: it reaches past the 160x90 image")) << past.err;
+  const auto malformed = render({"--region", "1,2,3"}, "malformed.exr");
+  EXPECT_EQ(malformed.exit_code, 2);
+  EXPECT_TRUE(contains(malformed.err, "--region: region '1,2,3': expected x,y,WIDTHxHEIGHT"))
+      << malformed.err;
+  EXPECT_FALSE(fs::exists(out / "past.exr"));
+  EXPECT_FALSE(fs::exists(out / "malformed.exr"));
 }
 
 TEST(CliRender, MemoryBudgetRendersTheSameImageInParts) {

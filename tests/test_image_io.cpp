@@ -492,6 +492,46 @@ TEST(ExrIo, ReadsFileWithoutAlphaAndWithOffsetDataWindow) {
   EXPECT_TRUE(image.splat_count.empty());
 }
 
+// A frame of RenderSettings::region: the data window inside the whole image's display window, read back
+// as the region's pixels; a region that is not the image's size or leaves the display is an error.
+TEST(ExrIo, ARegionIsTheDataWindowInsideTheDisplayWindow) {
+  const fs::path dir = fresh_dir();
+  const RenderImage image = make_image(5, 3, true, true);
+  ExrWriteOptions options{.colour = ColourEncoding::kSrgbDisplay};
+  options.region = {10, 20, 5, 3};
+  options.display_width = 64;
+  options.display_height = 48;
+  write_exr(dir / "region.exr", image, options);
+  const RenderImage back = read_exr(dir / "region.exr");
+  EXPECT_EQ(back.width, 5);
+  EXPECT_EQ(back.height, 3);
+  EXPECT_TRUE(same_bits(back.rgba, image.rgba));
+  EXPECT_TRUE(same_bits(back.depth, image.depth));
+#if TILESPLAT_TEST_HAS_OPENEXR
+  Imf::InputFile file((dir / "region.exr").c_str());
+  const Imath::Box2i data = file.header().dataWindow(), display = file.header().displayWindow();
+  EXPECT_EQ(data.min.x, 10);
+  EXPECT_EQ(data.min.y, 20);
+  EXPECT_EQ(data.max.x, 14);
+  EXPECT_EQ(data.max.y, 22);
+  EXPECT_EQ(display.min.x, 0);
+  EXPECT_EQ(display.max.x, 63);
+  EXPECT_EQ(display.max.y, 47);
+#endif
+  options.region = {60, 20, 5, 3};  // past the display's right edge
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              write_exr(dir / "outside.exr", image, options);
+            }).find("region 60,20,5x3 does not lie within the 64x48 display window"),
+            std::string::npos);
+  options.region = {0, 0, 4, 3};  // not the image's size
+  EXPECT_NE(tilesplat::testing::error_of([&] {
+              write_exr(dir / "size.exr", image, options);
+            }).find("is not the image's size, 5x3"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "outside.exr"));
+  EXPECT_FALSE(fs::exists(dir / "size.exr"));
+}
+
 TEST(ExrIo, MissingColourChannelIsAnErrorNamingTheFile) {
   const fs::path path = fresh_dir() / "no_red.exr";
   write_hand_made_exr(path, 0, 0, 2, 1, {{"G", {1, 2}}, {"B", {3, 4}}});

@@ -66,10 +66,13 @@ RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& ba
     cpu_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     gpu_ms_ = 0;
   }
-  if (image.width != camera.width || image.height != camera.height || image.rgba.size() != image.pixels() * 4)
+  // The camera's size, or the region's (--region).
+  const int width = settings.region.whole() ? camera.width : settings.region.width;
+  const int height = settings.region.whole() ? camera.height : settings.region.height;
+  if (image.width != width || image.height != height || image.rgba.size() != image.pixels() * 4)
     throw std::runtime_error("the renderer returned a " + std::to_string(image.width) + "x" +
-                             std::to_string(image.height) + " image for a " + std::to_string(camera.width) +
-                             "x" + std::to_string(camera.height) + " camera");
+                             std::to_string(image.height) + " image for a " + std::to_string(width) + "x" +
+                             std::to_string(height) + " frame");
   if (!settings.depth) image.depth.clear();
   if (!settings.splat_count) image.splat_count.clear();
   return image;

@@ -81,6 +81,7 @@ std::string settings_text(const tilesplat::RenderSettings& settings, const LensF
     text += " frames=" + std::to_string(settings.stochastic.frames) +
             " seed=" + std::to_string(settings.stochastic.seed);
   text += " lights=" + std::to_string(settings.lighting.lights.size());
+  if (!settings.region.whole()) text += " region=" + tilesplat::to_string(settings.region);
   text += " background=";
   for (size_t c = 0; c < 3; ++c) text += (c > 0 ? "," : "") + shortest_exact(settings.background[c]);
   if (lens.enabled())
@@ -133,6 +134,7 @@ void print_frame_stats(const tilesplat::FrameStats& stats, const tilesplat::Devi
   print_row("device memory", mib(stats.device_bytes), "MiB");
   print_row("peak device memory", mib(stats.peak_device_bytes), "MiB");
   print_row("scene parts", std::to_string(stats.scene_parts), "");
+  print_row("image bands", std::to_string(stats.image_bands), "");
   print_row("peak resident memory", mib(cli::peak_memory_bytes()), "MiB");
 }
 
@@ -286,6 +288,8 @@ struct FrameWriter {
   void write(const Frame& frame, const tilesplat::RenderImage& image) const {
     tilesplat::ExrWriteOptions options = exr;
     options.camera = frame.camera;  // worldToCamera, worldToNDC and the exact camera
+    options.display_width = frame.camera.width;  // a region's display window (--region)
+    options.display_height = frame.camera.height;
     options.attributes["view"] = frame.description;
     if (frame.view_index) {
       options.attributes["viewIndex"] = std::to_string(*frame.view_index);
@@ -468,6 +472,16 @@ int run(int argc, char** argv) {
   if (options.no_depth) settings.depth = false;
   if (options.no_count) settings.splat_count = false;
   settings.memory_budget = options.memory_budget;
+  settings.region = options.region;
+  for (const Frame& frame : frames) {  // every frame's image must hold the region, before any renders
+    try {
+      tilesplat::validate(options.region, frame.camera.width, frame.camera.height);
+    } catch (const std::invalid_argument& error) {
+      std::string why = error.what();
+      why = why.substr(why.find(": ") + 2);
+      throw cli::UsageError("--region " + tilesplat::to_string(options.region) + ": " + why);
+    }
+  }
   cli::apply_training_options(options.common, settings);
   if (options.stochastic_frames > 0) {  // --compositor stochastic or none (check_render_options)
     settings.compositor = tilesplat::Compositor::kStochastic;
@@ -485,6 +499,7 @@ int run(int argc, char** argv) {
   writer.exr.attributes["commandLine"] = cli::command_line(kProgram, argc, argv);
   writer.exr.compression = options.compression;
   writer.exr.colour = options.exr_colour;
+  writer.exr.region = settings.region;
   // Empty pixels far away, for depth compositing; with a background, an opaque frame (docs: README).
   writer.exr.empty_depth = tilesplat::kFarDepth;
   writer.exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
@@ -542,10 +557,11 @@ int run(int argc, char** argv) {
   if (!options.png.empty()) written += ", " + options.png;
 
   std::fflush(stdout);
-  const std::string summary = std::string(kProgram) + ": " + loaded.path.filename().string() + ", " +
-                              cli::describe_scene(loaded) + ", " + std::to_string(image.width) + "x" +
-                              std::to_string(image.height) + ", " + loaded.camera_description + ", " +
-                              timing + " -> " + written + "\n";
+  const std::string summary =
+      std::string(kProgram) + ": " + loaded.path.filename().string() + ", " + cli::describe_scene(loaded) +
+      ", " + std::to_string(frame.camera.width) + "x" + std::to_string(frame.camera.height) +
+      (settings.region.whole() ? "" : " (region " + tilesplat::to_string(settings.region) + ")") + ", " +
+      loaded.camera_description + ", " + timing + " -> " + written + "\n";
   std::fputs(summary.c_str(), stderr);
   return cli::kExitOk;
 }

@@ -203,15 +203,27 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                    });
 
   cli::add_camera_model_options(parser, options.camera_model);
-  parser.add_switch("--stats",
-                    "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
-                    "intersections, retries, device memory and its peak, scene parts, peak resident memory",
-                    &options.stats);
+  parser.add_switch(
+      "--stats",
+      "print the frame statistics to stdout: GPU ms per pass, frame ms, visible Gaussians, "
+      "intersections, retries, device memory and its peak, scene parts, image bands, peak resident memory",
+      &options.stats);
   cli::add_memory_budget_option(
       parser, options.memory_budget,
       "--stats prints the parts and peaks; without a budget, a frame past the device's limits still renders "
       "in parts; ");
   cli::add_splat_budget_option(parser, options.common);
+  parser.add_value("--region", "X,Y,WxH",
+                   "render only these pixels of each frame (e.g. 0,540,1920x64), each the whole frame's to "
+                   "the bit: the EXR holds them as its data window inside the whole image's display window, "
+                   "where compositing tools place it; only the tiles the region meets are binned and sorted",
+                   [&options](const std::string& text) {
+                     try {
+                       options.region = parse_pixel_region(text);
+                     } catch (const std::invalid_argument& error) {
+                       throw cli::UsageError(std::string("--region: ") + error.what());
+                     }
+                   });
 
   parser.section("many frames (one process; -o and --png then take a frame number: out/view_%04d.exr)");
   parser.add_string(

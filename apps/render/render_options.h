@@ -80,6 +80,7 @@ struct RenderOptions {
   ShutterFlags shutter;
   bool stats = false;
   uint64_t memory_budget = 0;  // --memory-budget: RenderSettings::memory_budget (0: the device's limits)
+  PixelRegion region;          // --region: RenderSettings::region (whole: the image)
   // Many frames in one run.
   std::string views;      // --views: a selection of the camera set's views
   int orbit_frames = 0;   // --orbit N

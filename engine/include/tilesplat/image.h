@@ -12,6 +12,7 @@
 
 #include "tilesplat/camera.h"
 #include "tilesplat/export.h"
+#include "tilesplat/render_settings.h"  // PixelRegion
 
 namespace tilesplat {
 
@@ -95,6 +96,13 @@ struct ExrWriteOptions {
   /// and every compositing tool assume; kSrgbDisplay keeps the rendered values bit for bit. Either way the
   /// string attribute `colorInteropID` names it, and read_exr() converts back.
   ColourEncoding colour = ColourEncoding::kSceneLinear;
+  /// The image is the pixels `region` of a display_width x display_height image (a frame of
+  /// RenderSettings::region): written as OpenEXR's dataWindow inside that displayWindow, where compositing
+  /// tools place it (read_exr() reads the data window). Whole (the default): the image is its own display
+  /// window. Otherwise the region must be the image's size and lie within the display window.
+  PixelRegion region;
+  int display_width = 0;   ///< the whole image's width, with `region`
+  int display_height = 0;  ///< the whole image's height, with `region`
 };
 
 /// Blender's Z for pixels that show no surface: finite, so that filters and resampling stay finite,

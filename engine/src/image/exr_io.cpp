@@ -82,7 +82,21 @@ bool is_written_by_the_writer(const std::string& name) {
   return name.rfind("tilesplat", 0) == 0;
 }
 
-void check_attributes(const std::filesystem::path& path, const ExrWriteOptions& options) {
+void check_attributes(const std::filesystem::path& path, const RenderImage& image,
+                      const ExrWriteOptions& options) {
+  const PixelRegion& region = options.region;
+  if (!region.whole()) {
+    const std::string where = "cannot write " + path.string() + ": the image's region " + to_string(region);
+    if (region.width != image.width || region.height != image.height)
+      throw std::runtime_error(where + " is not the image's size, " + std::to_string(image.width) + "x" +
+                               std::to_string(image.height));
+    try {
+      validate(region, options.display_width, options.display_height);
+    } catch (const std::invalid_argument&) {
+      throw std::runtime_error(where + " does not lie within the " + std::to_string(options.display_width) +
+                               "x" + std::to_string(options.display_height) + " display window");
+    }
+  }
   for (const auto& [name, value] : options.attributes) {
     if (name.empty())
       throw std::runtime_error("cannot write " + path.string() + ": an attribute has an empty name");
@@ -276,7 +290,7 @@ auto with_exr_file_named_in_errors(const std::filesystem::path& path, const Read
 
 void write_exr(const std::filesystem::path& path, const RenderImage& image, const ExrWriteOptions& options) {
   check_writable_image(path, image);
-  check_attributes(path, options);
+  check_attributes(path, image, options);
 
   // What the file holds where the options change the image: the colours in the encoding asked for
   // (a file without A, or with A = 1, is opaque, so its colours convert as they are), A = 1 for an
@@ -310,7 +324,14 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
   const size_t colour_value_bytes = options.half ? sizeof(Imath::half) : sizeof(float);
 
   detail::write_file_atomically(path, [&](const std::filesystem::path& temp) {
-    Imf::Header header(image.width, image.height);
+    // A region's pixels as the data window inside the whole image's display window.
+    const PixelRegion& region = options.region;
+    Imf::Header header =
+        region.whole()
+            ? Imf::Header(image.width, image.height)
+            : Imf::Header(Imath::Box2i({0, 0}, {options.display_width - 1, options.display_height - 1}),
+                          Imath::Box2i({region.x, region.y},
+                                       {region.x + region.width - 1, region.y + region.height - 1}));
     header.compression() = openexr_compression(options.compression);
     add_string_attributes(header, options);
     Imf::addChromaticities(header, Imf::Chromaticities());  // Rec. 709 primaries, D65 white
@@ -345,7 +366,7 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
     // Scoped so the file is complete and closed before write_file_atomically renames it.
     Imf::OutputFile file(temp.c_str(), header);
     file.setFrameBuffer(frame);
-    file.writePixels(image.height);
+    file.writePixels(image.height);  // the data window's rows
   });
 }
 
