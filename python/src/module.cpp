@@ -153,6 +153,7 @@ nb::dict stats_dict(const FrameStats& stats) {
   out["reused_sorted_lists"] = stats.reused_sorted_lists;
   out["samples"] = stats.samples;  // frames averaged (lens, shutter)
   out["scene_parts"] = stats.scene_parts;  // depth-ordered parts under a memory budget
+  out["image_bands"] = stats.image_bands;  // bands of rows of an image past the device
   out["peak_device_bytes"] = stats.peak_device_bytes;
   return out;
 }
@@ -657,10 +658,11 @@ void bind(nb::module_& m) {
              const std::array<float, 3>& background, bool reuse_lists, double near_plane, double max_alpha,
              const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter,
              const GaussianScene* scene, uint64_t memory_budget, const LodSet* lod_set, uint64_t splat_budget,
-             const SceneInstances* instances) {
+             const SceneInstances* instances, const std::optional<std::array<int, 4>>& region) {
             RenderSettings settings = make_settings(
                 sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames, seed,
                 background, reuse_lists, near_plane, max_alpha, lens, shutter, memory_budget);
+            if (region) settings.region = {(*region)[0], (*region)[1], (*region)[2], (*region)[3]};
             if (int(scene != nullptr) + int(lod_set != nullptr) + int(instances != nullptr) > 1)
               throw std::invalid_argument("render takes one of scene, lod_set and instances");
             if (splat_budget > 0 && !lod_set)
@@ -677,13 +679,15 @@ void bind(nb::module_& m) {
           "background"_a = std::array<float, 3>{0, 0, 0}, "reuse_lists"_a = true,
           "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
           "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0, "lod_set"_a = nb::none(),
-          "splat_budget"_a = 0, "instances"_a = nb::none(),
+          "splat_budget"_a = 0, "instances"_a = nb::none(), "region"_a = nb::none(),
           "Renders the scene from `camera`: the one set_scene uploaded, or `scene`, which replaces it and is "
           "rendered within memory_budget bytes of device memory (0: the device's own limits), "
           "in depth-ordered parts into the same image where the whole frame would need more "
           "(docs/big-scenes.md); a LodSet `lod_set`: level 0, or under splat_budget the levels this camera "
           "calls for (LodSet.select); or SceneInstances `instances`, whose moving models blur under an open "
           "shutter (with or without its end_camera). "
+          "region (x, y, width, height) renders only those pixels, each the whole frame's to the bit, into "
+          "an image of that size (RenderSettings::region). "
           "Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted', 'stochastic' or 'raster' (the depth-sorted splats drawn as quads by the "

@@ -162,6 +162,26 @@ def test_a_scene_past_the_device_renders_in_parts_without_a_budget(playbot_rende
     assert small.validation_messages == 0
 
 
+def test_a_region_is_the_whole_frames_pixels(playbot_renderer, monkeypatch):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 160, 90, azimuth_deg=30)
+    whole = renderer.render(camera)
+    part = renderer.render(camera, region=(10, 21, 100, 30))
+    assert part.rgba.shape == (30, 100, 4)
+    assert np.array_equal(part.rgba, whole.rgba[21:51, 10:110])
+    assert np.array_equal(part.depth, whole.depth[21:51, 10:110])
+    with pytest.raises(ValueError, match="reaches past the 160x90 image"):
+        renderer.render(camera, region=(100, 0, 100, 10))
+    # An image past the device's largest allocation renders in bands of rows.
+    monkeypatch.setenv("TILESPLAT_MAX_ALLOCATION", "256K")
+    small = tilesplat.Renderer(validation=True)
+    monkeypatch.delenv("TILESPLAT_MAX_ALLOCATION")
+    banded = small.render(camera, scene=scene)
+    assert small.last_frame_stats["image_bands"] == 6
+    assert np.array_equal(banded.rgba, whole.rgba)
+    assert small.validation_messages == 0
+
+
 def test_a_scene_files_moving_models_blur_under_an_open_shutter(playbot_renderer):
     _, renderer = playbot_renderer
     instances = tilesplat.SceneInstances(REPO / "scenes" / "moving_playbots.json")
