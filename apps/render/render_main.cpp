@@ -92,7 +92,7 @@ std::string settings_text(const tilesplat::RenderSettings& settings, const LensF
             ",samples:" + std::to_string(settings.lens.samples);
   if (shutter.enabled()) {
     text += " shutter=" + shutter_text(shutter);
-  } else if (settings.shutter.close > settings.shutter.open) {  // a scene file's shutter for the view
+  } else if (settings.shutter.opens()) {  // a scene file's shutter for the view
     text += " shutter=open:" + shortest_exact(settings.shutter.open) +
             ",close:" + shortest_exact(settings.shutter.close) +
             ",samples:" + std::to_string(settings.shutter.samples) +
@@ -515,9 +515,8 @@ int run(int argc, char** argv) {
   if (sequence && !options.lens.enabled() &&
       std::any_of(frames.begin(), frames.end(), [](const Frame& f) { return f.lens.enabled(); }))
     writer.exr.attributes["renderSettings"] += " lens=the scene file's, per view";
-  if (sequence && !options.shutter.enabled() && std::any_of(frames.begin(), frames.end(), [](const Frame& f) {
-        return f.shutter.close > f.shutter.open;
-      }))
+  if (sequence && !options.shutter.enabled() &&
+      std::any_of(frames.begin(), frames.end(), [](const Frame& f) { return f.shutter.opens(); }))
     writer.exr.attributes["renderSettings"] += " shutter=the scene file's, per view";
 
   if (sequence) {

@@ -52,7 +52,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     FUZZ_CHECK(description.shutters.size() == description.lenses.size());
     for (size_t i = 0; i < description.shutters.size(); ++i) {
       const tilesplat::Shutter& shutter = description.shutters[i];
-      FUZZ_CHECK(shutter.close > shutter.open || shutter == tilesplat::Shutter{});
+      FUZZ_CHECK(shutter.opens() || shutter == tilesplat::Shutter{});
       if (shutter.end_camera) {  // the same camera, moved
         tilesplat::validate(shutter);
         FUZZ_CHECK(shutter.end_camera->width == description.cameras[i].camera.width);

@@ -43,7 +43,10 @@ struct Shutter {
   std::optional<Camera> end_camera;  ///< the camera at time 1: the same size as the rendered one
   ShutterScan scan = ShutterScan::kGlobal;  ///< global, or a rolling shutter's direction
   /// Whether the shutter blurs anything: open for a while over a camera that moves.
-  bool enabled() const { return close > open && end_camera.has_value(); }
+  bool enabled() const { return opens() && end_camera.has_value(); }
+  /// Whether the shutter is open for a while (close > open): what blurs a scene's moving models
+  /// (SceneInstances::moves), with or without an end camera.
+  bool opens() const { return close > open; }
   /// Member-wise equality.
   bool operator==(const Shutter&) const = default;
 };

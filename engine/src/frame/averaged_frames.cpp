@@ -140,7 +140,7 @@ RenderImage render_averaged(const Camera& camera, const RenderSettings& settings
 }
 
 bool blurs_moving_models(const SceneInstances& scene, const RenderSettings& settings) {
-  return scene.moves() && settings.shutter.close > settings.shutter.open;
+  return scene.moves() && settings.shutter.opens();
 }
 
 RenderSettings shutter_over_moving_models(const RenderSettings& settings, const Camera& camera) {

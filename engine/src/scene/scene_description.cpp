@@ -325,7 +325,7 @@ Shutter read_shutter(const Reader& reader, const Node& node, const Camera& camer
   if (const auto open = reader.optional_child(node, "open")) shutter.open = reader.number(*open, 0, 1);
   const Node close = reader.required_child(node, "close", "when the shutter closes, in (open, 1]");
   shutter.close = reader.number(close, 0, 1);
-  if (!(shutter.close > shutter.open))
+  if (!shutter.opens())
     reader.fail(close.path, "must be after 'open' (" + format_number(shutter.open) + "), got " +
                                 format_number(shutter.close));
   if (const auto samples = reader.optional_child(node, "samples"))
