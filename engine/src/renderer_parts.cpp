@@ -11,6 +11,7 @@
 
 #include "camera/camera_models.h"
 #include "frame/averaged_frames.h"
+#include "frame/frame_stats_sum.h"
 #include "frame/scene_parts.h"
 #include "renderer_impl.h"
 #include "tilesplat/lod_set.h"
@@ -30,16 +31,7 @@ void add_part_stats(FrameStats& total, const FrameStats& part) {
     total.scene_parts = 1;
     return;
   }
-  add_pass_times(total.passes, part.passes);
-  total.gpu_ms += part.gpu_ms;
-  total.visible += part.visible;
-  total.intersections += part.intersections;
-  total.retries += part.retries;
-  total.submissions += part.submissions;
-  total.sort_fallbacks += part.sort_fallbacks;
-  total.uploaded_bytes += part.uploaded_bytes;
-  total.device_bytes = part.device_bytes;
-  total.peak_device_bytes = std::max(total.peak_device_bytes, part.device_bytes);
+  add_frame_stats(total, part, FrameCounts::kDisjoint);
   total.scene_parts += 1;
 }
 

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "frame/frame_stats_sum.h"
 #include "frame/image_regions.h"
 #include "settings_checks.h"
 
@@ -149,36 +150,12 @@ RenderSettings shutter_over_moving_models(const RenderSettings& settings, const 
   return moving;
 }
 
-void add_pass_times(std::vector<PassTiming>& into, const std::vector<PassTiming>& from) {
-  for (const PassTiming& pass : from) {
-    auto it =
-        std::find_if(into.begin(), into.end(), [&](const PassTiming& p) { return p.name == pass.name; });
-    if (it == into.end())
-      into.push_back(pass);
-    else
-      it->gpu_ms += pass.gpu_ms;
-  }
-}
-
 void add_sample_stats(FrameStats& frame, const FrameStats& sample) {
   if (frame.samples == 0) {
     frame = sample;
     return;
   }
-  add_pass_times(frame.passes, sample.passes);
-  frame.gpu_ms += sample.gpu_ms;
-  frame.visible = std::max(frame.visible, sample.visible);
-  frame.intersections = std::max(frame.intersections, sample.intersections);
-  frame.sort_bits = std::max(frame.sort_bits, sample.sort_bits);
-  frame.retries += sample.retries;
-  frame.submissions += sample.submissions;
-  frame.sort_fallbacks += sample.sort_fallbacks;
-  frame.device_bytes = std::max(frame.device_bytes, sample.device_bytes);
-  frame.peak_device_bytes = std::max(frame.peak_device_bytes, sample.peak_device_bytes);
-  frame.scene_parts = std::max(frame.scene_parts, sample.scene_parts);
-  frame.uploaded_bytes += sample.uploaded_bytes;
-  frame.reused_sorted_lists = frame.reused_sorted_lists && sample.reused_sorted_lists;
-  frame.complete = frame.complete && sample.complete;
+  add_frame_stats(frame, sample, FrameCounts::kRepeated);
   frame.samples += sample.samples;
 }
 

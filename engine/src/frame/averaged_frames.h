@@ -66,12 +66,9 @@ bool blurs_moving_models(const SceneInstances& scene, const RenderSettings& sett
 // (a still camera), so that render_averaged takes the shutter's times.
 RenderSettings shutter_over_moving_models(const RenderSettings& settings, const Camera& camera);
 
-// Adds a sample frame's statistics to those of the frame it is part of: GPU times summed (pass by pass),
-// the largest visible and intersection counts, retries and submissions summed; samples summed (a sample
-// that was itself averaged brings its own count). frame.samples == 0: `sample` is the first, and becomes
-// the frame's.
+// Adds a sample frame's statistics to those of the frame it is part of (add_frame_stats: the largest
+// visible and intersection counts, each sample being the whole frame); samples summed (a sample that was
+// itself averaged brings its own count). frame.samples == 0: `sample` is the first, and becomes the frame's.
 void add_sample_stats(FrameStats& frame, const FrameStats& sample);
-// Adds each pass's GPU time of `from` to the pass of that name in `into` (appended where it has none).
-void add_pass_times(std::vector<PassTiming>& into, const std::vector<PassTiming>& from);
 
 }  // namespace tilesplat

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "frame/averaged_frames.h"  // add_pass_times
+#include "frame/frame_stats_sum.h"
 #include "tilesplat/reference.h"    // kTileSize
 
 namespace tilesplat {
@@ -158,20 +158,7 @@ void add_band_stats(FrameStats& frame, const FrameStats& band) {
     frame.image_bands = 1;
     return;
   }
-  add_pass_times(frame.passes, band.passes);
-  frame.gpu_ms += band.gpu_ms;
-  frame.visible = std::max(frame.visible, band.visible);
-  frame.intersections += band.intersections;
-  frame.sort_bits = std::max(frame.sort_bits, band.sort_bits);
-  frame.retries += band.retries;
-  frame.submissions += band.submissions;
-  frame.sort_fallbacks += band.sort_fallbacks;
-  frame.device_bytes = std::max(frame.device_bytes, band.device_bytes);
-  frame.peak_device_bytes = std::max(frame.peak_device_bytes, band.peak_device_bytes);
-  frame.scene_parts = std::max(frame.scene_parts, band.scene_parts);
-  frame.uploaded_bytes += band.uploaded_bytes;
-  frame.reused_sorted_lists = frame.reused_sorted_lists && band.reused_sorted_lists;
-  frame.complete = frame.complete && band.complete;
+  add_frame_stats(frame, band, FrameCounts::kDisjoint);
   ++frame.image_bands;
 }
 
