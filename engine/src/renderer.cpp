@@ -256,12 +256,7 @@ RenderImage Renderer::Impl::render_bands(
     const std::function<RenderImage(const RenderSettings&)>& render_band) {
   const auto start = std::chrono::steady_clock::now();
   const PixelRegion whole = resolved_region(settings.region, camera.width, camera.height);
-  RenderImage image;
-  image.width = whole.width;
-  image.height = whole.height;
-  image.rgba.resize(4 * image.pixels());
-  if (settings.depth) image.depth.resize(image.pixels());
-  if (settings.splat_count) image.splat_count.resize(image.pixels());
+  RenderImage image = image_to_assemble(whole, settings);
   FrameStats frame;
   frame.image_bands = 0;
   RenderSettings band_settings = settings;

@@ -79,12 +79,7 @@ RenderImage render_rolling(const Camera& camera, const RenderSettings& settings,
   const PixelRegion wanted = resolved_region(settings.region, camera.width, camera.height);
   RenderSettings sample_settings = settings;
   sample_settings.shutter = {};
-  RenderImage image;
-  image.width = wanted.width;
-  image.height = wanted.height;
-  image.rgba.resize(4 * image.pixels());
-  if (settings.depth) image.depth.resize(image.pixels());
-  if (settings.splat_count) image.splat_count.resize(image.pixels());
+  RenderImage image = image_to_assemble(wanted, settings);
   const std::vector<double> times = shutter_times(shutter.open, shutter.close, bands);
   for (int k = 0; k < bands; ++k) {
     // Band k in scan order covers [first, last) along the scan's axis, counted from where the scan starts.

@@ -110,6 +110,16 @@ RenderImage crop(const RenderImage& image, const PixelRegion& held, const PixelR
   return out;
 }
 
+RenderImage image_to_assemble(const PixelRegion& region, const RenderSettings& settings) {
+  RenderImage image;
+  image.width = region.width;
+  image.height = region.height;
+  image.rgba.resize(4 * image.pixels());
+  if (settings.depth) image.depth.resize(image.pixels());
+  if (settings.splat_count) image.splat_count.resize(image.pixels());
+  return image;
+}
+
 void paste(RenderImage& into, const PixelRegion& into_origin, const RenderImage& part,
            const PixelRegion& at) {
   copy_pixels(part, at, into, into_origin, at);

@@ -22,6 +22,8 @@ PixelRegion resolved_region(const PixelRegion& region, int image_width, int imag
 PixelRegion tile_aligned(const PixelRegion& region, int image_width, int image_height);
 // The pixels `within` (in the image's coordinates) of an image that holds `held`.
 RenderImage crop(const RenderImage& image, const PixelRegion& held, const PixelRegion& within);
+// An image of the region's size with the outputs the settings ask for (all zero), for paste to fill.
+RenderImage image_to_assemble(const PixelRegion& region, const RenderSettings& settings);
 // Copies `part`, the pixels `at` of `into`'s image (whose pixels start at into_origin), into `into`.
 void paste(RenderImage& into, const PixelRegion& into_origin, const RenderImage& part, const PixelRegion& at);
 
