@@ -562,6 +562,16 @@ TEST(CliRender, MemoryBudgetRendersTheSameImageInParts) {
   EXPECT_TRUE(contains(placed.err, "62,000 Gaussians (SH2), 2 placed copies of 1 file")) << placed.err;
   EXPECT_FALSE(contains(placed.out, "scene parts                         1\n")) << placed.out;
   EXPECT_EQ(tilesplat::read_exr(out / "two_parts.exr").rgba, tilesplat::read_exr(out / "two_whole.exr").rgba);
+  // Without a budget, on a device whose largest allocation (1 MiB) the copies' frame passes: they stay
+  // placed copies too, taken part by part (FrameRenderer::decide_holding), into the same image.
+  const auto small_device =
+      tilesplat::testing::run_process("env TILESPLAT_MAX_ALLOCATION=1M ", kRenderExe,
+                                      {two.string(), "--view", "0", "--width", "320", "--stats", "-o",
+                                       (out / "two_small_device.exr").string()});
+  ASSERT_EQ(small_device.exit_code, 0) << small_device.err;
+  EXPECT_FALSE(contains(small_device.out, "scene parts                         1\n")) << small_device.out;
+  EXPECT_EQ(tilesplat::read_exr(out / "two_small_device.exr").rgba,
+            tilesplat::read_exr(out / "two_whole.exr").rgba);
 }
 
 TEST(CliRender, AntialiasingFlagSetsTheFootprintFilter) {

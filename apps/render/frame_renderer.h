@@ -33,8 +33,11 @@ class FrameRenderer {
   const LodSelection& lod_selection() const { return lod_selection_; }
 
  private:
-  const GaussianScene& scene_;
-  const SceneInstances* instances_;  // a scene file's placed copies: under --memory-budget, or moving
+  const GaussianScene* scene_;
+  // A scene file's placed copies: under --memory-budget, when some move, or when their frame does not fit
+  // the device (decide_holding merges them into merged_ otherwise).
+  const SceneInstances* instances_;
+  GaussianScene merged_;
   const cli::LoadedLodSet* lod_;     // a LOD set drawn under --splat-budget
   LodSelection lod_selection_;
   bool warned_over_budget_ = false;

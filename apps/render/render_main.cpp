@@ -432,10 +432,11 @@ int run(int argc, char** argv) {
   if (!options.png.empty())
     cli::check_output_path(sequence ? cli::frame_file("--png", options.png, 0) : options.png, "--png");
 
-  // Under a memory budget a scene file's models stay placed copies of their files, never merged; so do
-  // they when some of them move (each time of a shutter places them anew).
+  // The GPU renderer takes a scene file's models as placed copies of their files, and merges them only
+  // when their frame fits the device (FrameRenderer::decide_holding); the reference merges them at load
+  // unless some move (each time of a shutter places them anew).
   const cli::SceneHolding holding =
-      options.memory_budget > 0 ? cli::SceneHolding::kInstances : cli::SceneHolding::kInstancesIfMoving;
+      !options.reference ? cli::SceneHolding::kInstances : cli::SceneHolding::kInstancesIfMoving;
   cli::LoadedScene loaded = sequence ? cli::load_scene_file(options.common.scene, options.common.strict,
                                                             kProgram, holding, options.common.lod)
                                      : cli::load_scene_and_camera(options.common, kProgram, holding);
