@@ -25,6 +25,7 @@
 #include "tilesplat/image.h"
 #include "tilesplat/lens.h"
 #include "tilesplat/lod_set.h"
+#include "tilesplat/reference.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
@@ -618,6 +619,34 @@ void bind(nb::module_& m) {
         return out;
       },
       "a"_a, "b"_a, "PSNR (RGB, peak 1) and the largest differences of two images of one size.");
+
+  m.def(
+      "render_reference",
+      [](const Camera& camera, const GaussianScene* scene, const SceneInstances* instances, bool depth,
+         bool splat_count, const std::string& accuracy, const std::string& antialiasing,
+         const std::string& compositor, const std::array<float, 3>& background, double near_plane,
+         double max_alpha, const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter,
+         const std::optional<std::array<int, 4>>& region) {
+        if (int(scene != nullptr) + int(instances != nullptr) != 1)
+          throw std::invalid_argument("render_reference takes one of scene and instances");
+        RenderSettings settings =
+            make_settings("auto", depth, splat_count, accuracy, antialiasing, compositor, 1, 1, background,
+                          true, near_plane, max_alpha, lens, shutter, 0);
+        if (region) settings.region = {(*region)[0], (*region)[1], (*region)[2], (*region)[3]};
+        nb::gil_scoped_release release;
+        return instances ? render_reference(*instances, camera, settings)
+                         : render_reference(*scene, camera, settings);
+      },
+      "camera"_a, "scene"_a = nb::none(), "instances"_a = nb::none(), "depth"_a = true,
+      "splat_count"_a = true, "accuracy"_a = "reference", "antialiasing"_a = "classic",
+      "compositor"_a = "sorted", "background"_a = std::array<float, 3>{0, 0, 0},
+      "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
+      "shutter"_a = nb::none(), "region"_a = nb::none(),
+      "The float64 CPU reference the GPU renderer is held to (docs/rendering-math.md): the frame of `scene` "
+      "(or SceneInstances `instances`) from `camera`, in double precision on the host's cores, with "
+      "Renderer.render's keywords that apply to it (compositor 'sorted' or 'raster', whose rule it has; "
+      "accuracy modes such as 'resort16' change its per-pixel order). Slow: seconds for a small image of "
+      "a real scene. Releases the GIL.");
 
   // --- the renderer
   m.def("devices", &list_devices, "The Vulkan devices, in the order Renderer(device=INDEX) counts them.");

@@ -182,6 +182,19 @@ def test_a_region_is_the_whole_frames_pixels(playbot_renderer, monkeypatch):
     assert small.validation_messages == 0
 
 
+def test_the_float64_reference(playbot_renderer):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 96, 54, azimuth_deg=30)
+    gpu = renderer.render(camera)
+    reference = tilesplat.render_reference(camera, scene=scene)
+    assert reference.rgba.shape == gpu.rgba.shape
+    assert tilesplat.compare_images(gpu, reference)["psnr_db"] > 60
+    part = tilesplat.render_reference(camera, scene=scene, region=(10, 5, 40, 20))
+    assert np.array_equal(part.rgba, reference.rgba[5:25, 10:50])
+    with pytest.raises(ValueError, match="one of scene and instances"):
+        tilesplat.render_reference(camera)
+
+
 def test_a_scene_files_moving_models_blur_under_an_open_shutter(playbot_renderer):
     _, renderer = playbot_renderer
     instances = tilesplat.SceneInstances(REPO / "scenes" / "moving_playbots.json")

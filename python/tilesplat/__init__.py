@@ -39,6 +39,7 @@ from ._core import (
     load_scene,
     orbit_cameras,
     read_exr,
+    render_reference,
     shutter_times,
     sort_strategies,
 )
@@ -69,6 +70,7 @@ __all__ = [
     "orbit_cameras",
     "rasterization",
     "read_exr",
+    "render_reference",
     "shutter_times",
     "sort_strategies",
 ]
