@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "frame/frame_plan.h"
+#include "frame/image_regions.h"
 #include "tilesplat/reference.h"
 #include "vulkan/compute_pipeline.h"
 
@@ -379,6 +380,52 @@ TEST(FramePlan, RasterFrameSortsByDepthThenDraws) {
 
 // CPU drivers take the texel-buffer layouts before Mesa 25 only (vk::texel_buffers_wanted), by the
 // driver's description.
+// A region's frame: the tiles it meets, in the camera's grid, their pixels within the image as its outputs;
+// the raster frame culls by the whole image's tiles.
+TEST(FramePlan, ARegionsFrameHasTheTilesItMeets) {
+  RenderSettings settings;
+  settings.region = {37, 1070, 101, 10};  // columns 37..137, rows 1070..1079: tiles 2..8 of the last row
+  const FramePlan plan = plan_frame(camera(), settings, context());
+  EXPECT_EQ(plan.tiles.first_x, 2u);
+  EXPECT_EQ(plan.tiles.first_y, 66u);
+  EXPECT_EQ(plan.tiles.tiles_x, 7u);
+  EXPECT_EQ(plan.tiles.tiles_y, 2u);  // rows 1056..1079: the image's last tile row is partial
+  EXPECT_EQ(plan.tiles.width, 112u);
+  EXPECT_EQ(plan.tiles.height, 24u);
+  EXPECT_EQ(plan.tiles.count, 14u);
+  EXPECT_EQ(plan.tiles.packed_first(), 2u | 66u << 16);
+  EXPECT_EQ(plan.culling_tiles, plan.tiles);
+  EXPECT_EQ(plan.lists.region, settings.region);
+  settings.compositor = Compositor::kRaster;
+  const FramePlan raster = plan_frame(camera(), settings, context());
+  EXPECT_EQ(raster.culling_tiles.first_x, 0u);
+  EXPECT_EQ(raster.culling_tiles.tiles_x, 120u);
+  EXPECT_EQ(raster.tiles, plan.tiles);
+  // The whole image is the region of the whole image.
+  EXPECT_EQ(plan_frame(camera(), {}, context()).tiles.packed_first(), 0u);
+}
+
+// Bands of whole tile rows cover a region once; one band where its tiles' pixels fit.
+TEST(ImageBands, CoverTheRegionInWholeTileRows) {
+  const PixelRegion region{5, 21, 300, 200};  // tiles' pixels: columns 0..319, rows 16..223
+  EXPECT_EQ(bands_within(region, 64, uint64_t(320) * 208 * 64), (std::vector<PixelRegion>{region}));
+  const std::vector<PixelRegion> bands = bands_within(region, 64, uint64_t(320) * 208 * 64 - 1);
+  ASSERT_GT(bands.size(), 1u);
+  int y = region.y;
+  for (size_t b = 0; b < bands.size(); ++b) {
+    EXPECT_EQ(bands[b].x, region.x);
+    EXPECT_EQ(bands[b].width, region.width);
+    EXPECT_EQ(bands[b].y, y) << b;
+    if (b > 0) {
+      EXPECT_EQ(bands[b].y % kTileSize, 0) << b;  // every band after the first starts a tile row
+    }
+    y += bands[b].height;
+  }
+  EXPECT_EQ(y, region.y + region.height);
+  // At least a row of tiles a band, however small the limit.
+  EXPECT_EQ(bands_within(region, 64, 1).size(), 13u);  // rows 21..31, then 11 of 16, then 208..220
+}
+
 TEST(TexelLayouts, MesaMajorVersionFromTheDriverDescription) {
   EXPECT_EQ(vk::mesa_major_version("llvmpipe Mesa 22.3.6 (LLVM 15.0.6)"), 22);
   EXPECT_EQ(vk::mesa_major_version("llvmpipe Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)"), 25);

@@ -127,9 +127,13 @@ void paste(RenderImage& into, const PixelRegion& into_origin, const RenderImage&
 
 std::vector<PixelRegion> bands_within(const PixelRegion& region, uint64_t bytes_per_pixel,
                                       uint64_t bytes_per_band) {
-  // The band's outputs are its tiles' pixels: up to a tile more on either side.
-  const uint64_t row_bytes = (uint64_t(region.width) + 2 * kTileSize) * bytes_per_pixel;
-  if (uint64_t(region.height) * row_bytes <= bytes_per_band) return {region};
+  // A band's outputs are its tiles' pixels: the columns of the tiles the region meets.
+  const int64_t first_column = int64_t(region.x) / kTileSize * kTileSize;
+  const int64_t end_column = (int64_t(region.x) + region.width + kTileSize - 1) / kTileSize * kTileSize;
+  const uint64_t row_bytes = uint64_t(end_column - first_column) * bytes_per_pixel;
+  const int64_t first_row = int64_t(region.y) / kTileSize * kTileSize;
+  const int64_t end_row = (int64_t(region.y) + region.height + kTileSize - 1) / kTileSize * kTileSize;
+  if (uint64_t(end_row - first_row) * row_bytes <= bytes_per_band) return {region};
   // Whole rows of tiles a band, so that no tile is rendered twice.
   const uint64_t tile_rows = std::max<uint64_t>(1, bytes_per_band / (row_bytes * kTileSize));
   const int band_rows = int(std::min<uint64_t>(tile_rows * kTileSize, uint64_t(region.height)));
