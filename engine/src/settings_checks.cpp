@@ -63,6 +63,14 @@ void check_camera_model(const RenderSettings& settings, const Camera& camera) {
                                 ") needs a pinhole camera, not " + camera_model_name(camera.model));
 }
 
+void check_region(const RenderSettings& settings, const Camera& camera) {
+  validate(settings.region, camera.width, camera.height);
+  if (settings.host && !settings.region.whole())
+    throw std::invalid_argument("RenderSettings::region " + to_string(settings.region) +
+                                ": a region cannot be combined with a host's depth (RenderSettings::host), "
+                                "which is the whole image's");
+}
+
 void check_single_frame(const RenderSettings& settings) {
   validate(settings.lens);  // an aperture below 0 or NaN is not "off"
   validate(settings.shutter);

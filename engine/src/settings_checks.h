@@ -19,6 +19,9 @@ void check_shutter(const RenderSettings& settings, const Camera& camera);
 // What a camera model rules out: the per-pixel re-sorting (its rays are the pinhole's) needs
 // CameraModel::kPinhole. Throws std::invalid_argument.
 void check_camera_model(const RenderSettings& settings, const Camera& camera);
+// RenderSettings::region: whole, or within the camera's image (validate(PixelRegion)), and not with a host's
+// depth, which is the whole image's. Throws std::invalid_argument.
+void check_region(const RenderSettings& settings, const Camera& camera);
 // A single pinhole frame (the frame plan, render_to_image): RenderSettings::lens and shutter must be valid
 // and off.
 void check_single_frame(const RenderSettings& settings);

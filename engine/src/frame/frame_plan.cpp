@@ -23,7 +23,7 @@ namespace {
 
 // A camera this device cannot render is a runtime_error (render() documents it so), bad settings an
 // invalid_argument.
-void check_camera(const Camera& camera, const PixelRegion& region, const DeviceCaps& device) {
+void check_camera(const Camera& camera, const RenderSettings& settings, const DeviceCaps& device) {
   try {
     validate(camera);  // size, intrinsics, pose; then what this device can hold
   } catch (const std::invalid_argument& e) {
@@ -40,8 +40,9 @@ void check_camera(const Camera& camera, const PixelRegion& region, const DeviceC
   if (tiles_x > max_tiles || tiles_y > std::min<uint64_t>(max_tiles, 0xffff))
     fail("image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
          " exceeds the renderer's limit of " + std::to_string(max_tiles) + " tiles (of 16 pixels) per axis");
-  validate(region, camera.width, camera.height);
-  // Renderer::render splits such an image into regions by itself (render_in_bands).
+  check_region(settings, camera);
+  // Renderer::render splits such an image into bands of rows by itself (Renderer::Impl::image_bands).
+  const PixelRegion& region = settings.region;
   const PixelRegion tiles = tile_aligned(region, camera.width, camera.height);
   const uint64_t rgba_bytes = uint64_t(tiles.width) * uint64_t(tiles.height) * 16;
   if (rgba_bytes > device.max_allocation_size)
@@ -256,11 +257,7 @@ ProjectionVariant projection_variant(const RenderSettings& settings, const Scene
 }
 
 FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const FrameContext& context) {
-  check_camera(camera, settings.region, context.device);
-  if (settings.host && !settings.region.whole())
-    throw std::invalid_argument("RenderSettings::region " + to_string(settings.region) +
-                                ": a region cannot be combined with a host's depth (RenderSettings::host), "
-                                "which is the whole image's");
+  check_camera(camera, settings, context.device);
   validate(settings.accuracy);
   validate_compositor(settings);
   validate_host_depth(settings, camera);

@@ -141,11 +141,7 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
   }
   const PixelRule rule = pixel_rule(settings, reference_order);
   validate(camera);
-  validate(settings.region, camera.width, camera.height);
-  if (settings.host && !settings.region.whole())
-    throw std::invalid_argument("RenderSettings::region " + to_string(settings.region) +
-                                ": a region cannot be combined with a host's depth (RenderSettings::host), "
-                                "which is the whole image's");
+  check_region(settings, camera);
   check_scene(scene);
   validate_host_depth(settings, camera);
   check_near_plane(settings.near_plane);
