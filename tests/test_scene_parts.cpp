@@ -367,8 +367,17 @@ TEST(SceneParts, AnImagePastTheLargestAllocationRendersInBands) {
   const RenderImage big_banded = small_images->render(wide, big);
   EXPECT_GE(small_images->last_frame_stats().image_bands, 9);
   expect_bit_identical(big_banded, big_whole, "1024x576 in bands of 4 MiB");
+  // On a device of 64 MiB the whole image's per-pixel buffers (52 MB) would leave the scene no room, but
+  // each band's leave enough: the scene fits whole, is set once, and the image renders in bands.
+  const std::unique_ptr<Renderer> small_memory = renderer_with_limits("TILESPLAT_DEVICE_MEMORY", "64M");
+  EXPECT_FALSE(small_memory->renders_in_parts(view.scene, wide, big));
+  const RenderImage small_memory_banded = small_memory->render(view.scene, wide, big);
+  EXPECT_GE(small_memory->last_frame_stats().image_bands, 3);
+  EXPECT_EQ(small_memory->last_frame_stats().scene_parts, 1);
+  expect_bit_identical(small_memory_banded, big_whole, "1024x576 in bands on a device of 64 MiB");
   EXPECT_EQ(small->validation_messages(), 0u);
   EXPECT_EQ(small_images->validation_messages(), 0u);
+  EXPECT_EQ(small_memory->validation_messages(), 0u);
 }
 
 TEST(SceneParts, WithoutABudgetAFramePastTheDevicesMemorySplits) {

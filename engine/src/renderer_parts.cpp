@@ -59,7 +59,15 @@ uint64_t Renderer::Impl::parts_memory_budget(const RenderSettings& settings) con
 bool Renderer::Impl::needs_parts(const PartSource& scene, const Camera& camera,
                                  const RenderSettings& settings) {
   const std::string sort_name = choose_sort_strategy(settings.sort, device_caps(), /*without_waiting=*/false);
-  const PartCosts costs = part_costs_for(scene, camera, settings, sort_name);
+  // An image past the device renders in bands of rows (image_bands): the largest band's frame is the one
+  // that must fit, not the whole image's.
+  const std::vector<PixelRegion> bands = image_bands(camera, settings);
+  auto pixels = [](const PixelRegion& band) { return uint64_t(band.width) * uint64_t(band.height); };
+  RenderSettings frame = settings;
+  frame.region =
+      *std::max_element(bands.begin(), bands.end(),
+                        [&](const PixelRegion& a, const PixelRegion& b) { return pixels(a) < pixels(b); });
+  const PartCosts costs = part_costs_for(scene, camera, frame, sort_name);
   // Without a budget, the device's: whole where the frame fits it, as every frame did before budgets.
   if (settings.memory_budget == 0)
     return !whole_frame_fits(costs, scene.size(), kFirstPairsPerGaussian, device_capacity());
