@@ -5,6 +5,12 @@
 // 1 - T, and the blend adds src * (1 - dst alpha). Fragments below ALPHA_MIN are discarded; nothing
 // stops early, as the hardware blend cannot skip a fragment by what the pixel already holds (the
 // reference's raster rule, render_reference with Compositor::kRaster).
+//
+// TS_RASTER_SURFACE_DEPTH (raster_blend_surface, a host's depth out, HostDepth::write_depth): the
+// fragment also reads the colour attachment's alpha, 1 - T before it, which rasterization-order
+// attachment access makes exactly what the earlier splats at this pixel blended; the fragment whose
+// alpha first lifts 1 - T to pc.surface_alpha writes its depth, every other one +inf, and a MIN blend
+// keeps it: composite.comp's threshold rule.
 #extension GL_GOOGLE_include_directive : require
 #define TS_RASTER_PUSH
 #include "common.glsl"
@@ -19,6 +25,10 @@ layout(location = 2) flat in vec4 colour_mean_lo_y;
 layout(location = 0) out vec4 out_colour;      // (alpha rgb, alpha), blended under
 layout(location = 1) out vec4 out_depth_sum;   // (alpha depth, 0, 0, alpha), blended under
 layout(location = 2) out float out_count;      // 1, added
+#ifdef TS_RASTER_SURFACE_DEPTH
+layout(location = 3) out float out_surface;    // the depth where 1 - T reaches surface_alpha, else +inf; MIN
+layout(input_attachment_index = 0, set = 0, binding = 0) uniform subpassInput blended;  // location 0's
+#endif
 
 void main() {
   // The pixel's offset from the mean as composite.comp forms it: relative to the pixel's tile.
@@ -38,4 +48,9 @@ void main() {
   out_colour = vec4(colour_mean_lo_y.rgb * alpha, alpha);
   out_depth_sum = vec4(mdo.z * alpha, 0.0, 0.0, alpha);
   out_count = 1.0;
+#ifdef TS_RASTER_SURFACE_DEPTH
+  float before = subpassLoad(blended).a;
+  float after = before + alpha * (1.0 - before);  // what the "under" blend makes of it
+  out_surface = before < pc.surface_alpha && after >= pc.surface_alpha ? mdo.z : uintBitsToFloat(0x7f800000u);
+#endif
 }

@@ -184,6 +184,7 @@ TS_PUSH_CONSTANTS(RasterPush) {
   uint width;                     // of the attachments: the image's, or a region's tiles'
   uint height;
   uint first_tile;  // the attachments' first tile in the camera's grid (first_tile_of)
+  float surface_alpha;  // raster_blend_surface: the alpha at which a pixel's depth out is taken
 }
 TS_PUSH_INSTANCE;
 #endif
@@ -218,10 +219,14 @@ TS_PUSH_CONSTANTS(RasterResolvePush) {
   TS_REF(Vec4Array) depth_sums;  // in: (sum of w depth, -, -, 1 - T), when the depth is written
   TS_REF(FloatArray) out_depth;  // the weighted mean depth
   TS_REF(UintArray) count;       // in: float counts; out: the same as uints
+  TS_REF(FloatArray) surface;    // in: the depth out's MIN (+inf: none); out: the same, 0 for none
+  TS_REF(UintArray) half_rgba;   // fp16-blend: the RGBA16F attachment's texels, read into rgba
   vec4 background;
   uint pixels;
   uint write_depth;
   uint write_count;
+  uint write_surface;
+  uint half_colour;  // the colour comes from half_rgba (fp16-blend), else it is in rgba already
 }
 TS_PUSH_INSTANCE;
 #endif

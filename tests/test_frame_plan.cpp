@@ -364,8 +364,8 @@ TEST(FramePlan, RasterFrameSortsByDepthThenDraws) {
   resort.accuracy = parse_accuracy_modes("resort8");
   EXPECT_THROW(plan_frame(camera(), resort, context()), std::invalid_argument);
 
-  // A host's depth image is converted first, into the draw's depth attachment; the raster cannot
-  // write the splats' depth out.
+  // A host's depth image is converted first, into the draw's depth attachment; the draw itself writes
+  // the splats' depth out (no pass of its own).
   RenderSettings host;
   host.compositor = Compositor::kRaster;
   host.host = HostDepth{};
@@ -375,7 +375,9 @@ TEST(FramePlan, RasterFrameSortsByDepthThenDraws) {
             (std::vector<P>{P::kHostDepthIn, P::kClearCounters, P::kProjection, P::kDepthSort,
                             P::kRasterComposite}));
   host.host->write_depth = true;
-  EXPECT_THROW(plan_frame(camera(), host, with_image), std::invalid_argument);
+  EXPECT_EQ(plan_frame(camera(), host, with_image).passes,
+            (std::vector<P>{P::kHostDepthIn, P::kClearCounters, P::kProjection, P::kDepthSort,
+                            P::kRasterComposite}));
 }
 
 // CPU drivers take the texel-buffer layouts before Mesa 25 only (vk::texel_buffers_wanted), by the

@@ -220,15 +220,6 @@ TEST(Raster, AccuracyModesAndRefusals) {
               renderer.render(camera, resort);
             }).find("raster compositor"),
             std::string::npos);
-  RenderSettings host = raster_settings();
-  const std::vector<float> host_depth(size_t(camera.width) * camera.height, 0.5f);
-  host.host = HostDepth{};
-  host.host->depth = host_depth;
-  host.host->write_depth = true;
-  EXPECT_NE(testing::error_of<std::invalid_argument>([&] {
-              renderer.render(camera, host);
-            }).find("the raster compositor cannot write the splats' depth out"),
-            std::string::npos);
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
@@ -282,6 +273,122 @@ TEST(Raster, HostDepthIsTheDepthAttachment) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// A host's depth out (HostDepth::write_depth) through the raster compositor: each fragment reads the
+// alpha its pixel blended so far (rasterization-order attachment access) and the one that lifts it to the
+// threshold gives the depth, as in the reference's raster rule and the tile compositor. Host surfaces cut
+// the scene; where the splats never reach the threshold the host's own depth comes back.
+TEST(Raster, HostDepthOutIsTheThresholdRule) {
+  Renderer& renderer = testing::validated_renderer();
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  renderer.set_scene(scene);
+  const Camera camera = playbot_camera(240, 136);
+  // A plane at 1.1 times the splats' median depth over the left half, nothing (far) on the right.
+  const RenderImage unhidden = renderer.render(camera, raster_settings());
+  std::vector<float> depths;
+  for (float z : unhidden.depth)
+    if (z > 0) depths.push_back(z);
+  ASSERT_FALSE(depths.empty());
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  const double plane = 1.1 * depths[depths.size() / 2];
+  std::vector<float> host_depth(size_t(camera.width) * camera.height, 1.0f);
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width / 2; ++x)
+      host_depth[size_t(y) * camera.width + x] = float(1.0 - 1.0 / plane);
+  size_t host_own_before = 0;
+  for (const float threshold : {0.5f, 0.9f}) {
+    RenderSettings settings = raster_settings();
+    settings.host = HostDepth{};
+    settings.host->depth = host_depth;
+    settings.host->write_depth = true;
+    settings.host->alpha_threshold = threshold;
+    const RenderImage gpu = renderer.render(camera, settings);
+    const RenderImage reference = render_reference(scene, camera, settings);
+    RenderSettings tiles = settings;
+    tiles.compositor = Compositor::kSorted;
+    const RenderImage sorted = renderer.render(camera, tiles);
+    ASSERT_EQ(gpu.host_depth.size(), gpu.pixels());
+    size_t differ_reference = 0, differ_sorted = 0, splats_out = 0, host_own = 0;
+    for (size_t i = 0; i < gpu.pixels(); ++i) {
+      // The reference's splat depths are float64, the device's float32 (test_host_depth.cpp's tolerance).
+      differ_reference += std::abs(gpu.host_depth[i] - reference.host_depth[i]) > 1e-6f ? 1 : 0;
+      differ_sorted += gpu.host_depth[i] != sorted.host_depth[i] ? 1 : 0;
+      if (gpu.host_depth[i] == host_depth[i])
+        ++host_own;
+      else
+        ++splats_out;
+      // Never behind the host's surface: the splats behind it are not drawn.
+      EXPECT_LE(gpu.host_depth[i], host_depth[i]) << i;
+    }
+    std::printf(
+        "raster depth out at alpha %.1f: %zu of %zu pixels the splats', %zu the host's; differs from the "
+        "reference's raster rule at %zu, from the sorted compositor at %zu\n",
+        threshold, splats_out, gpu.pixels(), host_own, differ_reference, differ_sorted);
+    // Both kinds occur, and a higher threshold leaves more pixels the host's.
+    EXPECT_GT(splats_out, gpu.pixels() / 10);
+    EXPECT_GT(host_own, gpu.pixels() / 10);
+    EXPECT_GT(host_own, host_own_before);
+    host_own_before = host_own;
+    // The running alpha is 1 - T in float32 here, T in float64 there: a crossing within rounding of the
+    // threshold may fall one splat apart. The sorted compositor (the same float32 depths) also differs
+    // where its tile rectangles cut a splat that the raster's quad still blends.
+    EXPECT_LE(differ_reference, gpu.pixels() / 1000);
+    EXPECT_LE(differ_sorted, gpu.pixels() / 100);
+    EXPECT_GE(compare_images(gpu, reference).psnr_db, 60.0);
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// fp16-blend (AccuracyModes::fp16_blend): the raster compositor's colour and 1 - T blended in an RGBA16F
+// attachment. It changes the colour by half precision's rounding, not the depth, the counts or (beyond
+// rounding at the threshold) a host's depth out; the other compositors refuse it by name.
+TEST(Raster, Fp16BlendIsAnAccuracyMode) {
+  EXPECT_EQ(to_string(parse_accuracy_modes("fp16-blend")), "fp16-blend");
+  EXPECT_TRUE(parse_accuracy_modes("depth16+fp16-blend").fp16_blend);
+  EXPECT_FALSE(compositor_draws(Compositor::kSorted, parse_accuracy_modes("fp16-blend")));
+  EXPECT_FALSE(compositor_draws(Compositor::kStochastic, parse_accuracy_modes("fp16-blend")));
+  EXPECT_TRUE(compositor_draws(Compositor::kRaster, parse_accuracy_modes("fp16-blend")));
+
+  Renderer& renderer = testing::validated_renderer();
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  renderer.set_scene(scene);
+  const Camera camera = playbot_camera(240, 136);
+  const std::vector<float> host_depth(size_t(camera.width) * camera.height, float(1.0 - 1.0 / 4.0));
+  RenderSettings full = raster_settings();
+  full.host = HostDepth{};
+  full.host->depth = host_depth;
+  full.host->write_depth = true;
+  RenderSettings half = full;
+  half.accuracy = parse_accuracy_modes("fp16-blend");
+  const RenderImage f32 = renderer.render(camera, full);
+  const RenderImage f16 = renderer.render(camera, half);
+  const RenderImage reference = render_reference(scene, camera, full);
+  const ImageDifference to_f32 = compare_images(f16, f32), to_reference = compare_images(f16, reference);
+  size_t depth_out_differs = 0;
+  for (size_t i = 0; i < f16.pixels(); ++i)
+    depth_out_differs += f16.host_depth[i] != f32.host_depth[i] ? 1 : 0;
+  std::printf(
+      "fp16-blend: %.2f dB (max abs %.2g) from the float32 blend, %.2f dB from the reference's raster rule; "
+      "depth out differs at %zu of %zu pixels\n",
+      to_f32.psnr_db, to_f32.max_abs, to_reference.psnr_db, depth_out_differs, f16.pixels());
+  EXPECT_NE(f16.rgba, f32.rgba);  // half precision shows
+  EXPECT_GE(to_f32.psnr_db, 55.0);
+  EXPECT_GE(to_reference.psnr_db, 55.0);
+  EXPECT_EQ(f16.depth, f32.depth);  // the depth sums and counts keep their float32 attachments
+  EXPECT_EQ(f16.splat_count, f32.splat_count);
+  EXPECT_LE(depth_out_differs, f16.pixels() / 100);
+
+  for (Compositor other : {Compositor::kSorted, Compositor::kStochastic}) {
+    RenderSettings refused = raster_settings();
+    refused.compositor = other;
+    refused.accuracy = half.accuracy;
+    EXPECT_NE(testing::error_of<std::invalid_argument>([&] {
+                renderer.render(camera, refused);
+              }).find("fp16-blend is the raster compositor's"),
+              std::string::npos);
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 // tilesplat-render --compositor raster on the GPU and with --reference; a name it does not know is a
 // usage error naming the choices.
 TEST(Raster, RenderCommandLine) {
@@ -326,6 +433,8 @@ TEST(RasterStages, MeshAndVertexStagesDrawTheSameImage) {
   frames[1].host = HostDepth{};
   frames[1].host->depth = host_depth;
   frames[1].splat_count = false;
+  frames.push_back(frames[1]);  // and the splats' depth out
+  frames[2].host->write_depth = true;
   // One renderer per stage; the stage is chosen on its first raster frame.
   auto render_with = [&](const char* stage, std::string& driver) {
     ::setenv("TILESPLAT_RASTER_STAGE", stage, 1);
@@ -356,6 +465,7 @@ TEST(RasterStages, MeshAndVertexStagesDrawTheSameImage) {
       EXPECT_EQ(mesh[k].rgba, vertex[k].rgba) << "frame " << k;
       EXPECT_EQ(mesh[k].depth, vertex[k].depth) << "frame " << k;
       EXPECT_EQ(mesh[k].splat_count, vertex[k].splat_count) << "frame " << k;
+      EXPECT_EQ(mesh[k].host_depth, vertex[k].host_depth) << "frame " << k;
     }
     std::printf("mesh and vertex stages: the same images on %s\n", driver.c_str());
   } catch (const std::runtime_error& e) {

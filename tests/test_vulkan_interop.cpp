@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <stdexcept>
+#include <string_view>
 #include <vector>
 
 #include "effects_report.h"
@@ -78,10 +79,29 @@ class HostApplication : public ::testing::Test {
     qci.queueFamilyIndex = family;
     qci.queueCount = 1;
     qci.pQueuePriorities = &priority;
+    // What the raster compositor may use where the host says so (ExternalVulkanDevice): the blends of
+    // its counts and depth out, and its fragments' reads of the running alpha.
+    f.features.independentBlend = has.features.independentBlend;
+    uint32_t extension_count = 0;
+    vkEnumerateDeviceExtensionProperties(physical, nullptr, &extension_count, nullptr);
+    std::vector<VkExtensionProperties> extensions(extension_count);
+    vkEnumerateDeviceExtensionProperties(physical, nullptr, &extension_count, extensions.data());
+    for (const VkExtensionProperties& e : extensions)
+      rasterization_order =
+          rasterization_order ||
+          std::string_view(e.extensionName) == VK_EXT_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_EXTENSION_NAME;
+    VkPhysicalDeviceRasterizationOrderAttachmentAccessFeaturesEXT order{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_FEATURES_EXT};
+    order.rasterizationOrderColorAttachmentAccess = VK_TRUE;
+    const char* order_extension = VK_EXT_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_EXTENSION_NAME;
+    if (rasterization_order) f12.pNext = &order;
+    independent_blend = has.features.independentBlend == VK_TRUE;
     VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     dci.pNext = &f;
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;
+    dci.enabledExtensionCount = rasterization_order ? 1 : 0;
+    dci.ppEnabledExtensionNames = &order_extension;
     HOST_CHECK(vkCreateDevice(physical, &dci, nullptr, &device));
     vkGetDeviceQueue(device, family, 0, &queue);
     float64 = has.features.shaderFloat64 == VK_TRUE;
@@ -347,6 +367,8 @@ class HostApplication : public ::testing::Test {
   VkQueue queue = VK_NULL_HANDLE;
   uint32_t family = 0;
   bool float64 = false;
+  // Enabled on the device where it has them; external() does not say so, as a host that did not would.
+  bool independent_blend = false, rasterization_order = false;
   int messages = 0;
 };
 
@@ -553,6 +575,53 @@ TEST_F(HostApplication, RasterCompositorTestsTheDepthImage) {
   EXPECT_EQ(rgba, expected.rgba);
   EXPECT_EQ(depth_after, wall);    // tested, never written
   EXPECT_NE(rgba, unhidden.rgba);  // the wall hides some of the scene
+
+  release_host_objects();
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
+// The raster compositor's depth out on the host's device, into the host's depth image: the same as
+// render()'s with the surfaces in host memory. It needs independentBlend and rasterization-order
+// attachment access, which the host says it enabled; a host that did not say so is refused by name.
+TEST_F(HostApplication, RasterCompositorWritesTheDepthOut) {
+  constexpr uint32_t kWidth = 160, kHeight = 90;
+  const auto [scene, camera, convention, wall] = wall_through_scene(kWidth, kHeight);
+  const auto [colour, depth] = draw_wall(wall, kWidth, kHeight);
+  ASSERT_TRUE(independent_blend && rasterization_order)
+      << "lavapipe has independentBlend and VK_EXT_rasterization_order_attachment_access";
+
+  RenderSettings settings;
+  settings.compositor = Compositor::kRaster;
+  settings.splat_count = false;
+  settings.host = HostDepth{convention, {}, true, 0.5f};
+  ExternalVulkanDevice without_order = external();
+  without_order.independent_blend_enabled = true;
+  ExternalVulkanDevice with_order = without_order;
+  with_order.rasterization_order_attachment_access_enabled = true;
+  RenderImage expected;
+  {
+    auto refused = create_renderer(without_order);
+    refused->set_scene(scene);
+    RenderSettings in_memory = settings;
+    in_memory.host->depth = wall;
+    EXPECT_NE(testing::error_of<std::runtime_error>([&] {
+                refused->render(camera, in_memory);
+              }).find("VK_EXT_rasterization_order_attachment_access"),
+              std::string::npos);
+    auto renderer = create_renderer(with_order);
+    renderer->set_scene(scene);
+    render_to_image(*renderer, camera, settings,
+                    {colour.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_LAYOUT_UNDEFINED},
+                    {depth.image, kWidth, kHeight, VK_FORMAT_D32_SFLOAT,
+                     VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL});
+    expected = renderer->render(camera, in_memory);
+  }
+  const auto [rgba, depth_after] = read_colour_and_depth(colour, depth, kWidth, kHeight);
+  EXPECT_EQ(rgba, expected.rgba);
+  EXPECT_EQ(depth_after, expected.host_depth);
+  size_t splats = 0;
+  for (size_t i = 0; i < wall.size(); ++i) splats += depth_after[i] != wall[i] ? 1 : 0;
+  EXPECT_GT(splats, wall.size() / 10) << "the splats' depth out reaches the image";
 
   release_host_objects();
   EXPECT_EQ(messages, 0) << "validation messages on the host's instance";

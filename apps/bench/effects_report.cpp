@@ -159,10 +159,15 @@ std::vector<Row> plan_rows(const GaussianScene& scene, const RenderSettings& bas
     add("host depth in + out (a plane through the scene)", SceneVariant::kScene, [](RenderSettings&) {});
     rows.back().host_plane = true;
     // The third compositor: the same depth sort, the splats drawn and blended by the graphics pipeline;
-    // with a host's depth as its depth attachment (in only: it cannot write the splats' depth out).
+    // with a host's depth as its depth attachment, and with the splats' depth out too (its fragments
+    // read the running alpha).
     add("raster compositor", SceneVariant::kScene,
         [](RenderSettings& s) { s.compositor = Compositor::kRaster; });
     add("raster, host depth in (a plane through the scene)", SceneVariant::kScene,
+        [](RenderSettings& s) { s.compositor = Compositor::kRaster; });
+    rows.back().host_plane = true;
+    rows.back().host_depth_out = false;
+    add("raster, host depth in + out (a plane through the scene)", SceneVariant::kScene,
         [](RenderSettings& s) { s.compositor = Compositor::kRaster; });
     rows.back().host_plane = true;
   }
@@ -276,9 +281,8 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
       settings.sort = options.sort;
       settings.reuse_lists = false;  // whole frames: consecutive rows often share the camera and lists
       for (size_t v = 0; v < options.views.size(); ++v) {
-        if (rows[r].host_plane)  // the raster compositor tests the host's depth but writes none out
-          settings.host = HostDepth{bench_depth_convention(), planes[v],
-                                    settings.compositor != Compositor::kRaster, 0.5f};
+        if (rows[r].host_plane)
+          settings.host = HostDepth{bench_depth_convention(), planes[v], rows[r].host_depth_out, 0.5f};
         const Camera view = rows[r].camera ? rows[r].camera(options.views[v]) : options.views[v];
         if (rows[r].for_view) rows[r].for_view(settings, view);
         renderer.render(view, settings);

@@ -39,9 +39,10 @@ struct Row {
   std::string name;  // "sh1", "lights 2", "mip", "+depth", ...
   SceneVariant scene_variant = SceneVariant::kScene;
   RenderSettings settings;
-  // Depth-test against a host's plane through the scene (plane_through_scene) and write depth out;
-  // settings.host is filled per view.
+  // Depth-test against a host's plane through the scene (plane_through_scene) and, with host_depth_out,
+  // write depth out; settings.host is filled per view.
   bool host_plane = false;
+  bool host_depth_out = true;
   // The row's frame of a view: its camera (another model of the view, say) and what its settings need
   // of the view (a lens focused on the scene's centre, a shutter's end camera). Empty: the view as is.
   std::function<Camera(const Camera&)> camera;

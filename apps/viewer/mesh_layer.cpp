@@ -472,8 +472,10 @@ bool MeshLayer::depth_testable(const RenderSettings& settings) {
   return settings.compositor != Compositor::kStochastic && settings.accuracy.resort_window == 0;
 }
 
-bool MeshLayer::writes_depth_out(const RenderSettings& settings) {
-  return depth_testable(settings) && settings.compositor != Compositor::kRaster;
+bool MeshLayer::writes_depth_out(const RenderSettings& settings) const {
+  return depth_testable(settings) && (settings.compositor != Compositor::kRaster ||
+                                      (device_.external().independent_blend_enabled &&
+                                       device_.external().rasterization_order_attachment_access_enabled));
 }
 
 void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSettings& settings,

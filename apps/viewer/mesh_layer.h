@@ -34,8 +34,9 @@ class MeshLayer {
   // Whether the frame's modes depth-test against a host's surfaces (not per-pixel re-sorting, not the
   // stochastic compositor); draw() shows the splats alone over the background in the others.
   static bool depth_testable(const RenderSettings& settings);
-  // And whether they also write the splats' depth out for the grid (not the raster compositor's).
-  static bool writes_depth_out(const RenderSettings& settings);
+  // And whether they also write the splats' depth out for the grid (the raster compositor's where the
+  // device reads attachments in rasterization order).
+  bool writes_depth_out(const RenderSettings& settings) const;
 
   // The composed picture, R16G16B16A16_SFLOAT in TRANSFER_SRC_OPTIMAL after draw(), for the blit.
   VkImage picture() const { return picture_.image; }

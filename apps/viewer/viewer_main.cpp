@@ -375,8 +375,8 @@ class Viewer {
       title += " | mesh off: this mode does not depth-test";
     else if (mesh_layer_ && !depth_out_)
       title += " | no depth out";
-    else if (mesh_layer_ && !MeshLayer::writes_depth_out(settings()))
-      title += " | no depth out: the raster compositor writes none";
+    else if (mesh_layer_ && !mesh_layer_->writes_depth_out(settings()))
+      title += " | no depth out: this device's raster compositor writes none";
     glfwSetWindowTitle(window_, title.c_str());
   }
 

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
+#include <string_view>
 #include <vector>
 
 namespace tilesplat::viewer {
@@ -122,7 +123,8 @@ void WindowDevice::destroy() {
 }
 
 ExternalVulkanDevice WindowDevice::external() const {
-  return {instance_, physical_device_, device_, queue_, queue_family_, shader_float64_, independent_blend_};
+  return {instance_,          physical_device_,    device_, queue_, queue_family_, shader_float64_,
+          independent_blend_, rasterization_order_};
 }
 
 std::string WindowDevice::name() const { return device_name(physical_device_); }
@@ -292,13 +294,34 @@ void WindowDevice::create_device() {
   queue_info.queueFamilyIndex = queue_family_;
   queue_info.queueCount = 1;
   queue_info.pQueuePriorities = &priority;
-  const char* swapchain_extension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+  std::vector<const char*> extensions = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
+  // Rasterization-order attachment access lets the raster compositor write the splats' depth out for
+  // the mesh drawn after them; optional too.
+  uint32_t extension_count = 0;
+  vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &extension_count, nullptr);
+  std::vector<VkExtensionProperties> available(extension_count);
+  vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &extension_count, available.data());
+  VkPhysicalDeviceRasterizationOrderAttachmentAccessFeaturesEXT order{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_FEATURES_EXT};
+  for (const VkExtensionProperties& e : available)
+    if (std::string_view(e.extensionName) == VK_EXT_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_EXTENSION_NAME) {
+      VkPhysicalDeviceFeatures2 has_order{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+      has_order.pNext = &order;
+      vkGetPhysicalDeviceFeatures2(physical_device_, &has_order);
+      rasterization_order_ = order.rasterizationOrderColorAttachmentAccess == VK_TRUE;
+    }
+  if (rasterization_order_) {
+    extensions.push_back(VK_EXT_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_EXTENSION_NAME);
+    order = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_FEATURES_EXT};
+    order.rasterizationOrderColorAttachmentAccess = VK_TRUE;
+    want12.pNext = &order;
+  }
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   info.pNext = &want;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue_info;
-  info.enabledExtensionCount = 1;
-  info.ppEnabledExtensionNames = &swapchain_extension;
+  info.enabledExtensionCount = uint32_t(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
   vk_check(vkCreateDevice(physical_device_, &info, nullptr, &device_), "vkCreateDevice");
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
 }

@@ -69,6 +69,7 @@ class WindowDevice {
   uint32_t queue_family_ = 0;
   bool shader_float64_ = false;
   bool independent_blend_ = false;
+  bool rasterization_order_ = false;  // VK_EXT_rasterization_order_attachment_access, enabled
   std::atomic<uint64_t> validation_messages_{0};
 };
 

@@ -111,6 +111,7 @@ std::string to_string(const AccuracyModes& m) {
     parts.push_back("t-cutoff=" + format_value(m.transmittance_cutoff));
   if (m.alpha_cutoff != reference.alpha_cutoff) parts.push_back("alpha-cutoff=" + format_value(m.alpha_cutoff));
   if (m.resort_window != reference.resort_window) parts.push_back("resort" + std::to_string(m.resort_window));
+  if (m.fp16_blend) parts.push_back("fp16-blend");
   if (parts.empty()) return "reference";
   std::string text = parts[0];
   for (size_t i = 1; i < parts.size(); ++i) text += "+" + parts[i];
@@ -141,6 +142,8 @@ AccuracyModes parse_accuracy_modes(const std::string& text) {
       m.fp16_sh = true;
     } else if (token == "fp16-cov") {
       m.fp16_covariance = true;
+    } else if (token == "fp16-blend") {
+      m.fp16_blend = true;
     } else if (name == "t-cutoff" && eq != std::string::npos) {
       m.transmittance_cutoff = parse_value(token, value);
     } else if (name == "alpha-cutoff" && eq != std::string::npos) {
@@ -150,8 +153,9 @@ AccuracyModes parse_accuracy_modes(const std::string& text) {
     } else if (token.compare(0, 6, "resort") == 0 && token.size() > 6) {
       m.resort_window = parse_int(token, token.substr(6));
     } else {
-      bad(token, "unknown; known: reference, depth24, depth16, opacity-extent, square-tiles, sh0..sh3, fp16-sh, "
-                 "fp16-cov, t-cutoff=X, alpha-cutoff=X, resortN");
+      bad(token,
+          "unknown; known: reference, depth24, depth16, opacity-extent, square-tiles, sh0..sh3, fp16-sh, "
+          "fp16-cov, t-cutoff=X, alpha-cutoff=X, resortN, fp16-blend");
     }
     if (end == text.size()) break;
   }

@@ -15,10 +15,6 @@ void validate_host_depth(const RenderSettings& settings, const Camera& camera) {
   if (settings.compositor == Compositor::kStochastic)
     fail(
         "the stochastic compositor does not depth-test against a host's surfaces: use the sorted compositor");
-  if (settings.compositor == Compositor::kRaster && host.write_depth)
-    fail(
-        "the raster compositor cannot write the splats' depth out: the hardware blend keeps each pixel's "
-        "running alpha from the fragment that would cross the threshold; use the sorted compositor");
   // The raster compositor's depth attachment holds view depths times 2^-64, normal floats from 2^-62.
   if (settings.compositor == Compositor::kRaster && !(settings.near_plane >= 0x1p-62))
     fail("the raster compositor tests a host's depth for view depths above 2^-62; the near plane is " +

@@ -50,6 +50,10 @@ struct AccuracyModes {
   /// depth of their density maximum along the pixel's ray (in the spirit of StopThePop), instead of
   /// blending in the order of the splats' centre depths. 0 = off (reference). 2 to 16.
   int resort_window = 0;
+  /// The raster compositor (Compositor::kRaster) blends the colour and 1 - T in a 16-bit float (RGBA16F)
+  /// attachment instead of a 32-bit one: half the attachment's bytes, at half precision's rounding per
+  /// blend. The other compositors blend in float32 registers and refuse it.
+  bool fp16_blend = false;
 
   /// Member-wise equality.
   bool operator==(const AccuracyModes&) const = default;
@@ -59,7 +63,7 @@ struct AccuracyModes {
 TILESPLAT_API std::string to_string(const AccuracyModes& modes);
 /// The inverse of to_string. Tokens: reference, depth24, depth16, opacity-extent, square-tiles,
 /// sh0..sh3, fp16-sh, fp16-cov, t-cutoff=X, alpha-cutoff=X (X a number or a fraction like 1/64),
-/// resortN or resort=N. Throws std::invalid_argument naming the bad token.
+/// resortN or resort=N, fp16-blend. Throws std::invalid_argument naming the bad token.
 TILESPLAT_API AccuracyModes parse_accuracy_modes(const std::string& text);
 /// Throws std::invalid_argument when a value is out of range (naming it).
 TILESPLAT_API void validate(const AccuracyModes& modes);
@@ -151,8 +155,9 @@ struct StochasticSettings {
 };
 
 /// Splats inside a host's 3D world (docs/embedding.md): the host's depth image in, and a depth the
-/// host can test its later geometry against out. Only the sorted compositor without per-pixel
-/// re-sorting honours it (other compositors throw std::invalid_argument).
+/// host can test its later geometry against out. The sorted and the raster compositors honour it, without
+/// per-pixel re-sorting (the stochastic compositor and resortN throw std::invalid_argument); the raster
+/// compositor's depth out needs VK_EXT_rasterization_order_attachment_access (else std::runtime_error).
 struct HostDepth {
   /// How the host's depth values relate to view depth (DepthConvention::from_projection of the
   /// projection it drew with).

@@ -29,6 +29,10 @@ struct ExternalVulkanDevice {
   /// Whether `device` was created with independentBlend on, which the raster compositor's splat counts
   /// need (Compositor::kRaster); without it, render with RenderSettings::splat_count off.
   bool independent_blend_enabled = false;
+  /// Whether `device` was created with VK_EXT_rasterization_order_attachment_access and its
+  /// rasterizationOrderColorAttachmentAccess on, which the raster compositor's depth out with a host's
+  /// depth needs (HostDepth::write_depth with Compositor::kRaster).
+  bool rasterization_order_attachment_access_enabled = false;
 };
 
 /// A renderer on the host's device. RendererOptions::device and RendererOptions::validation do not apply (the

@@ -57,6 +57,11 @@ void check_camera(const Camera& camera, const RenderSettings& settings, const De
 // validate_compositor. The raster compositor blends in the Gaussians' depth order, each splat over whole
 // pixels; the stochastic one sorts nothing.
 std::optional<std::string> modes_refusal(Compositor compositor, const AccuracyModes& modes) {
+  if (compositor != Compositor::kRaster && modes.fp16_blend)
+    return to_string(compositor) +
+           " compositor: fp16-blend is the raster compositor's 16-bit colour attachment; this compositor "
+           "blends "
+           "in float32 registers: use --compositor raster or leave fp16-blend out";
   if (compositor == Compositor::kSorted) return std::nullopt;
   const std::string resort = "per-pixel re-sorting (resort" + std::to_string(modes.resort_window) + ")";
   if (compositor == Compositor::kRaster) {

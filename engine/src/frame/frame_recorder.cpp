@@ -44,7 +44,8 @@ void FrameRecorder::prepare(const FramePlan& plan, const RenderSettings& setting
   resources.prepare_frame(plan, needs_state);
   if (plan.compositor == Compositor::kRaster)
     raster_composite_.prepare({plan.tiles.width, plan.tiles.height, settings.depth, settings.splat_count,
-                               plan.host.from_memory || plan.host.from_image});
+                               plan.host.from_memory || plan.host.from_image, plan.host.write_depth,
+                               settings.accuracy.fp16_blend});
   if (!plan.build_lists) return;
   projection_.prepare(resources.scene, plan.projection);
   // The depth sort's buffers hold the projected records (more than this frame's after a larger part).
@@ -163,7 +164,8 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
                 .write_depth = r.settings.depth,
                 .write_count = r.settings.splat_count,
                 .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff, float(r.settings.max_alpha)},
-                .host_view_depth = res.host_surface(r.settings).view_depth});
+                .host = res.host_surface(r.settings),
+                .half_colour = modes.fp16_blend});
       return;
     }
   }

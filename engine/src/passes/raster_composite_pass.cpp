@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <cstdlib>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -20,6 +21,7 @@ using shader_io::RasterResolvePush;
 
 // Float attachments: the blend runs in float32, as the tile compositor's sums do.
 constexpr VkFormat kColourFormat = VK_FORMAT_R32G32B32A32_SFLOAT;  // (sum of w rgb, 1 - T)
+constexpr VkFormat kHalfColourFormat = VK_FORMAT_R16G16B16A16_SFLOAT;  // the same, with fp16-blend
 constexpr VkFormat kCountFormat = VK_FORMAT_R32_SFLOAT;            // exact for counts below 2^24
 constexpr VkFormat kHostSurfacesFormat = VK_FORMAT_D32_SFLOAT;     // view depths times 2^-64
 constexpr VkImageUsageFlags kAttachmentUsage =
@@ -94,11 +96,24 @@ void RasterCompositePass::check_device(const Shape& shape) const {
       fail(std::string("the raster compositor blends into ") +
            (format == kColourFormat ? "R32G32B32A32_SFLOAT" : "R32_SFLOAT") +
            " attachments, which this device cannot: use the sorted compositor");
+  if (shape.half_colour && !vk::format_supports(ctx_, kHalfColourFormat, attachment))
+    fail("fp16-blend blends into an R16G16B16A16_SFLOAT attachment, which this device cannot: leave it out");
   // The counts are added where the colour is blended under: two blend states in one pipeline.
   if (shape.write_count && !ctx_.features().independent_blend)
     fail(
         "the raster compositor's splat counts need the independentBlend feature, which this device (or "
         "the host that made it) has not enabled: render without splat counts");
+  // The depth out is kept by a MIN blend beside the colour's, from fragments that read the colour.
+  if (shape.surface_depth && !ctx_.features().independent_blend)
+    fail(
+        "the raster compositor's depth out (HostDepth::write_depth) needs the independentBlend feature, "
+        "which this device (or the host that made it) has not enabled: use the sorted compositor");
+  if (shape.surface_depth && !ctx_.features().rasterization_order_colour)
+    fail(
+        "the raster compositor's depth out (HostDepth::write_depth) reads each pixel's running alpha in the "
+        "fragment stage, which needs VK_EXT_rasterization_order_attachment_access "
+        "(rasterizationOrderColorAttachmentAccess), not on this device or not enabled by the host that "
+        "made it: use the sorted compositor");
   if (shape.host_depth && !vk::format_supports(ctx_, kHostSurfacesFormat,
                                                VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT |
                                                    VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
@@ -128,13 +143,20 @@ void RasterCompositePass::prepare(const Shape& shape) {
   t = {};
   const uint32_t width = shape.width, height = shape.height;
   const VkDeviceSize pixels = VkDeviceSize(width) * height;
-  t.colour = vk::Image(ctx_, kColourFormat, width, height, kAttachmentUsage, "raster colour");
+  // The depth out's fragments read the colour as an input attachment.
+  t.colour = vk::Image(ctx_, shape.half_colour ? kHalfColourFormat : kColourFormat, width, height,
+                       kAttachmentUsage | (shape.surface_depth ? VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT : 0),
+                       "raster colour");
+  if (shape.half_colour)
+    t.half_colour_copy = vk::Buffer(ctx_, pixels * 8, vk::MemoryUse::Device, "raster colour (half, copy)");
   if (shape.write_depth) {
     t.depth_sums = vk::Image(ctx_, kColourFormat, width, height, kAttachmentUsage, "raster depth sums");
     t.depth_sums_copy = vk::Buffer(ctx_, pixels * 16, vk::MemoryUse::Device, "raster depth sums (copy)");
   }
   if (shape.write_count)
     t.count = vk::Image(ctx_, kCountFormat, width, height, kAttachmentUsage, "raster counts");
+  if (shape.surface_depth)
+    t.surface = vk::Image(ctx_, kCountFormat, width, height, kAttachmentUsage, "raster depth out");
   if (shape.host_depth) {
     t.host_surfaces = vk::Image(ctx_, kHostSurfacesFormat, width, height,
                                 VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
@@ -145,7 +167,7 @@ void RasterCompositePass::prepare(const Shape& shape) {
   t.shape = shape;
 }
 
-const vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
+vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
   auto it = pipelines_.find(v);
   if (it != pipelines_.end()) return it->second;
   vk::GraphicsPipelineDesc desc;
@@ -153,24 +175,33 @@ const vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
     desc.mesh_shader = "raster_quads";
   else
     desc.vertex_shader = "raster_quad";
-  desc.fragment_shader = "raster_blend";
+  desc.fragment_shader = v.surface_depth ? "raster_blend_surface" : "raster_blend";
   desc.push_constant_bytes = sizeof(RasterPush);
   desc.spec = {{0, std::bit_cast<uint32_t>(coverage_alpha_inv(v.cutoffs.alpha))},
                {1, std::bit_cast<uint32_t>(v.cutoffs.alpha)},
                {2, std::bit_cast<uint32_t>(v.cutoffs.max_alpha)},
                {3, v.host_depth ? 1u : 0u}};
   // Without the counts every blend state is the same, as a device without independentBlend requires.
-  desc.attachments = {{kColourFormat, vk::Blend::kUnder, true},
+  desc.attachments = {{v.half_colour ? kHalfColourFormat : kColourFormat, vk::Blend::kUnder, true},
                       {kColourFormat, vk::Blend::kUnder, v.write_depth},
                       {kCountFormat, v.write_count ? vk::Blend::kAdd : vk::Blend::kUnder, v.write_count}};
+  if (v.surface_depth) {
+    desc.attachments.push_back({kCountFormat, vk::Blend::kMin, true});
+    desc.input_attachment = 0;  // the colour, whose alpha is 1 - T
+  }
   if (v.host_depth) desc.depth_test = vk::DepthTest{kHostSurfacesFormat, VK_COMPARE_OP_LESS};
   return pipelines_.emplace(v, vk::GraphicsPipeline(ctx_, desc)).first->second;
 }
 
 void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   Targets& t = targets_;
-  const Shape shape{in.out.width, in.out.height, in.write_depth, in.write_count,
-                    in.host_view_depth != nullptr};
+  const Shape shape{in.out.width,
+                    in.out.height,
+                    in.write_depth,
+                    in.write_count,
+                    in.host.view_depth != nullptr,
+                    in.host.surface_depth != nullptr,
+                    in.half_colour};
   if (!t.colour || !(t.shape == shape))
     throw std::logic_error("RasterCompositePass::record before prepare() for this frame's shape");
   // The transmittance cut-off does not apply: one pipeline whatever it is.
@@ -178,12 +209,15 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
                         in.write_depth,
                         in.write_count,
                         shape.host_depth,
+                        shape.surface_depth,
+                        shape.half_colour,
                         {in.cutoffs.alpha, 0.0f, in.cutoffs.max_alpha}};
-  const vk::GraphicsPipeline& drawing = pipeline(variant);
+  vk::GraphicsPipeline& drawing = pipeline(variant);
   if (!t.framebuffer) {
     std::vector<VkImageView> views = {t.colour.view()};
     if (shape.write_depth) views.push_back(t.depth_sums.view());
     if (shape.write_count) views.push_back(t.count.view());
+    if (shape.surface_depth) views.push_back(t.surface.view());
     if (shape.host_depth) views.push_back(t.host_surfaces.view());
     VkFramebufferCreateInfo info{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
     info.renderPass = drawing.render_pass();  // compatible with every variant of this shape
@@ -196,7 +230,7 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   }
   const uint32_t pixels = shape.width * shape.height;
   if (shape.host_depth) {
-    const RasterHostSurfacesPush surfaces{in.host_view_depth->address(), t.host_surfaces_input.address(),
+    const RasterHostSurfacesPush surfaces{in.host.view_depth->address(), t.host_surfaces_input.address(),
                                           pixels};
     host_surfaces_.bind(cmd, surfaces);
     host_surfaces_.dispatch(cmd, vk::div_ceil(pixels, 256));
@@ -219,13 +253,19 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
     vkCmdCopyBuffer(cmd, in.counters.handle(), draw_args_.handle(), 1, &visible);
   }
 
-  VkClearValue clears[3]{};  // all zero: no colour, T = 1, no depth, no splats (a host's depth is loaded)
+  // Zero: no colour, T = 1, no depth, no splats; +inf: no depth out yet (a host's depth is loaded).
+  std::vector<VkClearValue> clears(1 + (shape.write_depth ? 1 : 0) + (shape.write_count ? 1 : 0));
+  if (shape.surface_depth) {
+    VkClearValue none{};
+    none.color.float32[0] = std::numeric_limits<float>::infinity();
+    clears.push_back(none);
+  }
   VkRenderPassBeginInfo begin{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
   begin.renderPass = drawing.render_pass();
   begin.framebuffer = t.framebuffer;
   begin.renderArea = {{0, 0}, {shape.width, shape.height}};
-  begin.clearValueCount = 1 + (shape.write_depth ? 1 : 0) + (shape.write_count ? 1 : 0);
-  begin.pClearValues = clears;
+  begin.clearValueCount = uint32_t(clears.size());
+  begin.pClearValues = clears.data();
   vkCmdBeginRenderPass(cmd, &begin, VK_SUBPASS_CONTENTS_INLINE);
   RasterPush push{};
   push.splats = in.splats.address();
@@ -234,7 +274,9 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   push.width = shape.width;
   push.height = shape.height;
   push.first_tile = in.out.first_tile;
+  push.surface_alpha = in.host.surface_alpha;
   drawing.bind(cmd, push, shape.width, shape.height);
+  if (shape.surface_depth) drawing.bind_input_attachment(cmd, t.colour.view());
   if (mesh_)
     ctx_.cmd_draw_mesh_tasks_indirect()(cmd, draw_args_.handle(), 0, 1,
                                         sizeof(VkDrawMeshTasksIndirectCommandEXT));
@@ -243,19 +285,24 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   vkCmdEndRenderPass(cmd);
 
   // The attachments into the outputs, then the resolve in place.
-  copy_to_buffer(cmd, t.colour, in.out.rgba);
+  copy_to_buffer(cmd, t.colour, shape.half_colour ? t.half_colour_copy : in.out.rgba);
   if (shape.write_depth) copy_to_buffer(cmd, t.depth_sums, t.depth_sums_copy);
   if (shape.write_count) copy_to_buffer(cmd, t.count, in.out.count);
+  if (shape.surface_depth) copy_to_buffer(cmd, t.surface, *in.host.surface_depth);
   vk::barrier(cmd);
   RasterResolvePush resolve{};
   resolve.rgba = in.out.rgba.address();
   resolve.depth_sums = shape.write_depth ? t.depth_sums_copy.address() : in.out.rgba.address();
   resolve.out_depth = shape.write_depth ? in.out.depth.address() : in.out.rgba.address();
   resolve.count = shape.write_count ? in.out.count.address() : in.out.rgba.address();
+  resolve.surface = shape.surface_depth ? in.host.surface_depth->address() : in.out.rgba.address();
+  resolve.half_rgba = shape.half_colour ? t.half_colour_copy.address() : in.out.rgba.address();
   resolve.background = {in.background[0], in.background[1], in.background[2], 0.0f};
   resolve.pixels = pixels;
   resolve.write_depth = shape.write_depth ? 1 : 0;
   resolve.write_count = shape.write_count ? 1 : 0;
+  resolve.write_surface = shape.surface_depth ? 1 : 0;
+  resolve.half_colour = shape.half_colour ? 1 : 0;
   resolve_.bind(cmd, resolve);
   resolve_.dispatch(cmd, vk::div_ceil(pixels, 256));
   vk::barrier(cmd);
@@ -263,8 +310,9 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
 
 uint64_t RasterCompositePass::device_bytes() const {
   const Targets& t = targets_;
-  return t.colour.bytes() + t.depth_sums.bytes() + t.count.bytes() + t.host_surfaces.bytes() +
-         t.depth_sums_copy.size() + t.host_surfaces_input.size() + draw_args_.size();
+  return t.colour.bytes() + t.depth_sums.bytes() + t.count.bytes() + t.surface.bytes() +
+         t.host_surfaces.bytes() + t.depth_sums_copy.size() + t.half_colour_copy.size() +
+         t.host_surfaces_input.size() + draw_args_.size();
 }
 
 }  // namespace tilesplat

@@ -4,7 +4,8 @@
 // writes them. raster_quad.vert (or, on a GPU with VK_EXT_mesh_shader, raster_quads.mesh) expands each
 // splat around its alpha >= cut-off ellipse, raster_blend.frag evaluates it with the tile compositor's
 // expression, raster_resolve.comp puts the background under it and turns the depth sums and counts into
-// the outputs.
+// the outputs. A host's depth out reads the running alpha in the fragment stage (raster_blend_surface,
+// through rasterization-order attachment access).
 //
 // It has no transmittance early-out (the blend cannot skip a fragment by what the pixel holds) and no
 // tile rectangles (a splat reaches every pixel where its alpha passes the cut-off): the reference's
@@ -15,6 +16,7 @@
 #include <compare>
 #include <cstdint>
 #include <map>
+#include <vector>
 
 #include "passes/composite_pass.h"
 #include "vulkan/buffer.h"
@@ -35,9 +37,12 @@ struct RasterInputs {
   bool write_depth = true;
   bool write_count = true;
   CompositeCutoffs cutoffs;  // alpha and max_alpha; the transmittance cut-off does not apply
-  // A host's surfaces as view depths per pixel (+inf where none; FrameResources::host_view_depth):
-  // the depth attachment, which hides the splats behind them. Null: no depth test.
-  const vk::Buffer* host_view_depth = nullptr;
+  // A host's surfaces (FrameResources::host_surface): view_depth, as view depths per pixel (+inf where
+  // none), is the depth attachment, which hides the splats behind them (null: no depth test);
+  // surface_depth, when not null, receives the splats' depth out as the tile compositor writes it (the
+  // depth at which a pixel's alpha first reaches surface_alpha, 0 where it never does).
+  CompositePass::HostSurface host;
+  bool half_colour = false;  // fp16-blend (AccuracyModes::fp16_blend): an RGBA16F colour attachment
 };
 
 // Which stage draws the quads: the mesh stage where a GPU has VK_EXT_mesh_shader (each splat's record
@@ -58,6 +63,8 @@ class RasterCompositePass {
   struct Shape {
     uint32_t width = 0, height = 0;
     bool write_depth = false, write_count = false, host_depth = false;
+    bool surface_depth = false;  // a host's depth out: the colour attachment is also an input attachment
+    bool half_colour = false;    // fp16-blend: the colour attachment is RGBA16F
     bool operator==(const Shape&) const = default;
   };
   // Sizes the attachments for a frame (outside any command buffer). Throws std::runtime_error naming
@@ -73,10 +80,12 @@ class RasterCompositePass {
     bool write_depth = true;
     bool write_count = true;
     bool host_depth = false;  // the depth attachment holds a host's surfaces (HOST_DEPTH)
+    bool surface_depth = false;  // the fragment stage writes a host's depth out (raster_blend_surface)
+    bool half_colour = false;    // the colour attachment is RGBA16F (fp16-blend)
     CompositeCutoffs cutoffs;
     auto operator<=>(const Variant&) const = default;
   };
-  const vk::GraphicsPipeline& pipeline(const Variant& variant);
+  vk::GraphicsPipeline& pipeline(const Variant& variant);
   void check_device(const Shape& shape) const;
 
   vk::Context& ctx_;
@@ -92,8 +101,9 @@ class RasterCompositePass {
   // every Variant of it has a compatible one).
   struct Targets {
     Shape shape;
-    vk::Image colour, depth_sums, count, host_surfaces;
+    vk::Image colour, depth_sums, count, surface, host_surfaces;
     vk::Buffer depth_sums_copy;      // the depth sums copied out for the resolve
+    vk::Buffer half_colour_copy;     // fp16-blend: the RGBA16F colour copied out for the resolve
     vk::Buffer host_surfaces_input;  // the host's scaled view depths, copied into host_surfaces
     VkFramebuffer framebuffer = VK_NULL_HANDLE;
   } targets_;

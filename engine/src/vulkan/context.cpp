@@ -69,15 +69,19 @@ uint64_t env_bytes(const char* name) {
   return value << shift;
 }
 
+bool has_extension(const std::vector<VkExtensionProperties>& available, std::string_view name) {
+  return std::any_of(available.begin(), available.end(), [&](const VkExtensionProperties& e) {
+    return std::string_view(e.extensionName) == name;
+  });
+}
+
 // The bytes of memory the device's memory type for device buffers draws on. With VK_EXT_memory_budget,
 // the budget the driver gives this process; without it, the heap's size, except on a CPU driver, whose
 // device memory is the host's (Mesa 22's lavapipe reports a 2 GiB heap and allocates past it): there,
 // the host's physical memory.
 uint64_t device_memory(VkPhysicalDevice physical_device, bool cpu,
                        const std::vector<VkExtensionProperties>& available) {
-  const bool has_budget = std::any_of(available.begin(), available.end(), [](const VkExtensionProperties& e) {
-    return std::string_view(e.extensionName) == VK_EXT_MEMORY_BUDGET_EXTENSION_NAME;
-  });
+  const bool has_budget = has_extension(available, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
   VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
   VkPhysicalDeviceMemoryProperties2 memory{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2};
@@ -140,6 +144,8 @@ Context::Context(const ExternalVulkanDevice& borrowed) : owns_handles_(false) {
     // The host enabled the device's features; shaderFloat64 only counts if it says so.
     features_.shader_float64 = features_.shader_float64 && borrowed.shader_float64_enabled;
     features_.independent_blend = features_.independent_blend && borrowed.independent_blend_enabled;
+    features_.rasterization_order_colour =
+        features_.rasterization_order_colour && borrowed.rasterization_order_attachment_access_enabled;
     create_command_objects();
   } catch (...) {
     destroy();
@@ -259,9 +265,14 @@ void Context::read_device_properties() {
     limits_.device_memory = std::min(limits_.device_memory, bytes);
 
   VkPhysicalDeviceVulkan12Features has12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceRasterizationOrderAttachmentAccessFeaturesEXT has_order{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_FEATURES_EXT};
   VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   has.pNext = &has12;
+  if (has_extension(available, VK_EXT_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_EXTENSION_NAME))
+    has12.pNext = &has_order;
   vkGetPhysicalDeviceFeatures2(physical_device_, &has);
+  features_.rasterization_order_colour = has_order.rasterizationOrderColorAttachmentAccess == VK_TRUE;
   if (!has12.bufferDeviceAddress) throw std::runtime_error(device_name_ + ": bufferDeviceAddress is required");
   if (!has.features.shaderInt64) throw std::runtime_error(device_name_ + ": shaderInt64 is required");
   features_.shader_float64 = has.features.shaderFloat64 == VK_TRUE;
@@ -315,14 +326,20 @@ void Context::create_device() {
   std::vector<VkExtensionProperties> available(extension_count);
   vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &extension_count, available.data());
   std::vector<const char*> extensions;
-  bool has_push_descriptor = false, has_mesh_shader = false;
-  for (const auto& e : available) {
-    has_push_descriptor =
-        has_push_descriptor || std::string_view(e.extensionName) == VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME;
-    has_mesh_shader =
-        has_mesh_shader || std::string_view(e.extensionName) == VK_EXT_MESH_SHADER_EXTENSION_NAME;
-  }
+  const bool has_push_descriptor = has_extension(available, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+  const bool has_mesh_shader = has_extension(available, VK_EXT_MESH_SHADER_EXTENSION_NAME);
   if (has_push_descriptor) extensions.push_back(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+  // The features chained after want12, each when the device has it.
+  void** next_feature = &want12.pNext;
+  // A fragment reads what its pixel blended so far: the raster compositor's depth out.
+  VkPhysicalDeviceRasterizationOrderAttachmentAccessFeaturesEXT want_order{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_FEATURES_EXT};
+  if (features_.rasterization_order_colour) {
+    extensions.push_back(VK_EXT_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_EXTENSION_NAME);
+    want_order.rasterizationOrderColorAttachmentAccess = VK_TRUE;
+    *next_feature = &want_order;
+    next_feature = &want_order.pNext;
+  }
   // Mesh shaders draw the raster compositor's quads a workgroup of splats at a time; the mesh stage
   // alone (no task stage).
   VkPhysicalDeviceMeshShaderFeaturesEXT want_mesh{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
@@ -344,7 +361,8 @@ void Context::create_device() {
     if (has_mesh.meshShader && fits) {
       extensions.push_back(VK_EXT_MESH_SHADER_EXTENSION_NAME);
       want_mesh.meshShader = VK_TRUE;
-      want12.pNext = &want_mesh;
+      *next_feature = &want_mesh;
+      next_feature = &want_mesh.pNext;
       limits_.max_mesh_workgroup_count_x = mesh_properties.maxMeshWorkGroupCount[0];
     }
   }

@@ -44,6 +44,9 @@ struct DeviceFeatures {
   bool graphics_queue = false;   // the queue also draws: the raster compositor (Compositor::kRaster)
   bool independent_blend = false;  // attachments blended differently: the raster compositor's splat counts
   bool mesh_shader = false;  // VK_EXT_mesh_shader: the raster compositor's mesh stage (an engine-made device)
+  // VK_EXT_rasterization_order_attachment_access's rasterizationOrderColorAttachmentAccess: a fragment
+  // reads what the earlier fragments blended at its pixel; the raster compositor's depth out.
+  bool rasterization_order_colour = false;
 };
 
 // Semaphores a submission waits for and signals besides its fence: a host's, around a frame that

@@ -31,12 +31,13 @@ VkPipelineColorBlendAttachmentState blend_state(Blend blend) {
   state.blendEnable = VK_TRUE;
   const VkBlendFactor src =
       blend == Blend::kUnder ? VK_BLEND_FACTOR_ONE_MINUS_DST_ALPHA : VK_BLEND_FACTOR_ONE;
+  const VkBlendOp op = blend == Blend::kMin ? VK_BLEND_OP_MIN : VK_BLEND_OP_ADD;  // MIN ignores the factors
   state.srcColorBlendFactor = src;
   state.dstColorBlendFactor = VK_BLEND_FACTOR_ONE;
-  state.colorBlendOp = VK_BLEND_OP_ADD;
+  state.colorBlendOp = op;
   state.srcAlphaBlendFactor = src;
   state.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
-  state.alphaBlendOp = VK_BLEND_OP_ADD;
+  state.alphaBlendOp = op;
   state.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
                          VK_COLOR_COMPONENT_A_BIT;
   return state;
@@ -62,13 +63,19 @@ VkAttachmentDescription attachment(VkFormat format, VkAttachmentLoadOp load, VkA
 void GraphicsPipeline::create_render_pass(const GraphicsPipelineDesc& desc) {
   std::vector<VkAttachmentDescription> descriptions;
   std::vector<VkAttachmentReference> references;
-  for (const ColourAttachment& a : desc.attachments) {
+  VkAttachmentReference input_reference{VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED};
+  for (size_t i = 0; i < desc.attachments.size(); ++i) {
+    const ColourAttachment& a = desc.attachments[i];
     if (!a.used) {
       references.push_back({VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED});
       continue;
     }
+    // Written and read in the same subpass: GENERAL, the one layout for both.
+    const bool read = desc.input_attachment == i;
+    const VkImageLayout layout = read ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    if (read) input_reference = {uint32_t(descriptions.size()), layout};
     // Cleared: the last frame's contents are not needed.
-    references.push_back({uint32_t(descriptions.size()), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL});
+    references.push_back({uint32_t(descriptions.size()), layout});
     descriptions.push_back(attachment(a.format, VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_STORE,
                                       VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL));
   }
@@ -85,6 +92,13 @@ void GraphicsPipeline::create_render_pass(const GraphicsPipelineDesc& desc) {
   subpass.colorAttachmentCount = uint32_t(references.size());
   subpass.pColorAttachments = references.data();
   if (desc.depth_test) subpass.pDepthStencilAttachment = &depth_reference;
+  if (desc.input_attachment) {
+    if (input_reference.attachment == VK_ATTACHMENT_UNUSED)
+      throw std::logic_error("graphics pipeline: the input attachment is not a used colour attachment");
+    subpass.inputAttachmentCount = 1;
+    subpass.pInputAttachments = &input_reference;
+    subpass.flags = VK_SUBPASS_DESCRIPTION_RASTERIZATION_ORDER_ATTACHMENT_COLOR_ACCESS_BIT_EXT;
+  }
   // Before: the compute passes' and transfers' writes that the draw reads (the splat records, the depth
   // order, the indirect arguments), and the last frame's copies out of the attachments (which the
   // clear must not overtake). After: the blended attachments to the copies that read them.
@@ -102,6 +116,10 @@ void GraphicsPipeline::create_render_pass(const GraphicsPipelineDesc& desc) {
   dependencies[0].dstAccessMask = VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
                                   VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
                                   VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+  if (desc.input_attachment) {
+    dependencies[0].dstStageMask |= VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
+    dependencies[0].dstAccessMask |= VK_ACCESS_INPUT_ATTACHMENT_READ_BIT;
+  }
   dependencies[1].srcSubpass = 0;
   dependencies[1].dstSubpass = VK_SUBPASS_EXTERNAL;
   dependencies[1].srcStageMask = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
@@ -128,10 +146,13 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& des
   VkShaderModule vertex = VK_NULL_HANDLE, fragment = VK_NULL_HANDLE;
   try {
     create_render_pass(desc);
+    if (desc.input_attachment) create_input_set();
     VkPushConstantRange range{stages_, 0, desc.push_constant_bytes};
     VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
     layout_info.pushConstantRangeCount = desc.push_constant_bytes ? 1 : 0;
     layout_info.pPushConstantRanges = &range;
+    layout_info.setLayoutCount = input_layout_ ? 1 : 0;
+    layout_info.pSetLayouts = &input_layout_;
     TS_VK_CHECK(vkCreatePipelineLayout(ctx.device(), &layout_info, nullptr, &layout_));
     vertex = make_module(ctx, mesh ? desc.mesh_shader : desc.vertex_shader);
     fragment = make_module(ctx, desc.fragment_shader);
@@ -176,6 +197,8 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& des
     VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = uint32_t(blends.size());
     blend.pAttachments = blends.data();
+    if (desc.input_attachment)
+      blend.flags = VK_PIPELINE_COLOR_BLEND_STATE_CREATE_RASTERIZATION_ORDER_ATTACHMENT_ACCESS_BIT_EXT;
     VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
     if (desc.depth_test) {
       depth.depthTestEnable = VK_TRUE;
@@ -222,6 +245,10 @@ GraphicsPipeline& GraphicsPipeline::operator=(GraphicsPipeline&& other) noexcept
     render_pass_ = std::exchange(other.render_pass_, VK_NULL_HANDLE);
     layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
     pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
+    input_layout_ = std::exchange(other.input_layout_, VK_NULL_HANDLE);
+    input_pool_ = std::exchange(other.input_pool_, VK_NULL_HANDLE);
+    input_set_ = std::exchange(other.input_set_, VK_NULL_HANDLE);
+    input_view_ = std::exchange(other.input_view_, VK_NULL_HANDLE);
     stages_ = other.stages_;
     push_constant_bytes_ = other.push_constant_bytes_;
     name_ = std::move(other.name_);
@@ -234,10 +261,51 @@ void GraphicsPipeline::reset() {
   if (pipeline_) vkDestroyPipeline(ctx_->device(), pipeline_, nullptr);
   if (layout_) vkDestroyPipelineLayout(ctx_->device(), layout_, nullptr);
   if (render_pass_) vkDestroyRenderPass(ctx_->device(), render_pass_, nullptr);
+  if (input_pool_) vkDestroyDescriptorPool(ctx_->device(), input_pool_, nullptr);  // frees input_set_
+  if (input_layout_) vkDestroyDescriptorSetLayout(ctx_->device(), input_layout_, nullptr);
+  input_pool_ = VK_NULL_HANDLE;
+  input_layout_ = VK_NULL_HANDLE;
+  input_set_ = VK_NULL_HANDLE;
+  input_view_ = VK_NULL_HANDLE;
   pipeline_ = VK_NULL_HANDLE;
   layout_ = VK_NULL_HANDLE;
   render_pass_ = VK_NULL_HANDLE;
   ctx_ = nullptr;
+}
+
+void GraphicsPipeline::create_input_set() {
+  const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT, 1,
+                                             VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo layout{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  layout.bindingCount = 1;
+  layout.pBindings = &binding;
+  TS_VK_CHECK(vkCreateDescriptorSetLayout(ctx_->device(), &layout, nullptr, &input_layout_));
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT, 1};
+  VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool.maxSets = 1;
+  pool.poolSizeCount = 1;
+  pool.pPoolSizes = &size;
+  TS_VK_CHECK(vkCreateDescriptorPool(ctx_->device(), &pool, nullptr, &input_pool_));
+  VkDescriptorSetAllocateInfo allocate{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  allocate.descriptorPool = input_pool_;
+  allocate.descriptorSetCount = 1;
+  allocate.pSetLayouts = &input_layout_;
+  TS_VK_CHECK(vkAllocateDescriptorSets(ctx_->device(), &allocate, &input_set_));
+}
+
+void GraphicsPipeline::bind_input_attachment(VkCommandBuffer cmd, VkImageView view) {
+  if (!input_set_) throw std::logic_error("pipeline '" + name_ + "' reads no input attachment");
+  if (view != input_view_) {
+    const VkDescriptorImageInfo image{VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL};
+    VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    write.dstSet = input_set_;
+    write.descriptorCount = 1;
+    write.descriptorType = VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT;
+    write.pImageInfo = &image;
+    vkUpdateDescriptorSets(ctx_->device(), 1, &write, 0, nullptr);
+    input_view_ = view;
+  }
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &input_set_, 0, nullptr);
 }
 
 void GraphicsPipeline::bind_raw(VkCommandBuffer cmd, const void* data, uint32_t size, uint32_t width,
