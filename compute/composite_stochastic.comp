@@ -2,7 +2,8 @@
 // Stochastic composite (Compositor::kStochastic): sort-free transparency. Each tile's list comes in
 // no particular order (the frame bins the pairs by tile but never sorts by depth). For one sample,
 // each pixel keeps every splat of its tile's list whose alpha reaches the cut-off with probability
-// alpha, deciding with a hashed threshold u(pixel, splat, sample, seed) < alpha, and the kept splat
+// alpha, deciding with a threshold u(pixel, splat, sample, seed) < alpha (a hash, or with STRATIFIED
+// a stratum per sample: see threshold()), and the kept splat
 // nearest by (view depth, Gaussian index) -- the sorted order and its tie break -- gives the sample
 // its colour; no kept splat gives the background. The chance that splat i wins is
 // alpha_i * prod over the splats j before it of (1 - alpha_j): exactly its weight in the sorted
@@ -34,6 +35,7 @@ layout(constant_id = 2) const uint PIXELS_PER_INVOCATION = 1;  // 1, 2, 4, 8 or 
 layout(constant_id = 4) const float ALPHA_MIN = 1.0 / 255.0;   // the alpha cut-off (AccuracyModes)
 layout(constant_id = 5) const float ALPHA_INV = 255.0;         // 1 / ALPHA_MIN, as the tile coverage uses it
 layout(constant_id = 6) const float MAX_ALPHA = 0.99;          // RenderSettings::max_alpha
+layout(constant_id = 7) const bool STRATIFIED = false;         // StochasticSampler::kStratified
 
 // The push constants: StochasticCompositePush in shader_io.h.
 
@@ -71,6 +73,7 @@ shared uint s_reach[BATCH];     // composite_reach.glsl
 
 uint64_t best[P];    // the nearest kept splat of each pixel: its order key, NONE if none
 uint pixel_hash[P];  // each pixel's half of the threshold hash (pixel, sample, seed)
+uint pixel_key[P];   // STRATIFIED: each pixel's half of the permutation key (pixel, seed)
 
 // lowbias32 (Chris Wellons' hash prospector): a bijection on 32 bits with near-ideal avalanche.
 uint hash32(uint x) {
@@ -80,6 +83,39 @@ uint hash32(uint x) {
   x *= 0x846ca68bu;
   x ^= x >> 16;
   return x;
+}
+
+// STRATIFIED: the strata are the next power of two at or above pc.samples, M = stratum_mask + 1, set
+// once per invocation (main), with the xor-shift of mix_bits and 1 / M.
+uint stratum_mask = 1u;
+uint stratum_shift = 1u;
+float stratum_scale = 0.5;
+
+// A bijection of [0, M) keyed by `key`: multiplications by odd constants and additions modulo M, and an
+// xor-shift of the masked value, each invertible on those bits. Sample k takes stratum mix_bits(k, key):
+// the pc.samples samples take distinct strata, all of them when pc.samples is a power of two. (A
+// cycle-walk onto exactly pc.samples strata costs llvmpipe a data-dependent loop in the innermost test,
+// twice the composite; distinct strata of at most twice as many keep most of the gain.)
+uint mix_bits(uint x, uint key) {
+  x = ((x ^ key) * 0x9e3779b1u + (key >> 16)) & stratum_mask;
+  x ^= x >> stratum_shift;
+  x = (x * 0x85ebca6bu + (key >> 8)) & stratum_mask;
+  x ^= x >> stratum_shift;
+  x = (x * 0xc2b2ae35u + (key >> 24)) & stratum_mask;
+  x ^= x >> stratum_shift;
+  return x;
+}
+
+// u in [0, 1) for splat (hash splat_hash) at pixel p of this sample. The hash: one value per (pixel,
+// splat, sample, seed) on a 2^-24 grid. STRATIFIED: the stratum this sample takes of the pixel's and
+// splat's permutation, plus a hashed jitter within it: (stratum + jitter) / M. Each sample's u is
+// uniform on [0, 1) (the permutation's key is random per pixel and splat), so the mean stays unbiased.
+float threshold(uint p, uint splat_hash) {
+  uint h = hash32(pixel_hash[p] ^ splat_hash);
+  float jitter = float(h >> 8) * (1.0 / 16777216.0);
+  if (!STRATIFIED) return jitter;
+  uint stratum = mix_bits(pc.sample_index, hash32(pixel_key[p] ^ splat_hash));
+  return (float(stratum) + jitter) * stratum_scale;
 }
 
 // Tests staged splat j against the invocation's pixels first .. first + count - 1 (constants at the
@@ -97,8 +133,8 @@ void test_splat(uint j, uint local_x, uint local_y0, uint first, uint count) {
     float dy = mean_a_b.y - (float(local_y0 + p) + 0.5);
     float power = k0 + dy * (k1 + c_opacity.x * dy);
     float alpha = min(MAX_ALPHA, c_opacity.y * exp(power));
-    // u in [0, 1) on a 2^-24 grid: kept with probability alpha (rounded up to that grid).
-    float u = float(hash32(pixel_hash[p] ^ splat_hash) >> 8) * (1.0 / 16777216.0);
+    // u in [0, 1): kept with probability alpha (rounded up to u's grid).
+    float u = threshold(p, splat_hash);
     bool keep = alpha >= ALPHA_MIN && u < alpha;
     best[p] = keep ? min(best[p], a.w) : best[p];
   }
@@ -129,8 +165,16 @@ void main() {
 
   Uint64Array carried = Uint64Array(uint64_t(pc.state));  // the order keys in the state (see above)
   uint sample_hash = hash32(hash32(pc.seed) ^ pc.sample_index);
+  uint seed_key = hash32(pc.seed ^ 0x5bd1e995u);  // STRATIFIED: the permutations' seed
+  if (STRATIFIED) {
+    uint bits = uint(findMSB(max(pc.samples, 2u) - 1u)) + 1u;
+    stratum_mask = (1u << bits) - 1u;  // samples <= 4096: bits <= 12
+    stratum_shift = max(1u, (bits + 1u) / 2u);
+    stratum_scale = 1.0 / float(stratum_mask + 1u);  // exact: a power of two
+  }
   for (uint p = 0; p < P; ++p) {
     pixel_hash[p] = hash32(hash32(sample_hash ^ px) ^ (py0 + p));
+    if (STRATIFIED) pixel_key[p] = hash32(hash32(seed_key ^ px) ^ (py0 + p));
     best[p] = NONE;
     if (resume && out_x < pc.width && out_y0 + p < pc.height)
       best[p] = carried.v[4 * ((out_y0 + p) * pc.width + out_x) + 3];

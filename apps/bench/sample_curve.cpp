@@ -36,23 +36,63 @@ std::vector<std::vector<std::string>> table_rows(const std::vector<Row>& rows) {
 }
 
 std::string what_is_averaged(Effect effect) {
-  return effect == Effect::kLens ? "depth of field: a thin lens of aperture 0.05 of the view depth of the "
-                                   "scene's centre, focused there"
-                                 : "motion blur: the shutter open over the frame while the camera turns 5 "
-                                   "degrees about the scene's "
-                                   "centre";
+  switch (effect) {
+    case Effect::kLens:
+      return "depth of field: a thin lens of aperture 0.05 of the view depth of the scene's centre, focused "
+             "there";
+    case Effect::kTime:
+      return "motion blur: the shutter open over the frame while the camera turns 5 degrees about the "
+             "scene's "
+             "centre";
+    case Effect::kStochastic:
+      return "the stochastic compositor's frames, thresholds from the hash";
+    case Effect::kStochasticStratified:
+      return "the stochastic compositor's frames, thresholds from the stratified sampler";
+  }
+  return "";
+}
+
+// What the PSNR is against, for the reports.
+std::string held_to(Effect effect) {
+  return held_to_sorted_frame(effect) ? "the sorted frame" : std::to_string(kReferenceSamples) + " samples";
 }
 
 }  // namespace
 
 std::string effect_name(Effect effect) {
-  return effect == Effect::kLens ? "lens" : "time";
+  switch (effect) {
+    case Effect::kLens:
+      return "lens";
+    case Effect::kTime:
+      return "time";
+    case Effect::kStochastic:
+      return "stochastic";
+    case Effect::kStochasticStratified:
+      return "stochastic-stratified";
+  }
+  return "";
+}
+
+std::optional<Effect> parse_effect(const std::string& name) {
+  for (Effect e : {Effect::kLens, Effect::kTime, Effect::kStochastic, Effect::kStochasticStratified})
+    if (effect_name(e) == name) return e;
+  return std::nullopt;
+}
+
+bool held_to_sorted_frame(Effect effect) {
+  return effect == Effect::kStochastic || effect == Effect::kStochasticStratified;
 }
 
 RenderSettings effect_settings(const Options& options, const Camera& view, int samples) {
   RenderSettings settings = options.settings;
   settings.sort = options.sort;
-  if (options.effect == Effect::kLens) {
+  if (held_to_sorted_frame(options.effect)) {
+    settings.compositor = Compositor::kStochastic;
+    settings.stochastic.frames = uint32_t(samples);
+    settings.stochastic.sampler = options.effect == Effect::kStochasticStratified
+                                      ? StochasticSampler::kStratified
+                                      : StochasticSampler::kHash;
+  } else if (options.effect == Effect::kLens) {
     const double focus = view.to_camera(options.centre)[2];
     settings.lens = {.aperture_diameter = 0.05 * focus, .focus_distance = focus, .samples = samples};
   } else {
@@ -80,8 +120,13 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
   int done = 0;
   std::vector<RenderImage> references;
   for (const Camera& view : options.views) {
-    references.push_back(renderer->render(view, effect_settings(options, view, kReferenceSamples)));
-    progress(++done, total, std::to_string(kReferenceSamples) + " samples");
+    RenderSettings reference = effect_settings(options, view, kReferenceSamples);
+    if (held_to_sorted_frame(options.effect)) {
+      reference = options.settings;
+      reference.sort = options.sort;
+    }
+    references.push_back(renderer->render(view, reference));
+    progress(++done, total, held_to(options.effect));
   }
   const size_t views = options.views.size();
   std::vector<std::vector<std::vector<double>>> times(counts.size(), std::vector<std::vector<double>>(views));
@@ -127,9 +172,8 @@ std::string markdown(const std::vector<Row>& rows, Effect effect, const std::str
   std::string out = "# Samples against error and time, " + effect_name(effect) + ": " + scene + "\n\n";
   out += "Device: " + device.name + " (driver " + device.driver + "). Command: `" + command + "`.\n\n";
   out += "The effect: " + what_is_averaged(effect) +
-         ". GPU ms: median over repeats, then views. PSNR and max abs: "
-         "against the frame of " +
-         std::to_string(kReferenceSamples) + " samples from the same view.\n\n";
+         ". GPU ms: median over repeats, then views. PSNR and max abs: against " + held_to(effect) +
+         " from the same view.\n\n";
   return out + bench::markdown_table(kColumns, table_rows(rows), "|---:|---:|---:|---:|---:|");
 }
 
@@ -148,11 +192,11 @@ std::string svg(const std::vector<Row>& rows, Effect effect, const std::string& 
                 const DeviceInfo& device) {
   plot::LineChart chart;
   chart.title = "Samples against error, " + effect_name(effect) + ": " + scene;
-  chart.subtitle = device.name + "; PSNR against " + std::to_string(kReferenceSamples) + " samples";
+  chart.subtitle = device.name + "; PSNR against " + held_to(effect);
   chart.x_label = "samples";
-  chart.y_label = "PSNR against " + std::to_string(kReferenceSamples) + " samples (dB)";
+  chart.y_label = "PSNR against " + held_to(effect) + " (dB)";
   chart.x_scale = plot::Scale::kLog10;
-  plot::LineSeries series{effect == Effect::kLens ? "lens samples" : "time samples", 0, 0, {}};
+  plot::LineSeries series{effect_name(effect) + " samples", 0, 0, {}};
   for (const Row& row : rows)
     if (!std::isinf(row.psnr_db)) series.points.emplace_back(double(row.samples), row.psnr_db);
   chart.series = {series};

@@ -1,5 +1,7 @@
-// tilesplat-bench --sample-curve lens|time[:N,N...]: what an averaged effect's sample count costs in time,
-// and how far its image is from the image of many samples (docs/effects.md).
+// tilesplat-bench --sample-curve lens|time|stochastic|stochastic-stratified[:N,N...]: what an averaged
+// effect's sample count costs in time, and how far its image is from the image of many samples
+// (docs/effects.md), or for the stochastic compositor (its frames, with the hash or the stratified
+// sampler) from the sorted frame it converges to (docs/compositors.md).
 //
 // One scene at the chosen views through one effect: depth of field (a thin lens of aperture 0.05 of the
 // view depth of the scene's centre, focused there: the effects report's lens) or motion blur (the shutter
@@ -12,6 +14,7 @@
 
 #include <array>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,8 +24,13 @@
 
 namespace tilesplat::sample_curve {
 
-enum class Effect { kLens, kTime };
-std::string effect_name(Effect effect);  // "lens", "time"
+enum class Effect { kLens, kTime, kStochastic, kStochasticStratified };
+std::string effect_name(Effect effect);  // "lens", "time", "stochastic", "stochastic-stratified"
+// The inverse of effect_name, or nothing.
+std::optional<Effect> parse_effect(const std::string& name);
+// The image the effect's frames are held to: the sorted frame for the stochastic compositor, else the
+// effect with kReferenceSamples samples.
+bool held_to_sorted_frame(Effect effect);
 
 // The sample count the curve's images are held to (the "error against a 1,024-sample image").
 constexpr int kReferenceSamples = 1024;

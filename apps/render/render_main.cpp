@@ -79,7 +79,10 @@ std::string settings_text(const tilesplat::RenderSettings& settings, const LensF
   text += " compositor=" + tilesplat::to_string(settings.compositor);
   if (settings.compositor == tilesplat::Compositor::kStochastic)
     text += " frames=" + std::to_string(settings.stochastic.frames) +
-            " seed=" + std::to_string(settings.stochastic.seed);
+            " seed=" + std::to_string(settings.stochastic.seed) +
+            (settings.stochastic.sampler == tilesplat::StochasticSampler::kHash
+                 ? ""
+                 : " sampler=" + tilesplat::to_string(settings.stochastic.sampler));
   text += " lights=" + std::to_string(settings.lighting.lights.size());
   if (!settings.region.whole()) text += " region=" + tilesplat::to_string(settings.region);
   text += " background=";
@@ -488,6 +491,7 @@ int run(int argc, char** argv) {
     settings.compositor = tilesplat::Compositor::kStochastic;
     settings.stochastic.frames = static_cast<uint32_t>(options.stochastic_frames);
   }
+  settings.stochastic.sampler = options.stochastic_sampler;
   FrameWriter writer;
   if (loaded.description) {
     writer.preview.exposure_stops = loaded.description->effects.exposure_stops;

@@ -134,6 +134,19 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
       "composite without a depth sort: each splat kept per pixel with probability alpha, nearest kept "
       "wins, the mean of N such frames (1 to 4096; converges to the sorted image as 1/sqrt(N))",
       &options.stochastic_frames, 1, 4096);
+  parser.add_value(
+      "--stochastic-sampler", "NAME",
+      "how the stochastic compositor draws its thresholds: hash (independent frames, the default) "
+      "or stratified (each splat's N thresholds at a pixel one per stratum of [0, 1): faster "
+      "convergence)",
+      [&options](const std::string& text) {
+        try {
+          options.stochastic_sampler = tilesplat::parse_stochastic_sampler(text);
+        } catch (const std::invalid_argument&) {
+          throw cli::UsageError("--stochastic-sampler must be hash or stratified, got " +
+                                cli::single_quoted(text));
+        }
+      });
   parser.add_switch("--reference",
                     "render with the float64 CPU reference instead of the GPU (slow; for checking)",
                     &options.reference);
@@ -288,6 +301,8 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
   if (parser.seen("--lod") && parser.seen("--splat-budget"))
     throw cli::UsageError(
         "--lod draws one level of a LOD set and --splat-budget chooses the levels per frame: one of them");
+  if (parser.seen("--stochastic-sampler") && !stochastic)
+    throw cli::UsageError("--stochastic-sampler is the stochastic compositor's: add --stochastic N");
   if (options.reference && stochastic)
     throw cli::UsageError(
         "the stochastic compositor is the GPU's; the --reference renderer has the sorted and raster rules");

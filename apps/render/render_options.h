@@ -75,6 +75,8 @@ struct RenderOptions {
   bool no_count = false;
   bool reference = false;
   int stochastic_frames = 0;  // --stochastic N: the sort-free compositor averaging N frames; 0 = sorted
+  tilesplat::StochasticSampler stochastic_sampler =
+      tilesplat::StochasticSampler::kHash;  // --stochastic-sampler
   LensFlags lens;
   cli::CameraModelFlags camera_model;  // --fisheye, --orthographic, --equirectangular
   ShutterFlags shutter;

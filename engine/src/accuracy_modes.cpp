@@ -37,6 +37,16 @@ Compositor parse_compositor(const std::string& name) {
   throw std::invalid_argument("unknown compositor '" + name + "' (expected sorted, stochastic or raster)");
 }
 
+std::string to_string(StochasticSampler sampler) {
+  return sampler == StochasticSampler::kStratified ? "stratified" : "hash";
+}
+
+StochasticSampler parse_stochastic_sampler(const std::string& name) {
+  for (StochasticSampler s : {StochasticSampler::kHash, StochasticSampler::kStratified})
+    if (to_string(s) == name) return s;
+  throw std::invalid_argument("unknown stochastic sampler '" + name + "' (expected hash or stratified)");
+}
+
 namespace {
 
 [[noreturn]] void bad(const std::string& token, const std::string& why) {

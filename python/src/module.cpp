@@ -687,10 +687,14 @@ void bind(nb::module_& m) {
              const std::array<float, 3>& background, bool reuse_lists, double near_plane, double max_alpha,
              const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter,
              const GaussianScene* scene, uint64_t memory_budget, const LodSet* lod_set, uint64_t splat_budget,
-             const SceneInstances* instances, const std::optional<std::array<int, 4>>& region) {
+             const SceneInstances* instances, const std::optional<std::array<int, 4>>& region,
+             const std::string& stochastic_sampler) {
             RenderSettings settings = make_settings(
                 sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames, seed,
                 background, reuse_lists, near_plane, max_alpha, lens, shutter, memory_budget);
+            settings.stochastic.sampler =
+                parse_choice("stochastic_sampler", stochastic_sampler,
+                             std::array{StochasticSampler::kHash, StochasticSampler::kStratified});
             if (region) settings.region = {(*region)[0], (*region)[1], (*region)[2], (*region)[3]};
             if (int(scene != nullptr) + int(lod_set != nullptr) + int(instances != nullptr) > 1)
               throw std::invalid_argument("render takes one of scene, lod_set and instances");
@@ -709,6 +713,7 @@ void bind(nb::module_& m) {
           "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
           "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0, "lod_set"_a = nb::none(),
           "splat_budget"_a = 0, "instances"_a = nb::none(), "region"_a = nb::none(),
+          "stochastic_sampler"_a = "hash",
           "Renders the scene from `camera`: the one set_scene uploaded, or `scene`, which replaces it and is "
           "rendered within memory_budget bytes of device memory (0: the device's own limits), "
           "in depth-ordered parts into the same image where the whole frame would need more "
@@ -720,7 +725,9 @@ void bind(nb::module_& m) {
           "Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted', 'stochastic' or 'raster' (the depth-sorted splats drawn as quads by the "
-          "graphics pipeline); near_plane the view depth at or below which a Gaussian is "
+          "graphics pipeline); stochastic_sampler 'hash' or 'stratified' (the stochastic compositor's "
+          "thresholds: each splat's stratified over the frames, converging faster); near_plane the view "
+          "depth at or below which a Gaussian is "
           "culled; max_alpha the cap on one splat's alpha (0.99 as 3DGS trains, 0.999 as gsplat does); lens "
           "a ThinLens for depth of field (the mean of its samples' pinhole frames in linear light); shutter "
           "a "

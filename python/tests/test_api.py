@@ -124,6 +124,13 @@ def test_settings_are_keyword_arguments(playbot_renderer):
     assert not np.array_equal(mip.rgba, exact.rgba)
     stochastic = renderer.render(camera, compositor="stochastic", stochastic_frames=64, seed=3)
     assert tilesplat.compare_images(stochastic, exact)["psnr_db"] > 20
+    stratified = renderer.render(camera, compositor="stochastic", stochastic_frames=64, seed=3,
+                                 stochastic_sampler="stratified")
+    assert not np.array_equal(stratified.rgba, stochastic.rgba)
+    assert (tilesplat.compare_images(stratified, exact)["psnr_db"]
+            > tilesplat.compare_images(stochastic, exact)["psnr_db"])
+    with pytest.raises(ValueError, match="stochastic_sampler must be one of hash, stratified, got 'blue'"):
+        renderer.render(camera, compositor="stochastic", stochastic_sampler="blue")
     white = renderer.render(camera, background=[1, 1, 1])
     assert white.rgba[0, 0, :3].min() > 0.5 or exact.rgba[0, 0, 3] > 0.5
 

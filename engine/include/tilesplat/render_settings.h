@@ -137,8 +137,26 @@ TILESPLAT_API Compositor parse_compositor(const std::string& name);
 /// depth keys below 32 bits (it sorts nothing). Renderer::render throws std::invalid_argument, saying
 /// why, for the others.
 TILESPLAT_API bool compositor_draws(Compositor compositor, const AccuracyModes& modes);
+/// How the stochastic compositor draws each splat's threshold u at a pixel (it keeps the splat when
+/// u < alpha). Both are uniform on [0, 1) for each splat, pixel and frame, independent between splats,
+/// so both converge to the sorted image; they differ in how the frames of one render() spread.
+enum class StochasticSampler {
+  /// A hash of (pixel, splat, frame, seed): independent frames, error falling as 1/sqrt(frames).
+  kHash,
+  /// Stratified over the frames (a Latin hypercube per pixel): over the N frames of one render(), each
+  /// splat's thresholds at a pixel fall once in each of the N strata [k/N, (k+1)/N), in an order permuted
+  /// per (pixel, splat, seed) and jittered within the stratum. Each splat's own coverage is then exact to
+  /// 1/N; what is left is the interplay between splats. docs/compositors.md has its curve.
+  kStratified,
+};
+/// "hash", "stratified".
+TILESPLAT_API std::string to_string(StochasticSampler sampler);
+/// The inverse of to_string; throws std::invalid_argument naming the text and the choices.
+TILESPLAT_API StochasticSampler parse_stochastic_sampler(const std::string& name);
+
 /// The stochastic compositor draws, per pixel and frame, each splat of its tile with probability
-/// alpha (the sorted composite's alpha and cut-off) from a hash of (pixel, splat index, frame, seed)
+/// alpha (the sorted composite's alpha and cut-off) by a threshold of (pixel, splat index, frame, seed)
+/// (StochasticSampler)
 /// and shows the nearest drawn splat (by view depth, then index), or the background. Its expectation
 /// is the sorted front-to-back blend without the transmittance early-out, so the mean of `frames`
 /// frames converges to the sorted image, with an error falling as 1/sqrt(frames). One render() runs
@@ -150,6 +168,7 @@ TILESPLAT_API bool compositor_draws(Compositor compositor, const AccuracyModes& 
 struct StochasticSettings {
   uint32_t frames = 16;  ///< frames averaged by one render() call, 1 to 4096
   uint32_t seed = 1;     ///< the hashed thresholds' seed: equal seeds give bit-identical images
+  StochasticSampler sampler = StochasticSampler::kHash;  ///< how the thresholds are drawn
   /// Member-wise equality.
   bool operator==(const StochasticSettings&) const = default;
 };

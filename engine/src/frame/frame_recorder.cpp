@@ -185,8 +185,10 @@ void FrameRecorder::record_composite(Recording& r, FramePass pass) {
       .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff, float(r.settings.max_alpha)}};
   const VkDeviceAddress counters = res.counters.address();
   if (pass == FramePass::kStochasticComposite)
-    stochastic_composite_.record(r.stream, inputs, {r.settings.stochastic.frames, r.settings.stochastic.seed},
-                                 {stochastic_chunks_, res.composite_state, counters});
+    stochastic_composite_.record(
+        r.stream, inputs,
+        {r.settings.stochastic.frames, r.settings.stochastic.seed, r.settings.stochastic.sampler},
+        {stochastic_chunks_, res.composite_state, counters});
   else if (pass == FramePass::kResortComposite)
     composite_resort_.record(r.stream.cmd(), inputs, res.projected.ray_depth, r.plan.lists.camera,
                              r.plan.resort_window, counters);

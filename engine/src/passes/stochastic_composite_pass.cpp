@@ -36,8 +36,9 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
       texel_buffers_ ? composite_texel_views(in.splats, in.tile_lists, out, in.write_depth, in.write_count,
                                              unused_output_)
                      : std::vector<VkBufferView>{};
-  const Variant variant{in.write_depth, in.write_count, in.cutoffs.alpha, in.cutoffs.max_alpha,
-                        !views.empty()};
+  const Variant variant{in.write_depth,   in.write_count,
+                        in.cutoffs.alpha, in.cutoffs.max_alpha,
+                        !views.empty(),   samples.sampler == StochasticSampler::kStratified};
   auto it = pipelines_.find(variant);
   if (it == pipelines_.end()) {
     it = pipelines_
@@ -52,7 +53,8 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
                       {3, kTileSize / pixels_per_invocation_},
                       {4, std::bit_cast<uint32_t>(variant.alpha_cutoff)},
                       {5, std::bit_cast<uint32_t>(coverage_alpha_inv(variant.alpha_cutoff))},
-                      {6, std::bit_cast<uint32_t>(variant.max_alpha)}},
+                      {6, std::bit_cast<uint32_t>(variant.max_alpha)},
+                      {7, variant.stratified ? 1u : 0u}},
                      variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }

@@ -19,6 +19,7 @@ class StochasticCompositePass {
   struct Samples {
     uint32_t count = 1;  // samples averaged (StochasticSettings::frames)
     uint32_t seed = 1;   // the hashed thresholds' seed
+    StochasticSampler sampler = StochasticSampler::kHash;
   };
   // Records every sample, each as chunks.count dispatches (as CompositePass::Chunks: chunk 0 writes
   // the longest list over one chunk to FrameCounters::max_tile_pairs, chunks_for() turns it into the
@@ -48,6 +49,7 @@ class StochasticCompositePass {
     float alpha_cutoff = 1.0f / 255.0f;
     float max_alpha = float(kDefaultMaxAlpha);
     bool texel_buffers = false;  // the CPU layout (composite_stochastic_texel)
+    bool stratified = false;     // StochasticSampler::kStratified (STRATIFIED)
     auto operator<=>(const Variant&) const = default;
   };
   std::map<Variant, vk::ComputePipeline> pipelines_;
