@@ -67,6 +67,12 @@ Case synthetic_case() {
 
 class StochasticConvergence : public ::testing::TestWithParam<int> {};
 
+// The convergence tests' frames: over a coloured background, so that alpha errors show in the colour.
+RenderSettings over_background(RenderSettings settings) {
+  settings.background = {0.2f, 0.3f, 0.4f};
+  return settings;
+}
+
 // The mean over N frames is an unbiased estimate of the sorted blend (up to its T < 1e-4 early-out):
 // PSNR rises with N and the RMS error falls as 1/sqrt(N).
 TEST_P(StochasticConvergence, ApproachesTheSortedImageAtTheMonteCarloRate) {
@@ -123,14 +129,11 @@ TEST_P(StochasticConvergence, StratifiedSamplerConvergesFasterThanTheHash) {
   const Case c = GetParam() == 0 ? playbot_case() : synthetic_case();
   Renderer& renderer = testing::validated_renderer();
   renderer.set_scene(c.scene);
-  RenderSettings sorted_settings;
-  sorted_settings.background = {0.2f, 0.3f, 0.4f};
-  const RenderImage sorted = renderer.render(c.camera, sorted_settings);
+  const RenderImage sorted = renderer.render(c.camera, over_background(RenderSettings{}));
   std::vector<double> gain;
   // Powers of two (every stratum taken), then 24 of 32 strata.
   for (uint32_t n : {1u, 4u, 16u, 64u, 256u, 24u}) {
-    RenderSettings hash = stochastic(n);
-    hash.background = sorted_settings.background;
+    const RenderSettings hash = over_background(stochastic(n));
     RenderSettings stratified = hash;
     stratified.stochastic.sampler = StochasticSampler::kStratified;
     const double psnr_hash = compare_images(renderer.render(c.camera, hash), sorted).psnr_db;
