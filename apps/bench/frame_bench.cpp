@@ -6,7 +6,7 @@
 #include <numeric>
 
 #include "bench_plot.h"
-#include "bench_progress.h"
+#include "progress.h"
 #include "tilesplat/sort.h"
 
 namespace tilesplat::bench {
@@ -396,7 +396,7 @@ int run_frame_bench(const BenchOptions& options) {
 
   const auto start = std::chrono::steady_clock::now();
   {
-    Progress progress(total_frames, cli::stderr_is_terminal());
+    cli::FrameProgress progress(kProgram, total_frames, cli::progress_style(false));
     int done = 0;
     std::vector<tilesplat::RenderImage> images;  // per strategy, of the current camera
     for (size_t i = 0; i < cases.size(); ++i) {

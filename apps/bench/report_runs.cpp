@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "bench_plot.h"
-#include "bench_progress.h"
+#include "progress.h"
 #include "bench_results.h"
 #include "effects_report.h"
 #include "formats_report.h"
@@ -74,7 +74,7 @@ int run_accuracy_report(const BenchOptions& options) {
   std::fflush(stdout);
   int total = 0;
   for (const auto& p : planned) total += tilesplat::accuracy::work_units(p.options, p.scene.sh_degree);
-  Progress progress(total, cli::stderr_is_terminal(), "renders");
+  cli::FrameProgress progress(kProgram, total, cli::progress_style(false), "renders");
   int done_before = 0;
   std::vector<tilesplat::accuracy::SceneReport> reports;
   for (auto& p : planned) {
@@ -162,7 +162,7 @@ int run_effects_report(const BenchOptions& options) {
   std::fflush(stdout);
   tilesplat::effects::Run run;
   {
-    Progress progress(tilesplat::effects::work_units(rows, effect_options), cli::stderr_is_terminal());
+    cli::FrameProgress progress(kProgram, tilesplat::effects::work_units(rows, effect_options), cli::progress_style(false));
     run = tilesplat::effects::measure(
         cli::renderer_options(options.common), scene.loaded.scene, rows, effect_options,
         [&](int done, int, const std::string& what) { progress.update(done, what); });
@@ -221,7 +221,7 @@ int run_scaling_report(const BenchOptions& options) {
   std::fflush(stdout);
   tilesplat::scaling::Run run;
   {
-    Progress progress(tilesplat::scaling::work_units(scenes, scaling_options), cli::stderr_is_terminal());
+    cli::FrameProgress progress(kProgram, tilesplat::scaling::work_units(scenes, scaling_options), cli::progress_style(false));
     run = tilesplat::scaling::measure(
         cli::renderer_options(options.common), scenes, scaling_options,
         [&](int done, int, const std::string& what) { progress.update(done, what); });
@@ -293,7 +293,7 @@ int run_formats_report(const BenchOptions& options) {
   tilesplat::formats::Report report;
   {
     const int total = tilesplat::formats::work_units(files.size(), format_options);
-    Progress progress(total, cli::stderr_is_terminal(), "steps");
+    cli::FrameProgress progress(kProgram, total, cli::progress_style(false), "steps");
     report = tilesplat::formats::measure(
         *renderer, options.common.scenes.front(), files, format_options,
         [&](int done, int, const std::string& what) { progress.update(done, what); });
@@ -342,7 +342,7 @@ int run_sample_curve(const BenchOptions& options) {
   std::vector<curve::Row> rows;
   curve::Run run;
   {
-    Progress progress(curve::work_units(curve_options), cli::stderr_is_terminal());
+    cli::FrameProgress progress(kProgram, curve::work_units(curve_options), cli::progress_style(false));
     run = curve::measure(cli::renderer_options(options.common), scene.loaded.scene, curve_options, rows,
                          [&](int done, int, const std::string& what) { progress.update(done, what); });
   }
@@ -391,7 +391,7 @@ int run_lod_report(const BenchOptions& options) {
   scene.loaded.scene = {};  // the report reads every level from the set itself
   tilesplat::lod_report::Run run;
   {
-    Progress progress(tilesplat::lod_report::work_units(rows, lod_options), cli::stderr_is_terminal());
+    cli::FrameProgress progress(kProgram, tilesplat::lod_report::work_units(rows, lod_options), cli::progress_style(false));
     run = tilesplat::lod_report::measure(
         cli::renderer_options(options.common), set, rows, lod_options,
         [&](int done, int, const std::string& what) { progress.update(done, what); });

@@ -7,7 +7,7 @@
 #include <random>
 
 #include "bench_plot.h"
-#include "bench_progress.h"
+#include "progress.h"
 #include "bench_results.h"
 #include "frame_bench.h"
 #include "tilesplat/sort.h"
@@ -210,7 +210,7 @@ int run_sort_bench(const BenchOptions& options) {
   std::vector<SortRow> rows;
   const auto start = std::chrono::steady_clock::now();
   {
-    Progress progress(total, cli::stderr_is_terminal(), "sorts");
+    cli::FrameProgress progress(kProgram, total, cli::progress_style(false), "sorts");
     int done = 0;
     for (const int bits : options.key_bits) {
       for (const int exponent : options.sort_sizes) {

@@ -312,10 +312,6 @@ struct FrameWriter {
   }
 };
 
-cli::FrameProgress::Style progress_style(bool quiet) {
-  if (quiet) return cli::FrameProgress::Style::kQuiet;
-  return cli::stderr_is_terminal() ? cli::FrameProgress::Style::kBar : cli::FrameProgress::Style::kLines;
-}
 
 std::optional<std::string> environment(const char* name) {
   const char* value = std::getenv(name);
@@ -361,7 +357,7 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
     FrameRenderer renderer(options, loaded);
     writer.exr.attributes["sortStrategy"] = renderer.sort_strategy(settings);
     cli::ManifestAppender manifest(folder / cli::manifest_file_name(shard));
-    cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()), progress_style(options.quiet));
+    cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()), cli::progress_style(options.quiet));
     std::future<void> writing;
     for (const Frame* frame : to_render) {
       tilesplat::RenderSettings frame_settings = settings;
