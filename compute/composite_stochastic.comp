@@ -36,6 +36,7 @@ layout(constant_id = 4) const float ALPHA_MIN = 1.0 / 255.0;   // the alpha cut-
 layout(constant_id = 5) const float ALPHA_INV = 255.0;         // 1 / ALPHA_MIN, as the tile coverage uses it
 layout(constant_id = 6) const float MAX_ALPHA = 0.99;          // RenderSettings::max_alpha
 layout(constant_id = 7) const bool STRATIFIED = false;         // StochasticSampler::kStratified
+layout(constant_id = 8) const bool KEEP_SUMS = false;          // StochasticSettings::accumulate
 
 // The push constants: StochasticCompositePush in shader_io.h.
 
@@ -241,11 +242,13 @@ void main() {
       sums += vec4(splat_vec4(g, 2).rgb, 1.0);
       depth_sum += uintBitsToFloat(uint(best[p] >> 32));
     }
-    if (!last_sample) {
+    // The sums stay in the state for the next sample, and after the last for the next frame's when
+    // it accumulates (its first sample is then pc.sample_index > 0 and reads them).
+    if (!last_sample || KEEP_SUMS) {
       pc.state.v[2 * i] = sums;
       pc.state.v[2 * i + 1].x = depth_sum;
-      continue;
     }
+    if (!last_sample) continue;
     float n = float(pc.samples);
     write_rgba(i, vec4((sums.rgb + (n - sums.w) * pc.background.rgb) / n, sums.w / n));
     if (WRITE_DEPTH) write_depth(i, sums.w > 0.0 ? depth_sum / sums.w : 0.0);

@@ -1,6 +1,7 @@
 // The stochastic (sort-free) compositor: its mean over frames converges to the sorted image at the
 // Monte Carlo rate, is deterministic per seed, runs no depth sort, and refuses what it cannot honour.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -194,6 +195,66 @@ TEST(Stochastic, RenderCommandLineChoosesTheSampler) {
   EXPECT_THROW(parse_stochastic_sampler("blue"), std::invalid_argument);
 }
 
+// StochasticSettings::accumulate: repeated calls on a view at rest add their frames to one mean (the
+// composite state keeps the sums), so N calls of 1 frame are one call of N frames, to the bit; a new
+// camera, background or an other frame in between starts the mean anew.
+TEST(Stochastic, AccumulatedCallsAreOneLongerCall) {
+  const Case c = playbot_case();
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(c.scene);
+  RenderSettings one = stochastic(1);
+  one.stochastic.accumulate = true;
+  RenderImage image;
+  for (uint32_t k = 1; k <= 6; ++k) {
+    image = renderer.render(c.camera, one);
+    EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, k);
+  }
+  const RenderImage six = renderer.render(c.camera, stochastic(6));
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, 6u);
+  EXPECT_EQ(image.rgba, six.rgba);
+  EXPECT_EQ(image.depth, six.depth);
+  EXPECT_EQ(image.splat_count, six.splat_count);
+
+  // Calls of several frames continue the same sequence: 3 + 5 frames are 8.
+  RenderSettings three = stochastic(3);
+  three.stochastic.accumulate = true;
+  renderer.render(c.camera, three);  // after a frame that did not accumulate: anew
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, 3u);
+  RenderSettings five = three;
+  five.stochastic.frames = 5;
+  const RenderImage eight = renderer.render(c.camera, five);
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, 8u);
+  EXPECT_EQ(eight.rgba, renderer.render(c.camera, stochastic(8)).rgba);
+
+  // What starts it anew: another camera, another background, a sorted frame in between.
+  renderer.render(c.camera, one);
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, 1u);
+  renderer.render(c.camera, one);
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, 2u);
+  const Camera moved =
+      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(1).camera, 160, 90);
+  const RenderImage first_moved = renderer.render(moved, one);
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, 1u);
+  EXPECT_EQ(first_moved.rgba, renderer.render(moved, stochastic(1)).rgba);
+  renderer.render(moved, one);
+  RenderSettings white = one;
+  white.background = {1, 1, 1};
+  renderer.render(moved, white);
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, 1u);
+  renderer.render(moved, white);
+  renderer.render(moved);  // sorted
+  renderer.render(moved, white);
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, 1u);
+
+  RenderSettings stratified = one;
+  stratified.stochastic.sampler = StochasticSampler::kStratified;
+  EXPECT_NE(testing::error_of<std::invalid_argument>([&] {
+              renderer.render(moved, stratified);
+            }).find("accumulate with the hash sampler"),
+            std::string::npos);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 TEST(Stochastic, SameSeedIsBitIdenticalAndOtherSeedsAreEquallyClose) {
   const Case c = playbot_case();
   Renderer& renderer = testing::validated_renderer();
@@ -369,6 +430,40 @@ TEST(Stochastic, RejectsSettingsItCannotHonour) {
   EXPECT_EQ(to_string(Compositor::kSorted), "sorted");
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
+
+#ifdef TILESPLAT_VIEWER_EXE
+// The viewer shows the stochastic compositor too (--compositor stochastic, key C): a view at rest adds a
+// frame a redraw to the mean, and its screenshot is that mean rendered in one call: the image of
+// tilesplat-render --stochastic N with the N it reports, to the bit.
+TEST(Stochastic, ViewerAccumulatesFramesWhileTheViewRests) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0 && !std::getenv("DISPLAY"))
+    TILESPLAT_SKIP_OR_FAIL("no display for the viewer's window and no xvfb-run (Debian: xvfb xauth)");
+  const std::filesystem::path out = testing::fresh_output_dir();
+  const std::vector<std::string> view = {testing::bundled_playbot().string(), "--width", "160", "--height",
+                                         "90"};
+  std::vector<std::string> viewer_args = view;
+  viewer_args.insert(viewer_args.end(), {"--compositor", "stochastic", "--frames", "6", "--validation",
+                                         "--screenshot", (out / "viewer.exr").string()});
+  const std::string prefix =
+      std::getenv("DISPLAY") ? "" : "xvfb-run -n " + std::to_string(100 + ::getpid() % 800) + " -a ";
+  const testing::ProcessResult viewer = testing::run_process(prefix, TILESPLAT_VIEWER_EXE, viewer_args);
+  ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
+  EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
+  const std::string said = "the screenshot is the mean of ";
+  const size_t at = viewer.err.find(said);
+  ASSERT_NE(at, std::string::npos) << viewer.err;
+  const int frames = std::atoi(viewer.err.c_str() + at + said.size());
+  // Six redraws of a view that never moved: each added its frame (a resize at the start may restart).
+  EXPECT_GE(frames, 4) << viewer.err;
+  EXPECT_LE(frames, 6) << viewer.err;
+  std::vector<std::string> render_args = view;
+  render_args.insert(render_args.end(),
+                     {"--stochastic", std::to_string(frames), "-o", (out / "render.exr").string()});
+  const testing::ProcessResult render = testing::run_process("", TILESPLAT_RENDER_EXE, render_args);
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  EXPECT_EQ(read_exr(out / "viewer.exr").rgba, read_exr(out / "render.exr").rgba);
+}
+#endif
 
 }  // namespace
 }  // namespace tilesplat

@@ -3,12 +3,12 @@
 #include <cstdio>
 
 #include "bench_plot.h"
-#include "progress.h"
 #include "bench_results.h"
 #include "effects_report.h"
 #include "formats_report.h"
 #include "frame_bench.h"
 #include "lod_report.h"
+#include "progress.h"
 #include "sample_curve.h"
 #include "scaling_report.h"
 
@@ -162,7 +162,8 @@ int run_effects_report(const BenchOptions& options) {
   std::fflush(stdout);
   tilesplat::effects::Run run;
   {
-    cli::FrameProgress progress(kProgram, tilesplat::effects::work_units(rows, effect_options), cli::progress_style(false));
+    cli::FrameProgress progress(kProgram, tilesplat::effects::work_units(rows, effect_options),
+                                cli::progress_style(false));
     run = tilesplat::effects::measure(
         cli::renderer_options(options.common), scene.loaded.scene, rows, effect_options,
         [&](int done, int, const std::string& what) { progress.update(done, what); });
@@ -221,7 +222,8 @@ int run_scaling_report(const BenchOptions& options) {
   std::fflush(stdout);
   tilesplat::scaling::Run run;
   {
-    cli::FrameProgress progress(kProgram, tilesplat::scaling::work_units(scenes, scaling_options), cli::progress_style(false));
+    cli::FrameProgress progress(kProgram, tilesplat::scaling::work_units(scenes, scaling_options),
+                                cli::progress_style(false));
     run = tilesplat::scaling::measure(
         cli::renderer_options(options.common), scenes, scaling_options,
         [&](int done, int, const std::string& what) { progress.update(done, what); });
@@ -391,7 +393,8 @@ int run_lod_report(const BenchOptions& options) {
   scene.loaded.scene = {};  // the report reads every level from the set itself
   tilesplat::lod_report::Run run;
   {
-    cli::FrameProgress progress(kProgram, tilesplat::lod_report::work_units(rows, lod_options), cli::progress_style(false));
+    cli::FrameProgress progress(kProgram, tilesplat::lod_report::work_units(rows, lod_options),
+                                cli::progress_style(false));
     run = tilesplat::lod_report::measure(
         cli::renderer_options(options.common), set, rows, lod_options,
         [&](int done, int, const std::string& what) { progress.update(done, what); });

@@ -7,9 +7,9 @@
 #include <random>
 
 #include "bench_plot.h"
-#include "progress.h"
 #include "bench_results.h"
 #include "frame_bench.h"
+#include "progress.h"
 #include "tilesplat/sort.h"
 
 namespace tilesplat::bench {

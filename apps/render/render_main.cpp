@@ -312,7 +312,6 @@ struct FrameWriter {
   }
 };
 
-
 std::optional<std::string> environment(const char* name) {
   const char* value = std::getenv(name);
   if (value == nullptr || *value == '\0') return std::nullopt;
@@ -357,7 +356,8 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
     FrameRenderer renderer(options, loaded);
     writer.exr.attributes["sortStrategy"] = renderer.sort_strategy(settings);
     cli::ManifestAppender manifest(folder / cli::manifest_file_name(shard));
-    cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()), cli::progress_style(options.quiet));
+    cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()),
+                                cli::progress_style(options.quiet));
     std::future<void> writing;
     for (const Frame* frame : to_render) {
       tilesplat::RenderSettings frame_settings = settings;

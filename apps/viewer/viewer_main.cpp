@@ -47,10 +47,13 @@ constexpr int kDefaultWindowWidth = 960;  // the height follows the view's aspec
 // What key M steps through: the reference; depth16, the web viewers' sort keys; resort8, per-pixel
 // re-sorting, more exact than the reference; and the web viewers' shortcuts all together.
 constexpr const char* kModeCycle[] = {"reference", "depth16", "resort8", "depth16+opacity-extent+fp16-sh+fp16-cov"};
-// What key C steps through: the tile compositor and the raster one (which draws no re-sorting: M skips
-// resort8 while it is on).
-constexpr std::array<tilesplat::Compositor, 2> kCompositorCycle = {tilesplat::Compositor::kSorted,
-                                                                   tilesplat::Compositor::kRaster};
+// What key C steps through: the tile compositor, the raster one (which draws no re-sorting: M skips
+// resort8 while it is on) and the stochastic one, whose frames add up while the view rests.
+constexpr std::array<tilesplat::Compositor, 3> kCompositorCycle = {
+    tilesplat::Compositor::kSorted, tilesplat::Compositor::kRaster, tilesplat::Compositor::kStochastic};
+// The stochastic frames a view at rest accumulates before the window stops redrawing it (about 40 dB
+// from the sorted image on the bundled scenes: docs/compositors.md).
+constexpr uint32_t kMaxAccumulatedFrames = 256;
 bool validation_from_environment() {
   const char* value = std::getenv("TILESPLAT_VALIDATION");
   return value && *value && std::string_view(value) != "0";
@@ -107,7 +110,8 @@ class Viewer {
     // --compositor: sorted or raster, and no re-sorting mode with the raster (check_viewer_flags; a scene
     // file sets no compositor).
     compositor_ =
-        base_settings_.compositor == tilesplat::Compositor::kRaster ? 1 : 0;  // kCompositorCycle order
+        size_t(std::find(kCompositorCycle.begin(), kCompositorCycle.end(), base_settings_.compositor) -
+               kCompositorCycle.begin());
     // Key L's lenses, without the box and the grid (drawn through a pinhole): the pinhole, a fisheye of
     // 180 degrees, the panorama, and --fisheye, --orthographic or --equirectangular where given.
     lenses_.push_back({});
@@ -168,10 +172,25 @@ class Viewer {
     settings.sort = sorts_[sort_];
     settings.accuracy = modes_[mode_];
     settings.compositor = kCompositorCycle[compositor_];
+    // The stochastic compositor: one frame a redraw, added to the mean of the earlier ones until the
+    // camera (or anything else) changes (StochasticSettings::accumulate).
+    settings.stochastic.frames = 1;
+    settings.stochastic.accumulate = true;
     // A scene file's sh_degree effect caps every mode, as in tilesplat-render.
     settings.accuracy.sh_degree_cap =
         std::min(settings.accuracy.sh_degree_cap, base_settings_.accuracy.sh_degree_cap);
     return settings;
+  }
+  // The settings of the window's last frame as one render: the stochastic frames it had accumulated
+  // in one call (the same image: N calls of 1 frame are 1 call of N).
+  tilesplat::RenderSettings screenshot_settings() {
+    tilesplat::RenderSettings shot = settings();
+    if (shot.compositor == tilesplat::Compositor::kStochastic) {
+      tilesplat::wait_for_frame(renderer_);
+      shot.stochastic.frames = std::max(1u, renderer_.last_frame_stats().accumulated_frames);
+      shot.stochastic.accumulate = false;
+    }
+    return shot;
   }
   int frames() const { return frames_; }
   VkFormat window_format() const { return swapchain_.format(); }
@@ -328,7 +347,10 @@ class Viewer {
     else
       tilesplat::render_to_image(renderer_, camera(), frame, image_->target(), nullptr,
                                  tilesplat::HostFrameSync{});
-    needs_render_ = false;
+    // A view at rest under the stochastic compositor goes on refining (the counts lag a frame: the
+    // last frame's statistics arrive when the next one starts).
+    needs_render_ = frame.compositor == tilesplat::Compositor::kStochastic &&
+                    renderer_.last_frame_stats().accumulated_frames + 1 < kMaxAccumulatedFrames;
     needs_present_ = true;
     ++frames_;
   }
@@ -367,6 +389,9 @@ class Viewer {
     const std::string sort = sorts_[sort_] == "auto" && !ran.empty() ? "auto (" + ran + ")" : sorts_[sort_];
     title += " | " + lens_name() + " | " + tilesplat::to_string(modes_[mode_]) + " | " + sort + " | " +
              tilesplat::to_string(kCompositorCycle[compositor_]) +
+             (kCompositorCycle[compositor_] == tilesplat::Compositor::kStochastic
+                  ? " (" + std::to_string(renderer_.last_frame_stats().accumulated_frames) + " frames)"
+                  : "") +
              (lod_ ? " | " + cli::group_thousands(lod_splats_) + " splats (LOD)" : "") + " | GPU " +
              cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
              cli::format_fixed(frame_ms, 1) + " ms (" +
@@ -433,7 +458,11 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewe
       for (size_t c = 0; c < 3; ++c) image.rgba[4 * pixel + c] = float(shown.rgb[3 * pixel + c]) / 255.0f;
     tilesplat::write_png_preview(path, image);
   } else {
-    const tilesplat::RenderImage image = renderer.render(viewer.camera(), viewer.settings());
+    const tilesplat::RenderSettings settings = viewer.screenshot_settings();
+    const tilesplat::RenderImage image = renderer.render(viewer.camera(), settings);
+    if (settings.compositor == tilesplat::Compositor::kStochastic)
+      std::fprintf(stderr, "%s: the screenshot is the mean of %u stochastic frames\n", kProgram,
+                   settings.stochastic.frames);
     tilesplat::ExrWriteOptions exr;
     exr.alpha = !loaded.description || loaded.description->outputs.alpha;
     exr.camera = viewer.camera();

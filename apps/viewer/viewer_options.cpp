@@ -28,8 +28,10 @@ void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& optio
     throw cli::UsageError(
         "--lod draws one level of a LOD set and --splat-budget chooses the levels per frame: one of them");
   // The compositors the window shows (key C), checked before a window opens.
-  if (options.common.compositor == Compositor::kStochastic)
-    throw cli::UsageError("the viewer shows the sorted or the raster compositor, not the stochastic one");
+  if (options.common.compositor == Compositor::kStochastic && !options.common.modes.empty() &&
+      !compositor_draws(Compositor::kStochastic, options.common.modes.front()))
+    throw cli::UsageError("the stochastic compositor sorts nothing (--mode " +
+                          to_string(options.common.modes.front()) + ")");
   if (options.common.compositor == Compositor::kRaster && !options.common.modes.empty() &&
       !compositor_draws(Compositor::kRaster, options.common.modes.front()))
     throw cli::UsageError("the raster compositor does not re-sort per pixel (--mode " +

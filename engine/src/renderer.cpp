@@ -27,6 +27,16 @@ namespace {
 constexpr int kMaxRetries = 4;
 }  // namespace
 
+Renderer::Impl::Accumulation Renderer::Impl::accumulation_of(const RenderSettings& settings,
+                                                             uint32_t frames) {
+  return {frames,
+          settings.background,
+          settings.depth,
+          settings.splat_count,
+          settings.stochastic.seed,
+          settings.max_alpha};
+}
+
 SortStrategy& Renderer::Impl::sort(const std::string& name) {
   auto it = sorts.find(name);
   if (it == sorts.end()) it = sorts.emplace(name, make_sort_strategy(name, ctx)).first;
@@ -60,6 +70,14 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
   start.plan = plan_frame(
       camera, settings, {resources.scene_shape(scene_generation), device, traits, lists, depth_image, part});
   resources.prepare_outputs(start.plan, settings);
+  // StochasticSettings::accumulate: this frame's samples follow the previous frame's in the composite
+  // state when it reuses that frame's lists with the same outputs; else they start the mean anew.
+  if (start.plan.stochastic_accumulate && !start.plan.build_lists && accumulated.frames > 0 &&
+      accumulation_of(settings, accumulated.frames) == accumulated)
+    start.plan.stochastic_first_sample = accumulated.frames;
+  start.accumulation =
+      accumulation_of(settings, start.plan.stochastic_first_sample + start.plan.stochastic_samples);
+  accumulated = {};  // the sums are the next frame's once this one completes
   stats = {};
   lists.reset();  // valid again once this frame's lists are complete (not if it throws)
   // Reused lists were built with an equal camera and equal (validated) lights, which are in their
@@ -85,7 +103,7 @@ FrameCounters Renderer::Impl::run_frame(const FramePlan& plan, const RenderSetti
 // drivers only; the lists are complete then). A frame on reused lists cannot overflow.
 void Renderer::Impl::render_frame(const Camera& camera, const RenderSettings& settings,
                                   const ExternalDepthImage* depth_image, const ScenePart& part) {
-  const FrameStart start = begin_frame(camera, settings, depth_image != nullptr, false, part);
+  FrameStart start = begin_frame(camera, settings, depth_image != nullptr, false, part);
   const FramePlan& plan = start.plan;
   SortStrategy& sorter = *start.sorter;
   uint32_t& chunks = recorder.composite_chunks(plan.compositor);
@@ -111,6 +129,9 @@ void Renderer::Impl::render_frame(const Camera& camera, const RenderSettings& se
     }
     if (retry > kMaxRetries) throw std::logic_error("composite chunks did not converge");  // one retry suffices
     chunks = needed;
+    // An accumulating frame's first attempt already added to the sums: the mean starts anew.
+    start.plan.stochastic_first_sample = 0;
+    start.accumulation.frames = plan.stochastic_samples;
     frame = run_frame(composite_only(plan), settings, sorter, depth_image);
     stats.retries = retry;
   }
@@ -142,6 +163,10 @@ void Renderer::Impl::check_resort_lists(const FramePlan& plan, const FrameCounte
 void Renderer::Impl::end_frame(const FrameStart& start, const FrameCounters& frame, std::vector<PassTiming> passes,
                                bool lists_whole) {
   if (lists_whole) lists = start.plan.lists;
+  if (start.plan.stochastic_accumulate && lists_whole && stats.complete) accumulated = start.accumulation;
+  stats.accumulated_frames = start.plan.compositor == Compositor::kStochastic
+                                 ? start.plan.stochastic_first_sample + start.plan.stochastic_samples
+                                 : 0;
   stats.passes = std::move(passes);
   stats.reused_sorted_lists = !start.plan.build_lists;
   stats.sort_bits = start.plan.build_lists ? start.plan.sort_bits : 0;

@@ -43,11 +43,24 @@ struct Renderer::Impl {
   DeviceCaps device_caps() const;
 
   // What a frame was planned as and started from, for its statistics once it completed.
+  // StochasticSettings::accumulate: what the stochastic frames in the composite state's sums were
+  // rendered with beyond their lists, and how many there are. A frame continues them when it reuses
+  // the lists and matches the rest.
+  struct Accumulation {
+    uint32_t frames = 0;
+    std::array<float, 3> background = {0, 0, 0};
+    bool depth = false, splat_count = false;
+    uint32_t seed = 0;
+    double max_alpha = 0;
+    bool operator==(const Accumulation&) const = default;
+  };
+  static Accumulation accumulation_of(const RenderSettings& settings, uint32_t frames);
   struct FrameStart {
     FramePlan plan;
     SortStrategy* sorter = nullptr;
     uint64_t fallbacks_before = 0;
     std::chrono::steady_clock::time_point time;
+    Accumulation accumulation;  // the sums this frame leaves, when it accumulates
   };
   // Plans the frame (validating the camera and settings), sizes the outputs and uploads what the
   // frame reads from the host. Waits for a frame in flight first: its buffers are the same.
@@ -130,6 +143,7 @@ struct Renderer::Impl {
   // The tile lists in the buffers: what they were built for (none after set_scene or a frame that
   // failed).
   std::optional<ListKey> lists;
+  Accumulation accumulated;  // the stochastic sums the last frame left (frames 0: none to continue)
   uint64_t scene_generation = 0;            // counts set_scene calls (and scene parts uploaded)
   bool scene_in_parts = false;              // the buffers hold a part of a scene, not a whole one
   uint64_t parts_budget = 0;                // the memory budget those parts were sized for

@@ -153,6 +153,7 @@ nb::dict stats_dict(const FrameStats& stats) {
   out["device_bytes"] = stats.device_bytes;
   out["reused_sorted_lists"] = stats.reused_sorted_lists;
   out["samples"] = stats.samples;  // frames averaged (lens, shutter)
+  out["accumulated_frames"] = stats.accumulated_frames;  // the stochastic frames in the mean
   out["scene_parts"] = stats.scene_parts;  // depth-ordered parts under a memory budget
   out["image_bands"] = stats.image_bands;  // bands of rows of an image past the device
   out["peak_device_bytes"] = stats.peak_device_bytes;
@@ -688,13 +689,14 @@ void bind(nb::module_& m) {
              const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter,
              const GaussianScene* scene, uint64_t memory_budget, const LodSet* lod_set, uint64_t splat_budget,
              const SceneInstances* instances, const std::optional<std::array<int, 4>>& region,
-             const std::string& stochastic_sampler) {
+             const std::string& stochastic_sampler, bool stochastic_accumulate) {
             RenderSettings settings = make_settings(
                 sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames, seed,
                 background, reuse_lists, near_plane, max_alpha, lens, shutter, memory_budget);
             settings.stochastic.sampler =
                 parse_choice("stochastic_sampler", stochastic_sampler,
                              std::array{StochasticSampler::kHash, StochasticSampler::kStratified});
+            settings.stochastic.accumulate = stochastic_accumulate;
             if (region) settings.region = {(*region)[0], (*region)[1], (*region)[2], (*region)[3]};
             if (int(scene != nullptr) + int(lod_set != nullptr) + int(instances != nullptr) > 1)
               throw std::invalid_argument("render takes one of scene, lod_set and instances");
@@ -713,7 +715,7 @@ void bind(nb::module_& m) {
           "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
           "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0, "lod_set"_a = nb::none(),
           "splat_budget"_a = 0, "instances"_a = nb::none(), "region"_a = nb::none(),
-          "stochastic_sampler"_a = "hash",
+          "stochastic_sampler"_a = "hash", "stochastic_accumulate"_a = false,
           "Renders the scene from `camera`: the one set_scene uploaded, or `scene`, which replaces it and is "
           "rendered within memory_budget bytes of device memory (0: the device's own limits), "
           "in depth-ordered parts into the same image where the whole frame would need more "
@@ -726,7 +728,10 @@ void bind(nb::module_& m) {
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted', 'stochastic' or 'raster' (the depth-sorted splats drawn as quads by the "
           "graphics pipeline); stochastic_sampler 'hash' or 'stratified' (the stochastic compositor's "
-          "thresholds: each splat's stratified over the frames, converging faster); near_plane the view "
+          "thresholds: each splat's stratified over the frames, converging faster); stochastic_accumulate "
+          "adds "
+          "this call's frames to the previous calls' mean while the view and settings stay the same "
+          "(last_frame_stats['accumulated_frames'] counts them); near_plane the view "
           "depth at or below which a Gaussian is "
           "culled; max_alpha the cap on one splat's alpha (0.99 as 3DGS trains, 0.999 as gsplat does); lens "
           "a ThinLens for depth of field (the mean of its samples' pinhole frames in linear light); shutter "

@@ -131,6 +131,13 @@ def test_settings_are_keyword_arguments(playbot_renderer):
             > tilesplat.compare_images(stochastic, exact)["psnr_db"])
     with pytest.raises(ValueError, match="stochastic_sampler must be one of hash, stratified, got 'blue'"):
         renderer.render(camera, compositor="stochastic", stochastic_sampler="blue")
+    # Frames that add up across calls: four calls of one frame are one call of four.
+    for calls in range(1, 5):
+        accumulated = renderer.render(camera, compositor="stochastic", stochastic_frames=1,
+                                      stochastic_accumulate=True)
+        assert renderer.last_frame_stats["accumulated_frames"] == calls
+    four = renderer.render(camera, compositor="stochastic", stochastic_frames=4)
+    assert np.array_equal(accumulated.rgba, four.rgba)
     white = renderer.render(camera, background=[1, 1, 1])
     assert white.rgba[0, 0, :3].min() > 0.5 or exact.rgba[0, 0, 3] > 0.5
 

@@ -169,6 +169,14 @@ struct StochasticSettings {
   uint32_t frames = 16;  ///< frames averaged by one render() call, 1 to 4096
   uint32_t seed = 1;     ///< the hashed thresholds' seed: equal seeds give bit-identical images
   StochasticSampler sampler = StochasticSampler::kHash;  ///< how the thresholds are drawn
+  /// Add this render()'s frames to the mean of the previous ones, so that repeated calls on a view at
+  /// rest converge (a viewer's progressive refinement): it continues while each call reuses the
+  /// previous call's lists (same scene, camera and list settings, RenderSettings::reuse_lists) with the
+  /// same background, outputs, seed and sampler, and starts anew otherwise.
+  /// FrameStats::accumulated_frames counts the frames in the mean; with the hash, N calls of 1 frame
+  /// give the image of one call of N frames, to the bit. Not with StochasticSampler::kStratified (its
+  /// strata need the count in advance: std::invalid_argument).
+  bool accumulate = false;
   /// Member-wise equality.
   bool operator==(const StochasticSettings&) const = default;
 };

@@ -76,6 +76,9 @@ struct FrameStats {
   /// (RenderSettings::lens, shutter). Over several, gpu_ms and passes are the sums, visible and
   /// intersections the largest of any sample.
   int samples = 1;
+  /// The stochastic compositor's frames in this image's mean: StochasticSettings::frames, plus the
+  /// earlier calls' when StochasticSettings::accumulate continued them; 0 for the other compositors.
+  uint32_t accumulated_frames = 0;
   /// Parts the scene was rendered in (Renderer::render(scene, camera, settings) under
   /// RenderSettings::memory_budget): 1 for a whole scene. Over several, gpu_ms, passes, visible,
   /// intersections, retries, submissions and uploaded_bytes are the sums over the parts.

@@ -91,6 +91,10 @@ void validate_compositor(const RenderSettings& settings) {
   if (settings.stochastic.frames < 1 || settings.stochastic.frames > kMaxStochasticFrames)
     fail("stochastic.frames must be 1 to " + std::to_string(kMaxStochasticFrames) + ", not " +
          std::to_string(settings.stochastic.frames));
+  if (settings.stochastic.accumulate && settings.stochastic.sampler == StochasticSampler::kStratified)
+    fail(
+        "stochastic.accumulate adds frames to an open-ended mean, and the stratified sampler needs the count "
+        "in advance: accumulate with the hash sampler");
 }
 
 }  // namespace
@@ -301,6 +305,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
                               : plan.depth_key_bits + plan.tiles.tile_bits;
   plan.resort_window = stochastic ? 0 : uint32_t(settings.accuracy.resort_window);
   plan.stochastic_samples = stochastic ? settings.stochastic.frames : 0;
+  plan.stochastic_accumulate = stochastic && settings.stochastic.accumulate;
   if (settings.host) {
     plan.host.from_memory = !settings.host->depth.empty();
     plan.host.from_image = context.depth_image;

@@ -140,6 +140,10 @@ struct FramePlan {
   Compositor compositor = Compositor::kSorted;
   uint32_t resort_window = 0;       // kResortComposite's window (AccuracyModes::resort_window)
   uint32_t stochastic_samples = 0;  // kStochasticComposite's averaged samples (StochasticSettings::frames)
+  // StochasticSettings::accumulate: the samples already in the composite state's sums (the renderer
+  // sets it when the frame continues the previous one), and that the sums stay for the next.
+  uint32_t stochastic_first_sample = 0;
+  bool stochastic_accumulate = false;
   HostDepthPlan host;
   ScenePart part;                 // of a scene rendered in parts (or the whole scene)
   std::vector<FramePass> passes;  // in order

@@ -38,7 +38,8 @@ void FrameRecorder::prepare(const FramePlan& plan, const RenderSettings& setting
                             SortStrategy& sorter) {
   const uint32_t chunks = composite_chunks(plan.compositor);
   const bool needs_state = plan.compositor == Compositor::kStochastic
-                               ? StochasticCompositePass::needs_state(plan.stochastic_samples, chunks)
+                               ? StochasticCompositePass::needs_state(plan.stochastic_samples, chunks) ||
+                                     plan.stochastic_accumulate
                            : plan.compositor == Compositor::kRaster ? false
                                                                     : chunks > 1 || !plan.part.whole();
   resources.prepare_frame(plan, needs_state);
@@ -187,7 +188,8 @@ void FrameRecorder::record_composite(Recording& r, FramePass pass) {
   if (pass == FramePass::kStochasticComposite)
     stochastic_composite_.record(
         r.stream, inputs,
-        {r.settings.stochastic.frames, r.settings.stochastic.seed, r.settings.stochastic.sampler},
+        {r.settings.stochastic.frames, r.settings.stochastic.seed, r.settings.stochastic.sampler,
+         r.plan.stochastic_first_sample, r.plan.stochastic_accumulate},
         {stochastic_chunks_, res.composite_state, counters});
   else if (pass == FramePass::kResortComposite)
     composite_resort_.record(r.stream.cmd(), inputs, res.projected.ray_depth, r.plan.lists.camera,

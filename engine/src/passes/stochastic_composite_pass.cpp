@@ -29,7 +29,7 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
                                      const Samples& samples, const CompositePass::Chunks& chunks) {
   OutputBuffers& out = in.out;
   if (samples.count == 0) throw std::logic_error("stochastic composite: no samples");
-  const bool with_state = needs_state(samples.count, chunks.count);
+  const bool with_state = needs_state(samples.count, chunks.count) || samples.keep_sums;
   if (with_state && chunks.state.size() < state_bytes(out.width, out.height))
     throw std::logic_error("stochastic composite: the state buffer is smaller than the image");
   const std::vector<VkBufferView> views =
@@ -38,7 +38,8 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
                      : std::vector<VkBufferView>{};
   const Variant variant{in.write_depth,   in.write_count,
                         in.cutoffs.alpha, in.cutoffs.max_alpha,
-                        !views.empty(),   samples.sampler == StochasticSampler::kStratified};
+                        !views.empty(),   samples.sampler == StochasticSampler::kStratified,
+                        samples.keep_sums};
   auto it = pipelines_.find(variant);
   if (it == pipelines_.end()) {
     it = pipelines_
@@ -54,17 +55,18 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
                       {4, std::bit_cast<uint32_t>(variant.alpha_cutoff)},
                       {5, std::bit_cast<uint32_t>(coverage_alpha_inv(variant.alpha_cutoff))},
                       {6, std::bit_cast<uint32_t>(variant.max_alpha)},
-                      {7, variant.stratified ? 1u : 0u}},
+                      {7, variant.stratified ? 1u : 0u},
+                      {8, variant.keep_sums ? 1u : 0u}},
                      variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
-  for (uint32_t sample = 0; sample < samples.count; ++sample) {
-    if (sample > 0 && sample % kSamplesPerSubmission == 0) stream.may_split();
+  for (uint32_t sample = samples.first; sample < samples.first + samples.count; ++sample) {
+    if (sample > samples.first && (sample - samples.first) % kSamplesPerSubmission == 0) stream.may_split();
     for (uint32_t chunk = 0; chunk < chunks.count; ++chunk) {
       // Each dispatch reads what the previous one left in the state buffer.
-      if (sample > 0 || chunk > 0) vk::barrier(stream.cmd());
+      if (sample > samples.first || chunk > 0) vk::barrier(stream.cmd());
       StochasticCompositePush push{in.splats.address(),
                                    in.tile_lists.address(),
                                    in.ranges.address(),
@@ -81,7 +83,7 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
                                    chunk_splats_,
                                    chunk + 1 == chunks.count ? 1u : 0u,
                                    sample,
-                                   samples.count,
+                                   samples.first + samples.count,
                                    samples.seed,
                                    out.first_tile};
       it->second.bind(stream.cmd(), push);

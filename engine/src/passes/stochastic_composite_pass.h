@@ -20,6 +20,10 @@ class StochasticCompositePass {
     uint32_t count = 1;  // samples averaged (StochasticSettings::frames)
     uint32_t seed = 1;   // the hashed thresholds' seed
     StochasticSampler sampler = StochasticSampler::kHash;
+    // StochasticSettings::accumulate: samples 0 .. first - 1 are in the state's sums already, this frame
+    // adds samples first .. first + count - 1, and its last sample keeps the sums for the next.
+    uint32_t first = 0;
+    bool keep_sums = false;
   };
   // Records every sample, each as chunks.count dispatches (as CompositePass::Chunks: chunk 0 writes
   // the longest list over one chunk to FrameCounters::max_tile_pairs, chunks_for() turns it into the
@@ -50,6 +54,7 @@ class StochasticCompositePass {
     float max_alpha = float(kDefaultMaxAlpha);
     bool texel_buffers = false;  // the CPU layout (composite_stochastic_texel)
     bool stratified = false;     // StochasticSampler::kStratified (STRATIFIED)
+    bool keep_sums = false;      // the last sample keeps the sums in the state (KEEP_SUMS)
     auto operator<=>(const Variant&) const = default;
   };
   std::map<Variant, vk::ComputePipeline> pipelines_;
