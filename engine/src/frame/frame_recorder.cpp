@@ -44,9 +44,13 @@ void FrameRecorder::prepare(const FramePlan& plan, const RenderSettings& setting
                                                                     : chunks > 1 || !plan.part.whole();
   resources.prepare_frame(plan, needs_state);
   if (plan.compositor == Compositor::kRaster)
-    raster_composite_.prepare({plan.tiles.width, plan.tiles.height, settings.depth, settings.splat_count,
-                               plan.host.from_memory || plan.host.from_image, plan.host.write_depth,
-                               settings.accuracy.fp16_blend});
+    raster_composite_.prepare({plan.tiles.width,
+                               plan.tiles.height,
+                               {.write_depth = settings.depth,
+                                .write_count = settings.splat_count,
+                                .host_depth = plan.host.from_memory || plan.host.from_image,
+                                .surface_depth = plan.host.write_depth,
+                                .half_colour = settings.accuracy.fp16_blend}});
   if (!plan.build_lists) return;
   projection_.prepare(resources.scene, plan.projection);
   // The depth sort's buffers hold the projected records (more than this frame's after a larger part).

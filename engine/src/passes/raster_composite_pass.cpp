@@ -83,6 +83,7 @@ bool raster_stage_is_mesh(const vk::Context& ctx) {
 RasterCompositePass::RasterCompositePass(vk::Context& ctx) : ctx_(ctx) {}
 
 void RasterCompositePass::check_device(const Shape& shape) const {
+  const Attachments& a = shape.attachments;
   auto fail = [&](const std::string& why) { throw std::runtime_error(ctx_.device_name() + ": " + why); };
   if (!ctx_.features().graphics_queue)
     fail(
@@ -96,25 +97,25 @@ void RasterCompositePass::check_device(const Shape& shape) const {
       fail(std::string("the raster compositor blends into ") +
            (format == kColourFormat ? "R32G32B32A32_SFLOAT" : "R32_SFLOAT") +
            " attachments, which this device cannot: use the sorted compositor");
-  if (shape.half_colour && !vk::format_supports(ctx_, kHalfColourFormat, attachment))
+  if (a.half_colour && !vk::format_supports(ctx_, kHalfColourFormat, attachment))
     fail("fp16-blend blends into an R16G16B16A16_SFLOAT attachment, which this device cannot: leave it out");
   // The counts are added where the colour is blended under: two blend states in one pipeline.
-  if (shape.write_count && !ctx_.features().independent_blend)
+  if (a.write_count && !ctx_.features().independent_blend)
     fail(
         "the raster compositor's splat counts need the independentBlend feature, which this device (or "
         "the host that made it) has not enabled: render without splat counts");
   // The depth out is kept by a MIN blend beside the colour's, from fragments that read the colour.
-  if (shape.surface_depth && !ctx_.features().independent_blend)
+  if (a.surface_depth && !ctx_.features().independent_blend)
     fail(
         "the raster compositor's depth out (HostDepth::write_depth) needs the independentBlend feature, "
         "which this device (or the host that made it) has not enabled: use the sorted compositor");
-  if (shape.surface_depth && !ctx_.features().rasterization_order_colour)
+  if (a.surface_depth && !ctx_.features().rasterization_order_colour)
     fail(
         "the raster compositor's depth out (HostDepth::write_depth) reads each pixel's running alpha in the "
         "fragment stage, which needs VK_EXT_rasterization_order_attachment_access "
         "(rasterizationOrderColorAttachmentAccess), not on this device or not enabled by the host that "
         "made it: use the sorted compositor");
-  if (shape.host_depth && !vk::format_supports(ctx_, kHostSurfacesFormat,
+  if (a.host_depth && !vk::format_supports(ctx_, kHostSurfacesFormat,
                                                VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT |
                                                    VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
     fail(
@@ -142,22 +143,23 @@ void RasterCompositePass::prepare(const Shape& shape) {
   release_framebuffer();
   t = {};
   const uint32_t width = shape.width, height = shape.height;
+  const Attachments& a = shape.attachments;
   const VkDeviceSize pixels = VkDeviceSize(width) * height;
   // The depth out's fragments read the colour as an input attachment.
-  t.colour = vk::Image(ctx_, shape.half_colour ? kHalfColourFormat : kColourFormat, width, height,
-                       kAttachmentUsage | (shape.surface_depth ? VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT : 0),
+  t.colour = vk::Image(ctx_, a.half_colour ? kHalfColourFormat : kColourFormat, width, height,
+                       kAttachmentUsage | (a.surface_depth ? VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT : 0),
                        "raster colour");
-  if (shape.half_colour)
+  if (a.half_colour)
     t.half_colour_copy = vk::Buffer(ctx_, pixels * 8, vk::MemoryUse::Device, "raster colour (half, copy)");
-  if (shape.write_depth) {
+  if (a.write_depth) {
     t.depth_sums = vk::Image(ctx_, kColourFormat, width, height, kAttachmentUsage, "raster depth sums");
     t.depth_sums_copy = vk::Buffer(ctx_, pixels * 16, vk::MemoryUse::Device, "raster depth sums (copy)");
   }
-  if (shape.write_count)
+  if (a.write_count)
     t.count = vk::Image(ctx_, kCountFormat, width, height, kAttachmentUsage, "raster counts");
-  if (shape.surface_depth)
+  if (a.surface_depth)
     t.surface = vk::Image(ctx_, kCountFormat, width, height, kAttachmentUsage, "raster depth out");
-  if (shape.host_depth) {
+  if (a.host_depth) {
     t.host_surfaces = vk::Image(ctx_, kHostSurfacesFormat, width, height,
                                 VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
                                 "raster host surfaces");
@@ -168,6 +170,7 @@ void RasterCompositePass::prepare(const Shape& shape) {
 }
 
 vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
+  const Attachments& a = v.attachments;
   auto it = pipelines_.find(v);
   if (it != pipelines_.end()) return it->second;
   vk::GraphicsPipelineDesc desc;
@@ -175,50 +178,44 @@ vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
     desc.mesh_shader = "raster_quads";
   else
     desc.vertex_shader = "raster_quad";
-  desc.fragment_shader = v.surface_depth ? "raster_blend_surface" : "raster_blend";
+  desc.fragment_shader = a.surface_depth ? "raster_blend_surface" : "raster_blend";
   desc.push_constant_bytes = sizeof(RasterPush);
   desc.spec = {{0, std::bit_cast<uint32_t>(coverage_alpha_inv(v.cutoffs.alpha))},
                {1, std::bit_cast<uint32_t>(v.cutoffs.alpha)},
                {2, std::bit_cast<uint32_t>(v.cutoffs.max_alpha)},
-               {3, v.host_depth ? 1u : 0u}};
+               {3, a.host_depth ? 1u : 0u}};
   // Without the counts every blend state is the same, as a device without independentBlend requires.
-  desc.attachments = {{v.half_colour ? kHalfColourFormat : kColourFormat, vk::Blend::kUnder, true},
-                      {kColourFormat, vk::Blend::kUnder, v.write_depth},
-                      {kCountFormat, v.write_count ? vk::Blend::kAdd : vk::Blend::kUnder, v.write_count}};
-  if (v.surface_depth) {
+  desc.attachments = {{a.half_colour ? kHalfColourFormat : kColourFormat, vk::Blend::kUnder, true},
+                      {kColourFormat, vk::Blend::kUnder, a.write_depth},
+                      {kCountFormat, a.write_count ? vk::Blend::kAdd : vk::Blend::kUnder, a.write_count}};
+  if (a.surface_depth) {
     desc.attachments.push_back({kCountFormat, vk::Blend::kMin, true});
     desc.input_attachment = 0;  // the colour, whose alpha is 1 - T
   }
-  if (v.host_depth) desc.depth_test = vk::DepthTest{kHostSurfacesFormat, VK_COMPARE_OP_LESS};
+  if (a.host_depth) desc.depth_test = vk::DepthTest{kHostSurfacesFormat, VK_COMPARE_OP_LESS};
   return pipelines_.emplace(v, vk::GraphicsPipeline(ctx_, desc)).first->second;
 }
 
 void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   Targets& t = targets_;
-  const Shape shape{in.out.width,
-                    in.out.height,
-                    in.write_depth,
-                    in.write_count,
-                    in.host.view_depth != nullptr,
-                    in.host.surface_depth != nullptr,
-                    in.half_colour};
+  const Shape shape{in.out.width, in.out.height,
+                    {.write_depth = in.write_depth,
+                     .write_count = in.write_count,
+                     .host_depth = in.host.view_depth != nullptr,
+                     .surface_depth = in.host.surface_depth != nullptr,
+                     .half_colour = in.half_colour}};
   if (!t.colour || !(t.shape == shape))
     throw std::logic_error("RasterCompositePass::record before prepare() for this frame's shape");
+  const Attachments& a = shape.attachments;
   // The transmittance cut-off does not apply: one pipeline whatever it is.
-  const Variant variant{mesh_,
-                        in.write_depth,
-                        in.write_count,
-                        shape.host_depth,
-                        shape.surface_depth,
-                        shape.half_colour,
-                        {in.cutoffs.alpha, 0.0f, in.cutoffs.max_alpha}};
+  const Variant variant{mesh_, shape.attachments, {in.cutoffs.alpha, 0.0f, in.cutoffs.max_alpha}};
   vk::GraphicsPipeline& drawing = pipeline(variant);
   if (!t.framebuffer) {
     std::vector<VkImageView> views = {t.colour.view()};
-    if (shape.write_depth) views.push_back(t.depth_sums.view());
-    if (shape.write_count) views.push_back(t.count.view());
-    if (shape.surface_depth) views.push_back(t.surface.view());
-    if (shape.host_depth) views.push_back(t.host_surfaces.view());
+    if (a.write_depth) views.push_back(t.depth_sums.view());
+    if (a.write_count) views.push_back(t.count.view());
+    if (a.surface_depth) views.push_back(t.surface.view());
+    if (a.host_depth) views.push_back(t.host_surfaces.view());
     VkFramebufferCreateInfo info{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
     info.renderPass = drawing.render_pass();  // compatible with every variant of this shape
     info.attachmentCount = uint32_t(views.size());
@@ -229,7 +226,7 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
     TS_VK_CHECK(vkCreateFramebuffer(ctx_.device(), &info, nullptr, &t.framebuffer));
   }
   const uint32_t pixels = shape.width * shape.height;
-  if (shape.host_depth) {
+  if (a.host_depth) {
     const RasterHostSurfacesPush surfaces{in.host.view_depth->address(), t.host_surfaces_input.address(),
                                           pixels};
     host_surfaces_.bind(cmd, surfaces);
@@ -254,8 +251,8 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   }
 
   // Zero: no colour, T = 1, no depth, no splats; +inf: no depth out yet (a host's depth is loaded).
-  std::vector<VkClearValue> clears(1 + (shape.write_depth ? 1 : 0) + (shape.write_count ? 1 : 0));
-  if (shape.surface_depth) {
+  std::vector<VkClearValue> clears(1 + (a.write_depth ? 1 : 0) + (a.write_count ? 1 : 0));
+  if (a.surface_depth) {
     VkClearValue none{};
     none.color.float32[0] = std::numeric_limits<float>::infinity();
     clears.push_back(none);
@@ -276,7 +273,7 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   push.first_tile = in.out.first_tile;
   push.surface_alpha = in.host.surface_alpha;
   drawing.bind(cmd, push, shape.width, shape.height);
-  if (shape.surface_depth) drawing.bind_input_attachment(cmd, t.colour.view());
+  if (a.surface_depth) drawing.bind_input_attachment(cmd, t.colour.view());
   if (mesh_)
     ctx_.cmd_draw_mesh_tasks_indirect()(cmd, draw_args_.handle(), 0, 1,
                                         sizeof(VkDrawMeshTasksIndirectCommandEXT));
@@ -285,24 +282,24 @@ void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   vkCmdEndRenderPass(cmd);
 
   // The attachments into the outputs, then the resolve in place.
-  copy_to_buffer(cmd, t.colour, shape.half_colour ? t.half_colour_copy : in.out.rgba);
-  if (shape.write_depth) copy_to_buffer(cmd, t.depth_sums, t.depth_sums_copy);
-  if (shape.write_count) copy_to_buffer(cmd, t.count, in.out.count);
-  if (shape.surface_depth) copy_to_buffer(cmd, t.surface, *in.host.surface_depth);
+  copy_to_buffer(cmd, t.colour, a.half_colour ? t.half_colour_copy : in.out.rgba);
+  if (a.write_depth) copy_to_buffer(cmd, t.depth_sums, t.depth_sums_copy);
+  if (a.write_count) copy_to_buffer(cmd, t.count, in.out.count);
+  if (a.surface_depth) copy_to_buffer(cmd, t.surface, *in.host.surface_depth);
   vk::barrier(cmd);
   RasterResolvePush resolve{};
   resolve.rgba = in.out.rgba.address();
-  resolve.depth_sums = shape.write_depth ? t.depth_sums_copy.address() : in.out.rgba.address();
-  resolve.out_depth = shape.write_depth ? in.out.depth.address() : in.out.rgba.address();
-  resolve.count = shape.write_count ? in.out.count.address() : in.out.rgba.address();
-  resolve.surface = shape.surface_depth ? in.host.surface_depth->address() : in.out.rgba.address();
-  resolve.half_rgba = shape.half_colour ? t.half_colour_copy.address() : in.out.rgba.address();
+  resolve.depth_sums = a.write_depth ? t.depth_sums_copy.address() : in.out.rgba.address();
+  resolve.out_depth = a.write_depth ? in.out.depth.address() : in.out.rgba.address();
+  resolve.count = a.write_count ? in.out.count.address() : in.out.rgba.address();
+  resolve.surface = a.surface_depth ? in.host.surface_depth->address() : in.out.rgba.address();
+  resolve.half_rgba = a.half_colour ? t.half_colour_copy.address() : in.out.rgba.address();
   resolve.background = {in.background[0], in.background[1], in.background[2], 0.0f};
   resolve.pixels = pixels;
-  resolve.write_depth = shape.write_depth ? 1 : 0;
-  resolve.write_count = shape.write_count ? 1 : 0;
-  resolve.write_surface = shape.surface_depth ? 1 : 0;
-  resolve.half_colour = shape.half_colour ? 1 : 0;
+  resolve.write_depth = a.write_depth ? 1 : 0;
+  resolve.write_count = a.write_count ? 1 : 0;
+  resolve.write_surface = a.surface_depth ? 1 : 0;
+  resolve.half_colour = a.half_colour ? 1 : 0;
   resolve_.bind(cmd, resolve);
   resolve_.dispatch(cmd, vk::div_ceil(pixels, 256));
   vk::barrier(cmd);

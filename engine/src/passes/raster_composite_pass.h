@@ -59,12 +59,20 @@ class RasterCompositePass {
   RasterCompositePass(const RasterCompositePass&) = delete;
   RasterCompositePass& operator=(const RasterCompositePass&) = delete;
 
-  // What a frame's attachments are: its size, its outputs and whether a host's surfaces are tested.
+  // Which attachments a frame draws into besides the colour, and the colour's format: its outputs and
+  // whether a host's surfaces are tested. The frame's shape and its pipeline both follow from them.
+  struct Attachments {
+    bool write_depth = false, write_count = false;
+    bool host_depth = false;     // the depth attachment holds a host's surfaces (HOST_DEPTH)
+    bool surface_depth = false;  // a host's depth out: the fragment stage reads the colour as an input
+                                 // attachment and writes the depth (raster_blend_surface)
+    bool half_colour = false;    // fp16-blend: the colour attachment is RGBA16F
+    auto operator<=>(const Attachments&) const = default;
+  };
+  // What a frame's attachments are: its size and which ones.
   struct Shape {
     uint32_t width = 0, height = 0;
-    bool write_depth = false, write_count = false, host_depth = false;
-    bool surface_depth = false;  // a host's depth out: the colour attachment is also an input attachment
-    bool half_colour = false;    // fp16-blend: the colour attachment is RGBA16F
+    Attachments attachments;
     bool operator==(const Shape&) const = default;
   };
   // Sizes the attachments for a frame (outside any command buffer). Throws std::runtime_error naming
@@ -74,14 +82,10 @@ class RasterCompositePass {
   uint64_t device_bytes() const;
 
  private:
-  // A pipeline of the pass: its outputs (which attachments exist) and its cut-offs.
+  // A pipeline of the pass: its stage, its attachments and its cut-offs.
   struct Variant {
     bool mesh = false;  // the mesh stage draws the quads (raster_quads.mesh), else the vertex stage
-    bool write_depth = true;
-    bool write_count = true;
-    bool host_depth = false;  // the depth attachment holds a host's surfaces (HOST_DEPTH)
-    bool surface_depth = false;  // the fragment stage writes a host's depth out (raster_blend_surface)
-    bool half_colour = false;    // the colour attachment is RGBA16F (fp16-blend)
+    Attachments attachments;
     CompositeCutoffs cutoffs;
     auto operator<=>(const Variant&) const = default;
   };
