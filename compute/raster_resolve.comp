@@ -2,8 +2,9 @@
 // The raster compositor's last step (RasterCompositePass): the blended attachments, copied to the
 // output buffers, become what the tile compositor writes: the background under the splats (the
 // remaining transmittance T = 1 - alpha of it), the weighted mean depth (the weights sum to 1 - T),
-// and the splat counts as integers (the colour from 16-bit floats with fp16-blend); a host's depth out (the splat depth at which the alpha reached its
-// threshold) as composite.comp writes it, 0 where it never did.
+// and the splat counts as integers (the colour from 16-bit floats with fp16-blend); a host's depth out
+// (the splat depth at which the alpha reached its threshold) as composite.comp writes it, 0 where it
+// never did.
 #extension GL_GOOGLE_include_directive : require
 #define TS_RASTER_RESOLVE_PUSH
 #include "common.glsl"

@@ -164,9 +164,7 @@ void Renderer::Impl::end_frame(const FrameStart& start, const FrameCounters& fra
                                bool lists_whole) {
   if (lists_whole) lists = start.plan.lists;
   if (start.plan.stochastic_accumulate && lists_whole && stats.complete) accumulated = start.accumulation;
-  stats.accumulated_frames = start.plan.compositor == Compositor::kStochastic
-                                 ? start.plan.stochastic_first_sample + start.plan.stochastic_samples
-                                 : 0;
+  stats.accumulated_frames = start.accumulation.frames;  // 0 for the other compositors (no samples)
   stats.passes = std::move(passes);
   stats.reused_sorted_lists = !start.plan.build_lists;
   stats.sort_bits = start.plan.build_lists ? start.plan.sort_bits : 0;

@@ -144,9 +144,11 @@ enum class StochasticSampler {
   /// A hash of (pixel, splat, frame, seed): independent frames, error falling as 1/sqrt(frames).
   kHash,
   /// Stratified over the frames (a Latin hypercube per pixel): over the N frames of one render(), each
-  /// splat's thresholds at a pixel fall once in each of the N strata [k/N, (k+1)/N), in an order permuted
-  /// per (pixel, splat, seed) and jittered within the stratum. Each splat's own coverage is then exact to
-  /// 1/N; what is left is the interplay between splats. docs/compositors.md has its curve.
+  /// splat's thresholds at a pixel fall in distinct strata of [0, 1), one per frame: the N strata
+  /// [k/N, (k+1)/N) when N is a power of two, else N of the 2^b of the next power of two. The order is
+  /// permuted per (pixel, splat, seed) and each threshold jittered within its stratum. Each splat's own
+  /// coverage is then exact to about 1/N; what is left is the interplay between splats.
+  /// docs/compositors.md has its curve.
   kStratified,
 };
 /// "hash", "stratified".
@@ -155,11 +157,11 @@ TILESPLAT_API std::string to_string(StochasticSampler sampler);
 TILESPLAT_API StochasticSampler parse_stochastic_sampler(const std::string& name);
 
 /// The stochastic compositor draws, per pixel and frame, each splat of its tile with probability
-/// alpha (the sorted composite's alpha and cut-off) by a threshold of (pixel, splat index, frame, seed)
-/// (StochasticSampler)
-/// and shows the nearest drawn splat (by view depth, then index), or the background. Its expectation
-/// is the sorted front-to-back blend without the transmittance early-out, so the mean of `frames`
-/// frames converges to the sorted image, with an error falling as 1/sqrt(frames). One render() runs
+/// alpha (the sorted composite's alpha and cut-off), by a threshold of (pixel, splat index, frame,
+/// seed) that StochasticSampler draws, and shows the nearest drawn splat (by view depth, then index),
+/// or the background. Its expectation is the sorted front-to-back blend without the transmittance
+/// early-out, so the mean of `frames` frames converges to the sorted image, with an error falling as
+/// 1/sqrt(frames) with the hash (faster with the stratified sampler). One render() runs
 /// them all, with no depth sort, and writes their means: rgb; alpha = the fraction of frames that drew
 /// a splat; depth = the mean depth of the drawn splats over those frames; splat_count = the splats
 /// each pixel tested (its tile's list length). AccuracyModes::transmittance_cutoff does not apply; the

@@ -60,8 +60,7 @@ std::optional<std::string> modes_refusal(Compositor compositor, const AccuracyMo
   if (compositor != Compositor::kRaster && modes.fp16_blend)
     return to_string(compositor) +
            " compositor: fp16-blend is the raster compositor's 16-bit colour attachment; this compositor "
-           "blends "
-           "in float32 registers: use --compositor raster or leave fp16-blend out";
+           "blends in float32 registers: use --compositor raster or leave fp16-blend out";
   if (compositor == Compositor::kSorted) return std::nullopt;
   const std::string resort = "per-pixel re-sorting (resort" + std::to_string(modes.resort_window) + ")";
   if (compositor == Compositor::kRaster) {

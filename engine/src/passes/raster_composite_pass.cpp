@@ -116,8 +116,8 @@ void RasterCompositePass::check_device(const Shape& shape) const {
         "(rasterizationOrderColorAttachmentAccess), not on this device or not enabled by the host that "
         "made it: use the sorted compositor");
   if (a.host_depth && !vk::format_supports(ctx_, kHostSurfacesFormat,
-                                               VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT |
-                                                   VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
+                                           VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                                               VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
     fail(
         "the raster compositor tests a host's depth in a D32_SFLOAT attachment, which this device cannot "
         "make: use the sorted compositor");
@@ -198,7 +198,8 @@ vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
 
 void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {
   Targets& t = targets_;
-  const Shape shape{in.out.width, in.out.height,
+  const Shape shape{in.out.width,
+                    in.out.height,
                     {.write_depth = in.write_depth,
                      .write_count = in.write_count,
                      .host_depth = in.host.view_depth != nullptr,
