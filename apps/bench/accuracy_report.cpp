@@ -28,17 +28,32 @@ AccuracyModes with(std::initializer_list<const char*> tokens) {
 }  // namespace
 
 std::vector<AccuracyModes> default_modes() {
-  return {with({"reference"}), with({"depth24"}), with({"depth16"}), with({"square-tiles"}),
-          with({"opacity-extent"}), with({"opacity-extent", "square-tiles"}), with({"sh0"}), with({"sh1"}),
-          with({"sh2"}), with({"fp16-sh"}), with({"fp16-cov"}), with({"t-cutoff=1e-3"}),
-          with({"t-cutoff=1e-2"}), with({"alpha-cutoff=1/128"}), with({"alpha-cutoff=1/64"}),
-          with({"resort4"}), with({"resort8"}), with({"resort16"}),
-          // The raster compositor's half-precision blend (its report only: the others refuse it).
-          with({"fp16-blend"}),
-          // What a web viewer does: 16-bit depths, fp16 attributes, opacity-aware squares.
-          with({"depth16", "opacity-extent", "fp16-sh", "fp16-cov"}),
-          // ... and looser cut-offs on top.
-          with({"depth16", "opacity-extent", "fp16-sh", "fp16-cov", "t-cutoff=1e-3", "alpha-cutoff=1/64"})};
+  return {
+      with({"reference"}),
+      with({"depth24"}),
+      with({"depth16"}),
+      with({"square-tiles"}),
+      with({"opacity-extent"}),
+      with({"opacity-extent", "square-tiles"}),
+      with({"sh0"}),
+      with({"sh1"}),
+      with({"sh2"}),
+      with({"fp16-sh"}),
+      with({"fp16-cov"}),
+      with({"t-cutoff=1e-3"}),
+      with({"t-cutoff=1e-2"}),
+      with({"alpha-cutoff=1/128"}),
+      with({"alpha-cutoff=1/64"}),
+      with({"resort4"}),
+      with({"resort8"}),
+      with({"resort16"}),
+      // The raster compositor's half-precision blend (its report only: the others refuse it).
+      with({"fp16-blend"}),
+      // What a web viewer does: 16-bit depths, fp16 attributes, opacity-aware squares.
+      with({"depth16", "opacity-extent", "fp16-sh", "fp16-cov"}),
+      // ... and looser cut-offs on top.
+      with({"depth16", "opacity-extent", "fp16-sh", "fp16-cov", "t-cutoff=1e-3", "alpha-cutoff=1/64"}),
+  };
 }
 
 bool applies_to(const AccuracyModes& modes, int scene_sh_degree) {
@@ -274,8 +289,8 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
       if (row.compositor != Compositor::kSorted) {  // the sorted compositor's frames, timed alike
         RenderSettings sorted = settings;
         sorted.compositor = Compositor::kSorted;
-        sorted.accuracy.fp16_blend =
-            false;  // the raster's attachment format; the sorted one blends in float32
+        // fp16-blend is the raster's attachment format; the sorted compositor blends in float32.
+        sorted.accuracy.fp16_blend = false;
         RenderImage sorted_image;
         std::vector<double> sorted_frames;
         for (int r = 0; r < options.warmup + options.repeat; ++r) {

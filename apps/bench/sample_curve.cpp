@@ -42,8 +42,7 @@ std::string what_is_averaged(Effect effect) {
              "there";
     case Effect::kTime:
       return "motion blur: the shutter open over the frame while the camera turns 5 degrees about the "
-             "scene's "
-             "centre";
+             "scene's centre";
     case Effect::kStochastic:
       return "the stochastic compositor's frames, thresholds from the hash";
     case Effect::kStochasticStratified:
@@ -83,9 +82,20 @@ bool held_to_sorted_frame(Effect effect) {
   return effect == Effect::kStochastic || effect == Effect::kStochasticStratified;
 }
 
-RenderSettings effect_settings(const Options& options, const Camera& view, int samples) {
+namespace {
+
+// What every row's frames share: the options' settings and sort (the stochastic curves' reference, the
+// sorted frame).
+RenderSettings shared_settings(const Options& options) {
   RenderSettings settings = options.settings;
   settings.sort = options.sort;
+  return settings;
+}
+
+}  // namespace
+
+RenderSettings effect_settings(const Options& options, const Camera& view, int samples) {
+  RenderSettings settings = shared_settings(options);
   if (held_to_sorted_frame(options.effect)) {
     settings.compositor = Compositor::kStochastic;
     settings.stochastic.frames = uint32_t(samples);
@@ -120,12 +130,9 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
   int done = 0;
   std::vector<RenderImage> references;
   for (const Camera& view : options.views) {
-    RenderSettings reference = effect_settings(options, view, kReferenceSamples);
-    if (held_to_sorted_frame(options.effect)) {
-      reference = options.settings;
-      reference.sort = options.sort;
-    }
-    references.push_back(renderer->render(view, reference));
+    references.push_back(renderer->render(view, held_to_sorted_frame(options.effect)
+                                                    ? shared_settings(options)
+                                                    : effect_settings(options, view, kReferenceSamples)));
     progress(++done, total, held_to(options.effect));
   }
   const size_t views = options.views.size();
