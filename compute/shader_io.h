@@ -412,6 +412,22 @@ TS_PUSH_CONSTANTS(HostDepthPush) {
 TS_PUSH_INSTANCE;
 #endif
 
+#if defined(__cplusplus) || defined(TS_SAMPLE_ACCUMULATE_PUSH)
+// sample_accumulate.comp (SampleAccumulatePass).
+TS_PUSH_CONSTANTS(SampleAccumulatePush) {
+  TS_REF(Vec4Array) rgba;    // the sample frame's colour, replaced by the mean's
+  TS_REF(FloatArray) depth;  // its depth, likewise (when write_depth)
+  TS_REF(UintArray) count;   // its splat counts, likewise (when write_count)
+  TS_REF(Vec4Array) sums;    // two halves of 2 vec4 a pixel: linear RGBA, (alpha * depth, count, -, -)
+  uint pixels;
+  uint samples_before;  // samples in the sums already: the half read is samples_before % 2
+  uint write_depth;
+  uint write_count;
+  uint opaque;  // the frames were blended over a background: their colours are not premultiplied
+}
+TS_PUSH_INSTANCE;
+#endif
+
 #if defined(__cplusplus) || defined(TS_PACK_COLOUR_PUSH)
 // pack_colour.comp (PackColourPass).
 TS_PUSH_CONSTANTS(PackColourPush) {
@@ -601,8 +617,8 @@ static_assert(sizeof(CompositePush) <= 128 && sizeof(CompositeResortPush) <= 128
               sizeof(PrefixSumAddPush) <= 128 && sizeof(FrameSetupPush) <= 128 &&
               sizeof(ScatterOffsetsPush) <= 128 && sizeof(KeyEmissionPush) <= 128 &&
               sizeof(TileRangesPush) <= 128 && sizeof(HostDepthPush) <= 128 &&
-              sizeof(PackColourPush) <= 128 && sizeof(RadixSetupPush) <= 128 &&
-              sizeof(RadixPassPush) <= 128 && sizeof(RadixScanPush) <= 128 &&
+              sizeof(PackColourPush) <= 128 && sizeof(SampleAccumulatePush) <= 128 &&
+              sizeof(RadixSetupPush) <= 128 && sizeof(RadixPassPush) <= 128 && sizeof(RadixScanPush) <= 128 &&
               sizeof(OnesweepSetupPush) <= 128 && sizeof(OnesweepHistogramPush) <= 128 &&
               sizeof(OnesweepPassPush) <= 128 && sizeof(BitonicSetupPush) <= 128 &&
               sizeof(BitonicPassPush) <= 128 && sizeof(TileLocalSetupPush) <= 128 &&

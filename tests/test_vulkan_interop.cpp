@@ -13,6 +13,7 @@
 
 #include "effects_report.h"
 #include "test_support.h"
+#include "tilesplat/lens.h"
 #include "tilesplat/vulkan_interop.h"
 
 namespace tilesplat {
@@ -764,6 +765,52 @@ TEST_F(HostApplication, RendersIntoHalfAndEightBitColourImages) {
       render_to_image(*renderer, camera, {},
                       {images[0].image, kWidth, kHeight, VK_FORMAT_B8G8R8A8_UNORM, VK_IMAGE_LAYOUT_GENERAL}),
       std::invalid_argument);
+  renderer.reset();
+  release_host_objects();
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
+// Depth of field a sample a frame, as a window shows a still view converging
+// (RenderSettings::accumulate_samples): frames submitted without waiting (HostFrameSync), each adding one
+// lens sample on the device, leave in the host's image the mean that render() makes of the same samples.
+TEST_F(HostApplication, LensSamplesAccumulateFrameAfterFrameInTheHostsImage) {
+  constexpr uint32_t kWidth = 96, kHeight = 64;
+  constexpr int kSamples = 6;
+  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const Camera camera =
+      resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(2).camera, kWidth, kHeight);
+  make_staging(VkDeviceSize(kWidth) * kHeight * 16);
+  auto renderer = create_renderer(external());
+  renderer->set_scene(scene);
+  const Bounds bounds = compute_bounds(scene);
+  const double focus = camera.to_camera({bounds.center[0], bounds.center[1], bounds.center[2]})[2];
+  RenderSettings settings;
+  settings.lens = {.aperture_diameter = 0.05 * focus,
+                   .focus_distance = focus,
+                   .samples = kSamples,
+                   .pattern = SamplePattern::kSobol};
+  const std::vector<float> expected = renderer->render(camera, settings).rgba;
+
+  const Image image = make_image(VK_FORMAT_R32G32B32A32_SFLOAT, 0, kWidth, kHeight);
+  const ExternalImage target{image.image, kWidth, kHeight, VK_FORMAT_R32G32B32A32_SFLOAT,
+                             VK_IMAGE_LAYOUT_UNDEFINED};
+  settings.accumulate_samples = true;
+  for (int frame = 0; frame < kSamples; ++frame)
+    render_to_image(*renderer, camera, settings, target, nullptr, HostFrameSync{});
+  wait_for_frame(*renderer);
+  EXPECT_EQ(renderer->last_frame_stats().accumulated_samples, uint32_t(kSamples));
+  read_image(image.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
+  std::vector<float> rgba(expected.size());
+  std::memcpy(rgba.data(), staging_data, rgba.size() * sizeof(float));
+  float most = 0;
+  for (size_t i = 0; i < rgba.size(); ++i) most = std::max(most, std::abs(rgba[i] - expected[i]));
+  EXPECT_LE(most, 2e-5f);
+  // The blocking form continues the same sums; any other frame ends them.
+  render_to_image(*renderer, camera, settings, target);
+  EXPECT_EQ(renderer->last_frame_stats().accumulated_samples, uint32_t(kSamples + 1));
+  EXPECT_NE(rgba, renderer->render(camera).rgba);
+  render_to_image(*renderer, camera, settings, target);
+  EXPECT_EQ(renderer->last_frame_stats().accumulated_samples, 1u);
   renderer.reset();
   release_host_objects();
   EXPECT_EQ(messages, 0) << "validation messages on the host's instance";

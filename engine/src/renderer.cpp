@@ -14,12 +14,14 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "frame/averaged_frames.h"
 #include "frame/image_regions.h"
 #include "host_depth.h"
 #include "passes/frame_counters.h"
 #include "renderer_impl.h"
+#include "settings_checks.h"
 
 namespace tilesplat {
 
@@ -57,6 +59,9 @@ uint64_t Renderer::Impl::device_bytes() const {
 Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, const RenderSettings& settings,
                                                        bool depth_image, bool without_waiting,
                                                        const ScenePart& part) {
+  // A sample of an accumulated lens or shutter frame (next_frame_input) adds to the sums before it; armed
+  // for this frame alone, even one that throws.
+  const std::optional<SampleAccumulation> samples = std::exchange(next_frame_samples, std::nullopt);
   if (scene_in_parts && !rendering_parts)
     throw std::logic_error(
         "the renderer holds the last part of a scene rendered in parts (render(scene, camera, settings) "
@@ -67,8 +72,12 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
   const DeviceCaps device = device_caps();
   start.sorter = &sort(choose_sort_strategy(settings.sort, device, without_waiting));
   const SortTraits traits{start.sorter->name(), start.sorter->frame_plan(), start.sorter->sorts_on_host()};
+  start.samples = samples;
+  std::optional<uint32_t> samples_before;
+  if (start.samples) samples_before = start.samples->samples - 1;
   start.plan = plan_frame(
-      camera, settings, {resources.scene_shape(scene_generation), device, traits, lists, depth_image, part});
+      camera, settings,
+      {resources.scene_shape(scene_generation), device, traits, lists, depth_image, part, samples_before});
   resources.prepare_outputs(start.plan, settings);
   // StochasticSettings::accumulate: this frame's samples follow the previous frame's in the composite
   // state when it reuses that frame's lists with the same outputs; else they start the mean anew.
@@ -78,7 +87,10 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
   start.accumulation =
       accumulation_of(settings, start.plan.stochastic_first_sample + start.plan.stochastic_samples);
   accumulated = {};  // the sums are the next frame's once this one completes
-  stats = {};
+  accumulated_samples.reset();
+  // A frame the renderer waits for fills the statistics as it runs; one that goes on without waiting
+  // fills them once it is waited for (wait_for_submitted_frame), and until then the last frame's stay.
+  if (!without_waiting) stats = {};
   lists.reset();  // valid again once this frame's lists are complete (not if it throws)
   // Reused lists were built with an equal camera and equal (validated) lights, which are in their
   // buffers still: nothing to upload.
@@ -165,6 +177,8 @@ void Renderer::Impl::end_frame(const FrameStart& start, const FrameCounters& fra
   if (lists_whole) lists = start.plan.lists;
   if (start.plan.stochastic_accumulate && lists_whole && stats.complete) accumulated = start.accumulation;
   stats.accumulated_frames = start.accumulation.frames;  // 0 for the other compositors (no samples)
+  if (start.samples && lists_whole && stats.complete) accumulated_samples = start.samples;
+  stats.accumulated_samples = start.samples ? start.samples->samples : 0;
   stats.passes = std::move(passes);
   stats.reused_sorted_lists = !start.plan.build_lists;
   stats.sort_bits = start.plan.build_lists ? start.plan.sort_bits : 0;
@@ -219,8 +233,49 @@ RenderImage Renderer::Impl::average_samples(const Camera& camera, const RenderSe
   return image;
 }
 
+Renderer::Impl::FrameInput Renderer::Impl::next_frame_input(const Camera& camera,
+                                                            const RenderSettings& settings) {
+  if (!settings.accumulate_samples || !averages_samples(settings)) return {camera, settings};
+  check_accumulated_samples(settings, camera);
+  wait_for_submitted_frame();  // the sums it leaves, if it completes, are the ones to continue
+  SampleAccumulation sums{scene_generation, camera, settings, 0};
+  sums.settings.lens.samples = sums.settings.shutter.samples = 0;  // one sample a call, whatever they say
+  if (accumulated_samples) sums.samples = accumulated_samples->samples;
+  if (!accumulated_samples || !(sums == *accumulated_samples)) sums.samples = 0;
+  const int index = int(sums.samples);
+  ++sums.samples;
+  next_frame_samples = sums;
+  // Sample `index`: the camera at its time, seen from its point of the aperture (one joint sample).
+  FrameInput sample{camera, settings};
+  const Shutter& shutter = settings.shutter;
+  if (shutter.enabled())
+    sample.camera = camera_between(camera, *shutter.end_camera,
+                                   shutter_time(shutter.open, shutter.close, shutter.pattern, index, 1));
+  if (settings.lens.enabled())
+    sample.camera =
+        lens_sample_camera(sample.camera, settings.lens, lens_sample(settings.lens.pattern, index, 1));
+  sample.settings.lens = {};
+  sample.settings.shutter = {};
+  sample.settings.accumulate_samples = false;
+  return sample;
+}
+
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
   Impl& r = *impl_;
+  if (settings.accumulate_samples && averages_samples(settings)) {
+    // One more sample of the lens and the shutter, added to the earlier calls' on the device.
+    const auto start = std::chrono::steady_clock::now();
+    if (r.image_bands(camera, settings).size() > 1)
+      throw std::invalid_argument(
+          "RenderSettings::accumulate_samples: the image is larger than the device renders in one band; "
+          "render its samples in one call, without accumulate_samples");
+    const Impl::FrameInput sample = r.next_frame_input(camera, settings);
+    r.render_frame(sample.camera, sample.settings);
+    RenderImage image = r.read_image(sample.camera, sample.settings);
+    r.stats.cpu_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return image;
+  }
   if (averages_samples(settings))  // depth of field, motion blur
     return r.average_samples(camera, settings,
                              [&](const Camera& sample_camera, const RenderSettings& sample_settings, double) {

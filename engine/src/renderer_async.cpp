@@ -45,12 +45,6 @@ void Renderer::Impl::submit_frame(const Camera& camera, const RenderSettings& se
 void Renderer::Impl::record_frame_into(const HostCommandBuffer& host, const Camera& camera,
                                        const RenderSettings& settings, const ExternalImage& target,
                                        const ExternalDepthImage* depth_image) {
-  const DeviceCaps device = device_caps();
-  if (sort(choose_sort_strategy(settings.sort, device, /*without_waiting=*/true)).sorts_on_host())
-    throw std::invalid_argument(
-        "render_to_image: the sort strategy '" + settings.sort +
-        "' sorts on the host in the middle of the frame, which a command buffer of the "
-        "host's cannot hold: use a GPU strategy, or HostFrameSync");
   const FrameStart start = begin_frame(camera, settings, depth_image != nullptr, /*without_waiting=*/true);
   vk::CommandStream stream(ctx, host.command_buffer);
   record_frame_to_images(stream, start, settings, target, depth_image);
@@ -117,9 +111,10 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   Renderer::Impl& r = RendererAccess::impl(renderer);
   check_images(target, nullptr, camera, settings);
   const auto start = std::chrono::steady_clock::now();
-  r.render_frame(camera, settings);
+  const Renderer::Impl::FrameInput frame = r.next_frame_input(camera, settings);  // a sample, if accumulating
+  r.render_frame(frame.camera, frame.settings);
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    r.recorder.record_copies_to_images(cmd, settings, r.resources, target, nullptr);
+    r.recorder.record_copies_to_images(cmd, frame.settings, r.resources, target, nullptr);
   });
   r.stats.cpu_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -130,9 +125,10 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   Renderer::Impl& r = RendererAccess::impl(renderer);
   check_images(target, &depth, camera, settings);
   const auto start = std::chrono::steady_clock::now();
-  r.render_frame(camera, settings, &depth);
+  const Renderer::Impl::FrameInput frame = r.next_frame_input(camera, settings);  // a sample, if accumulating
+  r.render_frame(frame.camera, frame.settings, &depth);
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    r.recorder.record_copies_to_images(cmd, settings, r.resources, target, &depth);
+    r.recorder.record_copies_to_images(cmd, frame.settings, r.resources, target, &depth);
   });
   r.stats.cpu_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -152,7 +148,8 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   check_count(sync.wait_stages.size(), sync.wait.size(), "wait_stages");
   check_count(sync.wait_values.size(), sync.wait.size(), "wait_values");
   check_count(sync.signal_values.size(), sync.signal.size(), "signal_values");
-  r.submit_frame(camera, settings, target, depth,
+  const Renderer::Impl::FrameInput frame = r.next_frame_input(camera, settings);  // a sample, if accumulating
+  r.submit_frame(frame.camera, frame.settings, target, depth,
                  {sync.wait, sync.wait_stages, sync.wait_values, sync.signal, sync.signal_values});
 }
 
@@ -166,7 +163,13 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   if (commands.timeline == VK_NULL_HANDLE)
     throw std::invalid_argument(
         "render_to_image: HostCommandBuffer has no timeline semaphore to say when the frame has completed");
-  r.record_frame_into(commands, camera, settings, target, depth);
+  if (r.sort(choose_sort_strategy(settings.sort, r.device_caps(), /*without_waiting=*/true)).sorts_on_host())
+    throw std::invalid_argument(
+        "render_to_image: the sort strategy '" + settings.sort +
+        "' sorts on the host in the middle of the frame, which a command buffer of the "
+        "host's cannot hold: use a GPU strategy, or HostFrameSync");
+  const Renderer::Impl::FrameInput frame = r.next_frame_input(camera, settings);  // a sample, if accumulating
+  r.record_frame_into(commands, frame.camera, frame.settings, target, depth);
 }
 
 void wait_for_frame(Renderer& renderer) {

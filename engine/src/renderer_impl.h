@@ -55,12 +55,31 @@ struct Renderer::Impl {
     bool operator==(const Accumulation&) const = default;
   };
   static Accumulation accumulation_of(const RenderSettings& settings, uint32_t frames);
+  // RenderSettings::accumulate_samples: what the lens and shutter samples in resources.sample_sums were
+  // rendered for (the settings with their sample counts at 0, which do not matter a sample at a time),
+  // and how many there are. A call continues them when it matches.
+  struct SampleAccumulation {
+    uint64_t scene_generation = 0;
+    Camera camera;
+    RenderSettings settings;
+    uint32_t samples = 0;
+    bool operator==(const SampleAccumulation&) const = default;
+  };
+  // What one frame renders: the camera and settings asked for, or, for a frame whose lens and shutter
+  // samples accumulate, its next sample's pinhole camera and settings (with `samples` armed for
+  // begin_frame: the sums that sample leaves).
+  struct FrameInput {
+    Camera camera;
+    RenderSettings settings;
+  };
+  FrameInput next_frame_input(const Camera& camera, const RenderSettings& settings);
   struct FrameStart {
     FramePlan plan;
     SortStrategy* sorter = nullptr;
     uint64_t fallbacks_before = 0;
     std::chrono::steady_clock::time_point time;
     Accumulation accumulation;  // the sums this frame leaves, when it accumulates
+    std::optional<SampleAccumulation> samples;  // the sample sums it leaves, for a sample of one
   };
   // Plans the frame (validating the camera and settings), sizes the outputs and uploads what the
   // frame reads from the host. Waits for a frame in flight first: its buffers are the same.
@@ -144,6 +163,8 @@ struct Renderer::Impl {
   // failed).
   std::optional<ListKey> lists;
   Accumulation accumulated;  // the stochastic sums the last frame left (frames 0: none to continue)
+  std::optional<SampleAccumulation> accumulated_samples;  // the sample sums the last frame left
+  std::optional<SampleAccumulation> next_frame_samples;   // next_frame_input's, for begin_frame to take
   uint64_t scene_generation = 0;            // counts set_scene calls (and scene parts uploaded)
   bool scene_in_parts = false;              // the buffers hold a part of a scene, not a whole one
   uint64_t parts_budget = 0;                // the memory budget those parts were sized for

@@ -146,6 +146,7 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
 RenderImage Renderer::Impl::render_scene(const PartSource& scene, const std::function<void()>& set_whole,
                                          const Camera& camera, const RenderSettings& settings,
                                          Renderer& renderer) {
+  refuse_accumulated_samples(settings, "render(scene, camera, settings), which uploads its scene each call,");
   if (!needs_parts(scene, camera, settings)) {
     set_whole();
     return renderer.render(camera, settings);
@@ -174,6 +175,7 @@ RenderImage Renderer::render(const GaussianScene& scene, const Camera& camera,
 
 RenderImage Renderer::render(const SceneInstances& scene, const Camera& camera,
                              const RenderSettings& settings) {
+  refuse_accumulated_samples(settings, "render(scene, camera, settings), which uploads its scene each call,");
   if (blurs_moving_models(scene, settings)) {
     // Moving models under an open shutter: each time sample renders the copies where they are then (and
     // the camera where it is then: still without an end camera), whole or in parts as any frame.

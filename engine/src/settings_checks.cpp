@@ -84,4 +84,21 @@ void check_single_frame(const RenderSettings& settings) {
         "render_reference(), not by render_to_image or a frame submitted without waiting");
 }
 
+void check_accumulated_samples(const RenderSettings& settings, const Camera& camera) {
+  const auto progressive = [](SamplePattern pattern, const char* effect) {
+    if (pattern != SamplePattern::kSobol)
+      throw std::invalid_argument(std::string("RenderSettings::accumulate_samples continues a sequence of "
+                                              "samples from call to call: the ") +
+                                  effect + "'s pattern must be sobol, not " + sample_pattern_name(pattern));
+  };
+  if (settings.lens.enabled()) {
+    check_lens(settings, camera);
+    progressive(settings.lens.pattern, "lens");
+  }
+  if (settings.shutter.enabled()) {
+    check_shutter(settings, camera);
+    progressive(settings.shutter.pattern, "shutter");
+  }
+}
+
 }  // namespace tilesplat

@@ -25,5 +25,8 @@ void check_region(const RenderSettings& settings, const Camera& camera);
 // A single pinhole frame (the frame plan, render_to_image): RenderSettings::lens and shutter must be valid
 // and off.
 void check_single_frame(const RenderSettings& settings);
+// RenderSettings::accumulate_samples with an enabled lens or shutter: each enabled one as check_lens and
+// check_shutter want it, with SamplePattern::kSobol. Throws std::invalid_argument.
+void check_accumulated_samples(const RenderSettings& settings, const Camera& camera);
 
 }  // namespace tilesplat

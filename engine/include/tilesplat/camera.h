@@ -149,6 +149,8 @@ struct TILESPLAT_API DepthConvention {
   double view_depth(double d) const;
   /// The window depth where the host drew nothing as far as the splats are concerned: a, within [0, 1].
   double far_depth() const;
+  /// Member-wise equality.
+  bool operator==(const DepthConvention&) const = default;
 };
 
 /// Throws std::invalid_argument ("invalid camera: ...", saying what) for a camera no renderer can use:

@@ -202,6 +202,12 @@ struct HostDepth {
   /// papers), or, where it never does, the host's own depth (its far value without a depth image).
   bool write_depth = false;
   float alpha_threshold = 0.5f;  ///< in (0, 1]
+  /// Equal when they view the same depth memory (not equal values) with equal other fields.
+  bool operator==(const HostDepth& other) const {
+    return convention == other.convention && depth.data() == other.depth.data() &&
+           depth.size() == other.depth.size() && write_depth == other.write_depth &&
+           alpha_threshold == other.alpha_threshold;
+  }
 };
 
 /// The view depth at or below which a Gaussian is culled (RenderSettings::near_plane): the 3DGS
@@ -271,6 +277,18 @@ struct RenderSettings {
   /// Motion blur: a shutter open over camera motion (tilesplat/shutter.h). Off by default (closed, no end
   /// camera). Taken and refused where the lens is; with both, every time sample is a lens frame.
   Shutter shutter;
+  /// Depth of field and motion blur a sample at a time (docs/effects.md, "Samples that add up"): each call
+  /// renders one more sample of the lens and the shutter, both with SamplePattern::kSobol (else
+  /// std::invalid_argument), and returns the mean of it and the samples of the calls before it, as long as
+  /// they had the same camera, scene (set_scene) and settings, their `samples` counts aside; anything else
+  /// starts anew. Sample k is the camera at shutter_time(..., k, ...) seen from lens_sample(..., k, ...),
+  /// both from point k of effect_sample_point (with both effects, one joint sample, not a time's lens
+  /// frames), so that N calls give the mean of those N pinhole frames in linear light (within float
+  /// rounding: the sums are kept on the device in float32). FrameStats::accumulated_samples counts them.
+  /// Renderer::render(camera, settings) and render_to_image (every form) take it, so that a window's still
+  /// view converges a frame at a time; the scene and LOD forms of render() refuse it. Without an enabled
+  /// lens or shutter it does nothing.
+  bool accumulate_samples = false;
   /// Device memory, in bytes, that Renderer::render(scene, camera, settings) may hold for a frame: a
   /// scene whose frame would need more is rendered in parts that follow the depth order, each within
   /// the budget, into the same image bit for bit (docs/big-scenes.md). 0 (the default): the device's,
@@ -292,6 +310,8 @@ struct RenderSettings {
   /// frame's depth keys are quantized over its visible depth range (depth16, the approximate sort
   /// strategies), a region's range is its own. The whole image (the default) is what it always was.
   PixelRegion region;
+  /// Member-wise equality (HostDepth by the memory it views).
+  bool operator==(const RenderSettings&) const = default;
 };
 
 }  // namespace tilesplat

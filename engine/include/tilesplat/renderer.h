@@ -79,6 +79,9 @@ struct FrameStats {
   /// The stochastic compositor's frames in this image's mean: StochasticSettings::frames, plus the
   /// earlier calls' when StochasticSettings::accumulate continued them; 0 for the other compositors.
   uint32_t accumulated_frames = 0;
+  /// The lens and shutter samples in this image's mean under RenderSettings::accumulate_samples: this
+  /// call's and the earlier calls' it continued; 0 otherwise.
+  uint32_t accumulated_samples = 0;
   /// Parts the scene was rendered in (Renderer::render(scene, camera, settings) under
   /// RenderSettings::memory_budget): 1 for a whole scene. Over several, gpu_ms, passes, visible,
   /// intersections, retries, submissions and uploaded_bytes are the sums over the parts.

@@ -23,23 +23,47 @@ void validate(const ThinLens& lens) {
   if (!positive_finite(lens.focus_distance))
     throw std::invalid_argument("lens: focus_distance must be a positive, finite view depth, got " +
                                 std::to_string(lens.focus_distance));
+  if (std::string(sample_pattern_name(lens.pattern)) == "unknown")
+    throw std::invalid_argument("lens: unknown sample pattern " + std::to_string(int(lens.pattern)));
   if (lens.samples < 1 || lens.samples > kMaxLensSamples)
     throw std::invalid_argument("lens: samples must be 1 to " + std::to_string(kMaxLensSamples) + ", got " +
                                 std::to_string(lens.samples));
 }
 
-std::vector<std::array<double, 2>> lens_samples(int count) {
+namespace {
+
+void check_lens_count(const char* what, int count) {
   if (count < 1 || count > kMaxLensSamples)
-    throw std::invalid_argument("lens_samples: count must be 1 to " + std::to_string(kMaxLensSamples) +
-                                ", got " + std::to_string(count));
+    throw std::invalid_argument(std::string(what) + ": count must be 1 to " +
+                                std::to_string(kMaxLensSamples) + ", got " + std::to_string(count));
+}
+
+// Vogel's spiral: sample i of `count`.
+std::array<double, 2> spiral_sample(int index, int count) {
   const double golden_angle = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  const double radius = std::sqrt((index + 0.5) / count);
+  const double angle = index * golden_angle;
+  return {radius * std::cos(angle), radius * std::sin(angle)};
+}
+
+}  // namespace
+
+std::vector<std::array<double, 2>> lens_samples(int count) {
+  check_lens_count("lens_samples", count);
   std::vector<std::array<double, 2>> samples(static_cast<size_t>(count));
-  for (int i = 0; i < count; ++i) {
-    const double radius = std::sqrt((i + 0.5) / count);
-    const double angle = i * golden_angle;
-    samples[static_cast<size_t>(i)] = {radius * std::cos(angle), radius * std::sin(angle)};
-  }
+  for (int i = 0; i < count; ++i) samples[static_cast<size_t>(i)] = spiral_sample(i, count);
   return samples;
+}
+
+std::array<double, 2> lens_sample(SamplePattern pattern, int index, int count) {
+  check_lens_count("lens_sample", count);
+  if (index < 0 || (pattern == SamplePattern::kEven && index >= count))
+    throw std::invalid_argument("lens_sample: index " + std::to_string(index) + " is outside the " +
+                                sample_pattern_name(pattern) + " pattern's " + std::to_string(count) +
+                                " samples");
+  if (pattern == SamplePattern::kEven) return spiral_sample(index, count);
+  const std::array<double, 3> point = effect_sample_point(uint32_t(index));
+  return concentric_disk_point(point[0], point[1]);
 }
 
 Camera lens_sample_camera(const Camera& camera, const ThinLens& lens, const std::array<double, 2>& sample) {

@@ -16,6 +16,12 @@ void check_times(double open, double close) {
                                 std::to_string(open) + " and " + std::to_string(close));
 }
 
+void check_count(const char* what, int count) {
+  if (count < 1 || count > kMaxShutterSamples)
+    throw std::invalid_argument(std::string(what) + ": count must be 1 to " +
+                                std::to_string(kMaxShutterSamples) + ", got " + std::to_string(count));
+}
+
 }  // namespace
 
 const char* shutter_scan_name(ShutterScan scan) {
@@ -51,16 +57,31 @@ void validate(const Shutter& shutter) {
   if (shutter.end_camera) validate(*shutter.end_camera);
   if (std::string(shutter_scan_name(shutter.scan)) == "unknown")
     throw std::invalid_argument("shutter: unknown scan " + std::to_string(int(shutter.scan)));
+  if (std::string(sample_pattern_name(shutter.pattern)) == "unknown")
+    throw std::invalid_argument("shutter: unknown sample pattern " + std::to_string(int(shutter.pattern)));
+  if (shutter.scan != ShutterScan::kGlobal && shutter.pattern != SamplePattern::kEven)
+    throw std::invalid_argument(
+        "shutter: a rolling shutter exposes its bands at the even pattern's times, in order; the " +
+        std::string(sample_pattern_name(shutter.pattern)) + " pattern is a global shutter's");
 }
 
 std::vector<double> shutter_times(double open, double close, int count) {
   check_times(open, close);
-  if (count < 1 || count > kMaxShutterSamples)
-    throw std::invalid_argument("shutter_times: count must be 1 to " + std::to_string(kMaxShutterSamples) +
-                                ", got " + std::to_string(count));
+  check_count("shutter_times", count);
   std::vector<double> times(static_cast<size_t>(count));
   for (int i = 0; i < count; ++i) times[static_cast<size_t>(i)] = open + (i + 0.5) * (close - open) / count;
   return times;
+}
+
+double shutter_time(double open, double close, SamplePattern pattern, int index, int count) {
+  check_times(open, close);
+  check_count("shutter_time", count);
+  if (index < 0 || (pattern == SamplePattern::kEven && index >= count))
+    throw std::invalid_argument("shutter_time: index " + std::to_string(index) + " is outside the " +
+                                sample_pattern_name(pattern) + " pattern's " + std::to_string(count) +
+                                " samples");
+  if (pattern == SamplePattern::kEven) return open + (index + 0.5) * (close - open) / count;
+  return open + (close - open) * effect_sample_point(uint32_t(index))[2];
 }
 
 Camera camera_between(const Camera& start, const Camera& end, double t) {

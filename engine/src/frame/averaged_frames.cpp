@@ -62,6 +62,14 @@ bool averages_samples(const RenderSettings& settings) {
   return settings.shutter.enabled() || settings.lens.enabled();
 }
 
+void refuse_accumulated_samples(const RenderSettings& settings, const std::string& where) {
+  if (settings.accumulate_samples && averages_samples(settings))
+    throw std::invalid_argument(
+        "RenderSettings::accumulate_samples: " + where +
+        " keeps no samples from call to call (Renderer::render(camera, settings) on the scene set_scene "
+        "uploaded and render_to_image do): render the frame's samples in one call, without it");
+}
+
 namespace {
 
 // A rolling shutter's frame: band k of the image (in the scan's order) rendered at the k-th of the
@@ -112,6 +120,7 @@ RenderImage render_averaged(const Camera& camera, const RenderSettings& settings
 
 RenderImage render_averaged(const Camera& camera, const RenderSettings& settings,
                             const TimedSampleRenderer& render_sample) {
+  refuse_accumulated_samples(settings, "this renderer");
   validate(settings.region, camera.width, camera.height);
   LinearFrameMean mean(settings.background != std::array<float, 3>{0, 0, 0});
   RenderSettings sample_settings = settings;
@@ -123,14 +132,17 @@ RenderImage render_averaged(const Camera& camera, const RenderSettings& settings
     check_shutter(settings, camera);
     const Shutter& shutter = settings.shutter;
     sample_settings.shutter = {};
-    for (const double t : shutter_times(shutter.open, shutter.close, shutter.samples))
+    for (int i = 0; i < shutter.samples; ++i) {
+      const double t = shutter_time(shutter.open, shutter.close, shutter.pattern, i, shutter.samples);
       mean.add(render_sample(camera_between(camera, *shutter.end_camera, t), sample_settings, t));
+    }
   } else {
     check_lens(settings, camera);
     const ThinLens& lens = settings.lens;
     sample_settings.lens = {};
-    for (const auto& sample : lens_samples(lens.samples))
-      mean.add(render_sample(lens_sample_camera(camera, lens, sample), sample_settings, 0.0));
+    for (int i = 0; i < lens.samples; ++i)
+      mean.add(render_sample(lens_sample_camera(camera, lens, lens_sample(lens.pattern, i, lens.samples)),
+                             sample_settings, 0.0));
   }
   return mean.mean();
 }

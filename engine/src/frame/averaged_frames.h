@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
@@ -39,6 +40,10 @@ class LinearFrameMean {
 
 // Whether `settings` ask for a frame averaged from sample frames: an enabled shutter or lens.
 bool averages_samples(const RenderSettings& settings);
+
+// RenderSettings::accumulate_samples with an enabled lens or shutter where sums cannot be kept from call
+// to call (`where`: a scene given to render() each call, the float64 reference): std::invalid_argument.
+void refuse_accumulated_samples(const RenderSettings& settings, const std::string& where);
 
 // Renders one sample frame: a camera and the settings without the effect being averaged.
 using SampleRenderer = std::function<RenderImage(const Camera&, const RenderSettings&)>;

@@ -163,7 +163,7 @@ std::vector<FramePass> raster_frame_passes(const FramePlan& plan) {
 // The stochastic frame never sorts by depth: its composite needs each tile's splats, in any order.
 // Its tile binning is the strategy's sort over the tile bits of 32-bit keys, used only to group the
 // pairs by tile. A frame on reused lists runs the composite alone.
-std::vector<FramePass> frame_passes(const FramePlan& plan) {
+std::vector<FramePass> composited_frame_passes(const FramePlan& plan) {
   if (plan.compositor == Compositor::kRaster) return raster_frame_passes(plan);
   std::vector<FramePass> passes;
   if (plan.host.from_image) passes.push_back(FramePass::kHostDepthIn);  // every attempt converts it first
@@ -183,6 +183,13 @@ std::vector<FramePass> frame_passes(const FramePlan& plan) {
   passes.push_back(stochastic               ? FramePass::kStochasticComposite
                    : plan.resort_window > 0 ? FramePass::kResortComposite
                                             : FramePass::kComposite);
+  return passes;
+}
+
+// The composited frame, then for a sample of an accumulated lens or shutter frame the mean of the samples.
+std::vector<FramePass> frame_passes(const FramePlan& plan) {
+  std::vector<FramePass> passes = composited_frame_passes(plan);
+  if (plan.sample_sums) passes.push_back(FramePass::kAccumulateSamples);
   return passes;
 }
 
@@ -225,6 +232,8 @@ const char* timed_name(FramePass pass) {
       return "stochastic_composite";
     case FramePass::kRasterComposite:
       return "raster_composite";
+    case FramePass::kAccumulateSamples:
+      return "sample_accumulate";
   }
   return nullptr;
 }
@@ -310,6 +319,9 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
     plan.host.from_image = context.depth_image;
     plan.host.write_depth = settings.host->write_depth;
   }
+  if (context.samples_before)
+    plan.sample_sums =
+        SampleSums{*context.samples_before, settings.background != std::array<float, 3>{0, 0, 0}};
 
   plan.passes = frame_passes(plan);
   plan.splits_submissions = splits_submissions(plan);

@@ -36,6 +36,7 @@ enum class FramePass {
   kResortComposite,      // blending with per-pixel re-sorting (composite_resort.comp)
   kStochasticComposite,  // the sort-free composite (composite_stochastic.comp)
   kRasterComposite,      // the depth-sorted splats drawn as quads and blended by the hardware
+  kAccumulateSamples,  // a lens or shutter sample added to the earlier samples' sums, the outputs their mean
 };
 // The pass's name in FrameStats::passes and the benchmark, or nullptr for a step that is not timed.
 const char* timed_name(FramePass pass);
@@ -117,6 +118,14 @@ struct HostDepthPlan {
   bool write_depth = false;  // the composite writes the surface depth
 };
 
+// RenderSettings::accumulate_samples: the frame is one sample of a lens or shutter frame, added to the
+// sums of the samples rendered before it (kAccumulateSamples), its outputs then the mean of all.
+struct SampleSums {
+  uint32_t before = 0;  // samples in the sums already (0: this frame starts them)
+  bool opaque = false;  // blended over a background: colours averaged as opaque (LinearFrameMean)
+  bool operator==(const SampleSums&) const = default;
+};
+
 // Everything decided about one frame before any Vulkan call (plan_frame); FrameRecorder records it.
 struct FramePlan {
   ListKey lists;            // what this frame's tile lists are built for
@@ -145,6 +154,7 @@ struct FramePlan {
   uint32_t stochastic_first_sample = 0;
   bool stochastic_accumulate = false;
   HostDepthPlan host;
+  std::optional<SampleSums> sample_sums;  // a sample of an accumulated lens or shutter frame
   ScenePart part;                 // of a scene rendered in parts (or the whole scene)
   std::vector<FramePass> passes;  // in order
   // The frame ends its command buffer and goes on in another where the host must act: a host sort
@@ -164,6 +174,9 @@ struct FrameContext {
   std::optional<ListKey> lists;  // the lists in the buffers, if whole
   bool depth_image = false;      // render_to_image with a host depth image
   ScenePart part;                // the part of the scene in the buffers
+  // A sample of an accumulated lens or shutter frame (RenderSettings::accumulate_samples): the samples
+  // already in the sums.
+  std::optional<uint32_t> samples_before;
 };
 
 // Validates the camera for this device, the accuracy modes, the compositor's settings and the host

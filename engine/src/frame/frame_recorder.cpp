@@ -21,7 +21,8 @@ FrameRecorder::FrameRecorder(vk::Context& ctx, vk::GpuTimer& timer)
       stochastic_composite_(ctx),
       raster_composite_(ctx),
       host_depth_(ctx),
-      pack_colour_(ctx) {}
+      pack_colour_(ctx),
+      sample_accumulate_(ctx) {}
 
 void FrameRecorder::set_frame_inputs(const Camera& camera, const RenderSettings& settings,
                                      const TileGrid& tiles, SceneBuffers& scene) {
@@ -173,6 +174,15 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
                 .half_colour = modes.fp16_blend});
       return;
     }
+    case FramePass::kAccumulateSamples:
+      vk::barrier(cmd);  // the composite's outputs (the raster composite's resolve) before the sums read them
+      sample_accumulate_.record(cmd, res.outputs, res.sample_sums,
+                                {.samples_before = plan.sample_sums->before,
+                                 .write_depth = r.settings.depth,
+                                 .write_count = r.settings.splat_count,
+                                 .opaque = plan.sample_sums->opaque});
+      vk::barrier(cmd);
+      return;
   }
 }
 

@@ -16,6 +16,7 @@
 #include "passes/prefix_sum_pass.h"
 #include "passes/projection_pass.h"
 #include "passes/raster_composite_pass.h"
+#include "passes/sample_accumulate_pass.h"
 #include "passes/stochastic_composite_pass.h"
 #include "passes/tile_ranges_pass.h"
 #include "sort/sort_strategy.h"
@@ -75,7 +76,8 @@ class FrameRecorder {
   StochasticCompositePass stochastic_composite_;
   RasterCompositePass raster_composite_;
   HostDepthPass host_depth_;    // render_to_image with a depth image
-  PackColourPass pack_colour_;  // render_to_image into a colour image of another format than RGBA32F
+  PackColourPass pack_colour_;  // render_to_image into a colour image of another format than RGBA32
+  SampleAccumulatePass sample_accumulate_;  // RenderSettings::accumulate_samplesF
   uint32_t sorted_chunks_ = 1;
   uint32_t stochastic_chunks_ = 1;
 };

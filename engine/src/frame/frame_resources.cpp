@@ -9,6 +9,7 @@
 #include <string>
 
 #include "host_depth.h"
+#include "passes/sample_accumulate_pass.h"
 #include "passes/stochastic_composite_pass.h"
 
 namespace tilesplat {
@@ -139,6 +140,11 @@ void FrameResources::prepare_outputs(const FramePlan& plan, const RenderSettings
     ranges = vk::Buffer(ctx_, VkDeviceSize(plan.tiles.count) * 8, vk::MemoryUse::Device, "tile ranges");
   }
   outputs.first_tile = plan.tiles.packed_first();
+  if (!plan.sample_sums)
+    sample_sums.reset();
+  else if (sample_sums.size() != SampleAccumulatePass::sums_bytes(pixels))
+    sample_sums = vk::Buffer(ctx_, SampleAccumulatePass::sums_bytes(pixels), vk::MemoryUse::Device,
+                             "sample sums (accumulated lens and shutter samples)");
   if (!settings.depth)
     outputs.depth.reset();
   else if (outputs.depth.size() == 0)
@@ -234,6 +240,7 @@ uint64_t FrameResources::device_bytes() const {
                               &host_window_depth,
                               &host_surface_depth,
                               &packed_colour,
+                              &sample_sums,
                               &counters})
     bytes += b->size();
   return bytes + projected.depth_order.bytes() + keys.bytes();

@@ -73,6 +73,7 @@ class FrameResources {
   vk::Buffer counters;            // FrameCounters, read back after the frame
   vk::Buffer composite_state;     // per-pixel state between a composite's dispatches (chunks, samples)
   vk::Buffer packed_colour;       // render_to_image: the frame in the host image's texel format
+  vk::Buffer sample_sums;  // RenderSettings::accumulate_samples: the samples' sums (SampleAccumulatePass)
   vk::Buffer host_view_depth;     // RenderSettings::host: the host's surfaces as view depth, per pixel
   vk::Buffer host_window_depth;   // a depth image's window depths, and the depth out before it is copied back
   vk::Buffer host_surface_depth;  // and the view depth at which the splats' alpha reached its threshold

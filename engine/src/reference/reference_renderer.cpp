@@ -132,6 +132,7 @@ RenderImage render_reference(const SceneInstances& scene, const Camera& camera,
 
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
                              ReferenceOrder reference_order) {
+  refuse_accumulated_samples(settings, "render_reference");
   if (averages_samples(settings)) {
     // Depth of field, motion blur: the reference's own sample frames, averaged as the GPU's are.
     return render_averaged(camera, settings,
