@@ -71,10 +71,11 @@ TEST(CliRender, HelpListsEveryFlag) {
   EXPECT_TRUE(result.err.empty()) << result.err;
 }
 
-// --sample-curve: an averaged effect's sample counts against the frame of 1,024 samples, per effect.
+// --sample-curve: an averaged effect's sample counts against the frame of 1,024 samples, per effect and
+// sample pattern.
 TEST(CliBench, SampleCurveHoldsEachCountToManySamples) {
   const auto out = fresh_output_dir();
-  for (const char* effect : {"lens", "time"}) {
+  for (const char* effect : {"lens", "time", "lens-sobol", "time-sobol"}) {
     const fs::path csv = out / (std::string(effect) + ".csv");
     const auto run =
         run_exe(kBenchExe, {bundled_sh3().string(), "--sample-curve", std::string(effect) + ":1,4,16",

@@ -43,6 +43,10 @@ std::string what_is_averaged(Effect effect) {
     case Effect::kTime:
       return "motion blur: the shutter open over the frame while the camera turns 5 degrees about the "
              "scene's centre";
+    case Effect::kLensSobol:
+      return "depth of field as 'lens', its positions the progressive (sobol) pattern's";
+    case Effect::kTimeSobol:
+      return "motion blur as 'time', its times the progressive (sobol) pattern's";
     case Effect::kStochastic:
       return "the stochastic compositor's frames, thresholds from the hash";
     case Effect::kStochasticStratified:
@@ -53,7 +57,8 @@ std::string what_is_averaged(Effect effect) {
 
 // What the PSNR is against, for the reports.
 std::string held_to(Effect effect) {
-  return held_to_sorted_frame(effect) ? "the sorted frame" : std::to_string(kReferenceSamples) + " samples";
+  return held_to_sorted_frame(effect) ? "the sorted frame"
+                                      : std::to_string(kReferenceSamples) + " samples of the even pattern";
 }
 
 }  // namespace
@@ -64,6 +69,10 @@ std::string effect_name(Effect effect) {
       return "lens";
     case Effect::kTime:
       return "time";
+    case Effect::kLensSobol:
+      return "lens-sobol";
+    case Effect::kTimeSobol:
+      return "time-sobol";
     case Effect::kStochastic:
       return "stochastic";
     case Effect::kStochasticStratified:
@@ -73,7 +82,8 @@ std::string effect_name(Effect effect) {
 }
 
 std::optional<Effect> parse_effect(const std::string& name) {
-  for (Effect e : {Effect::kLens, Effect::kTime, Effect::kStochastic, Effect::kStochasticStratified})
+  for (Effect e : {Effect::kLens, Effect::kTime, Effect::kLensSobol, Effect::kTimeSobol, Effect::kStochastic,
+                   Effect::kStochasticStratified})
     if (effect_name(e) == name) return e;
   return std::nullopt;
 }
@@ -102,16 +112,29 @@ RenderSettings effect_settings(const Options& options, const Camera& view, int s
     settings.stochastic.sampler = options.effect == Effect::kStochasticStratified
                                       ? StochasticSampler::kStratified
                                       : StochasticSampler::kHash;
-  } else if (options.effect == Effect::kLens) {
+  } else if (options.effect == Effect::kLens || options.effect == Effect::kLensSobol) {
     const double focus = view.to_camera(options.centre)[2];
-    settings.lens = {.aperture_diameter = 0.05 * focus, .focus_distance = focus, .samples = samples};
+    settings.lens = {
+        .aperture_diameter = 0.05 * focus,
+        .focus_distance = focus,
+        .samples = samples,
+        .pattern = options.effect == Effect::kLensSobol ? SamplePattern::kSobol : SamplePattern::kEven};
   } else {
     settings.shutter = {
         .open = 0,
         .close = 1,
         .samples = samples,
-        .end_camera = turn_camera(view, options.centre, {0, -1, 0}, 5 * std::numbers::pi / 180)};
+        .end_camera = turn_camera(view, options.centre, {0, -1, 0}, 5 * std::numbers::pi / 180),
+        .scan = ShutterScan::kGlobal,
+        .pattern = options.effect == Effect::kTimeSobol ? SamplePattern::kSobol : SamplePattern::kEven};
   }
+  return settings;
+}
+
+RenderSettings reference_settings(const Options& options, const Camera& view) {
+  if (held_to_sorted_frame(options.effect)) return shared_settings(options);
+  RenderSettings settings = effect_settings(options, view, kReferenceSamples);
+  settings.lens.pattern = settings.shutter.pattern = SamplePattern::kEven;
   return settings;
 }
 
@@ -130,9 +153,7 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
   int done = 0;
   std::vector<RenderImage> references;
   for (const Camera& view : options.views) {
-    references.push_back(renderer->render(view, held_to_sorted_frame(options.effect)
-                                                    ? shared_settings(options)
-                                                    : effect_settings(options, view, kReferenceSamples)));
+    references.push_back(renderer->render(view, reference_settings(options, view)));
     progress(++done, total, held_to(options.effect));
   }
   const size_t views = options.views.size();

@@ -24,12 +24,15 @@
 
 namespace tilesplat::sample_curve {
 
-enum class Effect { kLens, kTime, kStochastic, kStochasticStratified };
-std::string effect_name(Effect effect);  // "lens", "time", "stochastic", "stochastic-stratified"
+// The lens and the shutter with their even pattern (lens_samples, shutter_times) or the progressive one
+// (SamplePattern::kSobol); the stochastic compositor with either sampler.
+enum class Effect { kLens, kTime, kLensSobol, kTimeSobol, kStochastic, kStochasticStratified };
+// "lens", "time", "lens-sobol", "time-sobol", "stochastic", "stochastic-stratified"
+std::string effect_name(Effect effect);
 // The inverse of effect_name, or nothing.
 std::optional<Effect> parse_effect(const std::string& name);
 // The image the effect's frames are held to: the sorted frame for the stochastic compositor, else the
-// effect with kReferenceSamples samples.
+// effect with kReferenceSamples samples of the even pattern (the same image for both patterns' curves).
 bool held_to_sorted_frame(Effect effect);
 
 // The sample count the curve's images are held to (the "error against a 1,024-sample image").
@@ -58,6 +61,8 @@ struct Options {
 
 // The settings of view `view` through the effect with `samples` samples.
 RenderSettings effect_settings(const Options& options, const Camera& view, int samples);
+// The settings of the image the effect's rows are held to from `view` (held_to_sorted_frame).
+RenderSettings reference_settings(const Options& options, const Camera& view);
 
 struct Run {
   DeviceInfo device;

@@ -151,38 +151,20 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
                     "render with the float64 CPU reference instead of the GPU (slow; for checking)",
                     &options.reference);
 
-  parser.section("depth of field (a thin lens: the mean of --lens-samples pinhole frames over the aperture)");
-  const auto positive = [](const char* flag, const std::string& text) {
-    const double value = cli::parse_double(flag, text);
-    if (!(value > 0 && std::isfinite(value)))
-      throw cli::UsageError(std::string(flag) + " must be a positive number, got " + single_quoted(text));
-    return value;
-  };
-  parser.add_value("--aperture", "D", "the lens's aperture diameter, in the scene's units",
-                   [&options, positive](const std::string& text) {
-                     options.lens.aperture = positive("--aperture", text);
-                   });
+  cli::add_lens_options(parser, options.lens,
+                        "pinhole frames averaged over the aperture (1 to 4096, default 32)");
   parser.add_value(
-      "--f-stop", "N",
-      "the aperture as an f-number: the focal length (fx and --sensor-width) over N, in metres "
-      "times --units-per-metre",
-      [&options, positive](const std::string& text) { options.lens.f_stop = positive("--f-stop", text); });
-  parser.add_value("--focus-distance", "Z",
-                   "the view depth in focus, in the scene's units (default: the scene's centre)",
-                   [&options, positive](const std::string& text) {
-                     options.lens.focus_distance = positive("--focus-distance", text);
-                   });
-  parser.add_int("--lens-samples", "N", "pinhole frames averaged over the aperture (1 to 4096, default 32)",
-                 &options.lens.samples, 1, kMaxLensSamples);
-  parser.add_value("--sensor-width", "MM",
-                   "the sensor's width for --f-stop, in millimetres (default 36: full frame)",
-                   [&options, positive](const std::string& text) {
-                     options.lens.sensor_width_mm = positive("--sensor-width", text);
-                   });
-  parser.add_value("--units-per-metre", "U", "the scene's units in a metre, for --f-stop (default 1)",
-                   [&options, positive](const std::string& text) {
-                     options.lens.units_per_metre = positive("--units-per-metre", text);
-                   });
+      "--sample-pattern", "PATTERN",
+      "where the lens positions and the shutter's times lie: even (the default: the golden-angle spiral and "
+      "the middles of equal slices, spread for the count) or sobol (a progressive sequence: the first N "
+      "samples of a longer frame are the frame of N; docs/effects.md)",
+      [&options](const std::string& text) {
+        try {
+          options.lens.pattern = options.shutter.pattern = tilesplat::parse_sample_pattern(text);
+        } catch (const std::invalid_argument&) {
+          throw cli::UsageError("--sample-pattern must be even or sobol, got " + cli::single_quoted(text));
+        }
+      });
   parser.section("motion blur (with --orbit or --path: the mean of frames over each frame's motion)");
   parser.add_value(
       "--shutter", "DEG",
@@ -324,18 +306,13 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
     throw cli::UsageError(
         "--shutter blurs the camera's motion from one frame to the next: it needs --orbit or "
         "--path");
-  if (options.lens.aperture && options.lens.f_stop)
-    throw cli::UsageError("--aperture and --f-stop both give the aperture: one of them");
-  if (!options.lens.enabled())
-    for (const char* lens_flag :
-         {"--focus-distance", "--lens-samples", "--sensor-width", "--units-per-metre"})
-      if (parser.seen(lens_flag))
-        throw cli::UsageError(std::string(lens_flag) +
-                              " shapes the lens, and neither --aperture nor --f-stop gave one");
-  if (!options.lens.f_stop)
-    for (const char* f_stop_flag : {"--sensor-width", "--units-per-metre"})
-      if (parser.seen(f_stop_flag))
-        throw cli::UsageError(std::string(f_stop_flag) + " applies to --f-stop only");
+  cli::check_lens_options(parser, options.lens);
+  if (parser.seen("--sample-pattern") && !options.lens.enabled() && !options.shutter.enabled())
+    throw cli::UsageError(
+        "--sample-pattern places lens and shutter samples: add --aperture, --f-stop or --shutter");
+  if (options.shutter.pattern != SamplePattern::kEven && options.shutter.scan != ShutterScan::kGlobal)
+    throw cli::UsageError(
+        "--rolling-shutter exposes its bands at the even pattern's times, in order: drop --sample-pattern");
   const bool sequence = renders_sequence(parser);
   // Fail before the (possibly long) load and render when the outputs cannot be written.
   if (sequence)
@@ -356,7 +333,8 @@ Shutter shutter_for_frame(const ShutterFlags& flags, const std::optional<Camera>
           .close = *flags.angle_deg / 360.0,
           .samples = flags.samples,
           .end_camera = next,
-          .scan = flags.scan};
+          .scan = flags.scan,
+          .pattern = flags.pattern};
 }
 
 std::string shutter_text(const ShutterFlags& flags) {
@@ -365,37 +343,9 @@ std::string shutter_text(const ShutterFlags& flags) {
   const auto end = std::to_chars(angle, angle + sizeof angle, *flags.angle_deg).ptr;  // shortest exact
   std::string text = std::string(angle, end) + "deg:samples:" + std::to_string(flags.samples);
   if (flags.scan != ShutterScan::kGlobal) text += std::string(":rolling:") + shutter_scan_name(flags.scan);
+  if (flags.pattern != SamplePattern::kEven)
+    text += std::string(":pattern:") + sample_pattern_name(flags.pattern);
   return text;
-}
-
-ThinLens lens_for_frame(const LensFlags& flags, const Camera& camera,
-                        const std::array<double, 3>& scene_centre) {
-  if (!flags.enabled()) return {};
-  ThinLens lens;
-  lens.samples = flags.samples;
-  lens.aperture_diameter = flags.aperture ? *flags.aperture
-                                          : aperture_for_f_stop(camera, *flags.f_stop, flags.sensor_width_mm,
-                                                                flags.units_per_metre);
-  if (flags.focus_distance) {
-    lens.focus_distance = *flags.focus_distance;
-  } else {
-    lens.focus_distance = camera.to_camera(scene_centre)[2];
-    if (!(lens.focus_distance > 0))
-      throw cli::UsageError("the scene's centre is behind the camera: give --focus-distance");
-  }
-  return lens;
-}
-
-std::string lens_text(const LensFlags& flags) {
-  if (!flags.enabled()) return {};
-  std::string text = flags.aperture
-                         ? "aperture:" + cli::format_number(*flags.aperture, 6)
-                         : "f/" + cli::format_number(*flags.f_stop, 3) +
-                               ":sensor:" + cli::format_number(flags.sensor_width_mm, 3) +
-                               "mm:units-per-metre:" + cli::format_number(flags.units_per_metre, 6);
-  text += ",focus:" +
-          (flags.focus_distance ? cli::format_number(*flags.focus_distance, 6) : std::string("scene-centre"));
-  return text + ",samples:" + std::to_string(flags.samples);
 }
 
 }  // namespace tilesplat::render_app

@@ -7,12 +7,17 @@
 #include <string>
 
 #include "cli.h"
+#include "lens_options.h"
 #include "tilesplat/image.h"
 #include "tilesplat/lens.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/shutter.h"
 
 namespace tilesplat::render_app {
+
+using cli::lens_for_frame;
+using cli::lens_text;
+using cli::LensFlags;
 
 inline constexpr const char* kProgram = "tilesplat-render";
 inline constexpr const char* kUsage = "tilesplat-render SCENE.ply|SCENE.json -o OUT.exr [options]";
@@ -25,28 +30,6 @@ inline constexpr const char* kDescription =
     "(out/manifest.jsonl) and in shards (--shard). A scene file's background and outputs "
     "apply unless --background, --no-depth or --no-count say otherwise.";
 
-// Depth of field from the command line: an aperture (a diameter, or an f-number through the sensor's
-// width and the scene's scale), focused at a view depth or, unless --focus-distance says, at the scene's
-// centre as each frame's camera sees it.
-struct LensFlags {
-  std::optional<double> aperture;        // --aperture D, world units
-  std::optional<double> f_stop;          // --f-stop N
-  std::optional<double> focus_distance;  // --focus-distance Z
-  double sensor_width_mm = 36.0;         // --sensor-width MM
-  double units_per_metre = 1.0;          // --units-per-metre U
-  int samples = 32;                      // --lens-samples N
-  bool enabled() const { return aperture.has_value() || f_stop.has_value(); }
-};
-
-// The lens of one frame: the flags' aperture and focus for `camera`, the focus on `scene_centre` unless
-// --focus-distance was given. Off (the pinhole) without --aperture or --f-stop. Throws UsageError for a
-// scene centre behind the camera when it would be the focus.
-ThinLens lens_for_frame(const LensFlags& flags, const Camera& camera,
-                        const std::array<double, 3>& scene_centre);
-// "aperture:D,focus:Z,samples:N" (f/N for an f-number, focus:scene-centre by default), for the EXR's
-// renderSettings; empty when off.
-std::string lens_text(const LensFlags& flags);
-
 // --shutter and --shutter-samples: motion blur over a sequence's camera motion. The shutter opens at a
 // frame's time and stays open for DEG/360 of the interval to the next frame (a film camera's shutter
 // angle: 180 is half the interval).
@@ -54,6 +37,7 @@ struct ShutterFlags {
   std::optional<double> angle_deg;  // --shutter DEG, in (0, 360]
   int samples = 16;                 // --shutter-samples N
   ShutterScan scan = ShutterScan::kGlobal;  // --rolling-shutter DIRECTION
+  SamplePattern pattern = SamplePattern::kEven;  // --sample-pattern
   bool enabled() const { return angle_deg.has_value(); }
 };
 // The shutter of a frame whose next frame's camera is `next`: off without --shutter, and for the last

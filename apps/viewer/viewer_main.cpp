@@ -101,7 +101,9 @@ class Viewer {
         lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
         views_(std::move(views)),
         view_(options.common.view),
-        sorts_(sort_cycle()) {
+        sorts_(sort_cycle()),
+        lens_flags_(options.lens),
+        depth_of_field_(options.lens.enabled()) {
     cli::apply_scene_settings(loaded, base_settings_);
     cli::apply_training_options(options.common, base_settings_);
     for (const char* mode : kModeCycle) modes_.push_back(tilesplat::parse_accuracy_modes(mode));
@@ -169,6 +171,12 @@ class Viewer {
   tilesplat::Camera camera() const { return cli::camera_for_frame(lenses_[lens_], controller_.camera()); }
   tilesplat::RenderSettings settings() const {
     tilesplat::RenderSettings settings = base_settings_;
+    // Depth of field (key F): one lens sample a redraw, added to the earlier ones on the device until the
+    // camera (or anything else) changes (RenderSettings::accumulate_samples).
+    if (draws_depth_of_field()) {
+      settings.lens = thin_lens(camera());
+      settings.accumulate_samples = settings.lens.enabled();
+    }
     settings.sort = sorts_[sort_];
     settings.accuracy = modes_[mode_];
     settings.compositor = kCompositorCycle[compositor_];
@@ -185,6 +193,11 @@ class Viewer {
   // in one call (the same image: N calls of 1 frame are 1 call of N).
   tilesplat::RenderSettings screenshot_settings() {
     tilesplat::RenderSettings shot = settings();
+    if (shot.accumulate_samples) {  // the lens samples on screen, in one call
+      tilesplat::wait_for_frame(renderer_);
+      shot.lens.samples = int(std::max(1u, renderer_.last_frame_stats().accumulated_samples));
+      shot.accumulate_samples = false;
+    }
     if (shot.compositor == tilesplat::Compositor::kStochastic) {
       tilesplat::wait_for_frame(renderer_);
       shot.stochastic.frames = std::max(1u, renderer_.last_frame_stats().accumulated_frames);
@@ -250,6 +263,10 @@ class Viewer {
         break;
       case GLFW_KEY_D:
         viewer.depth_out_ = !viewer.depth_out_;
+        break;
+      case GLFW_KEY_F:
+        if (viewer.mesh_) return;  // the box and the grid are drawn through a pinhole (--no-mesh)
+        viewer.depth_of_field_ = !viewer.depth_of_field_;
         break;
       case GLFW_KEY_L:
         viewer.lens_ = (viewer.lens_ + 1) % viewer.lenses_.size();
@@ -347,10 +364,15 @@ class Viewer {
     else
       tilesplat::render_to_image(renderer_, camera(), frame, image_->target(), nullptr,
                                  tilesplat::HostFrameSync{});
-    // A view at rest under the stochastic compositor goes on refining (the counts lag a frame: the
-    // last frame's statistics arrive when the next one starts).
-    needs_render_ = frame.compositor == tilesplat::Compositor::kStochastic &&
-                    renderer_.last_frame_stats().accumulated_frames + 1 < kMaxAccumulatedFrames;
+    // A view at rest goes on refining: its lens samples up to --lens-samples, or the stochastic
+    // compositor's frames up to kMaxAccumulatedFrames (the counts lag a frame: the last frame's
+    // statistics arrive when the next one starts).
+    const tilesplat::FrameStats& last = renderer_.last_frame_stats();
+    if (frame.accumulate_samples)
+      needs_render_ = last.accumulated_samples + 1 < uint32_t(lens_flags_.samples);
+    else
+      needs_render_ = frame.compositor == tilesplat::Compositor::kStochastic &&
+                      last.accumulated_frames + 1 < kMaxAccumulatedFrames;
     needs_present_ = true;
     ++frames_;
   }
@@ -371,12 +393,36 @@ class Viewer {
     return swapchain_.present(image_->image(), FloatImage::kLayout, shown_extent_);
   }
 
+  // Whether the frame is seen through key F's thin lens: on, through the pinhole (L), without the mesh.
+  bool draws_depth_of_field() const { return depth_of_field_ && !mesh_ && !lenses_[lens_].enabled(); }
+
+  // Key F's thin lens for `camera`: the flags' aperture (--aperture, --f-stop), else 5% of the focus
+  // distance; focused on the scene's centre unless --focus-distance says; its samples progressive
+  // (SamplePattern::kSobol, which a still view continues frame after frame). Off when the
+  // scene's centre, to be focused on, is behind the camera.
+  tilesplat::ThinLens thin_lens(const tilesplat::Camera& camera) const {
+    cli::LensFlags flags = lens_flags_;
+    flags.pattern = tilesplat::SamplePattern::kSobol;
+    if (!flags.enabled()) flags.aperture = 1.0;  // replaced below, once the focus is known
+    const std::array<double, 3> centre = {bounds_.center[0], bounds_.center[1], bounds_.center[2]};
+    if (!flags.focus_distance && !(camera.to_camera(centre)[2] > 0)) return {};
+    tilesplat::ThinLens lens = cli::lens_for_frame(flags, camera, centre);
+    if (!lens_flags_.enabled()) lens.aperture_diameter = 0.05 * lens.focus_distance;
+    return lens;
+  }
+
   // The GPU time is the previous frame's: a frame's statistics come once it has been waited for.
   std::string lens_name() const {
     const cli::CameraModelFlags& lens = lenses_[lens_];
     if (lens.fisheye_fov_deg) return "fisheye " + cli::format_fixed(*lens.fisheye_fov_deg, 0) + " deg";
     if (lens.view_height) return "orthographic " + cli::format_fixed(*lens.view_height, 2) + " tall";
-    return lens.equirectangular ? "panorama" : "pinhole";
+    if (lens.equirectangular) return "panorama";
+    if (!draws_depth_of_field()) return "pinhole";
+    const tilesplat::ThinLens thin = thin_lens(camera());
+    if (!thin.enabled()) return "pinhole (depth of field: the scene's centre is behind the camera)";
+    return "aperture " + cli::format_number(thin.aperture_diameter, 3) + " focus " +
+           cli::format_number(thin.focus_distance, 3) + " (" +
+           std::to_string(renderer_.last_frame_stats().accumulated_samples) + " samples)";
   }
 
   void show_title(double frame_ms) {
@@ -429,6 +475,8 @@ class Viewer {
   std::vector<cli::CameraModelFlags> lenses_;  // key L's cycle
   size_t lens_ = 0;
   size_t compositor_ = 0;                    // in kCompositorCycle (C cycles)
+  cli::LensFlags lens_flags_;                // --aperture, --f-stop, --focus-distance, --lens-samples
+  bool depth_of_field_ = false;  // key F's thin lens on (from the start with --aperture, --f-stop)
   tilesplat::RenderSettings base_settings_;  // the scene file's background, effects and outputs
 
   int drag_button_ = -1;  // the mouse button held, or -1
@@ -463,6 +511,9 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewe
     if (settings.compositor == tilesplat::Compositor::kStochastic)
       std::fprintf(stderr, "%s: the screenshot is the mean of %u stochastic frames\n", kProgram,
                    settings.stochastic.frames);
+    if (settings.lens.enabled())
+      std::fprintf(stderr, "%s: the screenshot is the mean of %d lens samples\n", kProgram,
+                   settings.lens.samples);
     tilesplat::ExrWriteOptions exr;
     exr.alpha = !loaded.description || loaded.description->outputs.alpha;
     exr.camera = viewer.camera();

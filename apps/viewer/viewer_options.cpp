@@ -8,6 +8,8 @@ void add_viewer_options(cli::ArgParser& parser, ViewerOptions& options) {
   cli::add_common_options(parser, options.common, cli::SortChoice::kOne);
   cli::add_splat_budget_option(parser, options.common);
   cli::add_camera_model_options(parser, options.camera_model);
+  cli::add_lens_options(parser, options.lens,
+                        "lens samples a still view adds up, one a frame (1 to 4096, default 32)");
   parser.section("scripting");
   parser.add_int("--frames", "N", "render N frames, then exit (default: run until the window is closed)",
                  &options.frames, 1, 1000000);
@@ -42,6 +44,17 @@ void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& optio
     throw cli::UsageError(
         "--fisheye, --orthographic and --equirectangular show the splats alone: add --no-mesh (the box "
         "and the grid are drawn through a pinhole)");
+  cli::check_lens_options(parser, options.lens);
+  // Depth of field does not test against the box's depth (a host's depth is the pinhole's).
+  if (options.lens.enabled() && !options.no_mesh)
+    throw cli::UsageError(
+        "depth of field (--aperture, --f-stop) shows the splats alone: add --no-mesh (the box and the grid "
+        "are drawn through a pinhole)");
+  if (options.lens.enabled() && options.camera_model.enabled())
+    throw cli::UsageError("depth of field (--aperture, --f-stop) needs a pinhole camera, not " +
+                          std::string(options.camera_model.fisheye_fov_deg ? "--fisheye"
+                                      : options.camera_model.view_height   ? "--orthographic"
+                                                                           : "--equirectangular"));
   if (options.camera_model.enabled() && !options.common.modes.empty() &&
       options.common.modes.front().resort_window > 0)
     throw cli::UsageError("per-pixel re-sorting (--mode " + to_string(options.common.modes.front()) +

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cli.h"
+#include "lens_options.h"
 
 namespace tilesplat::viewer {
 
@@ -18,7 +19,9 @@ inline constexpr const char* kDescription =
     "scene file, M cycles accuracy modes, S cycles sort strategies, C cycles the sorted, the raster and "
     "the stochastic compositor (whose frames add up while the view rests), L steps through the lenses (the "
     "pinhole, a 180-degree fisheye, the 360x180 "
-    "panorama; --no-mesh), D turns the splats' "
+    "panorama; --no-mesh), F turns depth of field on and off (--aperture or --f-stop, else an aperture of 5% "
+    "of "
+    "the focus distance; --no-mesh; its lens samples add up while the view rests), D turns the splats' "
     "depth out off and on, "
     "Esc or Q quits. The window starts at --width x --height (default 960 wide, the "
     "view's aspect) and the image "
@@ -34,6 +37,7 @@ struct ViewerOptions {
   bool no_mesh = false;       // the splats alone, straight into the float image
   bool no_depth_out = false;  // the splats write no depth: the grid is drawn over them
   tilesplat::cli::CameraModelFlags camera_model;  // --fisheye, --orthographic, --equirectangular (key L)
+  tilesplat::cli::LensFlags lens;  // depth of field, a sample a frame while the view rests (key F)
 };
 
 // Declares every flag of tilesplat-viewer.
