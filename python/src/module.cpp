@@ -154,6 +154,7 @@ nb::dict stats_dict(const FrameStats& stats) {
   out["reused_sorted_lists"] = stats.reused_sorted_lists;
   out["samples"] = stats.samples;  // frames averaged (lens, shutter)
   out["accumulated_frames"] = stats.accumulated_frames;  // the stochastic frames in the mean
+  out["accumulated_samples"] = stats.accumulated_samples;  // lens and shutter samples (accumulate_samples)
   out["scene_parts"] = stats.scene_parts;  // depth-ordered parts under a memory budget
   out["image_bands"] = stats.image_bands;  // bands of rows of an image past the device
   out["peak_device_bytes"] = stats.peak_device_bytes;
@@ -483,19 +484,45 @@ void bind(nb::module_& m) {
                        "focus_distance (the view depth in focus) and samples (pinhole frames averaged).")
       .def(
           "__init__",
-          [](ThinLens* lens, double aperture_diameter, double focus_distance, int samples) {
-            new (lens) ThinLens{aperture_diameter, focus_distance, samples};
+          [](ThinLens* lens, double aperture_diameter, double focus_distance, int samples,
+             const std::string& pattern) {
+            new (lens) ThinLens{aperture_diameter, focus_distance, samples, parse_sample_pattern(pattern)};
             validate(*lens);
           },
-          "aperture_diameter"_a = 0.0, "focus_distance"_a = 1.0, "samples"_a = 32)
+          "aperture_diameter"_a = 0.0, "focus_distance"_a = 1.0, "samples"_a = 32, "pattern"_a = "even")
       .def_rw("aperture_diameter", &ThinLens::aperture_diameter)
       .def_rw("focus_distance", &ThinLens::focus_distance)
       .def_rw("samples", &ThinLens::samples)
+      .def_prop_rw(
+          "pattern", [](const ThinLens& lens) { return std::string(sample_pattern_name(lens.pattern)); },
+          [](ThinLens& lens, const std::string& name) { lens.pattern = parse_sample_pattern(name); },
+          "'even' (the golden-angle spiral of `samples`) or 'sobol' (progressive: what accumulate_samples "
+          "continues)")
       .def("__repr__", [](const ThinLens& lens) {
         return "ThinLens(aperture_diameter=" + std::to_string(lens.aperture_diameter) +
                ", focus_distance=" + std::to_string(lens.focus_distance) +
-               ", samples=" + std::to_string(lens.samples) + ")";
+               ", samples=" + std::to_string(lens.samples) + ", pattern='" +
+               sample_pattern_name(lens.pattern) + "')";
       });
+  m.def(
+      "lens_sample",
+      [](const std::string& pattern, int index, int count) {
+        return lens_sample(parse_sample_pattern(pattern), index, count);
+      },
+      "pattern"_a, "index"_a, "count"_a,
+      "Lens position `index` of a frame of `count` samples on the unit disk: pattern 'even' (the spiral "
+      "of `count`) or 'sobol' (whatever the count).");
+  m.def(
+      "shutter_time",
+      [](double open, double close, const std::string& pattern, int index, int count) {
+        return shutter_time(open, close, parse_sample_pattern(pattern), index, count);
+      },
+      "open"_a, "close"_a, "pattern"_a, "index"_a, "count"_a,
+      "Time `index` of a frame of `count` samples of a shutter open from `open` to `close`: pattern "
+      "'even' (the middles of equal slices) or 'sobol' (whatever the count).");
+  m.def("effect_sample_point", &effect_sample_point, "index"_a,
+        "Point `index` of the progressive sample pattern in [0, 1)^3 (Sobol's sequence shifted by 1/2): "
+        "dimensions 0 and 1 place the lens position, 2 the shutter's time.");
   m.def("lens_samples", &lens_samples, "count"_a,
         "The lens positions of `count` samples on the unit disk (Vogel's golden-angle spiral), as (x, y) "
         "pairs.");
@@ -513,11 +540,17 @@ void bind(nb::module_& m) {
       .def(
           "__init__",
           [](Shutter* shutter, double open, double close, int samples, std::optional<Camera> end_camera,
-             const std::string& scan) {
-            new (shutter) Shutter{open, close, samples, std::move(end_camera), parse_shutter_scan(scan)};
+             const std::string& scan, const std::string& pattern) {
+            new (shutter) Shutter{open,
+                                  close,
+                                  samples,
+                                  std::move(end_camera),
+                                  parse_shutter_scan(scan),
+                                  parse_sample_pattern(pattern)};
             validate(*shutter);
           },
-          "open"_a = 0.0, "close"_a = 0.0, "samples"_a = 16, "end_camera"_a = nb::none(), "scan"_a = "global")
+          "open"_a = 0.0, "close"_a = 0.0, "samples"_a = 16, "end_camera"_a = nb::none(), "scan"_a = "global",
+          "pattern"_a = "even")
       .def_rw("open", &Shutter::open)
       .def_rw("close", &Shutter::close)
       .def_rw("samples", &Shutter::samples)
@@ -526,7 +559,12 @@ void bind(nb::module_& m) {
           "scan", [](const Shutter& s) { return std::string(shutter_scan_name(s.scan)); },
           [](Shutter& s, const std::string& name) { s.scan = parse_shutter_scan(name); },
           "'global' (the mean over the open interval) or a rolling shutter's 'top-to-bottom', "
-          "'bottom-to-top', 'left-to-right', 'right-to-left' (samples bands, each at its time)");
+          "'bottom-to-top', 'left-to-right', 'right-to-left' (samples bands, each at its time)")
+      .def_prop_rw(
+          "pattern", [](const Shutter& s) { return std::string(sample_pattern_name(s.pattern)); },
+          [](Shutter& s, const std::string& name) { s.pattern = parse_sample_pattern(name); },
+          "'even' (the middles of `samples` equal slices) or 'sobol' (progressive: what accumulate_samples "
+          "continues; a global shutter's)");
   m.def("shutter_times", &shutter_times, "open"_a, "close"_a, "count"_a,
         "The times of `count` samples of a shutter: the middles of equal slices of [open, close].");
   m.def("camera_between", &camera_between, "start"_a, "end"_a, "t"_a,
@@ -689,7 +727,7 @@ void bind(nb::module_& m) {
              const std::optional<ThinLens>& lens, const std::optional<Shutter>& shutter,
              const GaussianScene* scene, uint64_t memory_budget, const LodSet* lod_set, uint64_t splat_budget,
              const SceneInstances* instances, const std::optional<std::array<int, 4>>& region,
-             const std::string& stochastic_sampler, bool stochastic_accumulate) {
+             const std::string& stochastic_sampler, bool stochastic_accumulate, bool accumulate_samples) {
             RenderSettings settings = make_settings(
                 sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames, seed,
                 background, reuse_lists, near_plane, max_alpha, lens, shutter, memory_budget);
@@ -697,6 +735,7 @@ void bind(nb::module_& m) {
                 parse_choice("stochastic_sampler", stochastic_sampler,
                              std::array{StochasticSampler::kHash, StochasticSampler::kStratified});
             settings.stochastic.accumulate = stochastic_accumulate;
+            settings.accumulate_samples = accumulate_samples;
             if (region) settings.region = {(*region)[0], (*region)[1], (*region)[2], (*region)[3]};
             if (int(scene != nullptr) + int(lod_set != nullptr) + int(instances != nullptr) > 1)
               throw std::invalid_argument("render takes one of scene, lod_set and instances");
@@ -715,7 +754,7 @@ void bind(nb::module_& m) {
           "near_plane"_a = kDefaultNearPlane, "max_alpha"_a = kDefaultMaxAlpha, "lens"_a = nb::none(),
           "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0, "lod_set"_a = nb::none(),
           "splat_budget"_a = 0, "instances"_a = nb::none(), "region"_a = nb::none(),
-          "stochastic_sampler"_a = "hash", "stochastic_accumulate"_a = false,
+          "stochastic_sampler"_a = "hash", "stochastic_accumulate"_a = false, "accumulate_samples"_a = false,
           "Renders the scene from `camera`: the one set_scene uploaded, or `scene`, which replaces it and is "
           "rendered within memory_budget bytes of device memory (0: the device's own limits), "
           "in depth-ordered parts into the same image where the whole frame would need more "
@@ -736,7 +775,9 @@ void bind(nb::module_& m) {
           "culled; max_alpha the cap on one splat's alpha (0.99 as 3DGS trains, 0.999 as gsplat does); lens "
           "a ThinLens for depth of field (the mean of its samples' pinhole frames in linear light); shutter "
           "a "
-          "Shutter for motion blur (the mean of the frames at its times).")
+          "Shutter for motion blur (the mean of the frames at its times); accumulate_samples renders one "
+          "more sample of a 'sobol' lens and shutter a call and returns the mean of the calls' samples while "
+          "the view and settings stay the same (last_frame_stats['accumulated_samples'] counts them).")
       .def_prop_ro("last_frame_stats",
                    [](const RendererHandle& self) { return stats_dict(self.renderer->last_frame_stats()); })
       .def_prop_ro("device_info",

@@ -426,6 +426,28 @@ def test_depth_of_field_through_a_thin_lens(playbot_renderer):
         tilesplat.ThinLens(aperture_diameter=0.1, focus_distance=0)
 
 
+def test_lens_samples_that_add_up_call_after_call(playbot_renderer):
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 96, 54, azimuth_deg=30)
+    point = tilesplat.effect_sample_point(3)
+    assert len(point) == 3 and all(0 <= x < 1 for x in point)
+    assert tilesplat.lens_sample("sobol", 3, 1) == tilesplat.lens_sample("sobol", 3, 64)  # whatever the count
+    assert tilesplat.lens_sample("even", 2, 4) == tilesplat.lens_samples(4)[2]
+    assert tilesplat.shutter_time(0.0, 0.5, "sobol", 3, 1) == 0.5 * point[2]
+    lens = tilesplat.ThinLens(aperture_diameter=0.2, focus_distance=2.0, samples=6, pattern="sobol")
+    assert lens.pattern == "sobol"
+    six = renderer.render(camera, lens=lens)
+    for calls in range(1, 7):
+        accumulated = renderer.render(camera, lens=lens, accumulate_samples=True)
+        assert renderer.last_frame_stats["accumulated_samples"] == calls
+    np.testing.assert_allclose(accumulated.rgba, six.rgba, atol=2e-5)
+    with pytest.raises(ValueError, match="pattern must be sobol"):
+        renderer.render(camera, lens=tilesplat.ThinLens(aperture_diameter=0.2, focus_distance=2.0),
+                        accumulate_samples=True)
+    with pytest.raises(ValueError, match="known: even, sobol"):
+        tilesplat.ThinLens(aperture_diameter=0.2, focus_distance=2.0, pattern="halton")
+
+
 def test_motion_blur_through_a_shutter(playbot_renderer):
     scene, renderer = playbot_renderer
     start = tilesplat.Camera.orbit(scene, 96, 54, azimuth_deg=30)

@@ -33,6 +33,8 @@ from ._core import (
     camera_path,
     compare_images,
     devices,
+    effect_sample_point,
+    lens_sample,
     lens_sample_camera,
     lens_samples,
     load_cameras,
@@ -40,6 +42,7 @@ from ._core import (
     orbit_cameras,
     read_exr,
     render_reference,
+    shutter_time,
     shutter_times,
     sort_strategies,
 )
@@ -63,6 +66,8 @@ __all__ = [
     "camera_path",
     "compare_images",
     "devices",
+    "effect_sample_point",
+    "lens_sample",
     "lens_sample_camera",
     "lens_samples",
     "load_cameras",
@@ -71,6 +76,7 @@ __all__ = [
     "rasterization",
     "read_exr",
     "render_reference",
+    "shutter_time",
     "shutter_times",
     "sort_strategies",
 ]
