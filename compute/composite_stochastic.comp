@@ -37,6 +37,7 @@ layout(constant_id = 5) const float ALPHA_INV = 255.0;         // 1 / ALPHA_MIN,
 layout(constant_id = 6) const float MAX_ALPHA = 0.99;          // RenderSettings::max_alpha
 layout(constant_id = 7) const bool STRATIFIED = false;         // StochasticSampler::kStratified
 layout(constant_id = 8) const bool KEEP_SUMS = false;          // StochasticSettings::accumulate
+layout(constant_id = 9) const bool SOBOL = false;              // StochasticSampler::kSobol
 
 // The push constants: StochasticCompositePush in shader_io.h.
 
@@ -74,7 +75,7 @@ shared uint s_reach[BATCH];     // composite_reach.glsl
 
 uint64_t best[P];    // the nearest kept splat of each pixel: its order key, NONE if none
 uint pixel_hash[P];  // each pixel's half of the threshold hash (pixel, sample, seed)
-uint pixel_key[P];   // STRATIFIED: each pixel's half of the permutation key (pixel, seed)
+uint pixel_key[P];   // STRATIFIED, SOBOL: each pixel's half of the permutation key (pixel, seed)
 
 // lowbias32 (Chris Wellons' hash prospector): a bijection on 32 bits with near-ideal avalanche.
 uint hash32(uint x) {
@@ -111,7 +112,28 @@ uint mix_bits(uint x, uint key) {
 // splat, sample, seed) on a 2^-24 grid. STRATIFIED: the stratum this sample takes of the pixel's and
 // splat's permutation, plus a hashed jitter within it: (stratum + jitter) / M. Each sample's u is
 // uniform on [0, 1) (the permutation's key is random per pixel and splat), so the mean stays unbiased.
+// SOBOL: the effects' sequence in one dimension (engine/src/camera/effect_samples.cpp), padded across the
+// splats as Burley's "Practical Hash-based Owen Scrambling" pads dimensions: the sample index shuffled by a
+// nested scramble, its base-2 radical inverse taken, and that Owen-scrambled, both keyed per (pixel, splat,
+// seed). Each scramble is Laine and Karras's permutation on bit-reversed values (each bit changes only the
+// bits above it), so any 2^m consecutive samples still take the 2^m strata of [0, 1) once each, whatever
+// the count (progressive: StochasticSettings::accumulate continues it), while the shuffle keeps two splats'
+// thresholds from running in step from frame to frame.
+uint laine_karras(uint x, uint seed) {
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return x;
+}
 float threshold(uint p, uint splat_hash) {
+  if (SOBOL) {
+    uint key = hash32(pixel_key[p] ^ splat_hash);
+    uint radical_inverse = laine_karras(bitfieldReverse(pc.sample_index), hash32(key ^ 0x68e31da4u));
+    uint scrambled = bitfieldReverse(laine_karras(bitfieldReverse(radical_inverse), key));
+    return float(scrambled >> 8) * (1.0 / 16777216.0);
+  }
   uint h = hash32(pixel_hash[p] ^ splat_hash);
   float jitter = float(h >> 8) * (1.0 / 16777216.0);
   if (!STRATIFIED) return jitter;
@@ -175,7 +197,7 @@ void main() {
   }
   for (uint p = 0; p < P; ++p) {
     pixel_hash[p] = hash32(hash32(sample_hash ^ px) ^ (py0 + p));
-    if (STRATIFIED) pixel_key[p] = hash32(hash32(seed_key ^ px) ^ (py0 + p));
+    if (STRATIFIED || SOBOL) pixel_key[p] = hash32(hash32(seed_key ^ px) ^ (py0 + p));
     best[p] = NONE;
     if (resume && out_x < pc.width && out_y0 + p < pc.height)
       best[p] = carried.v[4 * ((out_y0 + p) * pc.width + out_x) + 3];

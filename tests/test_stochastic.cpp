@@ -159,6 +159,47 @@ TEST_P(StochasticConvergence, StratifiedSamplerConvergesFasterThanTheHash) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// The sobol sampler (the effects' Owen-scrambled sequence, per pixel and splat): stratified like the
+// stratified sampler at powers of two, so as far ahead of the hash, and progressive: calls of one frame
+// that accumulate are the one call of all of them, to the bit, which the stratified sampler cannot do.
+TEST_P(StochasticConvergence, SobolSamplerIsStratifiedAndContinuesAcrossCalls) {
+  const Case c = GetParam() == 0 ? playbot_case() : synthetic_case();
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(c.scene);
+  const RenderImage sorted = renderer.render(c.camera, over_background(RenderSettings{}));
+  std::vector<double> gain;
+  for (uint32_t n : {1u, 16u, 256u}) {
+    const RenderSettings hash = over_background(stochastic(n));
+    RenderSettings sobol = hash, stratified = hash;
+    sobol.stochastic.sampler = StochasticSampler::kSobol;
+    stratified.stochastic.sampler = StochasticSampler::kStratified;
+    const double psnr_hash = compare_images(renderer.render(c.camera, hash), sorted).psnr_db;
+    const double psnr_stratified = compare_images(renderer.render(c.camera, stratified), sorted).psnr_db;
+    const double psnr_sobol = compare_images(renderer.render(c.camera, sobol), sorted).psnr_db;
+    std::printf("[ measure  ] %s %dx%d: %4u frames: hash %.2f dB, stratified %.2f dB, sobol %.2f dB\n",
+                c.name.c_str(), c.camera.width, c.camera.height, n, psnr_hash, psnr_stratified, psnr_sobol);
+    gain.push_back(psnr_sobol - psnr_hash);
+    if (n > 1) {
+      EXPECT_NEAR(psnr_sobol, psnr_stratified, 1.0) << c.name << ", " << n << " frames";
+    }
+  }
+  EXPECT_NEAR(gain[0], 0.0, 1.0) << c.name;  // one frame: one uniform threshold per splat either way
+  EXPECT_GT(gain[1], 1.5) << c.name;
+  EXPECT_GT(gain[2], gain[1]) << c.name;
+
+  RenderSettings one = over_background(stochastic(1));
+  one.stochastic.sampler = StochasticSampler::kSobol;
+  one.stochastic.accumulate = true;
+  RenderImage image;
+  for (uint32_t k = 1; k <= 5; ++k) image = renderer.render(c.camera, one);
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_frames, 5u);
+  RenderSettings five = one;
+  five.stochastic.frames = 5;
+  five.stochastic.accumulate = false;
+  EXPECT_EQ(image.rgba, renderer.render(c.camera, five).rgba);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 // tilesplat-render --stochastic N --stochastic-sampler stratified renders what RenderSettings does and
 // records the sampler; a bad name, or the flag without the stochastic compositor, is a usage error.
 TEST(Stochastic, RenderCommandLineChoosesTheSampler) {
@@ -182,7 +223,8 @@ TEST(Stochastic, RenderCommandLineChoosesTheSampler) {
 
   const testing::ProcessResult bad = render({"--stochastic", "8", "--stochastic-sampler", "blue"}, "bad.exr");
   EXPECT_EQ(bad.exit_code, 2);
-  EXPECT_NE(bad.err.find("--stochastic-sampler must be hash or stratified, got 'blue'"), std::string::npos)
+  EXPECT_NE(bad.err.find("--stochastic-sampler must be hash, stratified or sobol, got 'blue'"),
+            std::string::npos)
       << bad.err;
   const testing::ProcessResult alone = render({"--stochastic-sampler", "stratified"}, "alone.exr");
   EXPECT_EQ(alone.exit_code, 2);

@@ -138,12 +138,13 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
       "--stochastic-sampler", "NAME",
       "how the stochastic compositor draws its thresholds: hash (independent frames, the default) "
       "or stratified (each splat's N thresholds at a pixel one per stratum of [0, 1): faster "
-      "convergence)",
+      "convergence) or sobol (stratified at powers of two, and progressive: the effects' Owen-scrambled "
+      "sequence)",
       [&options](const std::string& text) {
         try {
           options.stochastic_sampler = tilesplat::parse_stochastic_sampler(text);
         } catch (const std::invalid_argument&) {
-          throw cli::UsageError("--stochastic-sampler must be hash or stratified, got " +
+          throw cli::UsageError("--stochastic-sampler must be hash, stratified or sobol, got " +
                                 cli::single_quoted(text));
         }
       });

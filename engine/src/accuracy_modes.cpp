@@ -38,13 +38,23 @@ Compositor parse_compositor(const std::string& name) {
 }
 
 std::string to_string(StochasticSampler sampler) {
-  return sampler == StochasticSampler::kStratified ? "stratified" : "hash";
+  switch (sampler) {
+    case StochasticSampler::kHash:
+      return "hash";
+    case StochasticSampler::kStratified:
+      return "stratified";
+    case StochasticSampler::kSobol:
+      return "sobol";
+  }
+  return "unknown";
 }
 
 StochasticSampler parse_stochastic_sampler(const std::string& name) {
-  for (StochasticSampler s : {StochasticSampler::kHash, StochasticSampler::kStratified})
+  for (StochasticSampler s :
+       {StochasticSampler::kHash, StochasticSampler::kStratified, StochasticSampler::kSobol})
     if (to_string(s) == name) return s;
-  throw std::invalid_argument("unknown stochastic sampler '" + name + "' (expected hash or stratified)");
+  throw std::invalid_argument("unknown stochastic sampler '" + name +
+                              "' (expected hash, stratified or sobol)");
 }
 
 namespace {

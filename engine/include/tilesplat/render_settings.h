@@ -150,8 +150,14 @@ enum class StochasticSampler {
   /// coverage is then exact to about 1/N; what is left is the interplay between splats.
   /// docs/compositors.md has its curve.
   kStratified,
+  /// The effects' progressive sequence (tilesplat/effect_samples.h) in one dimension: frame k's threshold
+  /// is the radical inverse of k's nested shuffle, Owen-scrambled, both keyed per (pixel, splat, seed)
+  /// by the same hash (so that two splats' thresholds do not run in step). Any 2^m consecutive frames
+  /// take each stratum [j/2^m, (j+1)/2^m) once, whatever the count, so that it converges like
+  /// kStratified at powers of two and, unlike it, continues across calls (StochasticSettings::accumulate).
+  kSobol,
 };
-/// "hash", "stratified".
+/// "hash", "stratified", "sobol".
 TILESPLAT_API std::string to_string(StochasticSampler sampler);
 /// The inverse of to_string; throws std::invalid_argument naming the text and the choices.
 TILESPLAT_API StochasticSampler parse_stochastic_sampler(const std::string& name);

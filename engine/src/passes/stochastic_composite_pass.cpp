@@ -36,10 +36,10 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
       texel_buffers_ ? composite_texel_views(in.splats, in.tile_lists, out, in.write_depth, in.write_count,
                                              unused_output_)
                      : std::vector<VkBufferView>{};
-  const Variant variant{in.write_depth,   in.write_count,
-                        in.cutoffs.alpha, in.cutoffs.max_alpha,
-                        !views.empty(),   samples.sampler == StochasticSampler::kStratified,
-                        samples.keep_sums};
+  const Variant variant{in.write_depth,    in.write_count,
+                        in.cutoffs.alpha,  in.cutoffs.max_alpha,
+                        !views.empty(),    samples.sampler == StochasticSampler::kStratified,
+                        samples.keep_sums, samples.sampler == StochasticSampler::kSobol};
   auto it = pipelines_.find(variant);
   if (it == pipelines_.end()) {
     it = pipelines_
@@ -56,7 +56,8 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
                       {5, std::bit_cast<uint32_t>(coverage_alpha_inv(variant.alpha_cutoff))},
                       {6, std::bit_cast<uint32_t>(variant.max_alpha)},
                       {7, variant.stratified ? 1u : 0u},
-                      {8, variant.keep_sums ? 1u : 0u}},
+                      {8, variant.keep_sums ? 1u : 0u},
+                      {9, variant.sobol ? 1u : 0u}},
                      variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
              .first;
   }

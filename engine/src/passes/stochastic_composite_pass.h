@@ -55,6 +55,7 @@ class StochasticCompositePass {
     bool texel_buffers = false;  // the CPU layout (composite_stochastic_texel)
     bool stratified = false;     // StochasticSampler::kStratified (STRATIFIED)
     bool keep_sums = false;      // the last sample keeps the sums in the state (KEEP_SUMS)
+    bool sobol = false;          // StochasticSampler::kSobol (SOBOL)
     auto operator<=>(const Variant&) const = default;
   };
   std::map<Variant, vk::ComputePipeline> pipelines_;
