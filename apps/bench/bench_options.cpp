@@ -155,7 +155,7 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
       "while the camera turns 5 degrees about the centre), with N samples (default 1,2,4,...,128); per "
       "row the GPU time, the time per sample, and PSNR and max abs against 1,024 samples of the same "
       "effect (docs/effects.md); 'lens-sobol' and 'time-sobol' the same with the progressive sample "
-      "pattern; 'stochastic' or 'stochastic-stratified': the stochastic compositor's "
+      "pattern; 'stochastic', 'stochastic-stratified' or 'stochastic-sobol': the stochastic compositor's "
       "frames with either sampler, against the sorted frame; --markdown, --csv and --plot (PSNR against "
       "samples) write the report",
       [&options](const std::string& text) {
@@ -165,7 +165,7 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
         if (!options.sample_curve)
           throw cli::UsageError(
               "--sample-curve takes 'lens' or 'time' (or 'lens-sobol', 'time-sobol', 'stochastic', "
-              "'stochastic-stratified'), optionally "
+              "'stochastic-stratified', 'stochastic-sobol'), optionally "
               "with ':N,N,...', got " +
               cli::single_quoted(text));
         if (colon != std::string::npos)

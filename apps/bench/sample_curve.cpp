@@ -51,6 +51,8 @@ std::string what_is_averaged(Effect effect) {
       return "the stochastic compositor's frames, thresholds from the hash";
     case Effect::kStochasticStratified:
       return "the stochastic compositor's frames, thresholds from the stratified sampler";
+    case Effect::kStochasticSobol:
+      return "the stochastic compositor's frames, thresholds from the sobol sampler";
   }
   return "";
 }
@@ -77,19 +79,22 @@ std::string effect_name(Effect effect) {
       return "stochastic";
     case Effect::kStochasticStratified:
       return "stochastic-stratified";
+    case Effect::kStochasticSobol:
+      return "stochastic-sobol";
   }
   return "";
 }
 
 std::optional<Effect> parse_effect(const std::string& name) {
   for (Effect e : {Effect::kLens, Effect::kTime, Effect::kLensSobol, Effect::kTimeSobol, Effect::kStochastic,
-                   Effect::kStochasticStratified})
+                   Effect::kStochasticStratified, Effect::kStochasticSobol})
     if (effect_name(e) == name) return e;
   return std::nullopt;
 }
 
 bool held_to_sorted_frame(Effect effect) {
-  return effect == Effect::kStochastic || effect == Effect::kStochasticStratified;
+  return effect == Effect::kStochastic || effect == Effect::kStochasticStratified ||
+         effect == Effect::kStochasticSobol;
 }
 
 namespace {
@@ -111,7 +116,8 @@ RenderSettings effect_settings(const Options& options, const Camera& view, int s
     settings.stochastic.frames = uint32_t(samples);
     settings.stochastic.sampler = options.effect == Effect::kStochasticStratified
                                       ? StochasticSampler::kStratified
-                                      : StochasticSampler::kHash;
+                                  : options.effect == Effect::kStochasticSobol ? StochasticSampler::kSobol
+                                                                               : StochasticSampler::kHash;
   } else if (options.effect == Effect::kLens || options.effect == Effect::kLensSobol) {
     const double focus = view.to_camera(options.centre)[2];
     settings.lens = {

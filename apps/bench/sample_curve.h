@@ -26,8 +26,16 @@ namespace tilesplat::sample_curve {
 
 // The lens and the shutter with their even pattern (lens_samples, shutter_times) or the progressive one
 // (SamplePattern::kSobol); the stochastic compositor with either sampler.
-enum class Effect { kLens, kTime, kLensSobol, kTimeSobol, kStochastic, kStochasticStratified };
-// "lens", "time", "lens-sobol", "time-sobol", "stochastic", "stochastic-stratified"
+enum class Effect {
+  kLens,
+  kTime,
+  kLensSobol,
+  kTimeSobol,
+  kStochastic,
+  kStochasticStratified,
+  kStochasticSobol,
+};
+// "lens", "time", "lens-sobol", "time-sobol", "stochastic", "stochastic-stratified", "stochastic-sobol"
 std::string effect_name(Effect effect);
 // The inverse of effect_name, or nothing.
 std::optional<Effect> parse_effect(const std::string& name);

@@ -733,7 +733,8 @@ void bind(nb::module_& m) {
                 background, reuse_lists, near_plane, max_alpha, lens, shutter, memory_budget);
             settings.stochastic.sampler =
                 parse_choice("stochastic_sampler", stochastic_sampler,
-                             std::array{StochasticSampler::kHash, StochasticSampler::kStratified});
+                             std::array{StochasticSampler::kHash, StochasticSampler::kStratified,
+                                        StochasticSampler::kSobol});
             settings.stochastic.accumulate = stochastic_accumulate;
             settings.accumulate_samples = accumulate_samples;
             if (region) settings.region = {(*region)[0], (*region)[1], (*region)[2], (*region)[3]};
@@ -766,7 +767,8 @@ void bind(nb::module_& m) {
           "Keyword arguments are RenderSettings' fields: accuracy is a mode "
           "string ('reference', 'depth16+fp16-sh', ...), antialiasing 'classic', 'antialiased' or 'mip', "
           "compositor 'sorted', 'stochastic' or 'raster' (the depth-sorted splats drawn as quads by the "
-          "graphics pipeline); stochastic_sampler 'hash' or 'stratified' (the stochastic compositor's "
+          "graphics pipeline); stochastic_sampler 'hash', 'stratified' or 'sobol' (the stochastic "
+          "compositor's "
           "thresholds: each splat's stratified over the frames, converging faster); stochastic_accumulate "
           "adds "
           "this call's frames to the previous calls' mean while the view and settings stay the same "

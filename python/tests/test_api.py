@@ -129,7 +129,7 @@ def test_settings_are_keyword_arguments(playbot_renderer):
     assert not np.array_equal(stratified.rgba, stochastic.rgba)
     assert (tilesplat.compare_images(stratified, exact)["psnr_db"]
             > tilesplat.compare_images(stochastic, exact)["psnr_db"])
-    with pytest.raises(ValueError, match="stochastic_sampler must be one of hash, stratified, got 'blue'"):
+    with pytest.raises(ValueError, match="stochastic_sampler must be one of hash, stratified, sobol, got 'blue'"):
         renderer.render(camera, compositor="stochastic", stochastic_sampler="blue")
     # Frames that add up across calls: four calls of one frame are one call of four.
     for calls in range(1, 5):
