@@ -26,6 +26,7 @@
 
 using namespace tilesplat;
 using tilesplat::testing::error_of;
+using tilesplat::testing::max_abs_difference;
 
 namespace {
 
@@ -41,12 +42,6 @@ bool is_net(uint32_t first, int bits, size_t x, size_t y) {
     if (boxes.size() != size_t(1) << bits) return false;
   }
   return true;
-}
-
-float max_abs_difference(const std::vector<float>& a, const std::vector<float>& b) {
-  float most = 0;
-  for (size_t i = 0; i < a.size(); ++i) most = std::max(most, std::abs(a[i] - b[i]));
-  return most;
 }
 
 }  // namespace

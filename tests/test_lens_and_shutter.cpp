@@ -22,6 +22,7 @@
 #include "tilesplat/shutter.h"
 
 using namespace tilesplat;
+using tilesplat::testing::max_abs_difference;
 
 namespace {
 
@@ -45,12 +46,6 @@ RenderImage linear_mean(const std::vector<RenderImage>& frames, bool opaque = fa
   RenderImage image = frames.front();
   image.rgba = convert_colours(mean, ColourEncoding::kSceneLinear, ColourEncoding::kSrgbDisplay, opaque);
   return image;
-}
-
-float max_abs_difference(const std::vector<float>& a, const std::vector<float>& b) {
-  float most = 0;
-  for (size_t i = 0; i < a.size(); ++i) most = std::max(most, std::abs(a[i] - b[i]));
-  return most;
 }
 
 }  // namespace

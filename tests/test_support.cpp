@@ -168,4 +168,10 @@ void replay_fuzz_regressions(const std::string& reader, size_t at_least,
   }
 }
 
+float max_abs_difference(const std::vector<float>& a, const std::vector<float>& b) {
+  float most = 0;
+  for (size_t i = 0; i < a.size(); ++i) most = std::max(most, std::abs(a[i] - b[i]));
+  return most;
+}
+
 }  // namespace tilesplat::testing

@@ -70,6 +70,9 @@ struct CutoffAwareDifference {
 };
 // Needs splat counts in both images (RenderSettings::splat_count, the default).
 CutoffAwareDifference compare_allowing_cutoff_flips(const RenderImage& gpu, const RenderImage& reference);
+
+// The largest |a[i] - b[i]| over two arrays of the same length (0 for empty ones).
+float max_abs_difference(const std::vector<float>& a, const std::vector<float>& b);
 // The usual bounds: agreeing pixels within `max_abs` (colour and alpha), at most one pixel in 1,000
 // flipped, each by one splat and by less than 1/64 (a splat's whole contribution stays below that at
 // the cut-offs only because the transmittance left there is small).

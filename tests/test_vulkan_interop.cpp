@@ -802,9 +802,7 @@ TEST_F(HostApplication, LensSamplesAccumulateFrameAfterFrameInTheHostsImage) {
   read_image(image.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
   std::vector<float> rgba(expected.size());
   std::memcpy(rgba.data(), staging_data, rgba.size() * sizeof(float));
-  float most = 0;
-  for (size_t i = 0; i < rgba.size(); ++i) most = std::max(most, std::abs(rgba[i] - expected[i]));
-  EXPECT_LE(most, 2e-5f);
+  EXPECT_LE(testing::max_abs_difference(rgba, expected), 2e-5f);
   // The blocking form continues the same sums; any other frame ends them.
   render_to_image(*renderer, camera, settings, target);
   EXPECT_EQ(renderer->last_frame_stats().accumulated_samples, uint32_t(kSamples + 1));
