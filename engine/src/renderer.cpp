@@ -262,31 +262,25 @@ Renderer::Impl::FrameInput Renderer::Impl::next_frame_input(const Camera& camera
 
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
   Impl& r = *impl_;
-  if (settings.accumulate_samples && averages_samples(settings)) {
-    // One more sample of the lens and the shutter, added to the earlier calls' on the device.
-    const auto start = std::chrono::steady_clock::now();
-    if (r.image_bands(camera, settings).size() > 1)
-      throw std::invalid_argument(
-          "RenderSettings::accumulate_samples: the image is larger than the device renders in one band; "
-          "render its samples in one call, without accumulate_samples");
-    const Impl::FrameInput sample = r.next_frame_input(camera, settings);
-    r.render_frame(sample.camera, sample.settings);
-    RenderImage image = r.read_image(sample.camera, sample.settings);
-    r.stats.cpu_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    return image;
-  }
-  if (averages_samples(settings))  // depth of field, motion blur
+  const bool accumulates = settings.accumulate_samples && averages_samples(settings);
+  if (averages_samples(settings) && !accumulates)  // depth of field, motion blur
     return r.average_samples(camera, settings,
                              [&](const Camera& sample_camera, const RenderSettings& sample_settings, double) {
                                return render(sample_camera, sample_settings);
                              });
-  if (const std::vector<PixelRegion> bands = r.image_bands(camera, settings); bands.size() > 1)
+  if (const std::vector<PixelRegion> bands = r.image_bands(camera, settings); bands.size() > 1) {
+    if (accumulates)
+      throw std::invalid_argument(
+          "RenderSettings::accumulate_samples: the image is larger than the device renders in one band; "
+          "render its samples in one call, without accumulate_samples");
     return r.render_bands(camera, settings, bands,
                           [&](const RenderSettings& band) { return render(camera, band); });
+  }
   const auto start = std::chrono::steady_clock::now();
-  r.render_frame(camera, settings);
-  RenderImage image = r.read_image(camera, settings);
+  // The frame, or one more sample of the lens and the shutter added to the earlier calls' on the device.
+  const Impl::FrameInput frame = r.next_frame_input(camera, settings);
+  r.render_frame(frame.camera, frame.settings);
+  RenderImage image = r.read_image(frame.camera, frame.settings);
   r.stats.cpu_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return image;
