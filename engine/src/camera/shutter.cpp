@@ -16,6 +16,11 @@ void check_times(double open, double close) {
                                 std::to_string(open) + " and " + std::to_string(close));
 }
 
+// The even pattern's time: the middle of slice `index` of `count` equal slices of [open, close].
+double slice_middle(double open, double close, int index, int count) {
+  return open + (index + 0.5) * (close - open) / count;
+}
+
 void check_count(const char* what, int count) {
   if (count < 1 || count > kMaxShutterSamples)
     throw std::invalid_argument(std::string(what) + ": count must be 1 to " +
@@ -69,7 +74,7 @@ std::vector<double> shutter_times(double open, double close, int count) {
   check_times(open, close);
   check_count("shutter_times", count);
   std::vector<double> times(static_cast<size_t>(count));
-  for (int i = 0; i < count; ++i) times[static_cast<size_t>(i)] = open + (i + 0.5) * (close - open) / count;
+  for (int i = 0; i < count; ++i) times[static_cast<size_t>(i)] = slice_middle(open, close, i, count);
   return times;
 }
 
@@ -80,7 +85,7 @@ double shutter_time(double open, double close, SamplePattern pattern, int index,
     throw std::invalid_argument("shutter_time: index " + std::to_string(index) + " is outside the " +
                                 sample_pattern_name(pattern) + " pattern's " + std::to_string(count) +
                                 " samples");
-  if (pattern == SamplePattern::kEven) return open + (index + 0.5) * (close - open) / count;
+  if (pattern == SamplePattern::kEven) return slice_middle(open, close, index, count);
   return open + (close - open) * effect_sample_point(uint32_t(index))[2];
 }
 
