@@ -417,6 +417,50 @@ TEST_F(MovingModels, AreTheLinearMeanOfTheScenesAtTheShutterTimes) {
   EXPECT_EQ(fresh->validation_messages(), 0u);
 }
 
+// A renderer that keeps the copies (set_scene of SceneInstances) places them per time sample itself: the
+// frames of render(instances, camera, settings) without an upload per call, and samples that add up.
+TEST_F(MovingModels, ASetSceneOfCopiesPlacesThemAtEachSamplesTime) {
+  Renderer& renderer = *renderer_;
+  RenderSettings settings;
+  settings.shutter = {.open = 0.1,
+                      .close = 0.9,
+                      .samples = 5,
+                      .end_camera = std::nullopt,
+                      .scan = ShutterScan::kGlobal,
+                      .pattern = SamplePattern::kSobol};
+  const RenderImage uploaded_per_sample = renderer.render(instances_, camera_, settings);
+  renderer.set_scene(merge_instances(instances_));
+  const RenderImage still = renderer.render(camera_);
+
+  renderer.set_scene(instances_);
+  EXPECT_EQ(renderer.render(camera_).rgba, still.rgba);  // closed: where they are at time 0
+  const RenderImage blurred = renderer.render(camera_, settings);
+  EXPECT_EQ(renderer.last_frame_stats().samples, 5);
+  EXPECT_EQ(blurred.rgba, uploaded_per_sample.rgba);
+  EXPECT_EQ(renderer.render(camera_).rgba, still.rgba);  // closed again: placed back at time 0
+
+  // One time sample a call, added up on the device: the frame of all of them.
+  settings.accumulate_samples = true;
+  RenderImage accumulated;
+  for (int call = 1; call <= 5; ++call) {
+    accumulated = renderer.render(camera_, settings);
+    ASSERT_EQ(renderer.last_frame_stats().accumulated_samples, uint32_t(call));
+  }
+  EXPECT_LE(max_abs_difference(accumulated.rgba, blurred.rgba), 2e-5f);
+  // The copies' placings do not restart the sums; another scene does.
+  renderer.set_scene(instances_);
+  renderer.render(camera_, settings);
+  EXPECT_EQ(renderer.last_frame_stats().accumulated_samples, 1u);
+  // A scene without moving copies keeps nothing: an open shutter over it without an end camera blurs
+  // nothing.
+  SceneInstances still_copies = instances_;
+  still_copies.instances[1].end_transform.reset();
+  renderer.set_scene(still_copies);
+  settings.accumulate_samples = false;
+  EXPECT_EQ(renderer.render(camera_, settings).rgba, still.rgba);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 TEST_F(MovingModels, ARollingShutterPlacesEachBandsScene) {
   RenderSettings settings;
   settings.shutter = {

@@ -211,8 +211,33 @@ void Renderer::set_scene(const GaussianScene& scene) {
   Impl& r = *impl_;
   r.wait_for_submitted_frame();  // it reads the scene's buffers
   ++r.scene_generation;          // the tile lists in the buffers are the previous scene's
+  ++r.scene_identity;
+  r.moving_copies.reset();
   r.resources.upload_scene(scene);
   r.scene_in_parts = false;
+}
+
+void Renderer::set_scene(SceneInstances scene) {
+  set_scene(merge_instances(scene));  // where the copies are at time 0
+  if (!scene.moves()) return;
+  impl_->moving_copies = std::move(scene);
+  impl_->moving_copies_time = 0.0;
+}
+
+RenderSettings Renderer::Impl::settings_over_moving_copies(const Camera& camera,
+                                                           const RenderSettings& settings) {
+  if (!moving_copies) return settings;
+  if (settings.shutter.opens()) return shutter_over_moving_models(settings, camera);
+  place_moving_copies(0.0);
+  return settings;
+}
+
+void Renderer::Impl::place_moving_copies(double time) {
+  if (!moving_copies || time == moving_copies_time) return;
+  wait_for_submitted_frame();  // it reads the scene's buffers
+  ++scene_generation;          // the tile lists in the buffers are of the copies elsewhere
+  resources.upload_scene(merge_instances(*moving_copies, time));
+  moving_copies_time = time;
 }
 
 RenderImage Renderer::Impl::average_samples(const Camera& camera, const RenderSettings& settings,
@@ -238,7 +263,7 @@ Renderer::Impl::FrameInput Renderer::Impl::next_frame_input(const Camera& camera
   if (!settings.accumulate_samples || !averages_samples(settings)) return {camera, settings};
   check_accumulated_samples(settings, camera);
   wait_for_submitted_frame();  // the sums it leaves, if it completes, are the ones to continue
-  SampleAccumulation sums{scene_generation, camera, settings, 0};
+  SampleAccumulation sums{scene_identity, camera, settings, 0};
   sums.settings.lens.samples = sums.settings.shutter.samples = 0;  // one sample a call, whatever they say
   if (accumulated_samples) sums.samples = accumulated_samples->samples;
   if (!accumulated_samples || !(sums == *accumulated_samples)) sums.samples = 0;
@@ -248,9 +273,11 @@ Renderer::Impl::FrameInput Renderer::Impl::next_frame_input(const Camera& camera
   // Sample `index`: the camera at its time, seen from its point of the aperture (one joint sample).
   FrameInput sample{camera, settings};
   const Shutter& shutter = settings.shutter;
-  if (shutter.enabled())
-    sample.camera = camera_between(camera, *shutter.end_camera,
-                                   shutter_time(shutter.open, shutter.close, shutter.pattern, index, 1));
+  if (shutter.enabled()) {
+    const double time = shutter_time(shutter.open, shutter.close, shutter.pattern, index, 1);
+    sample.camera = camera_between(camera, *shutter.end_camera, time);
+    place_moving_copies(time);  // copies that move (set_scene of SceneInstances) where they are then
+  }
   if (settings.lens.enabled())
     sample.camera =
         lens_sample_camera(sample.camera, settings.lens, lens_sample(settings.lens.pattern, index, 1));
@@ -261,28 +288,32 @@ Renderer::Impl::FrameInput Renderer::Impl::next_frame_input(const Camera& camera
 }
 
 RenderImage Renderer::render(const Camera& camera, const RenderSettings& settings) {
-  Impl& r = *impl_;
+  return impl_->render_set_scene(camera, impl_->settings_over_moving_copies(camera, settings));
+}
+
+RenderImage Renderer::Impl::render_set_scene(const Camera& camera, const RenderSettings& settings) {
   const bool accumulates = settings.accumulate_samples && averages_samples(settings);
   if (averages_samples(settings) && !accumulates)  // depth of field, motion blur
-    return r.average_samples(camera, settings,
-                             [&](const Camera& sample_camera, const RenderSettings& sample_settings, double) {
-                               return render(sample_camera, sample_settings);
-                             });
-  if (const std::vector<PixelRegion> bands = r.image_bands(camera, settings); bands.size() > 1) {
+    return average_samples(
+        camera, settings,
+        [&](const Camera& sample_camera, const RenderSettings& sample_settings, double time) {
+          if (settings.shutter.opens()) place_moving_copies(time);  // (a lens alone samples no time)
+          return render_set_scene(sample_camera, sample_settings);
+        });
+  if (const std::vector<PixelRegion> bands = image_bands(camera, settings); bands.size() > 1) {
     if (accumulates)
       throw std::invalid_argument(
           "RenderSettings::accumulate_samples: the image is larger than the device renders in one band; "
           "render its samples in one call, without accumulate_samples");
-    return r.render_bands(camera, settings, bands,
-                          [&](const RenderSettings& band) { return render(camera, band); });
+    return render_bands(camera, settings, bands,
+                        [&](const RenderSettings& band) { return render_set_scene(camera, band); });
   }
   const auto start = std::chrono::steady_clock::now();
   // The frame, or one more sample of the lens and the shutter added to the earlier calls' on the device.
-  const Impl::FrameInput frame = r.next_frame_input(camera, settings);
-  r.render_frame(frame.camera, frame.settings);
-  RenderImage image = r.read_image(frame.camera, frame.settings);
-  r.stats.cpu_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const FrameInput frame = next_frame_input(camera, settings);
+  render_frame(frame.camera, frame.settings);
+  RenderImage image = read_image(frame.camera, frame.settings);
+  stats.cpu_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return image;
 }
 

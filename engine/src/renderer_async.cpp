@@ -106,9 +106,10 @@ std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device,
   return RendererAccess::make(std::make_unique<Renderer::Impl>(options, device));
 }
 
-void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& asked,
                      const ExternalImage& target) {
   Renderer::Impl& r = RendererAccess::impl(renderer);
+  const RenderSettings settings = r.settings_over_moving_copies(camera, asked);
   check_images(target, nullptr, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   const Renderer::Impl::FrameInput frame = r.next_frame_input(camera, settings);  // a sample, if accumulating
@@ -120,9 +121,10 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& asked,
                      const ExternalImage& target, const ExternalDepthImage& depth) {
   Renderer::Impl& r = RendererAccess::impl(renderer);
+  const RenderSettings settings = r.settings_over_moving_copies(camera, asked);
   check_images(target, &depth, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   const Renderer::Impl::FrameInput frame = r.next_frame_input(camera, settings);  // a sample, if accumulating
@@ -134,10 +136,11 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& asked,
                      const ExternalImage& target, const ExternalDepthImage* depth,
                      const HostFrameSync& sync) {
   Renderer::Impl& r = RendererAccess::impl(renderer);
+  const RenderSettings settings = r.settings_over_moving_copies(camera, asked);
   check_images(target, depth, camera, settings);
   auto check_count = [](size_t count, size_t semaphores, const char* what) {
     if (count != 0 && count != semaphores)
@@ -153,10 +156,11 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
                  {sync.wait, sync.wait_stages, sync.wait_values, sync.signal, sync.signal_values});
 }
 
-void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& settings,
+void render_to_image(Renderer& renderer, const Camera& camera, const RenderSettings& asked,
                      const ExternalImage& target, const ExternalDepthImage* depth,
                      const HostCommandBuffer& commands) {
   Renderer::Impl& r = RendererAccess::impl(renderer);
+  const RenderSettings settings = r.settings_over_moving_copies(camera, asked);
   check_images(target, depth, camera, settings);
   if (commands.command_buffer == VK_NULL_HANDLE)
     throw std::invalid_argument("render_to_image: HostCommandBuffer has no command buffer");

@@ -23,6 +23,7 @@
 #include "frame/scene_parts.h"
 #include "sort/sort_strategy.h"
 #include "tilesplat/renderer.h"
+#include "tilesplat/scene_description.h"
 #include "tilesplat/vulkan_interop.h"
 #include "vulkan/command_stream.h"
 #include "vulkan/context.h"
@@ -59,7 +60,7 @@ struct Renderer::Impl {
   // rendered for (the settings with their sample counts at 0, which do not matter a sample at a time),
   // and how many there are. A call continues them when it matches.
   struct SampleAccumulation {
-    uint64_t scene_generation = 0;
+    uint64_t scene_identity = 0;
     Camera camera;
     RenderSettings settings;
     uint32_t samples = 0;
@@ -73,6 +74,16 @@ struct Renderer::Impl {
     RenderSettings settings;
   };
   FrameInput next_frame_input(const Camera& camera, const RenderSettings& settings);
+  // The settings a frame of the scene set is rendered with: over copies that move (set_scene of
+  // SceneInstances), an open shutter blurs them (over a still camera unless it has an end camera of its
+  // own), and a closed one sees them at time 0, placed there; any other scene, `settings` as they are.
+  RenderSettings settings_over_moving_copies(const Camera& camera, const RenderSettings& settings);
+  // The moving copies placed where they are at `time` (SceneInstances::Instance::at) and uploaded,
+  // unless the buffers have them there already.
+  void place_moving_copies(double time);
+  // Renderer::render(camera, settings) of the scene as the buffers hold it (settings_over_moving_copies
+  // applied): the frame, its averaged samples, its bands, or one more accumulated sample.
+  RenderImage render_set_scene(const Camera& camera, const RenderSettings& settings);
   struct FrameStart {
     FramePlan plan;
     SortStrategy* sorter = nullptr;
@@ -166,6 +177,11 @@ struct Renderer::Impl {
   std::optional<SampleAccumulation> accumulated_samples;  // the sample sums the last frame left
   std::optional<SampleAccumulation> next_frame_samples;   // next_frame_input's, for begin_frame to take
   uint64_t scene_generation = 0;            // counts set_scene calls (and scene parts uploaded)
+  // What accumulated samples are of: counts the scenes set and the renders in parts, but not the
+  // placings of moving copies (a sample's time places them anew in the same scene).
+  uint64_t scene_identity = 0;
+  std::optional<SceneInstances> moving_copies;  // set_scene(SceneInstances) of copies that move
+  double moving_copies_time = 0;                // where the buffers have them
   bool scene_in_parts = false;              // the buffers hold a part of a scene, not a whole one
   uint64_t parts_budget = 0;                // the memory budget those parts were sized for
   bool rendering_parts = false;             // within render_in_parts: its frames are parts

@@ -106,6 +106,8 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
     ~RenderingParts() { flag = false; }
   } rendering(rendering_parts);
   ++scene_generation;
+  ++scene_identity;
+  moving_copies.reset();  // the buffers hold parts from now on
   lists.reset();
   FrameStats total;
   total.scene_parts = 0;

@@ -163,6 +163,13 @@ class TILESPLAT_API Renderer {
   /// previous scene is released. Throws std::invalid_argument for a scene whose arrays disagree in
   /// size, std::runtime_error for one beyond the device's memory or 2^30 Gaussians.
   void set_scene(const GaussianScene& scene);
+  /// Sets a scene file's placed copies (load_scene_instances): merged and copied as set_scene(scene) does.
+  /// Copies that move (SceneInstances::moves) are kept, and each frame places them where its shutter
+  /// sees them: render(camera, settings) under an open shutter (settings.shutter: close > open, with or
+  /// without an end camera) blurs them as render(scene, camera, settings) does, one time sample a call with
+  /// settings.accumulate_samples (render_to_image too); a closed shutter sees them at time 0. Take the
+  /// scene by std::move to keep no second copy of its files. Throws as set_scene(scene) does.
+  void set_scene(SceneInstances scene);
 
   /// Renders one frame of the scene last set and reads it back; the GPU work has finished when it
   /// returns. Throws std::runtime_error for a camera it cannot render (invalid, see validate(), or
