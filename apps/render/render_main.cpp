@@ -65,6 +65,33 @@ std::string shortest_exact(Number value) {
   return std::string(digits, std::to_chars(digits, digits + sizeof(digits), value).ptr);
 }
 
+// --shutter-samples and --sample-pattern without --shutter (--aperture, --f-stop) shape the scene file's
+// shutters (lenses) for the views rendered; a UsageError when there is nothing for them to shape.
+void reshape_scene_effects(const cli::ArgParser& parser, const RenderOptions& options,
+                           std::vector<Frame>& frames) {
+  const bool samples = parser.seen("--shutter-samples"), pattern = parser.seen("--sample-pattern");
+  bool shutters = false, lenses = false;
+  for (Frame& frame : frames) {
+    if (!options.shutter.enabled() && frame.shutter.opens()) {
+      shutters = true;
+      if (samples) frame.shutter.samples = options.shutter.samples;
+      if (pattern) frame.shutter.pattern = options.shutter.pattern;
+    }
+    if (!options.lens.enabled() && frame.lens.enabled()) {
+      lenses = true;
+      if (pattern) frame.lens.pattern = options.lens.pattern;
+    }
+  }
+  if (samples && !options.shutter.enabled() && !shutters)
+    throw cli::UsageError(
+        "--shutter-samples shapes the shutter, and no --shutter gave one (nor the scene file, for the views "
+        "rendered)");
+  if (pattern && !options.lens.enabled() && !options.shutter.enabled() && !shutters && !lenses)
+    throw cli::UsageError(
+        "--sample-pattern places lens and shutter samples: add --aperture, --f-stop or --shutter (or a scene "
+        "file whose views have a lens or a shutter)");
+}
+
 // What the EXR's renderSettings attribute records: everything that changes the image.
 std::string settings_text(const tilesplat::RenderSettings& settings, const LensFlags& lens,
                           const ShutterFlags& shutter, const std::optional<cli::LoadedLodSet>& lod) {
@@ -92,7 +119,10 @@ std::string settings_text(const tilesplat::RenderSettings& settings, const LensF
   else if (settings.lens.enabled())  // a scene file's lens for the view
     text += " lens=aperture:" + shortest_exact(settings.lens.aperture_diameter) +
             ",focus:" + shortest_exact(settings.lens.focus_distance) +
-            ",samples:" + std::to_string(settings.lens.samples);
+            ",samples:" + std::to_string(settings.lens.samples) +
+            (settings.lens.pattern == tilesplat::SamplePattern::kEven
+                 ? ""
+                 : ",pattern:" + std::string(tilesplat::sample_pattern_name(settings.lens.pattern)));
   if (shutter.enabled()) {
     text += " shutter=" + shutter_text(shutter);
   } else if (settings.shutter.opens()) {  // a scene file's shutter for the view
@@ -100,7 +130,10 @@ std::string settings_text(const tilesplat::RenderSettings& settings, const LensF
             ",close:" + shortest_exact(settings.shutter.close) +
             ",samples:" + std::to_string(settings.shutter.samples) +
             ",scan:" + tilesplat::shutter_scan_name(settings.shutter.scan) +
-            (settings.shutter.end_camera ? ",camera:moving" : ",camera:still");
+            (settings.shutter.end_camera ? ",camera:moving" : ",camera:still") +
+            (settings.shutter.pattern == tilesplat::SamplePattern::kEven
+                 ? ""
+                 : ",pattern:" + std::string(tilesplat::sample_pattern_name(settings.shutter.pattern)));
   }
   return text;
 }
@@ -462,6 +495,7 @@ int run(int argc, char** argv) {
     if (frame.shutter.end_camera)
       frame.shutter.end_camera = cli::camera_for_frame(options.camera_model, *frame.shutter.end_camera);
   }
+  reshape_scene_effects(parser, options, frames);
 
   tilesplat::RenderSettings settings;
   if (!options.common.sorts.empty()) settings.sort = options.common.sorts.front();
@@ -515,10 +549,18 @@ int run(int argc, char** argv) {
       settings_text(settings, options.lens, options.shutter, loaded.lod);
   if (sequence && !options.lens.enabled() &&
       std::any_of(frames.begin(), frames.end(), [](const Frame& f) { return f.lens.enabled(); }))
-    writer.exr.attributes["renderSettings"] += " lens=the scene file's, per view";
+    writer.exr.attributes["renderSettings"] +=
+        " lens=the scene file's, per view" +
+        std::string(parser.seen("--sample-pattern") ? ", pattern:" : "") +
+        (parser.seen("--sample-pattern") ? tilesplat::sample_pattern_name(options.lens.pattern) : "");
   if (sequence && !options.shutter.enabled() &&
       std::any_of(frames.begin(), frames.end(), [](const Frame& f) { return f.shutter.opens(); }))
-    writer.exr.attributes["renderSettings"] += " shutter=the scene file's, per view";
+    writer.exr.attributes["renderSettings"] +=
+        " shutter=the scene file's, per view" +
+        (parser.seen("--shutter-samples") ? ", samples:" + std::to_string(options.shutter.samples) : "") +
+        (parser.seen("--sample-pattern")
+             ? ", pattern:" + std::string(tilesplat::sample_pattern_name(options.shutter.pattern))
+             : "");
 
   if (sequence) {
     // Everything besides the camera that makes two runs' files differ, for the manifest.

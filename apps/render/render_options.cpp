@@ -300,17 +300,15 @@ void check_render_flags(const cli::ArgParser& parser, const RenderOptions& optio
                           std::string(options.camera_model.fisheye_fov_deg ? "--fisheye"
                                       : options.camera_model.view_height   ? "--orthographic"
                                                                            : "--equirectangular"));
-  for (const char* shutter_flag : {"--shutter-samples", "--rolling-shutter"})
-    if (parser.seen(shutter_flag) && !options.shutter.enabled())
-      throw cli::UsageError(std::string(shutter_flag) + " shapes the shutter, and no --shutter gave one");
+  // --shutter-samples and --sample-pattern may shape the scene file's shutter or lens instead, which the
+  // scene's load tells (reshape_scene_effects).
+  if (parser.seen("--rolling-shutter") && !options.shutter.enabled())
+    throw cli::UsageError("--rolling-shutter shapes the shutter, and no --shutter gave one");
   if (options.shutter.enabled() && !parser.seen("--orbit") && !parser.seen("--path"))
     throw cli::UsageError(
         "--shutter blurs the camera's motion from one frame to the next: it needs --orbit or "
         "--path");
   cli::check_lens_options(parser, options.lens);
-  if (parser.seen("--sample-pattern") && !options.lens.enabled() && !options.shutter.enabled())
-    throw cli::UsageError(
-        "--sample-pattern places lens and shutter samples: add --aperture, --f-stop or --shutter");
   if (options.shutter.pattern != SamplePattern::kEven && options.shutter.scan != ShutterScan::kGlobal)
     throw cli::UsageError(
         "--rolling-shutter exposes its bands at the even pattern's times, in order: drop --sample-pattern");
