@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 
@@ -27,7 +29,18 @@ std::string shell_quote(const std::string& text) {
   return quoted + "'";
 }
 
+bool env_set(const char* name) {
+  const char* value = std::getenv(name);
+  return value && *value;
+}
+
 }  // namespace
+
+std::optional<std::string> display_prefix() {
+  if (env_set("DISPLAY") || env_set("WAYLAND_DISPLAY")) return "";
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) return std::nullopt;
+  return "xvfb-run -n " + std::to_string(100 + ::getpid() % 800) + " -a ";
+}
 
 ProcessResult run_process(const std::string& prefix, const std::string& exe, const std::vector<std::string>& args) {
   static int invocation = 0;

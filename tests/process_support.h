@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,14 @@ struct ProcessResult {
 // VK_LOADER_DEBUG is emptied so that loader chatter cannot pollute stderr. A validation-layer message
 // in stderr (the apps print them and still exit 0) fails the calling test.
 ProcessResult run_process(const std::string& prefix, const std::string& exe, const std::vector<std::string>& args);
+
+// How a test gives the viewer a display: "" for the session's own (DISPLAY or WAYLAND_DISPLAY), else the
+// prefix of a private Xvfb server (each test process starts its search for a free server number at its
+// own, so parallel tests do not race for one); none when neither exists (then kNoDisplay says why).
+std::optional<std::string> display_prefix();
+inline constexpr const char* kNoDisplay =
+    "no display for the viewer's window: DISPLAY and WAYLAND_DISPLAY are unset and xvfb-run is not installed "
+    "(Debian: xvfb xauth)";
 
 std::string read_file(const std::filesystem::path& path);
 

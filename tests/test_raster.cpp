@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -530,15 +531,14 @@ TEST(Raster, EffectsAndAccuracyReportsHaveTheRasterRows) {
 // The viewer draws the raster compositor too (--compositor raster, the key C): its screenshot is
 // tilesplat-render's image of the same view with the same compositor.
 TEST(Raster, ViewerScreenshotIsTheRasterRender) {
-  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0 && !std::getenv("DISPLAY"))
-    TILESPLAT_SKIP_OR_FAIL("no display for the viewer's window and no xvfb-run (Debian: xvfb xauth)");
   const std::filesystem::path out = testing::fresh_output_dir();
   const std::vector<std::string> view = {
       testing::bundled_playbot().string(), "--width", "160", "--height", "90", "--compositor", "raster"};
   std::vector<std::string> viewer_args = view;
   viewer_args.insert(viewer_args.end(), {"--frames", "2", "--screenshot", (out / "viewer.exr").string()});
-  const std::string prefix =
-      std::getenv("DISPLAY") ? "" : "xvfb-run -n " + std::to_string(100 + ::getpid() % 800) + " -a ";
+  const std::optional<std::string> display = tilesplat::testing::display_prefix();
+  if (!display) TILESPLAT_SKIP_OR_FAIL(tilesplat::testing::kNoDisplay);
+  const std::string prefix = *display;
   const testing::ProcessResult viewer = testing::run_process(prefix, TILESPLAT_VIEWER_EXE, viewer_args);
   ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
   std::vector<std::string> render_args = view;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -478,16 +479,15 @@ TEST(Stochastic, RejectsSettingsItCannotHonour) {
 // frame a redraw to the mean, and its screenshot is that mean rendered in one call: the image of
 // tilesplat-render --stochastic N with the N it reports, to the bit.
 TEST(Stochastic, ViewerAccumulatesFramesWhileTheViewRests) {
-  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0 && !std::getenv("DISPLAY"))
-    TILESPLAT_SKIP_OR_FAIL("no display for the viewer's window and no xvfb-run (Debian: xvfb xauth)");
   const std::filesystem::path out = testing::fresh_output_dir();
   const std::vector<std::string> view = {testing::bundled_playbot().string(), "--width", "160", "--height",
                                          "90"};
   std::vector<std::string> viewer_args = view;
   viewer_args.insert(viewer_args.end(), {"--compositor", "stochastic", "--frames", "6", "--validation",
                                          "--screenshot", (out / "viewer.exr").string()});
-  const std::string prefix =
-      std::getenv("DISPLAY") ? "" : "xvfb-run -n " + std::to_string(100 + ::getpid() % 800) + " -a ";
+  const std::optional<std::string> display = tilesplat::testing::display_prefix();
+  if (!display) TILESPLAT_SKIP_OR_FAIL(tilesplat::testing::kNoDisplay);
+  const std::string prefix = *display;
   const testing::ProcessResult viewer = testing::run_process(prefix, TILESPLAT_VIEWER_EXE, viewer_args);
   ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
   EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;

@@ -27,7 +27,9 @@ using tilesplat::testing::bundled_playbot_cameras;
 using tilesplat::testing::bundled_sh3;
 using tilesplat::testing::bundled_sh3_cameras;
 using tilesplat::testing::DecodedPng;
+using tilesplat::testing::display_prefix;
 using tilesplat::testing::fresh_output_dir;
+using tilesplat::testing::kNoDisplay;
 using tilesplat::testing::line_count;
 using tilesplat::testing::ProcessResult;
 using tilesplat::testing::run_process;
@@ -42,23 +44,6 @@ constexpr const char* kViewerExe = "";
   TILESPLAT_SKIP_OR_FAIL("tilesplat-viewer is not built (configure with -DTILESPLAT_BUILD_VIEWER=ON)")
 #endif
 constexpr const char* kRenderExe = TILESPLAT_RENDER_EXE;
-
-bool env_set(const char* name) {
-  const char* value = std::getenv(name);
-  return value && *value;
-}
-
-// How the viewer gets a display: the session's own, else a private Xvfb server. Each test process
-// starts its search for a free server number (-a) at its own, so parallel tests do not race for one.
-std::optional<std::string> display_prefix() {
-  if (env_set("DISPLAY") || env_set("WAYLAND_DISPLAY")) return "";
-  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0) return std::nullopt;
-  return "xvfb-run -n " + std::to_string(100 + ::getpid() % 800) + " -a ";
-}
-
-constexpr const char* kNoDisplay =
-    "no display for the viewer's window: DISPLAY and WAYLAND_DISPLAY are unset and xvfb-run is not installed "
-    "(Debian: xvfb xauth)";
 
 std::vector<std::string> view_args(const fs::path& scene, const fs::path& cameras, int view) {
   return {scene.string(), "--cameras", cameras.string(), "--view", std::to_string(view), "--width", "320",
