@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <vector>
@@ -276,8 +277,6 @@ TEST_F(AccumulatedSamples, WhatCannotAccumulateIsRefused) {
 // screenshot is those samples rendered in one call: the image of tilesplat-render --f-stop with
 // --lens-samples N --sample-pattern sobol, N the count it reports, to the bit.
 TEST(AccumulatedSamplesViewer, AddUpLensSamplesWhileTheViewRests) {
-  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0 && !std::getenv("DISPLAY"))
-    TILESPLAT_SKIP_OR_FAIL("no display for the viewer's window and no xvfb-run (Debian: xvfb xauth)");
   const std::filesystem::path out = tilesplat::testing::fresh_output_dir();
   const std::vector<std::string> view = {tilesplat::testing::bundled_playbot().string(),
                                          "--width",
@@ -291,8 +290,9 @@ TEST(AccumulatedSamplesViewer, AddUpLensSamplesWhileTheViewRests) {
   std::vector<std::string> viewer_args = view;
   viewer_args.insert(viewer_args.end(), {"--no-mesh", "--frames", "6", "--validation", "--screenshot",
                                          (out / "viewer.exr").string()});
-  const std::string prefix =
-      std::getenv("DISPLAY") ? "" : "xvfb-run -n " + std::to_string(100 + ::getpid() % 800) + " -a ";
+  const std::optional<std::string> display = tilesplat::testing::display_prefix();
+  if (!display) TILESPLAT_SKIP_OR_FAIL(tilesplat::testing::kNoDisplay);
+  const std::string prefix = *display;
   const tilesplat::testing::ProcessResult viewer =
       tilesplat::testing::run_process(prefix, TILESPLAT_VIEWER_EXE, viewer_args);
   ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
@@ -322,5 +322,51 @@ TEST(AccumulatedSamplesViewer, AddUpLensSamplesWhileTheViewRests) {
                                            (out / "pinhole.exr").string()};
   ASSERT_EQ(tilesplat::testing::run_process("", TILESPLAT_RENDER_EXE, pinhole_args).exit_code, 0);
   EXPECT_LT(compare_images(shot, read_exr(out / "pinhole.exr")).psnr_db, 45.0);
+}
+
+// The viewer's motion blur (key B, on for a view whose shutter opens): the bundled moving_playbots.json's
+// view 1, its camera panning and a model moving, adds a time sample a redraw, placing the moving copy
+// anew each time, and its screenshot is tilesplat-render's image of the view with --shutter-samples N
+// --sample-pattern sobol, to the bit.
+TEST(AccumulatedSamplesViewer, AddUpTimeSamplesOfMovingModelsWhileTheViewRests) {
+  const std::optional<std::string> display = tilesplat::testing::display_prefix();
+  if (!display) TILESPLAT_SKIP_OR_FAIL(tilesplat::testing::kNoDisplay);
+  const std::filesystem::path out = tilesplat::testing::fresh_output_dir();
+  const std::string scene = (tilesplat::testing::bundled_scene_dir() / "moving_playbots.json").string();
+  const std::vector<std::string> view = {scene, "--view", "1", "--width", "160", "--height", "90"};
+  std::vector<std::string> viewer_args = view;
+  viewer_args.insert(viewer_args.end(), {"--no-mesh", "--frames", "6", "--validation", "--screenshot",
+                                         (out / "viewer.exr").string()});
+  const tilesplat::testing::ProcessResult viewer =
+      tilesplat::testing::run_process(*display, TILESPLAT_VIEWER_EXE, viewer_args);
+  ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
+  EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
+  const std::string said = "the screenshot is the mean of ";
+  const size_t at = viewer.err.find(said);
+  ASSERT_NE(at, std::string::npos) << viewer.err;
+  EXPECT_NE(viewer.err.find("time samples", at), std::string::npos) << viewer.err;
+  const int samples = std::atoi(viewer.err.c_str() + at + said.size());
+  EXPECT_GE(samples, 4) << viewer.err;
+  EXPECT_LE(samples, 6) << viewer.err;
+  auto render = [&](std::vector<std::string> extra, const std::string& name) {
+    std::vector<std::string> args = view;
+    args.insert(args.end(), extra.begin(), extra.end());
+    args.insert(args.end(), {"-o", (out / name).string()});
+    return tilesplat::testing::run_process("", TILESPLAT_RENDER_EXE, args);
+  };
+  const tilesplat::testing::ProcessResult blurred =
+      render({"--shutter-samples", std::to_string(samples), "--sample-pattern", "sobol"}, "render.exr");
+  ASSERT_EQ(blurred.exit_code, 0) << blurred.err;
+  EXPECT_NE(read_exr_string_attributes(out / "render.exr")
+                .at("renderSettings")
+                .find(",samples:" + std::to_string(samples) + ",scan:global,camera:moving,pattern:sobol"),
+            std::string::npos);
+  const RenderImage shot = read_exr(out / "viewer.exr");
+  EXPECT_EQ(shot.rgba, read_exr(out / "render.exr").rgba);
+  // And it is blurred: not the sharp frame of one time sample.
+  const tilesplat::testing::ProcessResult sharp =
+      render({"--shutter-samples", "1", "--sample-pattern", "sobol"}, "sharp.exr");
+  ASSERT_EQ(sharp.exit_code, 0) << sharp.err;
+  EXPECT_LT(compare_images(shot, read_exr(out / "sharp.exr")).psnr_db, 35.0);
 }
 #endif

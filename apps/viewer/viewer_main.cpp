@@ -29,6 +29,7 @@
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
+#include "view_shutter.h"
 #include "viewer_options.h"
 #include "window_device.h"
 
@@ -54,6 +55,8 @@ constexpr std::array<tilesplat::Compositor, 3> kCompositorCycle = {
 // The stochastic frames a view at rest accumulates before the window stops redrawing it (about 40 dB
 // from the sorted image on the bundled scenes: docs/compositors.md).
 constexpr uint32_t kMaxAccumulatedFrames = 256;
+// The time samples key B adds up over copies that move when the view has no shutter of its own.
+constexpr int kMotionSamples = 32;
 bool validation_from_environment() {
   const char* value = std::getenv("TILESPLAT_VALIDATION");
   return value && *value && std::string_view(value) != "0";
@@ -87,8 +90,7 @@ using WindowHandle = std::unique_ptr<GLFWwindow, decltype(&glfwDestroyWindow)>;
 class Viewer {
  public:
   Viewer(GLFWwindow* window, const WindowDevice& device, tilesplat::Renderer& renderer,
-         const ViewerOptions& options, const cli::LoadedScene& loaded,
-         std::vector<tilesplat::CameraView> views)
+         const ViewerOptions& options, const cli::LoadedScene& loaded, cli::SceneViews views)
       : window_(window),
         device_(device),
         renderer_(renderer),
@@ -99,8 +101,12 @@ class Viewer {
         depth_out_(!options.no_depth_out),
         scene_name_(loaded.path.filename().string()),
         lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
-        views_(std::move(views)),
+        views_(std::move(views.views)),
+        shutters_(std::move(views.shutters)),
         view_(options.common.view),
+        view_shutter_(loaded.shutter, loaded.camera),
+        copies_move_(loaded.instances && loaded.instances->moves()),
+        motion_blur_(view_shutter_.opens()),
         sorts_(sort_cycle()),
         lens_flags_(options.lens),
         depth_of_field_(options.lens.enabled()) {
@@ -177,6 +183,11 @@ class Viewer {
       settings.lens = thin_lens(camera());
       settings.accumulate_samples = settings.lens.enabled();
     }
+    // Motion blur (key B): likewise one time sample a redraw (with the lens on, one joint sample).
+    if (draws_motion_blur()) {
+      settings.shutter = frame_shutter().for_camera(camera());
+      settings.accumulate_samples = true;
+    }
     settings.sort = sorts_[sort_];
     settings.accuracy = modes_[mode_];
     settings.compositor = kCompositorCycle[compositor_];
@@ -193,10 +204,15 @@ class Viewer {
   // in one call (the same image: N calls of 1 frame are 1 call of N).
   tilesplat::RenderSettings screenshot_settings() {
     tilesplat::RenderSettings shot = settings();
-    if (shot.accumulate_samples) {  // the lens samples on screen, in one call
+    if (shot.accumulate_samples) {  // the lens or time samples on screen, in one call
       tilesplat::wait_for_frame(renderer_);
-      shot.lens.samples = int(std::max(1u, renderer_.last_frame_stats().accumulated_samples));
-      shot.accumulate_samples = false;
+      const int samples = int(std::max(1u, renderer_.last_frame_stats().accumulated_samples));
+      screenshot_samples_ = samples;
+      if (shot.lens.enabled()) shot.lens.samples = samples;
+      if (shot.shutter.opens()) shot.shutter.samples = samples;
+      // A lens and a shutter together take joint samples, which only calls of one sample add up
+      // (write_screenshot makes them); either alone, one call of them all is the same image.
+      shot.accumulate_samples = shot.lens.enabled() && shot.shutter.opens();
     }
     if (shot.compositor == tilesplat::Compositor::kStochastic) {
       tilesplat::wait_for_frame(renderer_);
@@ -206,6 +222,8 @@ class Viewer {
     return shot;
   }
   int frames() const { return frames_; }
+  // The samples the last frame had added up (screenshot_settings).
+  int screenshot_samples() const { return screenshot_samples_; }
   VkFormat window_format() const { return swapchain_.format(); }
   // The mean wall time of a frame (render and present) after the first; 0 before the second.
   double mean_frame_ms() const { return frames_ > 1 ? frame_ms_total_ / (frames_ - 1) : 0.0; }
@@ -268,6 +286,10 @@ class Viewer {
         if (viewer.mesh_) return;  // the box and the grid are drawn through a pinhole (--no-mesh)
         viewer.depth_of_field_ = !viewer.depth_of_field_;
         break;
+      case GLFW_KEY_B:
+        if (viewer.mesh_) return;  // the box's depth is a still pinhole's (--no-mesh)
+        viewer.motion_blur_ = !viewer.motion_blur_;
+        break;
       case GLFW_KEY_L:
         viewer.lens_ = (viewer.lens_ + 1) % viewer.lenses_.size();
         if (!viewer.draws(viewer.modes_[viewer.mode_])) viewer.next_mode();
@@ -329,6 +351,8 @@ class Viewer {
     const int count = int(views_.size());
     view_ = ((view_ + step) % count + count) % count;
     controller_.set_camera(views_[size_t(view_)].camera);
+    view_shutter_ = shutters_.empty() ? ViewShutter()
+                                      : ViewShutter(shutters_[size_t(view_)], views_[size_t(view_)].camera);
     needs_render_ = true;
   }
 
@@ -364,12 +388,14 @@ class Viewer {
     else
       tilesplat::render_to_image(renderer_, camera(), frame, image_->target(), nullptr,
                                  tilesplat::HostFrameSync{});
-    // A view at rest goes on refining: its lens samples up to --lens-samples, or the stochastic
-    // compositor's frames up to kMaxAccumulatedFrames (the counts lag a frame: the last frame's
-    // statistics arrive when the next one starts).
+    // A view at rest goes on refining: its lens samples up to --lens-samples and its time samples up to
+    // the shutter's, or the stochastic compositor's frames up to kMaxAccumulatedFrames (the counts lag a
+    // frame: the last frame's statistics arrive when the next one starts).
     const tilesplat::FrameStats& last = renderer_.last_frame_stats();
     if (frame.accumulate_samples)
-      needs_render_ = last.accumulated_samples + 1 < uint32_t(lens_flags_.samples);
+      needs_render_ = last.accumulated_samples + 1 <
+                      uint32_t(std::max(frame.lens.enabled() ? lens_flags_.samples : 0,
+                                        frame.shutter.opens() ? frame_shutter().samples() : 0));
     else
       needs_render_ = frame.compositor == tilesplat::Compositor::kStochastic &&
                       last.accumulated_frames + 1 < kMaxAccumulatedFrames;
@@ -395,6 +421,20 @@ class Viewer {
 
   // Whether the frame is seen through key F's thin lens: on, through the pinhole (L), without the mesh.
   bool draws_depth_of_field() const { return depth_of_field_ && !mesh_ && !lenses_[lens_].enabled(); }
+
+  // The shutter key B opens: the view's (the scene file's for it), else, over copies that move, one
+  // open for the whole frame (time 0 to 1).
+  ViewShutter frame_shutter() const {
+    if (view_shutter_.opens() || !copies_move_) return view_shutter_;
+    return ViewShutter({.open = 0, .close = 1, .samples = kMotionSamples}, tilesplat::Camera{});
+  }
+  // Whether the frame blurs motion (key B): on, without the mesh, over a shutter that opens on something
+  // that moves (the camera or copies of models); a rolling shutter's bands are tilesplat-render's.
+  bool draws_motion_blur() const {
+    const ViewShutter shutter = frame_shutter();
+    return motion_blur_ && !mesh_ && shutter.opens() && (shutter.camera_moves() || copies_move_) &&
+           shutter.for_camera(camera()).scan == tilesplat::ShutterScan::kGlobal;
+  }
 
   // Key F's thin lens for `camera`: the flags' aperture (--aperture, --f-stop), else 5% of the focus
   // distance; focused on the scene's centre unless --focus-distance says; its samples progressive
@@ -438,6 +478,10 @@ class Viewer {
              (kCompositorCycle[compositor_] == tilesplat::Compositor::kStochastic
                   ? " (" + std::to_string(renderer_.last_frame_stats().accumulated_frames) + " frames)"
                   : "") +
+             (draws_motion_blur()
+                  ? " | motion blur (" + std::to_string(renderer_.last_frame_stats().accumulated_samples) +
+                        " samples)"
+                  : "") +
              (lod_ ? " | " + cli::group_thousands(lod_splats_) + " splats (LOD)" : "") + " | GPU " +
              cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
              cli::format_fixed(frame_ms, 1) + " ms (" +
@@ -467,7 +511,12 @@ class Viewer {
   std::vector<int> lod_levels_;   // the levels the scene on the device has, per chunk
   uint64_t lod_splats_ = 0;
   std::vector<tilesplat::CameraView> views_;  // of --cameras or the scene file; N and P step through them
+  std::vector<tilesplat::Shutter> shutters_;  // the scene file's, one per view; none for --cameras
   int view_ = 0;
+  ViewShutter view_shutter_;  // the view's shutter (closed unless the scene file opens one for it)
+  bool copies_move_;          // the scene file's models move (the renderer has them as placed copies)
+  bool motion_blur_;          // key B: on from the start when the view's shutter opens
+  int screenshot_samples_ = 0;
   std::vector<tilesplat::AccuracyModes> modes_;
   size_t mode_ = 0;
   std::vector<std::string> sorts_;
@@ -507,16 +556,34 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewe
     tilesplat::write_png_preview(path, image);
   } else {
     const tilesplat::RenderSettings settings = viewer.screenshot_settings();
-    const tilesplat::RenderImage image = renderer.render(viewer.camera(), settings);
+    tilesplat::RenderImage image;
+    if (settings.accumulate_samples) {
+      // Joint lens and time samples: the window's count of them added up anew, one a call (a frame that
+      // accumulates nothing ends the window's sums).
+      tilesplat::RenderSettings pinhole = settings;
+      pinhole.lens = {};
+      pinhole.shutter = {};
+      renderer.render(viewer.camera(), pinhole);
+      for (int sample = 0; sample < viewer.screenshot_samples(); ++sample)
+        image = renderer.render(viewer.camera(), settings);
+    } else {
+      image = renderer.render(viewer.camera(), settings);
+    }
     if (settings.compositor == tilesplat::Compositor::kStochastic)
       std::fprintf(stderr, "%s: the screenshot is the mean of %u stochastic frames\n", kProgram,
                    settings.stochastic.frames);
-    if (settings.lens.enabled())
-      std::fprintf(stderr, "%s: the screenshot is the mean of %d lens samples\n", kProgram,
-                   settings.lens.samples);
+    if (settings.lens.enabled() || settings.shutter.opens())
+      std::fprintf(stderr, "%s: the screenshot is the mean of %d %s samples\n", kProgram,
+                   viewer.screenshot_samples(),
+                   settings.lens.enabled() && settings.shutter.opens() ? "joint lens and time"
+                   : settings.lens.enabled()                           ? "lens"
+                                                                       : "time");
     tilesplat::ExrWriteOptions exr;
     exr.alpha = !loaded.description || loaded.description->outputs.alpha;
     exr.camera = viewer.camera();
+    // Empty pixels far away; over a background, an opaque frame (as tilesplat-render writes them).
+    exr.empty_depth = tilesplat::kFarDepth;
+    exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
     tilesplat::write_exr(path, image, exr);
   }
 }
@@ -533,10 +600,15 @@ int run(int argc, char** argv) {
   options.common.validation = options.common.validation || validation_from_environment();
 
   // The scene and cameras before the window: a bad file fails without one flashing up.
-  const cli::LoadedScene loaded = cli::load_scene_and_camera(options.common, kProgram);
-  std::vector<tilesplat::CameraView> views = options.common.cameras.empty()
-                                                 ? cli::scene_views(loaded).views
-                                                 : cli::load_camera_views(options.common.cameras);
+  // A scene file whose models move is kept as placed copies, which the renderer places at each time
+  // sample of motion blur (key B).
+  const cli::LoadedScene loaded =
+      cli::load_scene_and_camera(options.common, kProgram, cli::SceneHolding::kInstancesIfMoving);
+  cli::SceneViews views;
+  if (options.common.cameras.empty())
+    views = cli::scene_views(loaded);
+  else
+    views.views = cli::load_camera_views(options.common.cameras);
 
   GlfwSession glfw;
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);  // Vulkan presents; no OpenGL context
@@ -545,7 +617,10 @@ int run(int argc, char** argv) {
   if (!window) throw std::runtime_error("cannot open a window: " + last_glfw_error);
   const WindowDevice device(window.get(), options.common.validation, options.common.device);
   const auto renderer = tilesplat::create_renderer(device.external());
-  if (!loaded.lod || loaded.lod->splat_budget == 0) renderer->set_scene(loaded.scene);  // else per frame
+  if (loaded.instances)
+    renderer->set_scene(*loaded.instances);
+  else if (!loaded.lod || loaded.lod->splat_budget == 0)
+    renderer->set_scene(loaded.scene);  // else per frame
 
   Viewer viewer(window.get(), device, *renderer, options, loaded, std::move(views));
   viewer.run(options.frames);
