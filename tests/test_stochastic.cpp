@@ -475,20 +475,19 @@ TEST(Stochastic, RejectsSettingsItCannotHonour) {
 }
 
 #ifdef TILESPLAT_VIEWER_EXE
-// The viewer shows the stochastic compositor too (--compositor stochastic, key C): a view at rest adds a
-// frame a redraw to the mean, and its screenshot is that mean rendered in one call: the image of
-// tilesplat-render --stochastic N with the N it reports, to the bit.
-TEST(Stochastic, ViewerAccumulatesFramesWhileTheViewRests) {
+// The viewer's screenshot after six redraws of the stochastic compositor with `sampler_flags`, and
+// tilesplat-render's image of the same view with --stochastic N (N the frames the viewer reports) and the
+// same flags, for the tests below to compare.
+void expect_viewer_screenshot_is_the_render(const std::vector<std::string>& sampler_flags) {
   const std::filesystem::path out = testing::fresh_output_dir();
-  const std::vector<std::string> view = {testing::bundled_playbot().string(), "--width", "160", "--height",
-                                         "90"};
+  std::vector<std::string> view = {testing::bundled_playbot().string(), "--width", "160", "--height", "90"};
+  view.insert(view.end(), sampler_flags.begin(), sampler_flags.end());
   std::vector<std::string> viewer_args = view;
   viewer_args.insert(viewer_args.end(), {"--compositor", "stochastic", "--frames", "6", "--validation",
                                          "--screenshot", (out / "viewer.exr").string()});
   const std::optional<std::string> display = tilesplat::testing::display_prefix();
   if (!display) TILESPLAT_SKIP_OR_FAIL(tilesplat::testing::kNoDisplay);
-  const std::string prefix = *display;
-  const testing::ProcessResult viewer = testing::run_process(prefix, TILESPLAT_VIEWER_EXE, viewer_args);
+  const testing::ProcessResult viewer = testing::run_process(*display, TILESPLAT_VIEWER_EXE, viewer_args);
   ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
   EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
   const std::string said = "the screenshot is the mean of ";
@@ -504,6 +503,19 @@ TEST(Stochastic, ViewerAccumulatesFramesWhileTheViewRests) {
   const testing::ProcessResult render = testing::run_process("", TILESPLAT_RENDER_EXE, render_args);
   ASSERT_EQ(render.exit_code, 0) << render.err;
   EXPECT_EQ(read_exr(out / "viewer.exr").rgba, read_exr(out / "render.exr").rgba);
+}
+
+// The viewer shows the stochastic compositor too (--compositor stochastic, key C): a view at rest adds a
+// frame a redraw to the mean, and its screenshot is that mean rendered in one call: the image of
+// tilesplat-render --stochastic N with the N it reports, to the bit.
+TEST(Stochastic, ViewerAccumulatesFramesWhileTheViewRests) {
+  expect_viewer_screenshot_is_the_render({});
+}
+
+// With --stochastic-sampler sobol the frames a still view adds up are the progressive sequence's: the
+// screenshot is tilesplat-render --stochastic N --stochastic-sampler sobol, to the bit.
+TEST(Stochastic, ViewerAddsUpTheSobolSequence) {
+  expect_viewer_screenshot_is_the_render({"--stochastic-sampler", "sobol"});
 }
 #endif
 

@@ -109,7 +109,8 @@ class Viewer {
         motion_blur_(view_shutter_.opens()),
         sorts_(sort_cycle()),
         lens_flags_(options.lens),
-        depth_of_field_(options.lens.enabled()) {
+        depth_of_field_(options.lens.enabled()),
+        stochastic_sampler_(options.stochastic_sampler) {
     cli::apply_scene_settings(loaded, base_settings_);
     cli::apply_training_options(options.common, base_settings_);
     for (const char* mode : kModeCycle) modes_.push_back(tilesplat::parse_accuracy_modes(mode));
@@ -195,6 +196,7 @@ class Viewer {
     // camera (or anything else) changes (StochasticSettings::accumulate).
     settings.stochastic.frames = 1;
     settings.stochastic.accumulate = true;
+    settings.stochastic.sampler = stochastic_sampler_;
     // A scene file's sh_degree effect caps every mode, as in tilesplat-render.
     settings.accuracy.sh_degree_cap =
         std::min(settings.accuracy.sh_degree_cap, base_settings_.accuracy.sh_degree_cap);
@@ -476,7 +478,8 @@ class Viewer {
     title += " | " + lens_name() + " | " + tilesplat::to_string(modes_[mode_]) + " | " + sort + " | " +
              tilesplat::to_string(kCompositorCycle[compositor_]) +
              (kCompositorCycle[compositor_] == tilesplat::Compositor::kStochastic
-                  ? " (" + std::to_string(renderer_.last_frame_stats().accumulated_frames) + " frames)"
+                  ? " (" + std::to_string(renderer_.last_frame_stats().accumulated_frames) + " " +
+                        tilesplat::to_string(stochastic_sampler_) + " frames)"
                   : "") +
              (draws_motion_blur()
                   ? " | motion blur (" + std::to_string(renderer_.last_frame_stats().accumulated_samples) +
@@ -526,6 +529,7 @@ class Viewer {
   size_t compositor_ = 0;                    // in kCompositorCycle (C cycles)
   cli::LensFlags lens_flags_;                // --aperture, --f-stop, --focus-distance, --lens-samples
   bool depth_of_field_ = false;  // key F's thin lens on (from the start with --aperture, --f-stop)
+  tilesplat::StochasticSampler stochastic_sampler_;  // --stochastic-sampler
   tilesplat::RenderSettings base_settings_;  // the scene file's background, effects and outputs
 
   int drag_button_ = -1;  // the mouse button held, or -1

@@ -10,6 +10,21 @@ void add_viewer_options(cli::ArgParser& parser, ViewerOptions& options) {
   cli::add_camera_model_options(parser, options.camera_model);
   cli::add_lens_options(parser, options.lens,
                         "lens samples a still view adds up, one a frame (1 to 4096, default 32)");
+  parser.add_value(
+      "--stochastic-sampler", "NAME",
+      "how the stochastic compositor (key C) draws its thresholds: hash (independent frames, the "
+      "default) or sobol (the effects' progressive sequence: stratified at powers of two, so a "
+      "still view converges faster)",
+      [&options](const std::string& text) {
+        if (text == "hash" || text == "sobol") {
+          options.stochastic_sampler = parse_stochastic_sampler(text);
+          return;
+        }
+        throw cli::UsageError(
+            "--stochastic-sampler must be hash or sobol (stratified needs the frame count "
+            "before the first frame, and a still view's frames add up one by one), got " +
+            cli::single_quoted(text));
+      });
   parser.section("scripting");
   parser.add_int("--frames", "N", "render N frames, then exit (default: run until the window is closed)",
                  &options.frames, 1, 1000000);

@@ -40,6 +40,8 @@ struct ViewerOptions {
   bool no_depth_out = false;  // the splats write no depth: the grid is drawn over them
   tilesplat::cli::CameraModelFlags camera_model;  // --fisheye, --orthographic, --equirectangular (key L)
   tilesplat::cli::LensFlags lens;  // depth of field, a sample a frame while the view rests (key F)
+  // The stochastic compositor's thresholds (key C): hash or sobol, the samplers whose frames add up.
+  tilesplat::StochasticSampler stochastic_sampler = tilesplat::StochasticSampler::kHash;
 };
 
 // Declares every flag of tilesplat-viewer.
