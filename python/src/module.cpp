@@ -719,6 +719,16 @@ void bind(nb::module_& m) {
           },
           "scene"_a, "Uploads the scene (a copy: the Python scene stays free to change).")
       .def(
+          "set_scene",
+          [](RendererHandle& self, const SceneInstances& instances) {
+            nb::gil_scoped_release release;
+            self.renderer->set_scene(instances);
+          },
+          "instances"_a,
+          "Uploads a scene file's placed copies where they are at time 0 and, when some move, keeps them (a "
+          "copy): render(camera, shutter=...) then places them at each time sample, one a call with "
+          "accumulate_samples=True; a closed shutter sees them at time 0.")
+      .def(
           "render",
           [](RendererHandle& self, const Camera& camera, const std::string& sort, bool depth,
              bool splat_count, const std::string& accuracy, const std::string& antialiasing,

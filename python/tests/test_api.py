@@ -247,6 +247,17 @@ def test_a_scene_files_moving_models_blur_under_an_open_shutter(playbot_renderer
     assert np.abs(alpha[..., 0] - blurred.rgba[..., 3]).max() <= 1e-6
     with pytest.raises(ValueError, match="one of scene, lod_set and instances"):
         renderer.render(camera, instances=instances, scene=instances.scene_at(0))
+    # Set once, the copies are placed at each time sample by the renderer: the same frame, and samples
+    # that add up a call at a time.
+    renderer.set_scene(instances)
+    assert np.array_equal(renderer.render(camera).rgba, still.rgba)
+    assert np.array_equal(renderer.render(camera, shutter=shutter).rgba, blurred.rgba)
+    sobol = tilesplat.Shutter(open=0.0, close=1.0, samples=4, pattern="sobol")
+    all_four = renderer.render(camera, shutter=sobol)
+    for call in range(4):
+        accumulated = renderer.render(camera, shutter=sobol, accumulate_samples=True)
+    assert renderer.last_frame_stats["accumulated_samples"] == 4
+    assert np.abs(accumulated.rgba - all_four.rgba).max() <= 2e-5
 
 
 def test_a_lod_set_by_level_and_under_a_splat_budget(playbot_renderer):
