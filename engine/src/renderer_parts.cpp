@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <future>
 
 #include "camera/camera_models.h"
 #include "frame/averaged_frames.h"
@@ -81,6 +82,28 @@ bool Renderer::Impl::needs_parts(const PartSource& scene, const Camera& camera,
          !whole_frame_fits(costs, scene.size(), kFirstPairsPerGaussian, buffers_only);
 }
 
+namespace {
+
+// A part's Gaussians on the host: positions [begin, end) of the depth order, gathered (and placed, for
+// copies) as a scene of their own.
+struct GatheredPart {
+  size_t begin = 0, end = 0;
+  size_t gaussians = 0;
+  GaussianScene scene;
+};
+
+GatheredPart gather_part(const PartSource& source, const DepthOrder& order, size_t begin, size_t capacity) {
+  GatheredPart part;
+  part.begin = begin;
+  part.end = order.size() == 0 ? 0 : order.part_end(begin, capacity);
+  const std::vector<uint32_t> indices = order.part_indices(part.begin, part.end);
+  part.gaussians = indices.size();
+  part.scene = source.gather(indices);
+  return part;
+}
+
+}  // namespace
+
 void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& camera,
                                      const RenderSettings& settings) {
   wait_for_submitted_frame();
@@ -111,35 +134,45 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
   lists.reset();
   FrameStats total;
   total.scene_parts = 0;
-  size_t begin = 0;
   size_t largest_part = 0;  // the scene buffers keep the size of the largest part so far
   double most_pairs_per_gaussian = 0;
+  GatheredPart part = gather_part(scene, order, 0, capacity);
+  // The next part, gathered on another thread while this one uploads and renders (on a GPU the host's
+  // gathering and placing is most of a part's time). It is gathered for the capacity so far, which a part
+  // can only shrink: when the next part then ends elsewhere, it is gathered again.
+  std::future<GatheredPart> next;
   for (uint32_t index = 0;; ++index) {
-    const size_t end = order.size() == 0 ? 0 : order.part_end(begin, capacity);
-    const std::vector<uint32_t> indices = order.part_indices(begin, end);
-    resources.upload_scene(scene.gather(indices), /*reuse_buffers=*/true);
+    const bool last = part.end == order.size();
+    if (!last)
+      next =
+          std::async(std::launch::async, gather_part, std::cref(scene), std::cref(order), part.end, capacity);
+    resources.upload_scene(part.scene, /*reuse_buffers=*/true);
+    part.scene = {};
     ++scene_generation;  // the lists in the buffers are the previous part's
     lists.reset();
     // Pairs for a part of the capacity the budget was reckoned for (the same from part to part: no new
     // buffers for each).
     resources.reserve_pairs(uint64_t(pairs_per_gaussian * double(capacity)) + 1, wide_keys);
-    render_frame(camera, settings, nullptr, ScenePart{index, end == order.size()});
+    render_frame(camera, settings, nullptr, ScenePart{index, last});
     lists.reset();  // a part's lists are no frame's
     add_part_stats(total, stats);
-    largest_part = std::max(largest_part, indices.size());
-    if (end == order.size()) break;
+    largest_part = std::max(largest_part, part.gaussians);
+    if (last) break;
     // The next parts: as many pairs per Gaussian as the most any part had (with a margin, as a part with
     // more pairs than its key buffers hold renders again), and room for the buffers beyond the estimate
     // (the sort strategy's, the pipelines' own).
     most_pairs_per_gaussian = std::max(
-        most_pairs_per_gaussian, double(stats.intersections) / double(std::max<size_t>(indices.size(), 1)));
+        most_pairs_per_gaussian, double(stats.intersections) / double(std::max<size_t>(part.gaussians, 1)));
     pairs_per_gaussian = std::max(1.0, 1.25 * most_pairs_per_gaussian);
     const uint64_t estimated =
         costs.fixed + uint64_t(largest_part) * costs.per_gaussian + resources.keys.bytes();
     const uint64_t overhead = stats.device_bytes > estimated ? stats.device_bytes - estimated : 0;
     // Never larger than a part before: the scene buffers keep the largest part's size.
     capacity = std::min(capacity, part_capacity(budget, costs, overhead, pairs_per_gaussian, device));
-    begin = end;
+    GatheredPart gathered = next.get();
+    part = order.part_end(gathered.begin, capacity) == gathered.end
+               ? std::move(gathered)
+               : gather_part(scene, order, gathered.begin, capacity);
   }
   total.gaussians = scene.size();
   stats = total;
