@@ -25,6 +25,8 @@ class ViewShutter {
   bool camera_moves() const { return camera_moves_; }
   // The samples the view's shutter asks for: how many a still view adds up.
   int samples() const { return shutter_.samples; }
+  // How the shutter scans the frame (a global one exposes it all at once).
+  ShutterScan scan() const { return shutter_.scan; }
   // The shutter of a frame seen from `camera`: the view's times and scan, its end camera `camera` moved
   // as the view's camera moves (none when it stays), the sobol pattern.
   Shutter for_camera(const Camera& camera) const;

@@ -29,6 +29,7 @@
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
+#include "view_effects.h"
 #include "view_shutter.h"
 #include "viewer_options.h"
 #include "window_device.h"
@@ -55,8 +56,6 @@ constexpr std::array<tilesplat::Compositor, 3> kCompositorCycle = {
 // The stochastic frames a view at rest accumulates before the window stops redrawing it (about 40 dB
 // from the sorted image on the bundled scenes: docs/compositors.md).
 constexpr uint32_t kMaxAccumulatedFrames = 256;
-// The time samples key B adds up over copies that move when the view has no shutter of its own.
-constexpr int kMotionSamples = 32;
 bool validation_from_environment() {
   const char* value = std::getenv("TILESPLAT_VALIDATION");
   return value && *value && std::string_view(value) != "0";
@@ -104,12 +103,10 @@ class Viewer {
         views_(std::move(views.views)),
         shutters_(std::move(views.shutters)),
         view_(options.common.view),
-        view_shutter_(loaded.shutter, loaded.camera),
-        copies_move_(loaded.instances && loaded.instances->moves()),
-        motion_blur_(view_shutter_.opens()),
+        effects_(options.lens, ViewShutter(loaded.shutter, loaded.camera),
+                 loaded.instances && loaded.instances->moves(),
+                 {bounds_.center[0], bounds_.center[1], bounds_.center[2]}, mesh_),
         sorts_(sort_cycle()),
-        lens_flags_(options.lens),
-        depth_of_field_(options.lens.enabled()),
         stochastic_sampler_(options.stochastic_sampler) {
     cli::apply_scene_settings(loaded, base_settings_);
     cli::apply_training_options(options.common, base_settings_);
@@ -178,17 +175,7 @@ class Viewer {
   tilesplat::Camera camera() const { return cli::camera_for_frame(lenses_[lens_], controller_.camera()); }
   tilesplat::RenderSettings settings() const {
     tilesplat::RenderSettings settings = base_settings_;
-    // Depth of field (key F): one lens sample a redraw, added to the earlier ones on the device until the
-    // camera (or anything else) changes (RenderSettings::accumulate_samples).
-    if (draws_depth_of_field()) {
-      settings.lens = thin_lens(camera());
-      settings.accumulate_samples = settings.lens.enabled();
-    }
-    // Motion blur (key B): likewise one time sample a redraw (with the lens on, one joint sample).
-    if (draws_motion_blur()) {
-      settings.shutter = frame_shutter().for_camera(camera());
-      settings.accumulate_samples = true;
-    }
+    effects_.apply(camera(), !lenses_[lens_].enabled(), settings);  // keys F and B
     settings.sort = sorts_[sort_];
     settings.accuracy = modes_[mode_];
     settings.compositor = kCompositorCycle[compositor_];
@@ -206,15 +193,10 @@ class Viewer {
   // in one call (the same image: N calls of 1 frame are 1 call of N).
   tilesplat::RenderSettings screenshot_settings() {
     tilesplat::RenderSettings shot = settings();
-    if (shot.accumulate_samples) {  // the lens or time samples on screen, in one call
+    if (shot.accumulate_samples) {  // the lens or time samples on screen
       tilesplat::wait_for_frame(renderer_);
-      const int samples = int(std::max(1u, renderer_.last_frame_stats().accumulated_samples));
-      screenshot_samples_ = samples;
-      if (shot.lens.enabled()) shot.lens.samples = samples;
-      if (shot.shutter.opens()) shot.shutter.samples = samples;
-      // A lens and a shutter together take joint samples, which only calls of one sample add up
-      // (write_screenshot makes them); either alone, one call of them all is the same image.
-      shot.accumulate_samples = shot.lens.enabled() && shot.shutter.opens();
+      screenshot_samples_ = int(std::max(1u, renderer_.last_frame_stats().accumulated_samples));
+      shot = tilesplat::viewer::screenshot_settings(shot, screenshot_samples_);
     }
     if (shot.compositor == tilesplat::Compositor::kStochastic) {
       tilesplat::wait_for_frame(renderer_);
@@ -285,12 +267,10 @@ class Viewer {
         viewer.depth_out_ = !viewer.depth_out_;
         break;
       case GLFW_KEY_F:
-        if (viewer.mesh_) return;  // the box and the grid are drawn through a pinhole (--no-mesh)
-        viewer.depth_of_field_ = !viewer.depth_of_field_;
+        if (!viewer.effects_.toggle_depth_of_field()) return;
         break;
       case GLFW_KEY_B:
-        if (viewer.mesh_) return;  // the box's depth is a still pinhole's (--no-mesh)
-        viewer.motion_blur_ = !viewer.motion_blur_;
+        if (!viewer.effects_.toggle_motion_blur()) return;
         break;
       case GLFW_KEY_L:
         viewer.lens_ = (viewer.lens_ + 1) % viewer.lenses_.size();
@@ -353,8 +333,9 @@ class Viewer {
     const int count = int(views_.size());
     view_ = ((view_ + step) % count + count) % count;
     controller_.set_camera(views_[size_t(view_)].camera);
-    view_shutter_ = shutters_.empty() ? ViewShutter()
-                                      : ViewShutter(shutters_[size_t(view_)], views_[size_t(view_)].camera);
+    effects_.set_view_shutter(shutters_.empty()
+                                  ? ViewShutter()
+                                  : ViewShutter(shutters_[size_t(view_)], views_[size_t(view_)].camera));
     needs_render_ = true;
   }
 
@@ -395,9 +376,7 @@ class Viewer {
     // frame: the last frame's statistics arrive when the next one starts).
     const tilesplat::FrameStats& last = renderer_.last_frame_stats();
     if (frame.accumulate_samples)
-      needs_render_ = last.accumulated_samples + 1 <
-                      uint32_t(std::max(frame.lens.enabled() ? lens_flags_.samples : 0,
-                                        frame.shutter.opens() ? frame_shutter().samples() : 0));
+      needs_render_ = last.accumulated_samples + 1 < uint32_t(tilesplat::viewer::samples_to_add_up(frame));
     else
       needs_render_ = frame.compositor == tilesplat::Compositor::kStochastic &&
                       last.accumulated_frames + 1 < kMaxAccumulatedFrames;
@@ -421,50 +400,13 @@ class Viewer {
     return swapchain_.present(image_->image(), FloatImage::kLayout, shown_extent_);
   }
 
-  // Whether the frame is seen through key F's thin lens: on, through the pinhole (L), without the mesh.
-  bool draws_depth_of_field() const { return depth_of_field_ && !mesh_ && !lenses_[lens_].enabled(); }
-
-  // The shutter key B opens: the view's (the scene file's for it), else, over copies that move, one
-  // open for the whole frame (time 0 to 1).
-  ViewShutter frame_shutter() const {
-    if (view_shutter_.opens() || !copies_move_) return view_shutter_;
-    return ViewShutter({.open = 0, .close = 1, .samples = kMotionSamples}, tilesplat::Camera{});
-  }
-  // Whether the frame blurs motion (key B): on, without the mesh, over a shutter that opens on something
-  // that moves (the camera or copies of models); a rolling shutter's bands are tilesplat-render's.
-  bool draws_motion_blur() const {
-    const ViewShutter shutter = frame_shutter();
-    return motion_blur_ && !mesh_ && shutter.opens() && (shutter.camera_moves() || copies_move_) &&
-           shutter.for_camera(camera()).scan == tilesplat::ShutterScan::kGlobal;
-  }
-
-  // Key F's thin lens for `camera`: the flags' aperture (--aperture, --f-stop), else 5% of the focus
-  // distance; focused on the scene's centre unless --focus-distance says; its samples progressive
-  // (SamplePattern::kSobol, which a still view continues frame after frame). Off when the
-  // scene's centre, to be focused on, is behind the camera.
-  tilesplat::ThinLens thin_lens(const tilesplat::Camera& camera) const {
-    cli::LensFlags flags = lens_flags_;
-    flags.pattern = tilesplat::SamplePattern::kSobol;
-    if (!flags.enabled()) flags.aperture = 1.0;  // replaced below, once the focus is known
-    const std::array<double, 3> centre = {bounds_.center[0], bounds_.center[1], bounds_.center[2]};
-    if (!flags.focus_distance && !(camera.to_camera(centre)[2] > 0)) return {};
-    tilesplat::ThinLens lens = cli::lens_for_frame(flags, camera, centre);
-    if (!lens_flags_.enabled()) lens.aperture_diameter = 0.05 * lens.focus_distance;
-    return lens;
-  }
-
   // The GPU time is the previous frame's: a frame's statistics come once it has been waited for.
   std::string lens_name() const {
     const cli::CameraModelFlags& lens = lenses_[lens_];
     if (lens.fisheye_fov_deg) return "fisheye " + cli::format_fixed(*lens.fisheye_fov_deg, 0) + " deg";
     if (lens.view_height) return "orthographic " + cli::format_fixed(*lens.view_height, 2) + " tall";
     if (lens.equirectangular) return "panorama";
-    if (!draws_depth_of_field()) return "pinhole";
-    const tilesplat::ThinLens thin = thin_lens(camera());
-    if (!thin.enabled()) return "pinhole (depth of field: the scene's centre is behind the camera)";
-    return "aperture " + cli::format_number(thin.aperture_diameter, 3) + " focus " +
-           cli::format_number(thin.focus_distance, 3) + " (" +
-           std::to_string(renderer_.last_frame_stats().accumulated_samples) + " samples)";
+    return effects_.lens_title(camera(), renderer_.last_frame_stats().accumulated_samples);
   }
 
   void show_title(double frame_ms) {
@@ -481,10 +423,7 @@ class Viewer {
                   ? " (" + std::to_string(renderer_.last_frame_stats().accumulated_frames) + " " +
                         tilesplat::to_string(stochastic_sampler_) + " frames)"
                   : "") +
-             (draws_motion_blur()
-                  ? " | motion blur (" + std::to_string(renderer_.last_frame_stats().accumulated_samples) +
-                        " samples)"
-                  : "") +
+             effects_.motion_title(renderer_.last_frame_stats().accumulated_samples) +
              (lod_ ? " | " + cli::group_thousands(lod_splats_) + " splats (LOD)" : "") + " | GPU " +
              cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
              cli::format_fixed(frame_ms, 1) + " ms (" +
@@ -516,9 +455,7 @@ class Viewer {
   std::vector<tilesplat::CameraView> views_;  // of --cameras or the scene file; N and P step through them
   std::vector<tilesplat::Shutter> shutters_;  // the scene file's, one per view; none for --cameras
   int view_ = 0;
-  ViewShutter view_shutter_;  // the view's shutter (closed unless the scene file opens one for it)
-  bool copies_move_;          // the scene file's models move (the renderer has them as placed copies)
-  bool motion_blur_;          // key B: on from the start when the view's shutter opens
+  ViewEffects effects_;  // keys F and B: depth of field and motion blur
   int screenshot_samples_ = 0;
   std::vector<tilesplat::AccuracyModes> modes_;
   size_t mode_ = 0;
@@ -526,9 +463,7 @@ class Viewer {
   size_t sort_ = 0;
   std::vector<cli::CameraModelFlags> lenses_;  // key L's cycle
   size_t lens_ = 0;
-  size_t compositor_ = 0;                    // in kCompositorCycle (C cycles)
-  cli::LensFlags lens_flags_;                // --aperture, --f-stop, --focus-distance, --lens-samples
-  bool depth_of_field_ = false;  // key F's thin lens on (from the start with --aperture, --f-stop)
+  size_t compositor_ = 0;                            // in kCompositorCycle (C cycles)
   tilesplat::StochasticSampler stochastic_sampler_;  // --stochastic-sampler
   tilesplat::RenderSettings base_settings_;  // the scene file's background, effects and outputs
 
@@ -560,19 +495,8 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewe
     tilesplat::write_png_preview(path, image);
   } else {
     const tilesplat::RenderSettings settings = viewer.screenshot_settings();
-    tilesplat::RenderImage image;
-    if (settings.accumulate_samples) {
-      // Joint lens and time samples: the window's count of them added up anew, one a call (a frame that
-      // accumulates nothing ends the window's sums).
-      tilesplat::RenderSettings pinhole = settings;
-      pinhole.lens = {};
-      pinhole.shutter = {};
-      renderer.render(viewer.camera(), pinhole);
-      for (int sample = 0; sample < viewer.screenshot_samples(); ++sample)
-        image = renderer.render(viewer.camera(), settings);
-    } else {
-      image = renderer.render(viewer.camera(), settings);
-    }
+    const tilesplat::RenderImage image = tilesplat::viewer::render_screenshot(
+        renderer, viewer.camera(), settings, viewer.screenshot_samples());
     if (settings.compositor == tilesplat::Compositor::kStochastic)
       std::fprintf(stderr, "%s: the screenshot is the mean of %u stochastic frames\n", kProgram,
                    settings.stochastic.frames);

@@ -209,11 +209,9 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
 
 void Renderer::set_scene(const GaussianScene& scene) {
   Impl& r = *impl_;
-  r.wait_for_submitted_frame();  // it reads the scene's buffers
-  ++r.scene_generation;          // the tile lists in the buffers are the previous scene's
+  r.upload_scene(scene);
   ++r.scene_identity;
   r.moving_copies.reset();
-  r.resources.upload_scene(scene);
   r.scene_in_parts = false;
 }
 
@@ -234,10 +232,14 @@ RenderSettings Renderer::Impl::settings_over_moving_copies(const Camera& camera,
 
 void Renderer::Impl::place_moving_copies(double time) {
   if (!moving_copies || time == moving_copies_time) return;
-  wait_for_submitted_frame();  // it reads the scene's buffers
-  ++scene_generation;          // the tile lists in the buffers are of the copies elsewhere
-  resources.upload_scene(merge_instances(*moving_copies, time));
+  upload_scene(merge_instances(*moving_copies, time));
   moving_copies_time = time;
+}
+
+void Renderer::Impl::upload_scene(const GaussianScene& scene) {
+  wait_for_submitted_frame();  // it reads the scene's buffers
+  ++scene_generation;
+  resources.upload_scene(scene);
 }
 
 RenderImage Renderer::Impl::average_samples(const Camera& camera, const RenderSettings& settings,

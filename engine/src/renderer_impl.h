@@ -81,6 +81,9 @@ struct Renderer::Impl {
   // The moving copies placed where they are at `time` (SceneInstances::Instance::at) and uploaded,
   // unless the buffers have them there already.
   void place_moving_copies(double time);
+  // `scene` into the scene buffers, once the submitted frame that reads them is done; the tile lists
+  // the buffers hold are then another scene's (scene_generation).
+  void upload_scene(const GaussianScene& scene);
   // Renderer::render(camera, settings) of the scene as the buffers hold it (settings_over_moving_copies
   // applied): the frame, its averaged samples, its bands, or one more accumulated sample.
   RenderImage render_set_scene(const Camera& camera, const RenderSettings& settings);
