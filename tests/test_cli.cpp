@@ -575,6 +575,52 @@ TEST(CliRender, MemoryBudgetRendersTheSameImageInParts) {
             tilesplat::read_exr(out / "two_whole.exr").rgba);
 }
 
+// --read-in-parts: a binary PLY read from its file part by part (MappedPly) is the same EXR, in parts or,
+// where the frame fits, loaded whole; what cannot be read so is a clear error and no file.
+TEST(CliRender, APlyReadInPartsIsTheSameImage) {
+  const auto out = fresh_output_dir();
+  auto render = [&](const fs::path& scene, const std::vector<std::string>& extra, const std::string& name) {
+    std::vector<std::string> args = {scene.string(),       "--width", "160", "--height", "90", "-o",
+                                     (out / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_exe(kRenderExe, args);
+  };
+  ASSERT_EQ(render(bundled_playbot(), {}, "whole.exr").exit_code, 0);
+  const tilesplat::RenderImage whole = tilesplat::read_exr(out / "whole.exr");
+  const auto parts =
+      render(bundled_playbot(), {"--read-in-parts", "--memory-budget", "4M", "--stats"}, "parts.exr");
+  ASSERT_EQ(parts.exit_code, 0) << parts.err;
+  EXPECT_FALSE(contains(parts.out, "scene parts                         1\n")) << parts.out;
+  EXPECT_TRUE(contains(parts.err, "31,000 Gaussians (SH2), read in parts from the file")) << parts.err;
+  const auto fits = render(bundled_playbot(), {"--read-in-parts"}, "fits.exr");
+  ASSERT_EQ(fits.exit_code, 0) << fits.err;
+  for (const char* name : {"parts.exr", "fits.exr"}) {
+    const tilesplat::RenderImage image = tilesplat::read_exr(out / name);
+    EXPECT_EQ(image.rgba, whole.rgba) << name;
+    EXPECT_EQ(image.depth, whole.depth) << name;
+  }
+  // The float64 reference takes the scene whole.
+  ASSERT_EQ(render(bundled_playbot(), {"--reference"}, "reference.exr").exit_code, 0);
+  const auto reference = render(bundled_playbot(), {"--read-in-parts", "--reference"}, "reference_parts.exr");
+  ASSERT_EQ(reference.exit_code, 0) << reference.err;
+  EXPECT_EQ(tilesplat::read_exr(out / "reference_parts.exr").rgba,
+            tilesplat::read_exr(out / "reference.exr").rgba);
+
+  // An ASCII PLY's rows vary in length: refused, naming the file.
+  std::string ascii = "ply\nformat ascii 1.0\nelement vertex 1\n";
+  for (const char* name : {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1",
+                           "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
+    ascii += std::string("property float ") + name + "\n";
+  ascii += "end_header\n0 0 0 0 0 0 0 -3 -3 -3 1 0 0 0\n";
+  const fs::path ascii_path = out / "ascii.ply";
+  std::ofstream(ascii_path) << ascii;
+  const auto refused = render(ascii_path, {"--read-in-parts"}, "ascii.exr");
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_TRUE(contains(refused.err, ascii_path.string() + ": an ASCII PLY cannot be read part by part"))
+      << refused.err;
+  EXPECT_FALSE(fs::exists(out / "ascii.exr"));
+}
+
 TEST(CliRender, AntialiasingFlagSetsTheFootprintFilter) {
   const auto out = fresh_output_dir();
   auto render = [&](const std::string& mode, const std::string& name) {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "test_support.h"
+#include "tilesplat/mapped_ply.h"
 #include "tilesplat/scene.h"
 
 namespace tilesplat {
@@ -381,6 +382,12 @@ TEST(PlyLoader, AFileOfManyBlocksLoadsEveryRowInOrder) {
       parse_ply(std::as_bytes(std::span(ply.data(), ply.size())), "many_blocks.ply");
   EXPECT_EQ(in_memory.positions, scene.positions);
   EXPECT_EQ(in_memory.sh, scene.sh);
+  // Read part by part, the dropped rows of every block are skipped as load_ply skips them.
+  const MappedPly mapped = MappedPly::open(path);
+  ASSERT_EQ(mapped.size(), scene.size());
+  const GaussianScene from_parts = mapped.load();
+  EXPECT_EQ(from_parts.positions, scene.positions);
+  EXPECT_EQ(from_parts.opacity_logits, scene.opacity_logits);
   std::filesystem::remove(path);
 }
 
@@ -1055,6 +1062,125 @@ TEST(PlyLoaderSharedScenes, CompressedPlyIsRead) {
   EXPECT_EQ(report.format, "compressed ply");
   EXPECT_EQ(scene.size(), 64u);
   EXPECT_EQ(scene.sh_degree, 3);
+}
+
+// ---------------------------------------------------------------------------------------------
+// MappedPly: a binary PLY read part by part holds load_ply's Gaussians, bit for bit.
+
+// The same arrays, bit for bit (rotations included: both normalize the same floats).
+void expect_identical_scene(const GaussianScene& actual, const GaussianScene& expected,
+                            const std::string& label) {
+  SCOPED_TRACE(label);
+  EXPECT_EQ(actual.sh_degree, expected.sh_degree);
+  EXPECT_EQ(actual.positions, expected.positions);
+  EXPECT_EQ(actual.log_scales, expected.log_scales);
+  EXPECT_EQ(actual.opacity_logits, expected.opacity_logits);
+  EXPECT_EQ(actual.sh, expected.sh);
+  EXPECT_EQ(actual.normals, expected.normals);
+  EXPECT_EQ(actual.rotations, expected.rotations);
+}
+
+void expect_same_bounds(const Bounds& actual, const Bounds& expected) {
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_EQ(actual.min[a], expected.min[a]);
+    EXPECT_EQ(actual.max[a], expected.max[a]);
+    EXPECT_EQ(actual.center[a], expected.center[a]);
+  }
+  EXPECT_EQ(actual.radius, expected.radius);
+}
+
+void expect_mapped_is_loaded(const std::filesystem::path& path, const LoadOptions& options = {}) {
+  LoadReport loaded_report, mapped_report;
+  const GaussianScene loaded = load_ply(path, options, &loaded_report);
+  const MappedPly mapped = MappedPly::open(path, options, &mapped_report);
+  EXPECT_EQ(mapped.size(), loaded.size()) << path;
+  EXPECT_EQ(mapped.sh_degree(), loaded.sh_degree) << path;
+  EXPECT_EQ(mapped.has_normals(), loaded.has_normals()) << path;
+  expect_same_bounds(mapped.bounds(), compute_bounds(loaded));
+  expect_identical_scene(mapped.load(), loaded, path.string());
+  EXPECT_EQ(mapped_report.summary(), loaded_report.summary());
+  EXPECT_EQ(mapped_report.format, loaded_report.format);
+  EXPECT_EQ(mapped_report.gaussians_in_file, loaded_report.gaussians_in_file);
+  EXPECT_EQ(mapped_report.ignored_properties, loaded_report.ignored_properties);
+}
+
+TEST(MappedPly, HoldsTheGaussiansLoadPlyReads) {
+  expect_mapped_is_loaded(testing::bundled_playbot());
+  expect_mapped_is_loaded(testing::bundled_sh3());
+  for (Encoding encoding : {Encoding::kBinaryLittleEndian, Encoding::kBinaryBigEndian})
+    for (int degree = 0; degree <= 3; ++degree) {
+      SCOPED_TRACE(std::string(format_name(encoding)) + " degree " + std::to_string(degree));
+      // Other elements (one with a list property) before and after the vertices, shuffled properties.
+      expect_mapped_is_loaded(
+          write_file("mapped_tiny.ply", encode_ply(encoding, tiny_scene_elements(degree))));
+    }
+  // No vertices: an empty scene.
+  const std::filesystem::path empty =
+      write_file("mapped_empty.ply", minimal_ply(Encoding::kBinaryLittleEndian, 0));
+  EXPECT_EQ(MappedPly::open(empty).size(), 0u);
+  EXPECT_EQ(MappedPly::open(empty).load().size(), 0u);
+}
+
+TEST(MappedPly, DropsNonFiniteGaussiansAsLoadPlyDoes) {
+  LoadOptions strict;
+  strict.strict = true;
+  for (Encoding encoding : {Encoding::kBinaryLittleEndian, Encoding::kBinaryBigEndian}) {
+    SCOPED_TRACE(format_name(encoding));
+    const auto path = write_file("mapped_non_finite.ply", encode_ply(encoding, {non_finite_vertex()}));
+    expect_mapped_is_loaded(path);
+    LoadReport report;
+    EXPECT_EQ(MappedPly::open(path, {}, &report).size(), 7u);
+    EXPECT_EQ(report.dropped, 5u);
+    try {
+      MappedPly::open(path, strict);
+      ADD_FAILURE() << "strict: opened";
+    } catch (const SceneError& error) {
+      EXPECT_NE(
+          std::string(error.what()).find("Gaussian 2 has a non-finite value in scale_1 (nan) (strict mode)"),
+          std::string::npos)
+          << error.what();
+    }
+  }
+}
+
+// Opens and expects a SceneError whose message starts with the path and holds every phrase.
+void expect_mapped_error(const std::filesystem::path& path, std::initializer_list<std::string_view> phrases) {
+  try {
+    MappedPly::open(path);
+    ADD_FAILURE() << "opened without an error: " << path;
+  } catch (const SceneError& error) {
+    const std::string message = error.what();
+    EXPECT_TRUE(message.starts_with(path.string())) << message;
+    for (std::string_view phrase : phrases) EXPECT_NE(message.find(phrase), std::string::npos) << message;
+  }
+}
+
+TEST(MappedPlyErrors, WhatCannotBeReadInPartsIsRefusedNamingTheFile) {
+  expect_mapped_error(testing::temp_dir() / "does_not_exist.ply", {"cannot open", "no such file"});
+  expect_mapped_error(write_file("mapped_ascii.ply", minimal_ply(Encoding::kAscii)),
+                      {"an ASCII PLY cannot be read part by part"});
+  expect_mapped_error(write_file("mapped_not.ply", "not a ply\n"), {"not a PLY file"});
+  const std::string good = minimal_ply();
+  expect_mapped_error(write_file("mapped_truncated.ply", good.substr(0, good.size() - 5)),
+                      {"truncated binary data"});
+  expect_mapped_error(write_file("mapped_trailing.ply", good + "xyz"), {"trailing data"});
+  // Every prefix of a binary file is an error, never a crash.
+  const std::string tiny = encode_ply(Encoding::kBinaryLittleEndian, tiny_scene_elements(1));
+  for (size_t length = 0; length < tiny.size(); length += 7) {
+    try {
+      MappedPly::open(write_file("mapped_prefix.ply", tiny.substr(0, length)));
+      ADD_FAILURE() << "prefix of " << length << " bytes opened";
+    } catch (const SceneError&) {
+    }
+  }
+}
+
+TEST(MappedPlySharedScenes, ACompressedPlyIsRefused) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  const auto path = testing::shared_scenes() / "playcanvas_test_64.compressed.ply";
+  if (!std::filesystem::exists(path)) TILESPLAT_SKIP_OR_FAIL(path << " not found");
+  expect_mapped_error(path, {"a compressed PLY (PlayCanvas) cannot be read part by part"});
+  expect_mapped_is_loaded(testing::shared_scenes() / "guitar_90854_sh0.ply");
 }
 
 }  // namespace

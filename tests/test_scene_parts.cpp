@@ -12,6 +12,7 @@
 
 #include "test_support.h"
 #include "tilesplat/camera.h"
+#include "tilesplat/mapped_ply.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
@@ -219,6 +220,31 @@ TEST(SceneParts, InstancesInPartsAreTheMergedScene) {
                        "merged whole");
   expect_bit_identical(parts_renderer().render(big.camera, settings), merged_in_parts,
                        "set by render(instances)");
+  EXPECT_EQ(parts_renderer().validation_messages(), 0u);
+}
+
+// A binary PLY read part by part (MappedPly): each part decoded from the file as it is drawn, the frame
+// the loaded scene renders, bit for bit; a frame that fits loads it whole and sets it.
+TEST(SceneParts, APlyReadPartByPartIsTheWholeFrame) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  const BigScene& big = big_scene();
+  const MappedPly mapped = MappedPly::open(testing::shared_scenes() / "playbot_lod0_500000_sh2.ply");
+  ASSERT_EQ(mapped.size(), big.scene.size());
+  Renderer& renderer = testing::validated_renderer();
+  RenderSettings settings;
+  settings.reuse_lists = false;
+  renderer.set_scene(big.scene);
+  const RenderImage whole = renderer.render(big.camera, settings);
+  settings.memory_budget = kSmallBudget;
+  EXPECT_TRUE(parts_renderer().renders_in_parts(mapped, big.camera, settings));
+  const RenderImage parts = parts_renderer().render(mapped, big.camera, settings);
+  EXPECT_GE(parts_renderer().last_frame_stats().scene_parts, 16);
+  EXPECT_EQ(parts_renderer().last_frame_stats().gaussians, big.scene.size());
+  expect_bit_identical(parts, whole, "read in parts");
+  settings.memory_budget = 0;
+  EXPECT_FALSE(parts_renderer().renders_in_parts(mapped, big.camera, settings));
+  expect_bit_identical(parts_renderer().render(mapped, big.camera, settings), whole, "loaded whole");
+  expect_bit_identical(parts_renderer().render(big.camera, settings), whole, "set by render(mapped)");
   EXPECT_EQ(parts_renderer().validation_messages(), 0u);
 }
 

@@ -14,6 +14,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/lens.h"
 #include "tilesplat/lod_set.h"
+#include "tilesplat/mapped_ply.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
@@ -25,6 +26,11 @@ namespace tilesplat::cli {
 // when some of them move (a merged scene is where they are at time 0: the renderer places moving copies
 // at each time of a shutter, docs/effects.md).
 enum class SceneHolding { kMerged, kInstances, kInstancesIfMoving };
+
+// How a binary PLY is held: read whole (load_scene), or mapped and read part by part as the frames draw
+// it (MappedPly: only its positions held), always or when the file is larger than half of the host's
+// memory (tilesplat-render, --read-in-parts).
+enum class PlyReading { kWhole, kInPartsWhenLarge, kInParts };
 
 // A LOD set the SCENE names (lod-meta.json): the index, and how the run draws it.
 struct LoadedLodSet {
@@ -44,6 +50,8 @@ struct LoadedScene {
   // as SceneHolding::kInstances, placed in `instances` (and `scene` is empty).
   std::optional<SceneDescription> description;
   std::optional<SceneInstances> instances;
+  // Set when a binary PLY is read part by part (PlyReading): `scene` is empty.
+  std::optional<MappedPly> mapped;
   // Set when the SCENE is a LOD set: `scene` holds its level lod->level, or nothing under a splat budget.
   std::optional<LoadedLodSet> lod;
   size_t gaussians() const;  // what a frame draws at most (under a splat budget: the finest level's size)
@@ -64,13 +72,15 @@ struct LoadedScene {
 // else the orbit. A missing or unreadable file throws std::runtime_error naming it; an
 // out-of-range --view throws UsageError naming the file and its number of views.
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program,
-                                  SceneHolding holding = SceneHolding::kMerged);
+                                  SceneHolding holding = SceneHolding::kMerged,
+                                  PlyReading ply = PlyReading::kWhole);
 
 // The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
 // load_scene_file fills path, scene, description, report and load_ms only.
 // A LOD set is read as `lod` says; `lod` given for any other scene is a UsageError.
 LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program,
-                            SceneHolding holding = SceneHolding::kMerged, const LodOptions& lod = {});
+                            SceneHolding holding = SceneHolding::kMerged, const LodOptions& lod = {},
+                            PlyReading ply = PlyReading::kWhole);
 
 // The views a scene file brings ("cameras") and the file that names them (the cameras.json it
 // refers to, else the scene file). No views for a .ply, or a scene file without cameras.

@@ -11,6 +11,7 @@ namespace tilesplat::render_app {
 FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScene& loaded)
     : scene_(&loaded.scene),
       instances_(loaded.instances ? &*loaded.instances : nullptr),
+      mapped_(loaded.mapped ? &*loaded.mapped : nullptr),
       lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
       lens_(options.lens),
       in_parts_(options.memory_budget > 0) {
@@ -18,7 +19,14 @@ FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScen
     const Bounds bounds = loaded.bounds();
     scene_centre_ = {bounds.center[0], bounds.center[1], bounds.center[2]};
   }
-  if (options.reference) return;
+  if (options.reference) {
+    if (mapped_) {  // the float64 reference takes a whole scene
+      merged_ = mapped_->load();
+      scene_ = &merged_;
+      mapped_ = nullptr;
+    }
+    return;
+  }
   renderer_ = Renderer::create(cli::renderer_options(options.common));
   // Under a memory budget each frame takes the scene (in parts where it does not fit); under a splat
   // budget each frame draws the levels its camera calls for. Otherwise the first frame decides: a scene
@@ -38,6 +46,17 @@ void FrameRenderer::decide_holding(const Camera& camera, const RenderSettings& s
     merged_ = merge_instances(*instances_);
     scene_ = &merged_;
     instances_ = nullptr;
+  }
+  if (mapped_) {
+    // A PLY read part by part stays in its file while its frames are drawn in parts; one whose frame fits
+    // the device is loaded and set once.
+    if (renderer_->renders_in_parts(*mapped_, camera, settings)) {
+      in_parts_ = true;
+      return;
+    }
+    merged_ = mapped_->load();
+    scene_ = &merged_;
+    mapped_ = nullptr;
   }
   in_parts_ = renderer_->renders_in_parts(*scene_, camera, settings);
   if (!in_parts_) renderer_->set_scene(*scene_);
@@ -63,7 +82,8 @@ RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& ba
   const GaussianScene& scene = lod_ ? selected : *scene_;
   RenderImage image;
   if (renderer_) {
-    image = instances_            ? renderer_->render(*instances_, camera, settings)
+    image = mapped_               ? renderer_->render(*mapped_, camera, settings)
+            : instances_          ? renderer_->render(*instances_, camera, settings)
             : !in_parts_ && !lod_ ? renderer_->render(camera, settings)
                                   : renderer_->render(scene, camera, settings);
     gpu_ms_ = renderer_->last_frame_stats().gpu_ms;

@@ -11,6 +11,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
 #include "tilesplat/lod_set.h"
+#include "tilesplat/mapped_ply.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 
@@ -37,6 +38,9 @@ class FrameRenderer {
   // A scene file's placed copies: under --memory-budget, when some move, or when their frame does not fit
   // the device (decide_holding merges them into merged_ otherwise).
   const SceneInstances* instances_;
+  // A binary PLY read part by part (--read-in-parts, or a large one): taken by every frame in parts, or
+  // loaded into merged_ when its frame fits the device.
+  const MappedPly* mapped_;
   GaussianScene merged_;
   const cli::LoadedLodSet* lod_;     // a LOD set drawn under --splat-budget
   LodSelection lod_selection_;

@@ -208,6 +208,12 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
       parser, options.memory_budget,
       "--stats prints the parts and peaks; without a budget, a frame past the device's limits still renders "
       "in parts; ");
+  parser.add_switch(
+      "--read-in-parts",
+      "read a binary PLY from its file part by part as the frame draws it, never whole: only the "
+      "Gaussians' positions stay on the host (a PLY larger than half of the host's memory is "
+      "read so without it); the frames are the same, to the bit",
+      &options.read_in_parts);
   cli::add_splat_budget_option(parser, options.common);
   parser.add_value("--region", "X,Y,WxH",
                    "render only these pixels of each frame (e.g. 0,540,1920x64), each the whole frame's to "

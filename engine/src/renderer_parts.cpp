@@ -226,12 +226,22 @@ RenderImage Renderer::render(const SceneInstances& scene, const Camera& camera,
       PartSource(scene), [&] { set_scene(merge_instances(scene)); }, camera, settings, *this);
 }
 
+RenderImage Renderer::render(const MappedPly& scene, const Camera& camera, const RenderSettings& settings) {
+  return impl_->render_scene(
+      PartSource(scene), [&] { set_scene(scene.load()); }, camera, settings, *this);
+}
+
 bool Renderer::renders_in_parts(const GaussianScene& scene, const Camera& camera,
                                 const RenderSettings& settings) {
   return impl_->needs_parts(PartSource(scene), camera, settings);
 }
 
 bool Renderer::renders_in_parts(const SceneInstances& scene, const Camera& camera,
+                                const RenderSettings& settings) {
+  return impl_->needs_parts(PartSource(scene), camera, settings);
+}
+
+bool Renderer::renders_in_parts(const MappedPly& scene, const Camera& camera,
                                 const RenderSettings& settings) {
   return impl_->needs_parts(PartSource(scene), camera, settings);
 }

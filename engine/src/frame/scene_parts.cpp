@@ -10,6 +10,7 @@
 #include "camera/camera_models.h"
 #include "frame/image_regions.h"
 #include "passes/projection_pass.h"
+#include "scene/mapped_ply_rows.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/sort.h"
 
@@ -35,6 +36,8 @@ uint32_t depth_key(double depth, int key_bits) {
 
 PartSource::PartSource(const GaussianScene& scene) : scene_(&scene), size_(scene.size()) {}
 
+PartSource::PartSource(const MappedPly& scene) : mapped_(scene.rows_.get()), size_(scene.size()) {}
+
 PartSource::PartSource(const SceneInstances& scene, double time) : instances_(&scene) {
   for (const SceneInstances::Instance& instance : scene.instances) {
     first_.push_back(size_);
@@ -46,14 +49,15 @@ PartSource::PartSource(const SceneInstances& scene, double time) : instances_(&s
 }
 
 int PartSource::sh_degree() const {
-  return scene_ ? scene_->sh_degree : instances_->sh_degree;
+  return scene_ ? scene_->sh_degree : mapped_ ? mapped_->sh_degree() : instances_->sh_degree;
 }
 bool PartSource::has_normals() const {
-  return scene_ ? scene_->has_normals() : instances_->normals;
+  return scene_ ? scene_->has_normals() : mapped_ ? mapped_->has_normals() : instances_->normals;
 }
 
 std::array<float, 3> PartSource::position(size_t i) const {
   if (scene_) return {scene_->positions[3 * i], scene_->positions[3 * i + 1], scene_->positions[3 * i + 2]};
+  if (mapped_) return mapped_->position(i);
   const size_t k = size_t(std::upper_bound(first_.begin(), first_.end(), i) - first_.begin()) - 1;
   const GaussianScene& file = instances_->files[instances_->instances[k].file];
   const size_t local = i - first_[k];
@@ -62,6 +66,7 @@ std::array<float, 3> PartSource::position(size_t i) const {
 
 GaussianScene PartSource::gather(std::span<const uint32_t> indices) const {
   if (scene_) return gather_gaussians(*scene_, indices);
+  if (mapped_) return mapped_->gather(indices);
   // Instance by instance (the indices ascend): its Gaussians gathered, placed as transform_scene places
   // them and appended as the merged scene appends them.
   GaussianScene part;

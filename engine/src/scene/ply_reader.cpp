@@ -19,15 +19,14 @@
 #include <vector>
 
 #include "scene/ply_header.h"
+#include "scene/ply_rows.h"
 #include "scene/ply_vertex_properties.h"
 #include "scene/scene_readers.h"
 #include "scene/scene_reading.h"
 #include "tilesplat/scene.h"
 
-namespace tilesplat {
+namespace tilesplat::detail {
 namespace {
-
-using namespace detail;
 
 // How many bytes of vertex rows are decoded before the reader lets go of them.
 constexpr size_t kReleaseBlockBytes = size_t(64) << 20;
@@ -44,6 +43,8 @@ struct Column {
   size_t stride = 0;
   const std::string* name = nullptr;
 };
+
+}  // namespace
 
 // Decodes a PLY held in memory. `name` (the file's path, for load_ply) prefixes every error.
 class PlyReader {
@@ -73,18 +74,64 @@ class PlyReader {
       read_binary(scene);
     }
     normalize_rotations(scene);
-
-    if (report) {
-      LoadReport result;
-      result.format = "ply " + header_.format_name;
-      result.version = "1.0";
-      result.gaussians_in_file = static_cast<size_t>(vertex().count);
-      result.dropped = non_finite_.dropped();
-      result.dropped_by_property = non_finite_.take();
-      result.ignored_properties = std::move(ignored_properties_);
-      *report = std::move(result);
-    }
+    if (report) *report = take_report();
     return scene;
+  }
+
+  // ---- rows on demand (PlyRows) ----
+
+  // Parses the header and finds the vertex rows of a binary 3DGS PLY, before any row is decoded.
+  void prepare_rows() {
+    if (size_ == 0) fail("empty file, not a PLY file");
+    header_ = ply_.parse_header();
+    if (is_compressed_ply(header_))
+      fail("a compressed PLY (PlayCanvas) cannot be read part by part: its rows are packed in chunks");
+    if (header_.format == PlyFormat::kAscii)
+      fail("an ASCII PLY cannot be read part by part: its rows vary in length");
+    plan_vertex_columns();
+    vertex_offset_ = swapped() ? locate_vertex_rows<true>() : locate_vertex_rows<false>();
+  }
+  size_t rows() const { return static_cast<size_t>(vertex().count); }
+  int sh_degree() const { return sh_degree_; }
+  bool has_normals() const { return has_normals_; }
+
+  // Rows [first, end) into `scene` (allocated here) from slot 0, the non-finite ones left out (their rows
+  // appended to `dropped`) and counted as load_ply counts them; returns the slots filled. The rotations
+  // are left as the file has them.
+  size_t decode_range(size_t first, size_t end, GaussianScene& scene, std::vector<size_t>& dropped) {
+    allocate(scene, end - first);
+    dropped_rows_ = &dropped;
+    const size_t kept = decode_rows_of(
+        scene, [first](size_t i) { return first + i; }, end - first);
+    dropped_rows_ = nullptr;
+    return kept;
+  }
+
+  // The rows `rows` into a scene of their own, rotations normalized: load_ply's Gaussians, bit for bit.
+  GaussianScene decode_rows_at(std::span<const uint64_t> rows) {
+    GaussianScene scene;
+    scene.sh_degree = sh_degree_;
+    if (rows.empty()) return scene;
+    for (uint64_t row : rows)
+      if (row >= this->rows()) fail("row " + std::to_string(row) + " is past the file's vertices");
+    allocate(scene, rows.size());
+    const size_t kept = decode_rows_of(
+        scene, [rows](size_t i) { return size_t(rows[i]); }, rows.size());
+    if (kept != rows.size())
+      fail("a row that was finite when the file was opened no longer is: the file changed while it was read");
+    normalize_rotations(scene);
+    return scene;
+  }
+
+  LoadReport take_report() {
+    LoadReport result;
+    result.format = "ply " + header_.format_name;
+    result.version = "1.0";
+    result.gaussians_in_file = static_cast<size_t>(vertex().count);
+    result.dropped = non_finite_.dropped();
+    result.dropped_by_property = non_finite_.take();
+    result.ignored_properties = std::move(ignored_properties_);
+    return result;
   }
 
  private:
@@ -244,6 +291,7 @@ class PlyReader {
       const float value = column.first[kept * column.stride];
       if (std::isfinite(value)) continue;
       non_finite_.record(gaussian_index, *column.name, value);
+      if (dropped_rows_) dropped_rows_->push_back(gaussian_index);
       return;
     }
   }
@@ -267,10 +315,11 @@ class PlyReader {
 
   // ---- binary ----
 
+  // Walks the binary elements, checking their sizes against the file's; returns where the vertex rows
+  // start.
   template <bool kSwap>
-  void read_binary_swapped(GaussianScene& scene) {
-    const PlyElement& vertex_element = vertex();
-    const size_t row_size = vertex_element.fixed_row_size;
+  size_t locate_vertex_rows() const {
+    const size_t row_size = vertex().fixed_row_size;
     size_t offset = header_.data_offset;
     size_t vertex_offset = 0;
     for (size_t e = 0; e < header_.elements.size(); ++e) {
@@ -298,35 +347,59 @@ class PlyReader {
       fail(
           std::to_string(size_ - offset) +
           " bytes of trailing data after the declared elements; the vertex count in the header may be wrong");
+    return vertex_offset;
+  }
 
-    const size_t count = static_cast<size_t>(vertex_element.count);
+  bool swapped() const {
+    const bool file_little = header_.format == PlyFormat::kBinaryLittleEndian;
+    return file_little != (std::endian::native == std::endian::little);
+  }
+
+  void read_binary(GaussianScene& scene) {
+    vertex_offset_ = swapped() ? locate_vertex_rows<true>() : locate_vertex_rows<false>();
+    const size_t count = rows();
     if (count == 0) return;
     allocate(scene, count);
-    const std::vector<Column> columns = make_columns(scene);
-    const unsigned char* rows = bytes_ + vertex_offset;
-    bool all_float = false;
-    if constexpr (!kSwap)
-      all_float = std::all_of(columns.begin(), columns.end(),
-                              [](const Column& c) { return c.type == ScalarType::kFloat32; });
     // In blocks of rows, each let go of once decoded: the file's pages and the decoded arrays are never
     // both whole in memory (a mapped file's pages count as resident while mapped).
+    const size_t row_size = vertex().fixed_row_size;
     const size_t block = std::max<size_t>(1, kReleaseBlockBytes / row_size);
+    const std::vector<Column> columns = make_columns(scene);
     size_t kept = 0;
     for (size_t first = 0; first < count; first += block) {
       const size_t end = std::min(count, first + block);
-      kept = all_float ? decode_rows<true, false>(rows, row_size, first, end, kept, columns)
-                       : decode_rows<false, kSwap>(rows, row_size, first, end, kept, columns);
-      if (done_with_) done_with_(vertex_offset + end * row_size);
+      kept = decode_rows(columns, kept, first, end, [](size_t i) { return i; });
+      if (done_with_) done_with_(vertex_offset_ + end * row_size);
     }
     shrink(scene, kept);
   }
 
-  // Rows [first, end) into the scene from slot `kept` on; returns the slots filled after them.
+  // Rows row_of(0), ..., row_of(count - 1) into `scene` (allocated for them) from slot 0.
+  template <typename RowOf>
+  size_t decode_rows_of(GaussianScene& scene, RowOf row_of, size_t count) {
+    return decode_rows(make_columns(scene), 0, 0, count, row_of);
+  }
+
+  // Rows row_of(first) to row_of(end - 1) into the columns' scene from slot `kept` on; returns the slots
+  // filled after them.
+  template <typename RowOf>
+  size_t decode_rows(const std::vector<Column>& columns, size_t kept, size_t first, size_t end,
+                     RowOf row_of) {
+    const bool all_float = std::all_of(columns.begin(), columns.end(),
+                                       [](const Column& c) { return c.type == ScalarType::kFloat32; });
+    if (swapped()) return decode_typed_rows<false, true>(columns, kept, first, end, row_of);
+    return all_float ? decode_typed_rows<true, false>(columns, kept, first, end, row_of)
+                     : decode_typed_rows<false, false>(columns, kept, first, end, row_of);
+  }
+
   // kFloatOnly: every used property is a native-endian float32, so a value is one memcpy.
-  template <bool kFloatOnly, bool kSwap>
-  size_t decode_rows(const unsigned char* rows, size_t row_size, size_t first, size_t end, size_t kept,
-                     const std::vector<Column>& columns) {
-    for (size_t i = first; i < end; ++i) {
+  template <bool kFloatOnly, bool kSwap, typename RowOf>
+  size_t decode_typed_rows(const std::vector<Column>& columns, size_t kept, size_t first, size_t end,
+                           RowOf row_of) {
+    const size_t row_size = vertex().fixed_row_size;
+    const unsigned char* rows = bytes_ + vertex_offset_;
+    for (size_t j = first; j < end; ++j) {
+      const size_t i = row_of(j);
       const unsigned char* row = rows + i * row_size;
       bool finite = true;
       for (const Column& column : columns) {
@@ -346,16 +419,6 @@ class PlyReader {
       }
     }
     return kept;
-  }
-
-  void read_binary(GaussianScene& scene) {
-    const bool file_little = header_.format == PlyFormat::kBinaryLittleEndian;
-    const bool host_little = std::endian::native == std::endian::little;
-    if (file_little == host_little) {
-      read_binary_swapped<false>(scene);
-    } else {
-      read_binary_swapped<true>(scene);
-    }
   }
 
   // ---- ASCII ----
@@ -454,11 +517,43 @@ class PlyReader {
   std::vector<ColumnTarget> targets_;  // one per vertex property
   int sh_degree_ = 0;
   bool has_normals_ = false;
+  size_t vertex_offset_ = 0;  // where the binary vertex rows start
   NonFiniteTally non_finite_;
+  std::vector<size_t>* dropped_rows_ = nullptr;  // decode_range's: the rows left out
   std::vector<std::string> ignored_properties_;
 };
 
-}  // namespace
+PlyRows::PlyRows(std::string name, const unsigned char* bytes, size_t size, const LoadOptions& options)
+    : name_(std::move(name)),
+      options_(options),
+      reader_(std::make_unique<PlyReader>(name_, bytes, size, options_)) {
+  reader_->prepare_rows();
+}
+PlyRows::~PlyRows() = default;
+size_t PlyRows::rows() const {
+  return reader_->rows();
+}
+int PlyRows::sh_degree() const {
+  return reader_->sh_degree();
+}
+bool PlyRows::has_normals() const {
+  return reader_->has_normals();
+}
+size_t PlyRows::decode_range(size_t first, size_t end, GaussianScene& scene, std::vector<size_t>& dropped) {
+  return reader_->decode_range(first, end, scene, dropped);
+}
+GaussianScene PlyRows::decode(std::span<const uint64_t> rows) const {
+  return reader_->decode_rows_at(rows);
+}
+LoadReport PlyRows::take_report() {
+  return reader_->take_report();
+}
+
+}  // namespace tilesplat::detail
+
+namespace tilesplat {
+
+using namespace detail;
 
 GaussianScene parse_ply(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
                         LoadReport* report) {

@@ -162,16 +162,23 @@ std::string LoadReport::summary() const {
 }
 
 Bounds compute_bounds(const GaussianScene& scene) {
+  if (scene.positions.size() < 3 * scene.size()) return {};
+  return detail::bounds_of_positions(std::span(scene.positions).first(3 * scene.size()));
+}
+
+namespace detail {
+
+Bounds bounds_of_positions(std::span<const float> positions) {
   Bounds bounds;
-  const size_t count = scene.size();
-  if (count == 0 || scene.positions.size() < 3 * count) return bounds;
+  const size_t count = positions.size() / 3;
+  if (count == 0) return bounds;
 
   std::vector<double> axis(count);
   for (size_t a = 0; a < 3; ++a) {
-    double low = scene.positions[a];
+    double low = positions[a];
     double high = low;
     for (size_t i = 0; i < count; ++i) {
-      const double value = scene.positions[3 * i + a];
+      const double value = positions[3 * i + a];
       axis[i] = value;
       low = std::min(low, value);
       high = std::max(high, value);
@@ -184,9 +191,9 @@ Bounds compute_bounds(const GaussianScene& scene) {
 
   std::vector<double> distances(count);
   for (size_t i = 0; i < count; ++i) {
-    const double dx = scene.positions[3 * i] - bounds.center[0];
-    const double dy = scene.positions[3 * i + 1] - bounds.center[1];
-    const double dz = scene.positions[3 * i + 2] - bounds.center[2];
+    const double dx = positions[3 * i] - bounds.center[0];
+    const double dy = positions[3 * i + 1] - bounds.center[1];
+    const double dz = positions[3 * i + 2] - bounds.center[2];
     distances[i] = std::sqrt(dx * dx + dy * dy + dz * dz);
   }
   // Nearest-rank 95th percentile: covers most Gaussians while ignoring the outlying 5%.
@@ -197,6 +204,8 @@ Bounds compute_bounds(const GaussianScene& scene) {
   bounds.radius = distances[index];
   return bounds;
 }
+
+}  // namespace detail
 
 SceneStatistics compute_statistics(const GaussianScene& scene) {
   SceneStatistics stats;

@@ -85,6 +85,12 @@ void FileContents::release_before(size_t end) {
 #endif
 }
 
+void FileContents::release_all() const {
+#if TILESPLAT_HAS_MMAP
+  if (mapping_) madvise(mapping_, size_, MADV_DONTNEED);
+#endif
+}
+
 void open_scene_file(const std::filesystem::path& path, FileContents& contents) {
   const std::string name = path.string();
   std::error_code ec;

@@ -45,6 +45,9 @@ class FileContents {
   // process's resident memory, and are read from the file again if touched. Nothing for a file read
   // into memory.
   void release_before(size_t end);
+  // Lets go of every page of a mapped file, whatever was touched before (a file read in parts, whose
+  // parts are scattered through it). Nothing for a file read into memory.
+  void release_all() const;
 
   const unsigned char* data() const { return data_; }
   size_t size() const { return size_; }
@@ -114,6 +117,9 @@ class NonFiniteTally {
 // original CUDA rasterizer, and as projection.comp and the float64 reference treat it. Others are
 // normalized in double (their squares cannot overflow or underflow there).
 void normalize_rotations(GaussianScene& scene);
+
+// compute_bounds of a scene whose positions (x, y, z of each Gaussian) are `positions`.
+Bounds bounds_of_positions(std::span<const float> positions);
 
 // The post-processing every reader but PLY's (which filters while it decodes) ends with: drops
 // (or, strict, rejects) Gaussians with a non-finite value, naming the first bad one by its PLY
