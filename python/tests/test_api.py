@@ -1,6 +1,8 @@
 """The engine's API from Python: scenes as numpy views, cameras, the renderer, images, errors."""
 
+import pathlib
 import subprocess
+import tempfile
 import threading
 import time
 
@@ -258,6 +260,30 @@ def test_a_scene_files_moving_models_blur_under_an_open_shutter(playbot_renderer
         accumulated = renderer.render(camera, shutter=sobol, accumulate_samples=True)
     assert renderer.last_frame_stats["accumulated_samples"] == 4
     assert np.abs(accumulated.rgba - all_four.rgba).max() <= 2e-5
+
+
+def test_a_ply_read_part_by_part_is_the_loaded_scenes_frame(playbot_renderer):
+    scene, renderer = playbot_renderer
+    mapped = tilesplat.MappedPly(BUNDLED_PLAYBOT)
+    assert mapped.size == scene.size and mapped.sh_degree == scene.sh_degree
+    assert np.array_equal(mapped.load().positions, scene.positions)
+    camera = tilesplat.Camera.orbit(scene, 160, 90, azimuth_deg=30)
+    whole = renderer.render(camera, scene=scene)
+    in_parts = renderer.render(camera, mapped_ply=mapped, memory_budget=4 << 20)
+    assert renderer.last_frame_stats["scene_parts"] > 1
+    assert np.array_equal(in_parts.rgba, whole.rgba) and np.array_equal(in_parts.depth, whole.depth)
+    with pytest.raises(ValueError, match="one of scene, lod_set and instances"):
+        renderer.render(camera, scene=scene, mapped_ply=mapped)
+    with pytest.raises(tilesplat.SceneError, match="ASCII PLY cannot be read part by part"):
+        ascii_ply = pathlib.Path(tempfile.mkdtemp()) / "ascii.ply"
+        names = ["x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1", "scale_2",
+                 "rot_0", "rot_1", "rot_2", "rot_3"]
+        ascii_ply.write_text("ply\nformat ascii 1.0\nelement vertex 1\n" +
+                             "".join(f"property float {name}\n" for name in names) +
+                             "end_header\n0 0 0 0 0 0 0 -3 -3 -3 1 0 0 0\n")
+        tilesplat.MappedPly(ascii_ply)
+    renderer.set_scene(scene)  # the other tests render the scene set
+    assert renderer.validation_messages == 0
 
 
 def test_a_lod_set_by_level_and_under_a_splat_budget(playbot_renderer):
