@@ -26,8 +26,12 @@ class ViewEffects {
   // Keys F and B: false (nothing changed) with the mesh.
   bool toggle_depth_of_field();
   bool toggle_motion_blur();
-  // Another view: its shutter (closed for a view the scene file opens none for).
-  void set_view_shutter(ViewShutter shutter) { view_shutter_ = shutter; }
+  // Another view: its shutter (closed for a view the scene file opens none for), and motion blur as the
+  // scene file gives the view (on when its shutter opens), whatever key B made of the view before.
+  void set_view_shutter(ViewShutter shutter) {
+    view_shutter_ = shutter;
+    motion_blur_ = shutter.opens();
+  }
 
   // Sets the lens, the shutter and accumulate_samples of a frame seen from `camera`; `pinhole`: key L's
   // lens is the pinhole (depth of field is a pinhole's alone; motion blur goes with every lens).
