@@ -309,19 +309,27 @@ void expect_sizes_consistent(const GaussianScene& scene) {
   }
 }
 
-// Loads and expects a SceneError whose message starts with the path and holds every phrase.
-void expect_load_error(const std::filesystem::path& path, std::initializer_list<std::string_view> phrases,
-                       const LoadOptions& options = {}) {
+// Reads `path` with `read` and expects a SceneError whose message starts with the path and holds every
+// phrase.
+template <typename Read>
+void expect_read_error(const std::filesystem::path& path, std::initializer_list<std::string_view> phrases,
+                       Read read) {
   std::string message;
   try {
-    load_ply(path, options);
-    ADD_FAILURE() << "loaded without an error: " << path;
+    read();
+    ADD_FAILURE() << "read without an error: " << path;
     return;
   } catch (const SceneError& error) {
     message = error.what();
   }
   EXPECT_TRUE(message.starts_with(path.string())) << message;
   for (std::string_view phrase : phrases) EXPECT_NE(message.find(phrase), std::string::npos) << message;
+}
+
+// Loads and expects a SceneError whose message starts with the path and holds every phrase.
+void expect_load_error(const std::filesystem::path& path, std::initializer_list<std::string_view> phrases,
+                       const LoadOptions& options = {}) {
+  expect_read_error(path, phrases, [&] { load_ply(path, options); });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1145,14 +1153,7 @@ TEST(MappedPly, DropsNonFiniteGaussiansAsLoadPlyDoes) {
 
 // Opens and expects a SceneError whose message starts with the path and holds every phrase.
 void expect_mapped_error(const std::filesystem::path& path, std::initializer_list<std::string_view> phrases) {
-  try {
-    MappedPly::open(path);
-    ADD_FAILURE() << "opened without an error: " << path;
-  } catch (const SceneError& error) {
-    const std::string message = error.what();
-    EXPECT_TRUE(message.starts_with(path.string())) << message;
-    for (std::string_view phrase : phrases) EXPECT_NE(message.find(phrase), std::string::npos) << message;
-  }
+  expect_read_error(path, phrases, [&] { MappedPly::open(path); });
 }
 
 TEST(MappedPlyErrors, WhatCannotBeReadInPartsIsRefusedNamingTheFile) {
