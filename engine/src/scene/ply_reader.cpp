@@ -99,6 +99,8 @@ class PlyReader {
   // appended to `dropped`) and counted as load_ply counts them; returns the slots filled. The rotations
   // are left as the file has them.
   size_t decode_range(size_t first, size_t end, GaussianScene& scene, std::vector<size_t>& dropped) {
+    scene.sh_degree = sh_degree_;
+    if (end <= first) return 0;  // no rows: no columns to point into empty arrays
     allocate(scene, end - first);
     dropped_rows_ = &dropped;
     const size_t kept = decode_rows_of(
