@@ -188,8 +188,13 @@ class GltfReader {
       if (type == type_name) type_components = n;
     if (type_components != components)
       fail(where + " has type " + type.dump() + "; expected " + std::to_string(components) + " components");
-    const int component_type =
-        static_cast<int>(number(at(a, "componentType", where), where + ".componentType"));
+    // One of glTF's GL enums (5120 to 5126): a number past int's range is refused before it becomes one.
+    const json& component_json = at(a, "componentType", where);
+    const double component_number = number(component_json, where + ".componentType");
+    if (!(component_number >= 0 && component_number <= 65535))
+      fail(where + " has component type " + component_json.dump() +
+           ", which the extension does not allow for it");
+    const int component_type = static_cast<int>(component_number);
     if (std::find(allowed.begin(), allowed.end(), component_type) == allowed.end())
       fail(where + " has component type " + std::to_string(component_type) +
            ", which the extension does not allow for it");
