@@ -11,13 +11,6 @@
 
 namespace tilesplat {
 namespace detail {
-namespace {
-
-// How many bytes of rows the first read decodes at a time.
-constexpr size_t kScanBlockBytes = size_t(64) << 20;
-
-}  // namespace
-
 MappedPlyRows::MappedPlyRows(const std::filesystem::path& path, const LoadOptions& options,
                              LoadReport* report) {
   open_scene_file(path, contents_);
@@ -25,8 +18,7 @@ MappedPlyRows::MappedPlyRows(const std::filesystem::path& path, const LoadOption
   const size_t rows = rows_->rows();
   if (rows > UINT32_MAX)
     fail(path.string(), std::to_string(rows) + " vertices: a scene read in parts holds at most 2^32 - 1");
-  const size_t row_bytes = std::max<size_t>(1, contents_.size() / std::max<size_t>(rows, 1));
-  const size_t block = std::max<size_t>(1, kScanBlockBytes / row_bytes);
+  const size_t block = rows_->rows_per_block();
   std::vector<size_t> dropped;
   GaussianScene decoded;
   positions_.reserve(3 * rows);

@@ -92,6 +92,8 @@ class PlyReader {
     vertex_offset_ = swapped() ? locate_vertex_rows<true>() : locate_vertex_rows<false>();
   }
   size_t rows() const { return static_cast<size_t>(vertex().count); }
+  // The rows of one block: as many as kReleaseBlockBytes hold, decoded before the file's pages are let go of.
+  size_t rows_per_block() const { return std::max<size_t>(1, kReleaseBlockBytes / vertex().fixed_row_size); }
   int sh_degree() const { return sh_degree_; }
   bool has_normals() const { return has_normals_; }
 
@@ -365,7 +367,7 @@ class PlyReader {
     // In blocks of rows, each let go of once decoded: the file's pages and the decoded arrays are never
     // both whole in memory (a mapped file's pages count as resident while mapped).
     const size_t row_size = vertex().fixed_row_size;
-    const size_t block = std::max<size_t>(1, kReleaseBlockBytes / row_size);
+    const size_t block = rows_per_block();
     const std::vector<Column> columns = make_columns(scene);
     size_t kept = 0;
     for (size_t first = 0; first < count; first += block) {
@@ -534,6 +536,9 @@ PlyRows::PlyRows(std::string name, const unsigned char* bytes, size_t size, cons
 PlyRows::~PlyRows() = default;
 size_t PlyRows::rows() const {
   return reader_->rows();
+}
+size_t PlyRows::rows_per_block() const {
+  return reader_->rows_per_block();
 }
 int PlyRows::sh_degree() const {
   return reader_->sh_degree();

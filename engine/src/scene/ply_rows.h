@@ -27,6 +27,8 @@ class PlyRows {
   PlyRows& operator=(const PlyRows&) = delete;
 
   size_t rows() const;  // the vertices the file holds, non-finite ones included
+  // How many rows load_ply decodes before it lets go of the file's pages (64 MiB of them).
+  size_t rows_per_block() const;
   int sh_degree() const;
   bool has_normals() const;
 
