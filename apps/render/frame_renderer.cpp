@@ -20,11 +20,7 @@ FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScen
     scene_centre_ = {bounds.center[0], bounds.center[1], bounds.center[2]};
   }
   if (options.reference) {
-    if (mapped_) {  // the float64 reference takes a whole scene
-      merged_ = mapped_->load();
-      scene_ = &merged_;
-      mapped_ = nullptr;
-    }
+    if (mapped_) load_mapped_whole();  // the float64 reference takes a whole scene
     return;
   }
   renderer_ = Renderer::create(cli::renderer_options(options.common));
@@ -54,12 +50,16 @@ void FrameRenderer::decide_holding(const Camera& camera, const RenderSettings& s
       in_parts_ = true;
       return;
     }
-    merged_ = mapped_->load();
-    scene_ = &merged_;
-    mapped_ = nullptr;
+    load_mapped_whole();
   }
   in_parts_ = renderer_->renders_in_parts(*scene_, camera, settings);
   if (!in_parts_) renderer_->set_scene(*scene_);
+}
+
+void FrameRenderer::load_mapped_whole() {
+  merged_ = mapped_->load();
+  scene_ = &merged_;
+  mapped_ = nullptr;
 }
 
 RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& base_settings) {

@@ -48,6 +48,8 @@ class FrameRenderer {
   LensFlags lens_;
   // The first frame's choice: the scene set once, or taken by each frame (in parts where it does not fit).
   void decide_holding(const Camera& camera, const RenderSettings& settings);
+  // The PLY read part by part, loaded into merged_ and drawn from there.
+  void load_mapped_whole();
 
   bool in_parts_ = false;  // --memory-budget, or a frame that does not fit the device
   bool decided_ = false;
