@@ -5,14 +5,17 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <latch>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "process_support.h"
@@ -357,6 +360,119 @@ TEST(LodSet, AMissingOrShortChunkFileIsAnErrorNamingIt) {
   } catch (const SceneError& error) {
     EXPECT_TRUE(contains(error.what(), "is itself a LOD set index")) << error.what();
   }
+}
+
+// Several threads loading from one set (a LodStreamer's, a renderer's, the caller's) get what one thread
+// gets, with a cache small enough that they evict one another's files.
+TEST(LodSet, LoadsFromSeveralThreadsAtOnceAsFromOne) {
+  LodSet set = LodSet::open(lod_index());
+  std::vector<tilesplat::GaussianScene> levels;
+  for (int level = 0; level < set.levels(); ++level) levels.push_back(set.load_level(level));
+  set.set_cache_bytes(200000);  // about two chunk files of level 0
+  std::vector<std::thread> threads;
+  std::atomic<int> wrong = 0;
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (int round = 0; round < 6; ++round) {
+        const int level = (t + round) % set.levels();
+        if (!same_scene(set.load_level(level), levels[size_t(level)])) ++wrong;
+      }
+    });
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_EQ(wrong, 0);
+  EXPECT_LE(set.cached_bytes(), 200000u);
+}
+
+// The camera `steps` of a tenth of the distance to the capture's centre closer than whole_view(): the
+// chunks near it take finer levels as it nears them.
+tilesplat::Camera dolly(int steps) {
+  tilesplat::Camera camera = whole_view();
+  const tilesplat::Bounds bounds =
+      tilesplat::compute_bounds(tilesplat::load_ply(tilesplat::testing::bundled_playbot()));
+  for (size_t a = 0; a < 3; ++a) camera.position[a] += 0.1 * steps * (bounds.center[a] - camera.position[a]);
+  return camera;
+}
+
+TEST(LodStreamer, LoadsTheLevelsACameraCallsForOnItsThread) {
+  const LodSet set = LodSet::open(lod_index());
+  std::atomic<int> loads = 0;
+  tilesplat::LodStreamer streamer(set, 10000, {}, [&loads] { ++loads; });
+  EXPECT_EQ(streamer.splat_budget(), 10000u);
+  EXPECT_FALSE(streamer.take());  // nothing asked for yet
+  EXPECT_FALSE(streamer.wait_and_take());
+
+  const LodSelection chosen = streamer.request(whole_view());
+  const LodSelection expected = tilesplat::select_lod_levels(set, whole_view(), 10000);
+  EXPECT_EQ(chosen.chunk_levels, expected.chunk_levels);
+  EXPECT_EQ(chosen.splats, expected.splats);
+  const std::optional<tilesplat::LodLoad> loaded = streamer.wait_and_take();
+  ASSERT_TRUE(loaded);
+  EXPECT_FALSE(streamer.busy());
+  EXPECT_EQ(loads, 1);
+  EXPECT_EQ(loaded->selection.chunk_levels, expected.chunk_levels);
+  EXPECT_EQ(loaded->scene.size(), expected.splats);
+  EXPECT_TRUE(same_scene(loaded->scene, set.load_selection(expected)));
+
+  // The same levels again are no request: nothing is read, nothing comes.
+  streamer.request(whole_view());
+  EXPECT_FALSE(streamer.busy());
+  EXPECT_FALSE(streamer.wait_and_take());
+  EXPECT_EQ(loads, 1);
+}
+
+// A camera moving faster than its levels are read: the streamer is held inside its first load (its
+// callback waits) while the camera moves on; the requests made meanwhile replace one another, and the next
+// load is the newest camera's levels alone.
+TEST(LodStreamer, OnlyTheNewestCamerasLevelsWaitToBeRead) {
+  const LodSet set = LodSet::open(lod_index());
+  std::atomic<int> loads = 0;
+  std::latch first_load_held(1);
+  tilesplat::LodStreamer streamer(set, 6000, {}, [&] {
+    if (++loads == 1) first_load_held.wait();
+  });
+  streamer.request(dolly(0));
+  while (loads == 0) std::this_thread::yield();  // the first load is done, its callback waits
+
+  std::vector<int> previous = tilesplat::select_lod_levels(set, dolly(0), 6000).chunk_levels;
+  int changes = 0;
+  for (int step = 1; step < 8; ++step) {
+    const LodSelection chosen = streamer.request(dolly(step));
+    if (chosen.chunk_levels != previous) ++changes;
+    previous = chosen.chunk_levels;
+  }
+  ASSERT_GE(changes, 3) << "the path should change the levels";
+  EXPECT_TRUE(streamer.busy());
+  const std::optional<tilesplat::LodLoad> first = streamer.take();
+  ASSERT_TRUE(first);
+  EXPECT_EQ(first->selection.chunk_levels, tilesplat::select_lod_levels(set, dolly(0), 6000).chunk_levels);
+
+  first_load_held.count_down();
+  const std::optional<tilesplat::LodLoad> last = streamer.wait_and_take();
+  ASSERT_TRUE(last);
+  const LodSelection expected = tilesplat::select_lod_levels(set, dolly(7), 6000);
+  EXPECT_EQ(last->selection.chunk_levels, expected.chunk_levels);
+  EXPECT_TRUE(same_scene(last->scene, set.load_selection(expected)));
+  EXPECT_EQ(loads, 2);  // the first camera's and the newest's: none of the steps between
+}
+
+// A load that fails is rethrown once, naming the file; the same levels can then be asked for again.
+TEST(LodStreamer, AFailedLoadIsRethrownAndCanBeAskedForAgain) {
+  const fs::path index = copy_of_set(tilesplat::testing::temp_dir() / "streamed_broken_set");
+  fs::remove_all(index.parent_path() / "0_0");
+  const LodSet set = LodSet::open(index);
+  tilesplat::LodStreamer streamer(set, 1000000);  // every chunk at level 0
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    streamer.request(whole_view());
+    try {
+      streamer.wait_and_take();
+      ADD_FAILURE() << "a level with a missing chunk file loaded";
+    } catch (const SceneError& error) {
+      EXPECT_TRUE(contains(error.what(), "the chunk file '0_0/meta.json' cannot be read")) << error.what();
+    }
+    EXPECT_FALSE(streamer.take());  // rethrown once
+  }
+  // Destroyed while a load runs: the destructor waits for it.
+  tilesplat::LodStreamer(set, 2000).request(whole_view());
 }
 
 TEST(LodSetCli, RendersALevelOrASplatBudgetAndTellsWhatItDrew) {

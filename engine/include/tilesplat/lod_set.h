@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -47,7 +48,8 @@ struct LodSelection {
 };
 
 /// An opened lod-meta.json: the index, read and checked in full; the chunk files are read when a level or
-/// a selection needs them, each decoded once and kept while the cache's byte limit allows.
+/// a selection needs them, each decoded once and kept while the cache's byte limit allows. Its const
+/// functions may run on several threads at once (the cache is locked; a LodStreamer loads on its own).
 class TILESPLAT_API LodSet {
  public:
   /// Reads and checks the index (version 1, or the older unversioned one): levels, per-level counts
@@ -100,5 +102,46 @@ TILESPLAT_API bool is_lod_set(const std::filesystem::path& path);
 /// A budget of at least the finest total draws every chunk in view at level 0. Ties go to the lower chunk
 /// index, so the choice is deterministic. Cameras other than the pinhole keep every chunk (no culling).
 TILESPLAT_API LodSelection select_lod_levels(const LodSet& set, const Camera& camera, uint64_t splat_budget);
+
+/// A scene a LodStreamer loaded: the selection it holds and its Gaussians (LodSet::load_selection's).
+struct LodLoad {
+  LodSelection selection;  ///< the levels chosen for the camera of the request
+  GaussianScene scene;     ///< those levels' Gaussians, then the environment
+  double load_ms = 0;      ///< the time the streamer's thread took to read and gather them
+};
+
+/// Loads the levels a moving camera calls for on a thread of its own, as streaming viewers do: the caller
+/// asks for each frame's camera and goes on drawing the scene it has until the new levels are read, then
+/// takes them. Requests come faster than files are read, so only the newest waits: a request replaces one
+/// queued before it that has not started, and one whose levels equal the newest requested is no request.
+///
+/// The functions are called from one thread (the caller's); the loads run on the streamer's. The set must
+/// outlive the streamer, whose destructor waits for a load in flight (a file is not read half).
+class TILESPLAT_API LodStreamer {
+ public:
+  /// `on_loaded`, if set, runs on the streamer's thread after each load, finished or failed (a viewer wakes
+  /// its event loop with it: glfwPostEmptyEvent); it must not call back into the streamer.
+  LodStreamer(const LodSet& set, uint64_t splat_budget, LoadOptions options = {},
+              std::function<void()> on_loaded = {});
+  ~LodStreamer();
+  LodStreamer(const LodStreamer&) = delete;
+  LodStreamer& operator=(const LodStreamer&) = delete;
+
+  /// The levels `camera` calls for under the budget (select_lod_levels). Queued for loading unless they
+  /// equal the newest levels requested. Returns the selection, to show what is being drawn or loaded.
+  LodSelection request(const Camera& camera);
+  /// The newest load finished since the last take, or nothing. Rethrows the SceneError of a failed load
+  /// (once; its levels may then be requested again).
+  std::optional<LodLoad> take();
+  /// Waits until nothing is queued or loading, then takes (a first frame, a screenshot, a test).
+  std::optional<LodLoad> wait_and_take();
+  /// Whether a load is queued or running.
+  bool busy() const;
+  uint64_t splat_budget() const;  ///< the budget requests are chosen under
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace tilesplat

@@ -17,6 +17,7 @@
 #include <list>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -121,7 +122,7 @@ class IndexParser {
 };
 
 // Decoded chunk files, least recently used first out. Entries are shared: one evicted while a load
-// still uses it lives until that load is done.
+// still uses it lives until that load is done. Not locked itself: LodSet::Impl guards it.
 class ChunkCache {
  public:
   using Scene = std::shared_ptr<const GaussianScene>;
@@ -134,13 +135,17 @@ class ChunkCache {
   }
 
   // Keeps `scene` unless it alone is over the limit, evicting the least recently used to make room.
-  void insert(uint32_t file, Scene scene) {
+  // Returns the file's scene as the cache has it: one that another thread decoded and kept first wins,
+  // so that every load shares one copy.
+  Scene insert(uint32_t file, Scene scene) {
+    if (Scene kept = find(file)) return kept;
     const uint64_t bytes = bytes_of(*scene);
-    if (bytes > limit_) return;
+    if (bytes > limit_) return scene;
     while (!order_.empty() && held_ + bytes > limit_) evict_oldest();
     order_.push_back(file);
-    entries_[file] = Entry{std::move(scene), bytes, std::prev(order_.end())};
+    entries_[file] = Entry{scene, bytes, std::prev(order_.end())};
     held_ += bytes;
+    return scene;
   }
 
   void set_limit(uint64_t bytes) {
@@ -186,6 +191,9 @@ struct LodSet::Impl {
   std::string generator;
   // What the cache is keyed by for the environment: one past the chunk files.
   uint32_t environment_key() const { return static_cast<uint32_t>(files.size()); }
+  // Several threads may load at once (LodStreamer's, a renderer's, the caller's): the cache is locked
+  // for its lookups and insertions only, never while a file is decoded.
+  mutable std::mutex cache_mutex;
   mutable ChunkCache cache;
 
   [[noreturn]] void fail(const std::string& what) const { detail::fail(index_path.string(), what); }
@@ -194,7 +202,10 @@ struct LodSet::Impl {
   // reader had to drop Gaussians from is refused: the index's offsets count every Gaussian of it.
   std::shared_ptr<const GaussianScene> decoded(uint32_t file, const LoadOptions& options) const {
     const std::string& name = file == environment_key() ? *environment : files[file];
-    if (auto cached = cache.find(file)) return cached;
+    {
+      const std::lock_guard lock(cache_mutex);
+      if (auto cached = cache.find(file)) return cached;
+    }
     const fs::path path = index_path.parent_path() / name;
     // A chunk that is itself an index would read the set again, and again.
     if (is_lod_set(path)) fail("the chunk file '" + name + "' is itself a LOD set index");
@@ -208,9 +219,8 @@ struct LodSet::Impl {
     if (report.dropped > 0)
       fail("the chunk file '" + name + "' has " + std::to_string(report.dropped) +
            " Gaussians with non-finite values; the index's offsets need every one of them");
-    auto shared = std::make_shared<const GaussianScene>(std::move(scene));
-    cache.insert(file, shared);
-    return shared;
+    const std::lock_guard lock(cache_mutex);
+    return cache.insert(file, std::make_shared<const GaussianScene>(std::move(scene)));
   }
 
   // The chunks at `chunk_levels` (-1: left out), then the environment.
@@ -375,9 +385,11 @@ GaussianScene LodSet::load_selection(const LodSelection& selection, const LoadOp
 }
 
 void LodSet::set_cache_bytes(uint64_t bytes) {
+  const std::lock_guard lock(impl_->cache_mutex);
   impl_->cache.set_limit(bytes);
 }
 uint64_t LodSet::cached_bytes() const {
+  const std::lock_guard lock(impl_->cache_mutex);
   return impl_->cache.held();
 }
 
