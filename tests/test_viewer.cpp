@@ -17,7 +17,10 @@
 
 #include "process_support.h"
 #include "test_support.h"
+#include "tilesplat/camera.h"
 #include "tilesplat/image.h"
+#include "tilesplat/lod_set.h"
+#include "tilesplat/renderer.h"
 
 namespace {
 
@@ -105,6 +108,42 @@ TEST(Viewer, ASplatBudgetDrawsWhatTheRendererDraws) {
   ASSERT_EQ(render.exit_code, 0) << render.err;
   const tilesplat::ImageDifference difference = tilesplat::compare_images(
       tilesplat::read_exr(out / "viewer.exr"), tilesplat::read_exr(out / "render.exr"));
+  EXPECT_GE(difference.psnr_db, 100.0) << "max abs " << difference.max_abs;
+}
+
+// --turn moves the camera every frame: under a splat budget the levels each camera calls for are read on
+// the streamer's thread while frames go on, and the EXR screenshot (its camera recorded in the file) is the
+// renderer's frame of the last camera's levels.
+TEST(Viewer, ATurningCameraStreamsTheLevelsItCallsFor) {
+  REQUIRE_VIEWER();
+  const std::optional<std::string> prefix = display_prefix();
+  if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
+  const fs::path out = fresh_output_dir();
+  const fs::path lod_set =
+      fs::path(TILESPLAT_SOURCE_DIR) / "tests" / "data" / "playbot_lod_set" / "lod-meta.json";
+  std::vector<std::string> viewer_args = view_args(lod_set, bundled_playbot_cameras(), 2);
+  viewer_args.insert(viewer_args.end(), {"--splat-budget", "6000", "--turn", "20", "--frames", "10",
+                                         "--validation", "--screenshot", (out / "viewer.exr").string()});
+  const ProcessResult viewer = run_process(*prefix, kViewerExe, viewer_args);
+  ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
+  EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
+  const size_t reads_at = viewer.err.find("levels read ");
+  ASSERT_NE(reads_at, std::string::npos) << viewer.err;
+  EXPECT_GE(std::stoi(viewer.err.substr(reads_at + 12)), 3) << "half a turn should change the levels";
+
+  const std::optional<tilesplat::Camera> camera = tilesplat::read_exr_camera(out / "viewer.exr");
+  ASSERT_TRUE(camera);
+  const tilesplat::Camera start = tilesplat::load_cameras_json(bundled_playbot_cameras()).at(2).camera;
+  EXPECT_GT(
+      std::abs(camera->position[0] - start.position[0]) + std::abs(camera->position[2] - start.position[2]),
+      0.5)
+      << "the camera did not turn";
+  const tilesplat::LodSet set = tilesplat::LodSet::open(lod_set);
+  tilesplat::RenderSettings settings;
+  settings.splat_budget = 6000;
+  const tilesplat::RenderImage rendered = tilesplat::Renderer::create()->render(set, *camera, settings);
+  const tilesplat::ImageDifference difference =
+      tilesplat::compare_images(tilesplat::read_exr(out / "viewer.exr"), rendered);
   EXPECT_GE(difference.psnr_db, 100.0) << "max abs " << difference.max_abs;
 }
 
@@ -309,6 +348,14 @@ TEST(Viewer, BadInputFailsWithOneLineAndWritesNothing) {
   const ProcessResult no_frames = run_process("", kViewerExe, {bundled_sh3().string(), "--frames", "0"});
   EXPECT_EQ(no_frames.exit_code, 2) << no_frames.err;
   expect_one_error_line(no_frames);
+
+  for (const char* turn : {"181", "nan", "ten"}) {
+    const ProcessResult bad_turn =
+        run_process("", kViewerExe, {bundled_sh3().string(), "--turn", turn, "--screenshot", shot});
+    EXPECT_EQ(bad_turn.exit_code, 2) << bad_turn.err;
+    EXPECT_NE(bad_turn.err.find("--turn"), std::string::npos) << bad_turn.err;
+    expect_one_error_line(bad_turn);
+  }
 
   const std::string jpg = (out / "x.jpg").string();
   const ProcessResult bad_shot = run_process("", kViewerExe, {bundled_sh3().string(), "--screenshot", jpg});

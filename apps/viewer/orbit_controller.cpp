@@ -53,6 +53,10 @@ void OrbitController::orbit(double dx, double dy) {
   if (std::abs(dot(axis(tilted, 2), kWorldUp)) < 0.99) camera_ = tilted;
 }
 
+void OrbitController::turn(double degrees) {
+  camera_ = turn_camera(camera_, pivot_, kWorldUp, degrees * std::numbers::pi / 180.0);
+}
+
 void OrbitController::pan(double dx, double dy) {
   const Vec3 to_pivot = {pivot_[0] - camera_.position[0], pivot_[1] - camera_.position[1],
                          pivot_[2] - camera_.position[2]};

@@ -27,6 +27,8 @@ class OrbitController {
   void orbit(double dx, double dy);
   // Slides the camera and the pivot in the image plane so that the pivot's depth follows the mouse.
   void pan(double dx, double dy);
+  // Turns the camera about world up through the pivot (--turn: a turntable, as a steady horizontal drag).
+  void turn(double degrees);
   // Scroll steps (positive: closer), each 15% of the way to the pivot's depth.
   void zoom(double steps);
 

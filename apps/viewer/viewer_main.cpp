@@ -8,11 +8,13 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -99,10 +101,15 @@ class Viewer {
         mesh_(!options.no_mesh),
         depth_out_(!options.no_depth_out),
         scene_name_(loaded.path.filename().string()),
-        lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
+        lod_streamer_(loaded.lod && loaded.lod->splat_budget > 0
+                          ? std::make_unique<tilesplat::LodStreamer>(
+                                *loaded.lod->set, loaded.lod->splat_budget, tilesplat::LoadOptions{},
+                                [this] { on_lod_loaded(); })
+                          : nullptr),
         views_(std::move(views.views)),
         shutters_(std::move(views.shutters)),
         view_(options.common.view),
+        turn_deg_(options.turn_deg),
         effects_(options.lens, ViewShutter(loaded.shutter, loaded.camera),
                  loaded.instances && loaded.instances->moves(),
                  {bounds_.center[0], bounds_.center[1], bounds_.center[2]}, mesh_),
@@ -149,21 +156,26 @@ class Viewer {
   // positive, each of which is rendered even if nothing changed.
   void run(int frame_limit) {
     while (!glfwWindowShouldClose(window_)) {
-      if (frame_limit > 0) needs_render_ = true;
+      if (frame_limit > 0 || turn_deg_ != 0) needs_render_ = true;
       if ((needs_render_ || needs_present_ || swapchain_.stale()) && !minimized_)
         glfwPollEvents();
       else
         glfwWaitEvents();
+      if (lod_arrived_.exchange(false)) needs_render_ = true;  // the camera's levels were read
       if (resized_ || swapchain_.stale()) fit_to_window();
       if (minimized_) continue;
       const auto start = std::chrono::steady_clock::now();
       const bool rendering = needs_render_;
+      if (rendering && turn_deg_ != 0 && frames_ > 0) controller_.turn(turn_deg_);
       if (rendering) render();
       if (needs_present_) needs_present_ = !present();
       if (rendering) {
         const double frame_ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        if (frames_ > 1) frame_ms_total_ += frame_ms;  // the first frame builds pipelines
+        if (frames_ > 1) {  // the first frame builds pipelines
+          frame_ms_total_ += frame_ms;
+          frame_ms_max_ = std::max(frame_ms_max_, frame_ms);
+        }
         show_title(frame_ms);
         if (frame_limit > 0 && frames_ >= frame_limit) break;
       }
@@ -206,11 +218,33 @@ class Viewer {
     return shot;
   }
   int frames() const { return frames_; }
+  // Under --splat-budget, the last camera's levels on the device, read to the end (an EXR screenshot is
+  // the frame of those levels, as tilesplat-render draws it, not of the ones still shown while loading).
+  void finish_streaming() {
+    if (!lod_streamer_) return;
+    tilesplat::wait_for_frame(renderer_);  // the last frame may still read the scene
+    set_lod_levels(lod_streamer_->wait_and_take());
+  }
   // The samples the last frame had added up (screenshot_settings).
   int screenshot_samples() const { return screenshot_samples_; }
   VkFormat window_format() const { return swapchain_.format(); }
   // The mean wall time of a frame (render and present) after the first; 0 before the second.
   double mean_frame_ms() const { return frames_ > 1 ? frame_ms_total_ / (frames_ - 1) : 0.0; }
+  double slowest_frame_ms() const { return frame_ms_max_; }  // after the first; 0 before the second
+  // Under --splat-budget: how often the levels were read, how long each read took on the streamer's
+  // thread (time a frame drawn while loading did not wait), and how many frames drew the levels before.
+  std::string lod_summary() const {
+    if (!lod_streamer_) return "";
+    std::vector<double> sorted = lod_load_ms_;
+    std::sort(sorted.begin(), sorted.end());
+    std::string summary = ", levels read " + std::to_string(sorted.size()) +
+                          (sorted.size() == 1 ? " time" : " times") + " on the streamer's thread";
+    if (!sorted.empty())
+      summary += " (median " + cli::format_fixed(sorted[sorted.size() / 2], 1) + " ms, longest " +
+                 cli::format_fixed(sorted.back(), 1) + " ms)";
+    return summary + ", " + std::to_string(lod_frames_behind_) +
+           (lod_frames_behind_ == 1 ? " frame" : " frames") + " drew the levels before while they were read";
+  }
 
   // What the window shows now: the last frame presented once more, its bytes read back from the
   // window's image.
@@ -362,7 +396,7 @@ class Viewer {
   }
 
   void render() {
-    if (lod_) choose_lod_levels();
+    if (lod_streamer_) stream_lod_levels();
     tilesplat::RenderSettings frame = settings();
     frame.depth = frame.splat_count = false;  // the window shows colour alone
     // Submitted without waiting (HostFrameSync): the presentation's blit is queued behind it.
@@ -384,20 +418,41 @@ class Viewer {
     ++frames_;
   }
 
-  // Under --splat-budget: the levels this frame's camera calls for, uploaded when they changed.
-  void choose_lod_levels() {
-    tilesplat::LodSelection selection =
-        tilesplat::select_lod_levels(*lod_->set, camera(), lod_->splat_budget);
-    lod_splats_ = selection.splats;
-    if (selection.chunk_levels == lod_levels_) return;
-    renderer_.set_scene(lod_->set->load_selection(selection));
-    lod_levels_ = std::move(selection.chunk_levels);
+  // Under --splat-budget: the levels this frame's camera calls for are read on the streamer's thread, and
+  // the frame draws the levels the device has until they arrive (on_lod_loaded then asks for a frame).
+  // The first frame waits for its levels: there is nothing else to draw.
+  void stream_lod_levels() {
+    lod_wanted_splats_ = lod_streamer_->request(camera()).splats;
+    set_lod_levels(lod_drawn_ ? lod_streamer_->take() : lod_streamer_->wait_and_take());
+    if (lod_streamer_->busy()) ++lod_frames_behind_;
+  }
+  void set_lod_levels(const std::optional<tilesplat::LodLoad>& loaded) {
+    if (!loaded) return;
+    renderer_.set_scene(loaded->scene);
+    lod_drawn_ = true;
+    lod_drawn_splats_ = loaded->selection.splats;
+    lod_load_ms_.push_back(loaded->load_ms);
+  }
+  // On the streamer's thread: wakes the event loop, which renders with the new levels.
+  void on_lod_loaded() {
+    lod_arrived_ = true;
+    glfwPostEmptyEvent();
   }
 
   bool present() {
     if (mesh_layer_)
       return swapchain_.present(mesh_layer_->picture(), MeshLayer::kPictureLayout, shown_extent_);
     return swapchain_.present(image_->image(), FloatImage::kLayout, shown_extent_);
+  }
+
+  // The Gaussians drawn, and while the camera's levels are read, how many they will be.
+  std::string lod_title() const {
+    if (!lod_streamer_) return "";
+    return " | " + cli::group_thousands(lod_drawn_splats_) + " splats (LOD" +
+           (lod_wanted_splats_ != lod_drawn_splats_ || lod_streamer_->busy()
+                ? "; loading " + cli::group_thousands(lod_wanted_splats_)
+                : "") +
+           ")";
   }
 
   // The GPU time is the previous frame's: a frame's statistics come once it has been waited for.
@@ -423,9 +478,8 @@ class Viewer {
                   ? " (" + std::to_string(renderer_.last_frame_stats().accumulated_frames) + " " +
                         tilesplat::to_string(stochastic_sampler_) + " frames)"
                   : "") +
-             effects_.motion_title(renderer_.last_frame_stats().accumulated_samples) +
-             (lod_ ? " | " + cli::group_thousands(lod_splats_) + " splats (LOD)" : "") + " | GPU " +
-             cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
+             effects_.motion_title(renderer_.last_frame_stats().accumulated_samples) + lod_title() +
+             " | GPU " + cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
              cli::format_fixed(frame_ms, 1) + " ms (" +
              cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps)";
     if (mesh_layer_ && !MeshLayer::depth_testable(settings()))
@@ -449,12 +503,18 @@ class Viewer {
   bool mesh_;       // draw the box and the grid (not --no-mesh)
   bool depth_out_;  // the splats write their depth for the grid (D toggles)
   std::string scene_name_;
-  const cli::LoadedLodSet* lod_;  // a LOD set drawn under --splat-budget, else null
-  std::vector<int> lod_levels_;   // the levels the scene on the device has, per chunk
-  uint64_t lod_splats_ = 0;
+  std::atomic<bool> lod_arrived_ = false;  // set on the streamer's thread when a load is done
+  // A LOD set drawn under --splat-budget, else null: reads each camera's levels on a thread of its own.
+  std::unique_ptr<tilesplat::LodStreamer> lod_streamer_;
+  bool lod_drawn_ = false;                    // the device has levels of the set
+  uint64_t lod_drawn_splats_ = 0;             // their Gaussians
+  uint64_t lod_wanted_splats_ = 0;            // those of the levels this camera calls for
+  std::vector<double> lod_load_ms_;           // each load's time on the streamer's thread
+  int lod_frames_behind_ = 0;                 // frames drawn while the camera's levels were read
   std::vector<tilesplat::CameraView> views_;  // of --cameras or the scene file; N and P step through them
   std::vector<tilesplat::Shutter> shutters_;  // the scene file's, one per view; none for --cameras
   int view_ = 0;
+  double turn_deg_;      // --turn: degrees the camera turns each frame
   ViewEffects effects_;  // keys F and B: depth of field and motion blur
   int screenshot_samples_ = 0;
   std::vector<tilesplat::AccuracyModes> modes_;
@@ -475,6 +535,7 @@ class Viewer {
   bool minimized_ = false;
   int frames_ = 0;
   double frame_ms_total_ = 0;  // over the frames after the first
+  double frame_ms_max_ = 0;    // the slowest of them
 };
 
 // A PNG is the window's pixels as shown (the mesh included; the bytes of the window's image, which
@@ -494,6 +555,7 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewe
       for (size_t c = 0; c < 3; ++c) image.rgba[4 * pixel + c] = float(shown.rgb[3 * pixel + c]) / 255.0f;
     tilesplat::write_png_preview(path, image);
   } else {
+    viewer.finish_streaming();
     const tilesplat::RenderSettings settings = viewer.screenshot_settings();
     const tilesplat::RenderImage image = tilesplat::viewer::render_screenshot(
         renderer, viewer.camera(), settings, viewer.screenshot_samples());
@@ -569,7 +631,10 @@ int run(int argc, char** argv) {
                         cli::format_size(camera.width, camera.height) + " in " +
                         cli::format_fixed(last_gpu_ms, 2) + " GPU ms";
   if (viewer.frames() > 1)
-    summary += ", " + cli::format_fixed(viewer.mean_frame_ms(), 1) + " ms a frame after the first";
+    summary += ", " + cli::format_fixed(viewer.mean_frame_ms(), 1) +
+               " ms a frame after the first (the slowest " + cli::format_fixed(viewer.slowest_frame_ms(), 1) +
+               " ms)";
+  summary += viewer.lod_summary();
   if (device.validation()) summary += ", validation: " + std::to_string(device.validation_messages()) + " messages";
   if (!options.screenshot.empty()) summary += " -> " + options.screenshot;
   std::fputs((summary + "\n").c_str(), stderr);

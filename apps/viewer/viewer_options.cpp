@@ -1,5 +1,7 @@
 #include "viewer_options.h"
 
+#include <cmath>
+
 namespace tilesplat::viewer {
 
 namespace cli = tilesplat::cli;
@@ -28,6 +30,10 @@ void add_viewer_options(cli::ArgParser& parser, ViewerOptions& options) {
   parser.section("scripting");
   parser.add_int("--frames", "N", "render N frames, then exit (default: run until the window is closed)",
                  &options.frames, 1, 1000000);
+  parser.add_double("--turn", "DEG",
+                    "turn the camera DEG degrees about the scene's vertical axis every frame, as a steady "
+                    "horizontal drag (a turntable; with --frames, a scripted orbit)",
+                    &options.turn_deg);
   parser.add_string(
       "--screenshot", "FILE",
       "on exit, write the last frame: an .exr of the splats as tilesplat-render writes it, or a .png "
@@ -53,6 +59,9 @@ void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& optio
       !compositor_draws(Compositor::kRaster, options.common.modes.front()))
     throw cli::UsageError("the raster compositor does not re-sort per pixel (--mode " +
                           to_string(options.common.modes.front()) + ")");
+  if (std::abs(options.turn_deg) > 180.0)
+    throw cli::UsageError("--turn must be between -180 and 180 degrees a frame, got " +
+                          cli::format_fixed(options.turn_deg, 1));
   cli::check_camera_model_options(options.camera_model);
   // The box and the grid are drawn through a pinhole, and the splats test against their depth.
   if (options.camera_model.enabled() && !options.no_mesh)

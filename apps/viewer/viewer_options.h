@@ -35,6 +35,7 @@ inline constexpr const char* kDescription =
 struct ViewerOptions {
   tilesplat::cli::CommonOptions common;
   int frames = 0;  // 0: until the window is closed
+  double turn_deg = 0;  // --turn: degrees the camera turns about the scene each frame
   std::string screenshot;
   bool no_mesh = false;       // the splats alone, straight into the float image
   bool no_depth_out = false;  // the splats write no depth: the grid is drawn over them
