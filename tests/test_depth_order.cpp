@@ -3,11 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "frame/scene_parts.h"
+#include "sort/parallel_radix_sort.h"
 #include "test_support.h"
+#include "tilesplat/sort.h"
 
 namespace tilesplat {
 namespace {
@@ -85,6 +89,76 @@ TEST(DepthOrder, AFisheyeSortsByDistance) {
   EXPECT_EQ(DepthOrder(PartSource(scene), fisheye_camera(pinhole, 180), 0.2, 32, kDepthMarginFloat64)
                 .part_indices(0, 1),
             std::vector<uint32_t>{0});
+}
+
+// Spread over threads, the order and its boundaries are one thread's, bit for bit: ranges that cull
+// differently, keys that tie across ranges, more threads than the host has.
+TEST(DepthOrder, AnyNumberOfThreadsGivesOneThreadsOrder) {
+  std::vector<float> depths;
+  uint32_t state = 12345;
+  for (int i = 0; i < 100003; ++i) {
+    state = state * 1664525u + 1013904223u;
+    depths.push_back(-1.0f + float(state >> 22) / 64.0f);  // -1 to 15 in steps of 1/64: many ties
+  }
+  const GaussianScene scene = on_axis(depths);
+  const Camera camera = testing::axis_camera(64, 64, 50);
+  for (const int bits : {32, 24})
+    for (const double margin : {kDepthMarginFloat64, kDepthMarginFloat32}) {
+      const DepthOrder one(PartSource(scene), camera, 0.2, bits, margin, 1);
+      ASSERT_GT(one.size(), 80000u);
+      ASSERT_LT(one.size(), depths.size());  // some are behind the near plane
+      // Depths 1/64 apart are far beyond either margin and the 24-bit keys' step, so a part may end
+      // exactly where the depth changes: a check of the order's own, whatever computed it.
+      size_t wrong_boundaries = 0;
+      for (size_t i = 1; i < one.size(); ++i) {
+        EXPECT_LE(depths[one.index(i - 1)], depths[one.index(i)]);
+        wrong_boundaries += one.boundary(i) != (depths[one.index(i - 1)] != depths[one.index(i)]);
+      }
+      EXPECT_EQ(wrong_boundaries, 0u) << bits << "-bit keys";
+      for (const unsigned threads : {2u, 3u, 7u, 16u}) {
+        const DepthOrder many(PartSource(scene), camera, 0.2, bits, margin, threads);
+        ASSERT_EQ(many.size(), one.size());
+        size_t different = 0;
+        for (size_t i = 0; i < one.size(); ++i)
+          different += many.index(i) != one.index(i) || many.boundary(i + 1) != one.boundary(i + 1);
+        EXPECT_EQ(different, 0u) << threads << " threads, " << bits << "-bit keys";
+      }
+    }
+}
+
+// The depth order's sort: cpu_radix_sort's result for any number of threads, stable (the values are
+// the keys' first positions, so a tie out of order shows).
+TEST(ParallelRadixSort, IsTheOneThreadSortForAnyNumberOfThreads) {
+  uint32_t state = 99;
+  for (const size_t n : {size_t(0), size_t(1), size_t(5), size_t(1000), size_t(100003)})
+    for (const uint32_t bits : {32u, 24u, 9u}) {
+      std::vector<uint32_t> keys(n), values(n);
+      for (size_t i = 0; i < n; ++i) {
+        state = state * 1664525u + 1013904223u;
+        keys[i] = (state >> 8) & ((bits == 32 ? 0u : (1u << bits)) - 1u);  // the low `bits` bits
+        values[i] = uint32_t(i);
+      }
+      std::vector<uint32_t> expected_keys = keys, expected_values = values, ks(n), vs(n);
+      if (cpu_radix_sort(std::span(expected_keys), std::span(expected_values), std::span(ks), std::span(vs),
+                         bits)) {
+        expected_keys.swap(ks);
+        expected_values.swap(vs);
+      }
+      for (const unsigned threads : {1u, 2u, 3u, 8u, 64u}) {
+        std::vector<uint32_t> k = keys, v = values, k2(n), v2(n);
+        if (detail::parallel_radix_sort(std::span(k), std::span(v), std::span(k2), std::span(v2), bits,
+                                        threads)) {
+          k.swap(k2);
+          v.swap(v2);
+        }
+        EXPECT_EQ(k, expected_keys) << n << " keys of " << bits << " bits, " << threads << " threads";
+        EXPECT_EQ(v, expected_values) << n << " keys of " << bits << " bits, " << threads << " threads";
+      }
+    }
+  std::vector<uint32_t> keys(4), values(3), scratch(4);
+  EXPECT_THROW(detail::parallel_radix_sort(std::span(keys), std::span(values), std::span(scratch),
+                                           std::span(scratch), 32, 2),
+               std::invalid_argument);
 }
 
 TEST(PartSizing, GatherKeepsEveryAttributeOfTheIndices) {

@@ -113,6 +113,7 @@ TEST(SceneParts, BudgetIsHeldAndReported) {
   EXPECT_GE(stats.scene_parts, 16);
   EXPECT_EQ(stats.gaussians, big.scene.size());
   EXPECT_GE(stats.peak_device_bytes, stats.device_bytes);
+  EXPECT_GT(stats.depth_order_ms, 0.0);  // the host's order of 500k Gaussians before the parts
   // The first part guesses its pairs (4 a Gaussian, more than this scene has); the later ones are sized
   // by what the earlier ones had. The peak passes the budget only by what a guess missed (the frame's
   // counters, a few hundred bytes, are not in the estimate).
@@ -296,6 +297,7 @@ TEST(SceneParts, SceneThatFitsRendersWholeAndStaysSet) {
   const RenderImage first = renderer.render(scene, camera, settings);
   EXPECT_EQ(renderer.last_frame_stats().scene_parts, 1);
   EXPECT_EQ(renderer.last_frame_stats().peak_device_bytes, renderer.last_frame_stats().device_bytes);
+  EXPECT_EQ(renderer.last_frame_stats().depth_order_ms, 0.0);  // no order for a whole scene
   // Whole: the scene is set, and render(camera) draws it again.
   expect_bit_identical(renderer.render(camera, settings), first, "the scene set by render(scene, ...)");
 }

@@ -89,6 +89,7 @@ class Collector {
     if (stats.scene_parts > 1) {  // a scene rendered in depth-ordered parts (--memory-budget)
       add_frame("scene parts", Unit::kCount, double(stats.scene_parts));
       add_frame("peak device memory", Unit::kMebibytes, double(stats.peak_device_bytes) / (1024.0 * 1024.0));
+      add_frame("depth order", Unit::kMilliseconds, stats.depth_order_ms);  // host time, before the parts
     }
   }
 

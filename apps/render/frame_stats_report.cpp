@@ -36,6 +36,7 @@ void print_frame_stats(const tilesplat::FrameStats& stats, const tilesplat::Devi
   print_row("device memory", mib(stats.device_bytes), "MiB");
   print_row("peak device memory", mib(stats.peak_device_bytes), "MiB");
   print_row("scene parts", std::to_string(stats.scene_parts), "");
+  print_row("depth order", cli::format_fixed(stats.depth_order_ms, 1), "ms");
   print_row("image bands", std::to_string(stats.image_bands), "");
   print_row("peak resident memory", mib(cli::peak_memory_bytes()), "MiB");
 }

@@ -115,8 +115,10 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
   const DeviceCapacity device = device_capacity();
   double pairs_per_gaussian = kFirstPairsPerGaussian;
   size_t capacity = part_capacity(budget, costs, 0, pairs_per_gaussian, device);  // or a clear error
+  const auto order_start = std::chrono::steady_clock::now();
   const DepthOrder order(scene, camera, settings.near_plane, settings.accuracy.depth_key_bits,
                          ctx.features().shader_float64 ? kDepthMarginFloat64 : kDepthMarginFloat32);
+  const std::chrono::duration<double, std::milli> order_time = std::chrono::steady_clock::now() - order_start;
 
   // A whole scene's buffers go: the parts size their own, which the next frame under the same budget
   // reuses.
@@ -175,6 +177,7 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
                : gather_part(scene, order, gathered.begin, capacity);
   }
   total.gaussians = scene.size();
+  total.depth_order_ms = order_time.count();
   stats = total;
 }
 

@@ -159,6 +159,7 @@ nb::dict stats_dict(const FrameStats& stats) {
   out["scene_parts"] = stats.scene_parts;  // depth-ordered parts under a memory budget
   out["image_bands"] = stats.image_bands;  // bands of rows of an image past the device
   out["peak_device_bytes"] = stats.peak_device_bytes;
+  out["depth_order_ms"] = stats.depth_order_ms;
   return out;
 }
 

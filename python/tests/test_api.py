@@ -152,6 +152,7 @@ def test_a_scene_in_parts_under_a_memory_budget(playbot_renderer):
     parts = other.render(camera, scene=scene, memory_budget=4 << 20)
     stats = other.last_frame_stats
     assert stats["scene_parts"] >= 4 and stats["peak_device_bytes"] <= (4 << 20) * 1.01
+    assert stats["depth_order_ms"] > 0
     assert np.array_equal(parts.rgba, whole.rgba)
     assert np.array_equal(parts.depth, whole.depth)
     assert np.array_equal(parts.splat_count, whole.splat_count)

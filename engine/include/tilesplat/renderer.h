@@ -94,6 +94,9 @@ struct FrameStats {
   /// The most device memory the renderer's buffers held at the end of any part (device_bytes is the
   /// last part's); the same as device_bytes for a whole scene.
   uint64_t peak_device_bytes = 0;
+  /// Host time spent ordering the scene by depth before its parts (on the host's cores; 0 for a whole
+  /// scene). Over several bands or samples, the sum.
+  double depth_order_ms = 0;
 };
 
 /// The Vulkan device a renderer runs on, and the limits that shape its passes.

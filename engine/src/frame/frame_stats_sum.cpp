@@ -7,6 +7,7 @@ namespace tilesplat {
 void add_frame_stats(FrameStats& total, const FrameStats& frame, FrameCounts counts) {
   add_pass_times(total.passes, frame.passes);
   total.gpu_ms += frame.gpu_ms;
+  total.depth_order_ms += frame.depth_order_ms;
   if (counts == FrameCounts::kDisjoint) {
     total.visible += frame.visible;
     total.intersections += frame.intersections;

@@ -4,13 +4,16 @@
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
 #include "camera/camera_models.h"
 #include "frame/image_regions.h"
+#include "host_threads.h"
 #include "passes/projection_pass.h"
 #include "scene/mapped_ply_rows.h"
+#include "sort/parallel_radix_sort.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/sort.h"
 
@@ -86,64 +89,137 @@ GaussianScene PartSource::gather(std::span<const uint32_t> indices) const {
   return part;
 }
 
+namespace {
+
+struct DepthBounds {
+  double depth, margin;
+};
+
+// Gaussian i's depth, and how far the GPU's may lie from it: computed again where needed rather than
+// stored (16 bytes a Gaussian of a scene that may be 100M). Each thread of the depth order works on a copy
+// of its own: read through references into the caller's stack, the camera shares cache lines with the
+// caller's own loop variables, and the threads slow each other down (measured: four times slower on two
+// threads than on one).
+class GaussianDepths {
+ public:
+  GaussianDepths(const PartSource& scene, const Camera& camera, double relative_margin)
+      : scene_(&scene),
+        camera_(camera),
+        distance_(sorts_by_distance(camera)),
+        centre_size_(std::abs(camera.position[0]) + std::abs(camera.position[1]) +
+                     std::abs(camera.position[2])),
+        relative_margin_(relative_margin) {}
+
+  DepthBounds operator()(size_t i) const {
+    const std::array<float, 3> position = scene_->position(i);
+    const std::array<double, 3> world = {double(position[0]), double(position[1]), double(position[2])};
+    const std::array<double, 3> t = camera_.to_camera(world);
+    const double rel = std::abs(world[0] - camera_.position[0]) + std::abs(world[1] - camera_.position[1]) +
+                       std::abs(world[2] - camera_.position[2]);
+    return DepthBounds{distance_ ? std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]) : t[2],
+                       relative_margin_ * (rel + centre_size_)};
+  }
+
+ private:
+  const PartSource* scene_;
+  Camera camera_;
+  bool distance_;
+  double centre_size_;
+  double relative_margin_;
+};
+
+}  // namespace
+
 DepthOrder::DepthOrder(const PartSource& scene, const Camera& camera, double near_plane, int depth_key_bits,
-                       double relative_margin) {
+                       double relative_margin, unsigned threads) {
   if (depth_key_bits != 24 && depth_key_bits != 32)
     throw std::invalid_argument("a scene in parts sorts by 24- or 32-bit depth keys, not " +
                                 std::to_string(depth_key_bits));
   const size_t n = scene.size();
-  const bool distance = sorts_by_distance(camera);
-  const double centre_size =
-      std::abs(camera.position[0]) + std::abs(camera.position[1]) + std::abs(camera.position[2]);
-  // Gaussian i's depth, and how far the GPU's may lie from it: computed again where needed rather than
-  // stored (16 bytes a Gaussian of a scene that may be 100M).
-  struct DepthBounds {
-    double depth, margin;
-  };
-  auto bounds = [&](size_t i) {
-    const std::array<float, 3> position = scene.position(i);
-    const std::array<double, 3> world = {double(position[0]), double(position[1]), double(position[2])};
-    const std::array<double, 3> t = camera.to_camera(world);
-    const double rel = std::abs(world[0] - camera.position[0]) + std::abs(world[1] - camera.position[1]) +
-                       std::abs(world[2] - camera.position[2]);
-    return DepthBounds{distance ? std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]) : t[2],
-                       relative_margin * (rel + centre_size)};
-  };
+  const GaussianDepths depths(scene, camera, relative_margin);
+  // Tens of millions of Gaussians take seconds of host time here, before the first part: the work is
+  // spread over the host's cores in contiguous ranges (host_threads.h), each kept in order, so the
+  // order and the bounds are one thread's, bit for bit.
+  if (threads == 0) threads = detail::host_threads_for(n);
   {
-    std::vector<uint32_t> keys, values;
-    keys.reserve(n);
-    values.reserve(n);
-    for (size_t i = 0; i < n; ++i) {
-      const DepthBounds b = bounds(i);
-      // The GPU culls at or below the near plane (and non-finite depths): only a Gaussian it surely
-      // culls is left out.
-      if (!std::isfinite(b.depth) || b.depth + b.margin <= near_plane) continue;
-      keys.push_back(depth_key(b.depth, 32));
-      values.push_back(uint32_t(i));
+    // Each range writes its kept Gaussians' keys from its own start; the gaps the culled left are then
+    // closed range by range (each block moves down, never over one not yet moved).
+    std::vector<uint32_t> keys(n), values(n);
+    std::vector<size_t> kept(threads);
+    detail::for_each_range(n, threads, [&](unsigned r, size_t begin, size_t end) {
+      const GaussianDepths depths_here = depths;  // on this thread's stack
+      const double near = near_plane;
+      uint32_t* const range_keys = keys.data();
+      uint32_t* const range_values = values.data();
+      size_t out = begin;
+      for (size_t i = begin; i < end; ++i) {
+        const DepthBounds b = depths_here(i);
+        // The GPU culls at or below the near plane (and non-finite depths): only a Gaussian it surely
+        // culls is left out.
+        if (!std::isfinite(b.depth) || b.depth + b.margin <= near) continue;
+        range_keys[out] = depth_key(b.depth, 32);
+        range_values[out] = uint32_t(i);
+        ++out;
+      }
+      kept[r] = out - begin;
+    });
+    size_t m = 0;
+    for (unsigned r = 0; r < threads; ++r) {
+      const size_t begin = detail::range_begin(n, threads, r);
+      std::copy_n(keys.begin() + std::ptrdiff_t(begin), kept[r], keys.begin() + std::ptrdiff_t(m));
+      std::copy_n(values.begin() + std::ptrdiff_t(begin), kept[r], values.begin() + std::ptrdiff_t(m));
+      m += kept[r];
     }
-    std::vector<uint32_t> key_scratch(keys.size()), value_scratch(keys.size());
+    keys.resize(m);
+    values.resize(m);
+    std::vector<uint32_t> key_scratch(m), value_scratch(m);
     // Stable: equal keys stay in scene order.
-    if (cpu_radix_sort(std::span(keys), std::span(values), std::span(key_scratch), std::span(value_scratch),
-                       32))
+    if (detail::parallel_radix_sort(std::span(keys), std::span(values), std::span(key_scratch),
+                                    std::span(value_scratch), 32, threads))
       values.swap(value_scratch);
     order_ = std::move(values);
   }
 
+  // The running maximum of the upper keys from the front and the running minimum of the lower keys from
+  // the back: per range first, then each range joined with the ranges before (after) it.
   const size_t m = order_.size();
   upper_max_.resize(m);
   lower_min_.resize(m);
-  uint32_t running = 0;
-  for (size_t k = 0; k < m; ++k) {
-    const DepthBounds b = bounds(order_[k]);
-    running = std::max(running, depth_key(b.depth + b.margin, depth_key_bits));
-    upper_max_[k] = running;
-  }
-  running = ~0u;
-  for (size_t k = m; k-- > 0;) {
-    const DepthBounds b = bounds(order_[k]);
-    running = std::min(running, depth_key(b.depth - b.margin, depth_key_bits));
-    lower_min_[k] = running;
-  }
+  std::vector<uint32_t> range_max(threads, 0), range_min(threads, ~0u);
+  detail::for_each_range(m, threads, [&](unsigned r, size_t begin, size_t end) {
+    const GaussianDepths depths_here = depths;  // on this thread's stack
+    const int key_bits = depth_key_bits;
+    const uint32_t* const order = order_.data();
+    uint32_t* const upper = upper_max_.data();
+    uint32_t* const lower = lower_min_.data();
+    uint32_t running = 0;
+    for (size_t k = begin; k < end; ++k) {
+      const DepthBounds b = depths_here(order[k]);
+      running = std::max(running, depth_key(b.depth + b.margin, key_bits));
+      upper[k] = running;
+      lower[k] = depth_key(b.depth - b.margin, key_bits);
+    }
+    range_max[r] = running;
+    running = ~0u;
+    for (size_t k = end; k-- > begin;) {
+      running = std::min(running, lower[k]);
+      lower[k] = running;
+    }
+    range_min[r] = running;
+  });
+  detail::for_each_range(m, threads, [&](unsigned r, size_t begin, size_t end) {
+    // The ranges before this one and after it (not this one's own totals, which hold its later keys).
+    const uint32_t before = std::accumulate(range_max.begin(), range_max.begin() + r, 0u,
+                                            [](uint32_t a, uint32_t b) { return std::max(a, b); });
+    const uint32_t after = std::accumulate(range_min.begin() + r + 1, range_min.end(), ~0u,
+                                           [](uint32_t a, uint32_t b) { return std::min(a, b); });
+    uint32_t* const upper = upper_max_.data();
+    uint32_t* const lower = lower_min_.data();
+    for (size_t k = begin; k < end; ++k) {
+      upper[k] = std::max(upper[k], before);
+      lower[k] = std::min(lower[k], after);
+    }
+  });
 }
 
 bool DepthOrder::boundary(size_t i) const {

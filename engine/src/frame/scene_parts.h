@@ -67,10 +67,14 @@ class DepthOrder {
   // The Gaussians the GPU may draw (those clearly behind the near plane, or with non-finite depths,
   // are left out), front to back. depth_key_bits is the frame's (24 or 32; std::invalid_argument
   // otherwise); relative_margin kDepthMarginFloat64 or kDepthMarginFloat32, as the device projects.
+  // `threads`: the host threads it computes on; 0 for as many as the scene's size calls for, up to
+  // the host's cores (the result is the same for any).
   DepthOrder(const PartSource& scene, const Camera& camera, double near_plane, int depth_key_bits,
-             double relative_margin);
+             double relative_margin, unsigned threads = 0);
 
   size_t size() const { return order_.size(); }
+  // The scene index of the Gaussian at `position` (< size()) of the order.
+  uint32_t index(size_t position) const { return order_[position]; }
   // The end of the part that starts at `begin` (< size()) and should hold at most `most` (>= 1)
   // Gaussians: the last boundary where a part may end in (begin, begin + most], else the first after
   // it (a part larger than asked, where the keys leave no gap sooner), else size().
