@@ -12,7 +12,9 @@
 #include <functional>
 #include <iterator>
 #include <latch>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -529,6 +531,33 @@ TEST(LodSetCli, RendersALevelOrASplatBudgetAndTellsWhatItDrew) {
   EXPECT_EQ(both.exit_code, 2);
   for (const char* name : {"no_level.exr", "ply.exr", "both.exr"})
     EXPECT_FALSE(fs::exists(out / name)) << name;
+}
+
+// A camera path under a splat budget: each frame's levels are read on a thread while the frame before
+// renders; every frame is still the renderer's frame of its own camera's levels.
+TEST(LodSetCli, ACameraPathDrawsEachFramesOwnLevels) {
+  const fs::path out = fresh_output_dir();
+  const auto rendered = run_process(
+      TILESPLAT_RENDER_EXE, {lod_index().string(), "--orbit", "6", "--elevation", "20", "--width", "160",
+                             "--height", "90", "--splat-budget", "6000", "-o", (out / "%02d.exr").string()});
+  ASSERT_EQ(rendered.exit_code, 0) << rendered.err;
+  const LodSet set = LodSet::open(lod_index());
+  const std::unique_ptr<tilesplat::Renderer> renderer = tilesplat::Renderer::create();
+  tilesplat::RenderSettings settings;
+  settings.splat_budget = 6000;
+  std::vector<std::vector<int>> levels;
+  for (int frame = 0; frame < 6; ++frame) {
+    const fs::path exr = out / (std::string(frame < 10 ? "0" : "") + std::to_string(frame) + ".exr");
+    const std::optional<tilesplat::Camera> camera = tilesplat::read_exr_camera(exr);
+    ASSERT_TRUE(camera) << exr;
+    const tilesplat::ImageDifference difference =
+        tilesplat::compare_images(tilesplat::read_exr(exr), renderer->render(set, *camera, settings));
+    // The same levels: the same image to float rounding (the app's EXR against the library's frame).
+    EXPECT_GE(difference.psnr_db, 100.0) << exr << ": max abs " << difference.max_abs;
+    const std::vector<int> chosen = tilesplat::select_lod_levels(set, *camera, 6000).chunk_levels;
+    if (std::find(levels.begin(), levels.end(), chosen) == levels.end()) levels.push_back(chosen);
+  }
+  EXPECT_GE(levels.size(), 3u) << "the orbit should change the levels";
 }
 
 TEST(LodSetCli, InfoListsTheLevels) {

@@ -53,6 +53,11 @@ std::vector<std::string> view_args(const fs::path& scene, const fs::path& camera
           "--height", "180"};
 }
 
+// The bundled playbot as a LOD set of 3 levels (tests/data/playbot_lod_set).
+fs::path playbot_lod_set() {
+  return fs::path(TILESPLAT_SOURCE_DIR) / "tests" / "data" / "playbot_lod_set" / "lod-meta.json";
+}
+
 void expect_one_error_line(const ProcessResult& result) {
   tilesplat::testing::expect_one_error_line(result, "tilesplat-viewer");
 }
@@ -91,8 +96,7 @@ TEST(Viewer, ASplatBudgetDrawsWhatTheRendererDraws) {
   const std::optional<std::string> prefix = display_prefix();
   if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
   const fs::path out = fresh_output_dir();
-  const fs::path lod_set =
-      fs::path(TILESPLAT_SOURCE_DIR) / "tests" / "data" / "playbot_lod_set" / "lod-meta.json";
+  const fs::path lod_set = playbot_lod_set();
   std::vector<std::string> viewer_args = view_args(lod_set, bundled_playbot_cameras(), 2);
   viewer_args.insert(viewer_args.end(), {"--splat-budget", "6000"});
   std::vector<std::string> render_args = viewer_args;
@@ -119,8 +123,7 @@ TEST(Viewer, ATurningCameraStreamsTheLevelsItCallsFor) {
   const std::optional<std::string> prefix = display_prefix();
   if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
   const fs::path out = fresh_output_dir();
-  const fs::path lod_set =
-      fs::path(TILESPLAT_SOURCE_DIR) / "tests" / "data" / "playbot_lod_set" / "lod-meta.json";
+  const fs::path lod_set = playbot_lod_set();
   std::vector<std::string> viewer_args = view_args(lod_set, bundled_playbot_cameras(), 2);
   viewer_args.insert(viewer_args.end(), {"--splat-budget", "6000", "--turn", "20", "--frames", "10",
                                          "--validation", "--screenshot", (out / "viewer.exr").string()});

@@ -1,6 +1,7 @@
 #include "frame_renderer.h"
 
 #include <chrono>
+#include <optional>
 #include <stdexcept>
 
 #include "tilesplat/reference.h"
@@ -19,6 +20,7 @@ FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScen
     const Bounds bounds = loaded.bounds();
     scene_centre_ = {bounds.center[0], bounds.center[1], bounds.center[2]};
   }
+  if (lod_) lod_streamer_ = std::make_unique<LodStreamer>(*lod_->set, lod_->splat_budget);
   if (options.reference) {
     if (mapped_) load_mapped_whole();  // the float64 reference takes a whole scene
     return;
@@ -62,14 +64,18 @@ void FrameRenderer::load_mapped_whole() {
   mapped_ = nullptr;
 }
 
-RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& base_settings) {
+RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& base_settings,
+                                  const Camera* next_camera) {
   RenderSettings settings = base_settings;
   // The flags' lens, its focus following the frame's camera, over the scene file's lens for the view.
   if (lens_.enabled()) settings.lens = lens_for_frame(lens_, camera, scene_centre_);
-  GaussianScene selected;  // the LOD set's chunks at the levels this camera calls for
   if (lod_) {
-    lod_selection_ = select_lod_levels(*lod_->set, camera, lod_->splat_budget);
-    selected = lod_->set->load_selection(lod_selection_);
+    // The levels this camera calls for: read ahead during the frame before where they were its next
+    // camera's (a request for the levels already asked for is none), or now; none comes where they are
+    // the last frame's.
+    lod_selection_ = lod_streamer_->request(camera);
+    if (std::optional<LodLoad> loaded = lod_streamer_->wait_and_take()) lod_scene_ = std::move(loaded->scene);
+    if (next_camera) lod_streamer_->request(*next_camera);
     if (lod_selection_.over_budget && !warned_over_budget_) {
       cli::print_warning(kProgram, "--splat-budget " + std::to_string(lod_->splat_budget) +
                                        " is below what the coarsest levels in view draw (" +
@@ -79,7 +85,7 @@ RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& ba
     }
   }
   if (renderer_) decide_holding(camera, settings);  // may merge a scene file's copies into scene_
-  const GaussianScene& scene = lod_ ? selected : *scene_;
+  const GaussianScene& scene = lod_ ? lod_scene_ : *scene_;
   RenderImage image;
   if (renderer_) {
     image = mapped_               ? renderer_->render(*mapped_, camera, settings)

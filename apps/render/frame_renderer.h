@@ -22,7 +22,10 @@ class FrameRenderer {
  public:
   FrameRenderer(const RenderOptions& options, const cli::LoadedScene& loaded);
 
-  RenderImage render(const Camera& camera, const RenderSettings& base_settings);
+  // `next_camera`, where given, is the next frame's: under --splat-budget its levels are read on the
+  // streamer's thread while this frame renders.
+  RenderImage render(const Camera& camera, const RenderSettings& base_settings,
+                     const Camera* next_camera = nullptr);
 
   // The strategy the frames sort with ("auto" resolved on the device), for the EXR's provenance.
   std::string sort_strategy(const RenderSettings& settings) const;
@@ -44,6 +47,8 @@ class FrameRenderer {
   GaussianScene merged_;
   const cli::LoadedLodSet* lod_;     // a LOD set drawn under --splat-budget
   LodSelection lod_selection_;
+  std::unique_ptr<LodStreamer> lod_streamer_;  // reads each frame's levels, the next frame's ahead
+  GaussianScene lod_scene_;                    // the levels the last frame drew
   bool warned_over_budget_ = false;
   LensFlags lens_;
   // The first frame's choice: the scene set once, or taken by each frame (in parts where it does not fit).

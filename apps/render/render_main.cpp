@@ -348,12 +348,15 @@ int render_sequence(const RenderOptions& options, const std::vector<Frame>& fram
     cli::FrameProgress progress(kProgram, static_cast<int>(to_render.size()),
                                 cli::progress_style(options.quiet));
     std::future<void> writing;
-    for (const Frame* frame : to_render) {
+    for (size_t index = 0; index < to_render.size(); ++index) {
+      const Frame* frame = to_render[index];
+      const tilesplat::Camera* next_camera =
+          index + 1 < to_render.size() ? &to_render[index + 1]->camera : nullptr;
       tilesplat::RenderSettings frame_settings = settings;
       frame_settings.shutter =
           options.shutter.enabled() ? shutter_for_frame(options.shutter, frame->next_camera) : frame->shutter;
       frame_settings.lens = frame->lens;
-      tilesplat::RenderImage image = renderer.render(frame->camera, frame_settings);
+      tilesplat::RenderImage image = renderer.render(frame->camera, frame_settings, next_camera);
       cli::ManifestEntry entry = manifest_entry(*frame, frame_count, folder, settings_line);
       entry.gpu_ms = renderer.gpu() ? renderer.gpu_ms() : renderer.cpu_ms();
       gpu_ms.push_back(entry.gpu_ms);
