@@ -121,10 +121,10 @@ uint mix_bits(uint x, uint key) {
 // thresholds from running in step from frame to frame.
 uint laine_karras(uint x, uint seed) {
   x += seed;
-  x ^= x * 0x6c50b47cu;
-  x ^= x * 0xb82f1e52u;
-  x ^= x * 0xc7afe638u;
-  x ^= x * 0x8d22f6e6u;
+  x ^= x * LAINE_KARRAS_MULTIPLIER_0;
+  x ^= x * LAINE_KARRAS_MULTIPLIER_1;
+  x ^= x * LAINE_KARRAS_MULTIPLIER_2;
+  x ^= x * LAINE_KARRAS_MULTIPLIER_3;
   return x;
 }
 float threshold(uint p, uint splat_hash) {

@@ -46,6 +46,15 @@ struct alignas(16) uvec4 {
 
 TS_CONST uint TILE_SIZE = 16;  // pixels per tile side (tilesplat::kTileSize)
 
+// Laine and Karras's permutation as Burley gives it ("Practical Hash-based Owen Scrambling", JCGT 2020):
+// x += seed, then x ^= x * M for each multiplier in turn; each bit changes only the bits above it. The
+// effects' Sobol samples (engine/src/camera/effect_samples.cpp) and the stochastic compositor's
+// (composite_stochastic.comp) scramble with it, so host and shader scramble alike.
+TS_CONST uint LAINE_KARRAS_MULTIPLIER_0 = 0x6c50b47cu;
+TS_CONST uint LAINE_KARRAS_MULTIPLIER_1 = 0xb82f1e52u;
+TS_CONST uint LAINE_KARRAS_MULTIPLIER_2 = 0xc7afe638u;
+TS_CONST uint LAINE_KARRAS_MULTIPLIER_3 = 0x8d22f6e6u;
+
 // Counters written on the GPU during a frame and read by the host after it (FrameCounters), in uints.
 TS_CONST uint COUNTER_INTERSECTIONS = 0;    // total (Gaussian, tile) pairs wanted this frame, modulo 2^32
 TS_CONST uint COUNTER_PAIRS_HIGH = 1;       // the total's high 32 bits (projection.comp, count_pairs)

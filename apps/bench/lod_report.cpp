@@ -36,12 +36,6 @@ std::vector<std::string> cells(const Row& row) {
 
 const std::vector<std::string> kColumns = {"row", "splats", "GPU ms", "select ms", "PSNR dB", "max abs"};
 
-std::vector<std::vector<std::string>> table_rows(const std::vector<Row>& rows) {
-  std::vector<std::vector<std::string>> out;
-  for (const Row& row : rows) out.push_back(cells(row));
-  return out;
-}
-
 }  // namespace
 
 std::string row_label(const Row& row) {
@@ -124,7 +118,7 @@ Run measure(const RendererOptions& renderer_options, const LodSet& set, std::vec
 }
 
 std::string text_table(const std::vector<Row>& rows) {
-  return bench::aligned_table(kColumns, table_rows(rows), /*label_column=*/true);
+  return bench::aligned_table(kColumns, bench::table_rows(rows, cells), /*label_column=*/true);
 }
 
 std::string markdown(const std::vector<Row>& rows, const std::string& scene, const DeviceInfo& device,
@@ -135,7 +129,8 @@ std::string markdown(const std::vector<Row>& rows, const std::string& scene, con
       "Splats: Gaussians drawn (mean over the views). GPU ms: median over repeats, then views. Select ms: "
       "choosing the levels and gathering the chunks on the host. PSNR and max abs: against level 0 from "
       "the same view.\n\n";
-  return out + bench::markdown_table(kColumns, table_rows(rows), "|---|---:|---:|---:|---:|---:|");
+  return out +
+         bench::markdown_table(kColumns, bench::table_rows(rows, cells), "|---|---:|---:|---:|---:|---:|");
 }
 
 std::string csv(const std::vector<Row>& rows, const std::string& scene, const DeviceInfo& device) {

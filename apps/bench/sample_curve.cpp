@@ -29,12 +29,6 @@ std::vector<std::string> cells(const Row& row) {
           bench::psnr_cell(row.psnr_db), fixed(row.max_abs, 4)};
 }
 
-std::vector<std::vector<std::string>> table_rows(const std::vector<Row>& rows) {
-  std::vector<std::vector<std::string>> out;
-  for (const Row& row : rows) out.push_back(cells(row));
-  return out;
-}
-
 std::string what_is_averaged(Effect effect) {
   switch (effect) {
     case Effect::kLens:
@@ -198,7 +192,7 @@ Run measure(const RendererOptions& renderer_options, const GaussianScene& scene,
 }
 
 std::string text_table(const std::vector<Row>& rows) {
-  return bench::aligned_table(kColumns, table_rows(rows), /*label_column=*/false);
+  return bench::aligned_table(kColumns, bench::table_rows(rows, cells), /*label_column=*/false);
 }
 
 std::string markdown(const std::vector<Row>& rows, Effect effect, const std::string& scene,
@@ -208,7 +202,7 @@ std::string markdown(const std::vector<Row>& rows, Effect effect, const std::str
   out += "The effect: " + what_is_averaged(effect) +
          ". GPU ms: median over repeats, then views. PSNR and max abs: against " + held_to(effect) +
          " from the same view.\n\n";
-  return out + bench::markdown_table(kColumns, table_rows(rows), "|---:|---:|---:|---:|---:|");
+  return out + bench::markdown_table(kColumns, bench::table_rows(rows, cells), "|---:|---:|---:|---:|---:|");
 }
 
 std::string csv(const std::vector<Row>& rows, Effect effect, const std::string& scene,

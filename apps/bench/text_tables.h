@@ -12,6 +12,15 @@ namespace tilesplat::bench {
 std::string aligned_table(const std::vector<std::string>& header,
                           const std::vector<std::vector<std::string>>& rows, bool label_column);
 
+// Each row's cells, in the tables' column order: cells(row) for every row.
+template <typename Row, typename Cells>
+std::vector<std::vector<std::string>> table_rows(const std::vector<Row>& rows, const Cells& cells) {
+  std::vector<std::vector<std::string>> out;
+  out.reserve(rows.size());
+  for (const Row& row : rows) out.push_back(cells(row));
+  return out;
+}
+
 // A PSNR in dB with two decimals, "inf" for identical images.
 std::string psnr_cell(double psnr_db);
 

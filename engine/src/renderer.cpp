@@ -19,6 +19,7 @@
 #include "frame/averaged_frames.h"
 #include "frame/image_regions.h"
 #include "host_depth.h"
+#include "host_resources.h"
 #include "passes/frame_counters.h"
 #include "renderer_impl.h"
 #include "settings_checks.h"
@@ -341,7 +342,7 @@ std::vector<PixelRegion> Renderer::Impl::image_bands(const Camera& camera,
   // The image comes back whole on the host: it must fit the machine.
   const uint64_t image_bytes = uint64_t(std::max(region.width, 0)) * uint64_t(std::max(region.height, 0)) *
                                image_bytes_per_pixel(settings);
-  if (const uint64_t host = host_physical_memory(); host > 0 && image_bytes > host)
+  if (const uint64_t host = detail::host_physical_memory(); host > 0 && image_bytes > host)
     throw std::runtime_error(
         "invalid camera: image size " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
         (settings.region.whole() ? std::string() : " (region " + to_string(settings.region) + ")") +

@@ -5,6 +5,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "shader_io.h"
+
 namespace tilesplat {
 namespace {
 
@@ -48,12 +50,13 @@ uint32_t reverse_bits(uint32_t x) {
 // bits above it, so that each digit of the value is flipped by a hash of the digits before it. Elementary
 // boxes map to elementary boxes (the net stays a net), and each point lands uniformly within its box.
 uint32_t owen_scramble(uint32_t value, uint32_t seed) {
+  using namespace shader_io;  // the multipliers composite_stochastic.comp scrambles with too
   uint32_t x = reverse_bits(value);
   x += seed;
-  x ^= x * 0x6c50b47cu;
-  x ^= x * 0xb82f1e52u;
-  x ^= x * 0xc7afe638u;
-  x ^= x * 0x8d22f6e6u;
+  x ^= x * LAINE_KARRAS_MULTIPLIER_0;
+  x ^= x * LAINE_KARRAS_MULTIPLIER_1;
+  x ^= x * LAINE_KARRAS_MULTIPLIER_2;
+  x ^= x * LAINE_KARRAS_MULTIPLIER_3;
   return reverse_bits(x);
 }
 

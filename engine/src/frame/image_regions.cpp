@@ -1,7 +1,5 @@
 #include "frame/image_regions.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -109,11 +107,6 @@ uint64_t frame_bytes_per_pixel(const RenderSettings& settings) {
 uint64_t image_bytes_per_pixel(const RenderSettings& settings) {
   return 16 + (settings.depth ? 4 : 0) + (settings.splat_count ? 4 : 0) +
          (settings.host && settings.host->write_depth ? 4 : 0);
-}
-
-uint64_t host_physical_memory() {
-  const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && page_size > 0 ? uint64_t(pages) * uint64_t(page_size) : 0;
 }
 
 void add_band_stats(FrameStats& frame, const FrameStats& band) {

@@ -39,10 +39,8 @@ std::vector<PixelRegion> bands_within(const PixelRegion& region, uint64_t bytes_
 uint64_t frame_bytes_per_pixel(const RenderSettings& settings);
 constexpr uint64_t kLargestBytesPerPixel = 64;
 
-// Host memory the frame's RenderImage takes per pixel (colour, depth and counts as asked, a host's depth),
-// and the machine's physical memory (0 where it cannot be read).
+// Host memory the frame's RenderImage takes per pixel (colour, depth and counts as asked, a host's depth).
 uint64_t image_bytes_per_pixel(const RenderSettings& settings);
-uint64_t host_physical_memory();
 
 // Adds a band's statistics to the frame's (FrameStats::image_bands); a frame of 0 bands takes the band's.
 void add_band_stats(FrameStats& frame, const FrameStats& band);

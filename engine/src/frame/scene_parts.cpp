@@ -10,7 +10,7 @@
 
 #include "camera/camera_models.h"
 #include "frame/image_regions.h"
-#include "host_threads.h"
+#include "host_resources.h"
 #include "passes/projection_pass.h"
 #include "scene/mapped_ply_rows.h"
 #include "sort/parallel_radix_sort.h"
@@ -138,7 +138,7 @@ DepthOrder::DepthOrder(const PartSource& scene, const Camera& camera, double nea
   const size_t n = scene.size();
   const GaussianDepths depths(scene, camera, relative_margin);
   // Tens of millions of Gaussians take seconds of host time here, before the first part: the work is
-  // spread over the host's cores in contiguous ranges (host_threads.h), each kept in order, so the
+  // spread over the host's cores in contiguous ranges (host_resources.h), each kept in order, so the
   // order and the bounds are one thread's, bit for bit.
   if (threads == 0) threads = detail::host_threads_for(n);
   {

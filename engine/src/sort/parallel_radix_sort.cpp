@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "host_threads.h"
+#include "host_resources.h"
 
 namespace tilesplat::detail {
 

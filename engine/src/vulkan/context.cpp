@@ -1,7 +1,5 @@
 #include "vulkan/context.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -10,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "host_resources.h"
 #include "vulkan/device_selection.h"
 #include "vulkan/vk_check.h"
 
@@ -96,8 +95,7 @@ uint64_t device_memory(VkPhysicalDevice physical_device, bool cpu,
     largest = std::max(largest, bytes);
   }
   if (cpu && !has_budget) {
-    const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
-    if (pages > 0 && page_size > 0) largest = std::max(largest, uint64_t(pages) * uint64_t(page_size));
+    largest = std::max(largest, detail::host_physical_memory());
   }
   return largest;
 }

@@ -1,17 +1,27 @@
-// Host work spread over the host's cores in contiguous ranges: range r of `count` items over `ranges`
-// threads is [range_begin(count, ranges, r), range_begin(count, ranges, r + 1)). Each range is handled in
-// order by one thread, so work that keeps its own range's order (a stable sort's counting, a running
-// maximum, a compaction) gives the one-thread result, bit for bit, with carries joined afterwards.
+// The host's memory and cores, and host work spread over the cores in contiguous ranges: range r of `count`
+// items over `ranges` threads is [range_begin(count, ranges, r), range_begin(count, ranges, r + 1)). Each
+// range is handled in order by one thread, so work that keeps its own range's order (a stable sort's
+// counting, a running maximum, a compaction) gives the one-thread result, bit for bit, with carries joined
+// afterwards.
 #pragma once
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <system_error>
 #include <thread>
 #include <vector>
 
 namespace tilesplat::detail {
+
+// The machine's physical memory in bytes (0 where it cannot be read).
+inline uint64_t host_physical_memory() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page_size > 0 ? uint64_t(pages) * uint64_t(page_size) : 0;
+}
 
 // The threads for `items` of host work: the host's cores, but no more than one per `items_per_thread`
 // (starting a thread costs tens of microseconds; a small scene stays on the caller's thread).
