@@ -8,13 +8,11 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -22,12 +20,12 @@
 
 #include "cli.h"
 #include "image_readback.h"
+#include "lod_view.h"
 #include "mesh_layer.h"
 #include "orbit_controller.h"
 #include "swapchain.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
-#include "tilesplat/lod_set.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
@@ -101,11 +99,10 @@ class Viewer {
         mesh_(!options.no_mesh),
         depth_out_(!options.no_depth_out),
         scene_name_(loaded.path.filename().string()),
-        lod_streamer_(loaded.lod && loaded.lod->splat_budget > 0
-                          ? std::make_unique<tilesplat::LodStreamer>(
-                                *loaded.lod->set, loaded.lod->splat_budget, tilesplat::LoadOptions{},
-                                [this] { on_lod_loaded(); })
-                          : nullptr),
+        lod_view_(
+            loaded.lod && loaded.lod->splat_budget > 0
+                ? std::make_unique<LodView>(*loaded.lod->set, loaded.lod->splat_budget, glfwPostEmptyEvent)
+                : nullptr),
         views_(std::move(views.views)),
         shutters_(std::move(views.shutters)),
         view_(options.common.view),
@@ -161,7 +158,7 @@ class Viewer {
         glfwPollEvents();
       else
         glfwWaitEvents();
-      if (lod_arrived_.exchange(false)) needs_render_ = true;  // the camera's levels were read
+      if (lod_view_ && lod_view_->arrived()) needs_render_ = true;  // the camera's levels were read
       if (resized_ || swapchain_.stale()) fit_to_window();
       if (minimized_) continue;
       const auto start = std::chrono::steady_clock::now();
@@ -221,9 +218,7 @@ class Viewer {
   // Under --splat-budget, the last camera's levels on the device, read to the end (an EXR screenshot is
   // the frame of those levels, as tilesplat-render draws it, not of the ones still shown while loading).
   void finish_streaming() {
-    if (!lod_streamer_) return;
-    tilesplat::wait_for_frame(renderer_);  // the last frame may still read the scene
-    set_lod_levels(lod_streamer_->wait_and_take());
+    if (lod_view_) lod_view_->finish(renderer_);
   }
   // The samples the last frame had added up (screenshot_settings).
   int screenshot_samples() const { return screenshot_samples_; }
@@ -231,20 +226,8 @@ class Viewer {
   // The mean wall time of a frame (render and present) after the first; 0 before the second.
   double mean_frame_ms() const { return frames_ > 1 ? frame_ms_total_ / (frames_ - 1) : 0.0; }
   double slowest_frame_ms() const { return frame_ms_max_; }  // after the first; 0 before the second
-  // Under --splat-budget: how often the levels were read, how long each read took on the streamer's
-  // thread (time a frame drawn while loading did not wait), and how many frames drew the levels before.
-  std::string lod_summary() const {
-    if (!lod_streamer_) return "";
-    std::vector<double> sorted = lod_load_ms_;
-    std::sort(sorted.begin(), sorted.end());
-    std::string summary = ", levels read " + std::to_string(sorted.size()) +
-                          (sorted.size() == 1 ? " time" : " times") + " on the streamer's thread";
-    if (!sorted.empty())
-      summary += " (median " + cli::format_fixed(sorted[sorted.size() / 2], 1) + " ms, longest " +
-                 cli::format_fixed(sorted.back(), 1) + " ms)";
-    return summary + ", " + std::to_string(lod_frames_behind_) +
-           (lod_frames_behind_ == 1 ? " frame" : " frames") + " drew the levels before while they were read";
-  }
+  // Under --splat-budget: how often the levels were read and how long each read took.
+  std::string lod_summary() const { return lod_view_ ? lod_view_->summary() : ""; }
 
   // What the window shows now: the last frame presented once more, its bytes read back from the
   // window's image.
@@ -396,7 +379,7 @@ class Viewer {
   }
 
   void render() {
-    if (lod_streamer_) stream_lod_levels();
+    if (lod_view_) lod_view_->prepare_frame(renderer_, camera());
     tilesplat::RenderSettings frame = settings();
     frame.depth = frame.splat_count = false;  // the window shows colour alone
     // Submitted without waiting (HostFrameSync): the presentation's blit is queued behind it.
@@ -418,41 +401,10 @@ class Viewer {
     ++frames_;
   }
 
-  // Under --splat-budget: the levels this frame's camera calls for are read on the streamer's thread, and
-  // the frame draws the levels the device has until they arrive (on_lod_loaded then asks for a frame).
-  // The first frame waits for its levels: there is nothing else to draw.
-  void stream_lod_levels() {
-    lod_wanted_splats_ = lod_streamer_->request(camera()).splats;
-    set_lod_levels(lod_drawn_ ? lod_streamer_->take() : lod_streamer_->wait_and_take());
-    if (lod_streamer_->busy()) ++lod_frames_behind_;
-  }
-  void set_lod_levels(const std::optional<tilesplat::LodLoad>& loaded) {
-    if (!loaded) return;
-    renderer_.set_scene(loaded->scene);
-    lod_drawn_ = true;
-    lod_drawn_splats_ = loaded->selection.splats;
-    lod_load_ms_.push_back(loaded->load_ms);
-  }
-  // On the streamer's thread: wakes the event loop, which renders with the new levels.
-  void on_lod_loaded() {
-    lod_arrived_ = true;
-    glfwPostEmptyEvent();
-  }
-
   bool present() {
     if (mesh_layer_)
       return swapchain_.present(mesh_layer_->picture(), MeshLayer::kPictureLayout, shown_extent_);
     return swapchain_.present(image_->image(), FloatImage::kLayout, shown_extent_);
-  }
-
-  // The Gaussians drawn, and while the camera's levels are read, how many they will be.
-  std::string lod_title() const {
-    if (!lod_streamer_) return "";
-    return " | " + cli::group_thousands(lod_drawn_splats_) + " splats (LOD" +
-           (lod_wanted_splats_ != lod_drawn_splats_ || lod_streamer_->busy()
-                ? "; loading " + cli::group_thousands(lod_wanted_splats_)
-                : "") +
-           ")";
   }
 
   // The GPU time is the previous frame's: a frame's statistics come once it has been waited for.
@@ -478,8 +430,9 @@ class Viewer {
                   ? " (" + std::to_string(renderer_.last_frame_stats().accumulated_frames) + " " +
                         tilesplat::to_string(stochastic_sampler_) + " frames)"
                   : "") +
-             effects_.motion_title(renderer_.last_frame_stats().accumulated_samples) + lod_title() +
-             " | GPU " + cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
+             effects_.motion_title(renderer_.last_frame_stats().accumulated_samples) +
+             (lod_view_ ? lod_view_->title() : "") + " | GPU " +
+             cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
              cli::format_fixed(frame_ms, 1) + " ms (" +
              cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps)";
     if (mesh_layer_ && !MeshLayer::depth_testable(settings()))
@@ -503,14 +456,7 @@ class Viewer {
   bool mesh_;       // draw the box and the grid (not --no-mesh)
   bool depth_out_;  // the splats write their depth for the grid (D toggles)
   std::string scene_name_;
-  std::atomic<bool> lod_arrived_ = false;  // set on the streamer's thread when a load is done
-  // A LOD set drawn under --splat-budget, else null: reads each camera's levels on a thread of its own.
-  std::unique_ptr<tilesplat::LodStreamer> lod_streamer_;
-  bool lod_drawn_ = false;                    // the device has levels of the set
-  uint64_t lod_drawn_splats_ = 0;             // their Gaussians
-  uint64_t lod_wanted_splats_ = 0;            // those of the levels this camera calls for
-  std::vector<double> lod_load_ms_;           // each load's time on the streamer's thread
-  int lod_frames_behind_ = 0;                 // frames drawn while the camera's levels were read
+  std::unique_ptr<LodView> lod_view_;         // a LOD set drawn under --splat-budget, else null
   std::vector<tilesplat::CameraView> views_;  // of --cameras or the scene file; N and P step through them
   std::vector<tilesplat::Shutter> shutters_;  // the scene file's, one per view; none for --cameras
   int view_ = 0;
