@@ -119,8 +119,9 @@ struct LodLoad {
 /// outlive the streamer, whose destructor waits for a load in flight (a file is not read half).
 class TILESPLAT_API LodStreamer {
  public:
-  /// `on_loaded`, if set, runs on the streamer's thread after each load, finished or failed (a viewer wakes
-  /// its event loop with it: glfwPostEmptyEvent); it must not call back into the streamer.
+  /// `on_loaded`, if set, runs on the streamer's thread after each load, finished or failed, once take()
+  /// can have it and before wait_and_take() returns (a viewer wakes its event loop with it:
+  /// glfwPostEmptyEvent); it must not call back into the streamer.
   LodStreamer(const LodSet& set, uint64_t splat_budget, LoadOptions options = {},
               std::function<void()> on_loaded = {});
   ~LodStreamer();

@@ -70,19 +70,21 @@ struct LodStreamer::Impl {
         error = std::current_exception();
       }
       lock.lock();
-      loading = false;
       if (error) {
         failure = error;
         newest_levels.reset();  // the same levels may be asked for again
       } else {
         finished = std::move(loaded);
       }
-      load_done.notify_all();
+      // The load can be taken from here on, and the callback (which wakes whoever takes it) runs; the
+      // streamer is busy until it has returned, so that wait_and_take() returns after it.
       if (on_loaded) {
         lock.unlock();
         on_loaded();
         lock.lock();
       }
+      loading = false;
+      load_done.notify_all();
     }
   }
 
