@@ -19,6 +19,7 @@
 #include "tilesplat/image.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/scene_in_parts.h"
 
 namespace tilesplat {
 namespace {
@@ -407,6 +408,91 @@ TEST(SceneFormatsMemory, ParseSceneReadsTheSameBytesAsLoadScene) {
     EXPECT_EQ(from_file.sh, from_memory.sh) << file;
     EXPECT_EQ(from_file.rotations, from_memory.rotations) << file;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// SceneInParts on an SPZ: the packed bytes held, any part decoded from them as load_scene decodes it.
+
+void expect_same_arrays(const GaussianScene& actual, const GaussianScene& expected, const std::string& what) {
+  EXPECT_EQ(actual.sh_degree, expected.sh_degree) << what;
+  EXPECT_EQ(actual.positions, expected.positions) << what;
+  EXPECT_EQ(actual.log_scales, expected.log_scales) << what;
+  EXPECT_EQ(actual.rotations, expected.rotations) << what;
+  EXPECT_EQ(actual.opacity_logits, expected.opacity_logits) << what;
+  EXPECT_EQ(actual.sh, expected.sh) << what;
+  EXPECT_EQ(actual.normals, expected.normals) << what;
+}
+
+void expect_in_parts_is_loaded(const fs::path& path) {
+  SCOPED_TRACE(path.filename().string());
+  LoadReport loaded_report, in_parts_report;
+  const GaussianScene loaded = load_scene(path, {}, &loaded_report);
+  const SceneInParts in_parts = SceneInParts::open(path, {}, &in_parts_report);
+  ASSERT_EQ(in_parts.size(), loaded.size());
+  EXPECT_EQ(in_parts.sh_degree(), loaded.sh_degree);
+  EXPECT_FALSE(in_parts.has_normals());
+  const Bounds bounds = compute_bounds(loaded);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_EQ(in_parts.bounds().min[a], bounds.min[a]);
+    EXPECT_EQ(in_parts.bounds().max[a], bounds.max[a]);
+  }
+  EXPECT_EQ(in_parts.bounds().radius, bounds.radius);
+  expect_same_arrays(in_parts.load(), loaded, "load");
+  EXPECT_EQ(in_parts_report.format, loaded_report.format);
+  EXPECT_EQ(in_parts_report.version, loaded_report.version);
+  EXPECT_EQ(in_parts_report.gaussians_in_file, loaded_report.gaussians_in_file);
+  EXPECT_EQ(in_parts_report.ignored_properties, loaded_report.ignored_properties);
+  // Any part of it: test_part_rows.cpp (the renderer's parts gather them).
+  // Read in parts is chosen by the Gaussians' size as floats: the header's count at its SH degree.
+  EXPECT_EQ(SceneInParts::whole_scene_bytes(path),
+            loaded.size() * (11 + 3 * size_t(loaded.sh_coefficients())) * sizeof(float));
+}
+
+TEST(SceneInPartsSpz, HoldsTheGaussiansLoadSceneReads) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  const fs::path formats = testing::shared_scenes() / "formats";
+  for (const std::string file : {"playbot_lod6_1873_sh2.v4.spz", "playbot_lod6_1873_sh2.v3.spz",
+                                 "playcanvas_test_64_sh3.v4.spz", "playcanvas_test_64_sh3.v3.spz"})
+    expect_in_parts_is_loaded(formats / file);
+  expect_in_parts_is_loaded(testing::shared_scenes() / "biker_152746.spz");  // SH degree 0
+  // Versions 2 and 3 may be stored uncompressed: the same bytes without gzip.
+  expect_in_parts_is_loaded(
+      write_file("plain.v3.spz", gunzip(read_file(formats / "playcanvas_test_64_sh3.v3.spz"))));
+  // A binary PLY's size is its floats; a file neither PLY nor SPZ, or missing, tells nothing.
+  const fs::path ply = testing::shared_scenes() / "playbot_lod0_500000_sh2.ply";
+  EXPECT_EQ(SceneInParts::whole_scene_bytes(ply), fs::file_size(ply));
+  EXPECT_EQ(SceneInParts::whole_scene_bytes(formats / "playbot_lod6_1873_sh2.sog"), 0u);
+  EXPECT_EQ(SceneInParts::whole_scene_bytes(testing::temp_dir() / "no_such.spz"), 0u);
+}
+
+// Whatever load_scene refuses, SceneInParts refuses with the same message (naming the file): cuts of a
+// version 3 and a version 4 file, an unknown version. A file too short to be told an SPZ is not a PLY
+// (MappedPlyErrors).
+TEST_F(FormatErrors, AnSpzInPartsRefusesWhatLoadSceneRefuses) {
+  auto message = [](auto&& read) {
+    try {
+      read();
+    } catch (const SceneError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  for (const std::string file : {"playcanvas_test_64_sh3.v4.spz", "playcanvas_test_64_sh3.v3.spz"}) {
+    const std::string bytes = original(file);
+    size_t refused = 0, cuts = 0;
+    for (size_t length = 4; length < bytes.size(); length += 37) {  // from the magic on: an SPZ by content
+      const fs::path cut = write_file("cut_in_parts.spz", bytes.substr(0, length));
+      const std::string expected = message([&] { load_scene(cut); });
+      EXPECT_EQ(message([&] { SceneInParts::open(cut); }), expected) << file << " cut to " << length;
+      refused += expected != "no error";  // a gzip stream cut in its trailer still holds every Gaussian
+      ++cuts;
+    }
+    EXPECT_GE(refused + 2, cuts) << file;
+  }
+  std::string v5 = original("playcanvas_test_64_sh3.v4.spz");
+  put_u32(v5, 4, 5);
+  const fs::path unknown = write_file("v5_in_parts.spz", v5);
+  EXPECT_EQ(message([&] { SceneInParts::open(unknown); }), message([&] { load_scene(unknown); }));
 }
 
 // The float64 reference found it: denormal quaternions are the identity, as float32 normalization

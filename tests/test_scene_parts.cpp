@@ -16,6 +16,7 @@
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
+#include "tilesplat/scene_in_parts.h"
 
 namespace tilesplat {
 namespace {
@@ -246,6 +247,29 @@ TEST(SceneParts, APlyReadPartByPartIsTheWholeFrame) {
   EXPECT_FALSE(parts_renderer().renders_in_parts(mapped, big.camera, settings));
   expect_bit_identical(parts_renderer().render(mapped, big.camera, settings), whole, "loaded whole");
   expect_bit_identical(parts_renderer().render(big.camera, settings), whole, "set by render(mapped)");
+  EXPECT_EQ(parts_renderer().validation_messages(), 0u);
+}
+
+// An SPZ read part by part (SceneInParts): held in its packed bytes, each part decoded from them as it is
+// drawn, the frame the loaded SPZ renders, bit for bit.
+TEST(SceneParts, AnSpzReadPartByPartIsTheWholeFrame) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  const BigScene& big = big_scene();
+  const std::filesystem::path path = testing::shared_scenes() / "formats" / "playbot_lod0_500000_sh2.v4.spz";
+  const GaussianScene loaded = load_scene(path);
+  const SceneInParts in_parts = SceneInParts::open(path);
+  ASSERT_EQ(in_parts.size(), loaded.size());
+  Renderer& renderer = testing::validated_renderer();
+  RenderSettings settings;
+  settings.reuse_lists = false;
+  renderer.set_scene(loaded);
+  const RenderImage whole = renderer.render(big.camera, settings);
+  settings.memory_budget = kSmallBudget;
+  EXPECT_TRUE(parts_renderer().renders_in_parts(in_parts, big.camera, settings));
+  const RenderImage parts = parts_renderer().render(in_parts, big.camera, settings);
+  EXPECT_GE(parts_renderer().last_frame_stats().scene_parts, 16);
+  EXPECT_EQ(parts_renderer().last_frame_stats().gaussians, loaded.size());
+  expect_bit_identical(parts, whole, "read in parts");
   EXPECT_EQ(parts_renderer().validation_messages(), 0u);
 }
 

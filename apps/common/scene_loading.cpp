@@ -51,14 +51,14 @@ double elapsed_ms(std::chrono::steady_clock::time_point start) {
 
 size_t LoadedScene::gaussians() const {
   if (instances) return instances->size();
-  if (mapped) return mapped->size();
+  if (in_parts) return in_parts->size();
   if (lod && lod->splat_budget > 0) return lod->set->level_size(0);
   return scene.size();
 }
 
 Bounds LoadedScene::bounds() const {
   if (lod) return lod->framing;
-  if (mapped) return mapped->bounds();
+  if (in_parts) return in_parts->bounds();
   return instances ? compute_bounds(*instances) : compute_bounds(scene);
 }
 
@@ -81,21 +81,21 @@ void load_lod_set(LoadedScene& loaded, const LodOptions& options, const LoadOpti
   loaded.lod = std::move(lod);
 }
 
-// Whether `path` is a PLY that `ply` reads part by part: always, or when the file is larger than half of
-// the host's memory.
-bool reads_in_parts(const fs::path& path, PlyReading ply) {
-  if (ply == PlyReading::kWhole || !has_extension(path, ".ply")) return false;
-  if (ply == PlyReading::kInParts) return true;
-  std::error_code error;
-  const uintmax_t bytes = fs::file_size(path, error);
+// Whether `path` is a binary PLY or an SPZ that `reading` reads part by part: always, or when its
+// Gaussians as floats would take more than half of the host's memory.
+bool reads_in_parts(const fs::path& path, PartReading reading) {
+  if (reading == PartReading::kWhole || !(has_extension(path, ".ply") || has_extension(path, ".spz")))
+    return false;
+  if (reading == PartReading::kInParts) return true;
+  const uint64_t bytes = SceneInParts::whole_scene_bytes(path);
   const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
-  return !error && pages > 0 && page_size > 0 && bytes > uintmax_t(pages) * uintmax_t(page_size) / 2;
+  return pages > 0 && page_size > 0 && bytes > uint64_t(pages) * uint64_t(page_size) / 2;
 }
 
 }  // namespace
 
 LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view program, SceneHolding holding,
-                            const LodOptions& lod, PlyReading ply) {
+                            const LodOptions& lod, PartReading ply) {
   LoadedScene loaded;
   loaded.path = path;
   require_input_file(loaded.path, "scene");
@@ -119,7 +119,7 @@ LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view 
       else
         loaded.scene = load_described_scene(*loaded.description, load_options, &loaded.report);
     } else if (reads_in_parts(loaded.path, ply)) {
-      loaded.mapped = MappedPly::open(loaded.path, load_options, &loaded.report);
+      loaded.in_parts = SceneInParts::open(loaded.path, load_options, &loaded.report);
     } else {
       loaded.scene = load_scene(loaded.path, load_options, &loaded.report);
     }
@@ -247,7 +247,7 @@ SceneViews camera_views(const CommonOptions& options, const LoadedScene& loaded)
 }
 
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program,
-                                  SceneHolding holding, PlyReading ply) {
+                                  SceneHolding holding, PartReading ply) {
   LoadedScene loaded = load_scene_file(options.scene, options.strict, program, holding, options.lod, ply);
   const SceneViews cameras = camera_views(options, loaded);
   NamedCamera named;
@@ -290,9 +290,10 @@ std::string describe_scene(const LoadedScene& loaded) {
       return what + ", at most " + group_thousands(loaded.lod->splat_budget) + " a frame";
     return what + ", level " + std::to_string(loaded.lod->level) + ": " + describe_scene(loaded.scene);
   }
-  if (loaded.mapped)
-    return group_thousands(loaded.mapped->size()) + " Gaussians (SH" +
-           std::to_string(loaded.mapped->sh_degree()) + "), read in parts from the file";
+  if (loaded.in_parts)
+    return group_thousands(loaded.in_parts->size()) + " Gaussians (SH" +
+           std::to_string(loaded.in_parts->sh_degree()) + "), read in parts from " +
+           (loaded.report.format == "spz" ? "its packed bytes" : "the file");
   if (!loaded.instances) return describe_scene(loaded.scene);
   return group_thousands(loaded.gaussians()) + " Gaussians (SH" +
          std::to_string(loaded.instances->sh_degree) + "), " +

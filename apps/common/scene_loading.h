@@ -14,10 +14,10 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/lens.h"
 #include "tilesplat/lod_set.h"
-#include "tilesplat/mapped_ply.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
+#include "tilesplat/scene_in_parts.h"
 
 namespace tilesplat::cli {
 
@@ -27,10 +27,10 @@ namespace tilesplat::cli {
 // at each time of a shutter, docs/effects.md).
 enum class SceneHolding { kMerged, kInstances, kInstancesIfMoving };
 
-// How a binary PLY is held: read whole (load_scene), or mapped and read part by part as the frames draw
-// it (MappedPly: only its positions held), always or when the file is larger than half of the host's
-// memory (tilesplat-render, --read-in-parts).
-enum class PlyReading { kWhole, kInPartsWhenLarge, kInParts };
+// How a binary PLY or an SPZ is held: read whole (load_scene), or read part by part as the frames draw it
+// (SceneInParts: its positions held, and an SPZ's packed bytes), always or when its Gaussians as floats
+// would take more than half of the host's memory (tilesplat-render, --read-in-parts).
+enum class PartReading { kWhole, kInPartsWhenLarge, kInParts };
 
 // A LOD set the SCENE names (lod-meta.json): the index, and how the run draws it.
 struct LoadedLodSet {
@@ -50,8 +50,8 @@ struct LoadedScene {
   // as SceneHolding::kInstances, placed in `instances` (and `scene` is empty).
   std::optional<SceneDescription> description;
   std::optional<SceneInstances> instances;
-  // Set when a binary PLY is read part by part (PlyReading): `scene` is empty.
-  std::optional<MappedPly> mapped;
+  // Set when a binary PLY or an SPZ is read part by part (PartReading): `scene` is empty.
+  std::optional<SceneInParts> in_parts;
   // Set when the SCENE is a LOD set: `scene` holds its level lod->level, or nothing under a splat budget.
   std::optional<LoadedLodSet> lod;
   size_t gaussians() const;  // what a frame draws at most (under a splat budget: the finest level's size)
@@ -73,14 +73,14 @@ struct LoadedScene {
 // out-of-range --view throws UsageError naming the file and its number of views.
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program,
                                   SceneHolding holding = SceneHolding::kMerged,
-                                  PlyReading ply = PlyReading::kWhole);
+                                  PartReading ply = PartReading::kWhole);
 
 // The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
 // load_scene_file fills path, scene, description, report and load_ms only.
 // A LOD set is read as `lod` says; `lod` given for any other scene is a UsageError.
 LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program,
                             SceneHolding holding = SceneHolding::kMerged, const LodOptions& lod = {},
-                            PlyReading ply = PlyReading::kWhole);
+                            PartReading ply = PartReading::kWhole);
 
 // The views a scene file brings ("cameras") and the file that names them (the cameras.json it
 // refers to, else the scene file). No views for a .ply, or a scene file without cameras.

@@ -12,7 +12,7 @@ namespace tilesplat::render_app {
 FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScene& loaded)
     : scene_(&loaded.scene),
       instances_(loaded.instances ? &*loaded.instances : nullptr),
-      mapped_(loaded.mapped ? &*loaded.mapped : nullptr),
+      file_in_parts_(loaded.in_parts ? &*loaded.in_parts : nullptr),
       lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
       lens_(options.lens),
       in_parts_(options.memory_budget > 0) {
@@ -22,7 +22,7 @@ FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScen
   }
   if (lod_) lod_streamer_ = std::make_unique<LodStreamer>(*lod_->set, lod_->splat_budget);
   if (options.reference) {
-    if (mapped_) load_mapped_whole();  // the float64 reference takes a whole scene
+    if (file_in_parts_) load_file_whole();  // the float64 reference takes a whole scene
     return;
   }
   renderer_ = Renderer::create(cli::renderer_options(options.common));
@@ -45,23 +45,23 @@ void FrameRenderer::decide_holding(const Camera& camera, const RenderSettings& s
     scene_ = &merged_;
     instances_ = nullptr;
   }
-  if (mapped_) {
+  if (file_in_parts_) {
     // A PLY read part by part stays in its file while its frames are drawn in parts; one whose frame fits
     // the device is loaded and set once.
-    if (renderer_->renders_in_parts(*mapped_, camera, settings)) {
+    if (renderer_->renders_in_parts(*file_in_parts_, camera, settings)) {
       in_parts_ = true;
       return;
     }
-    load_mapped_whole();
+    load_file_whole();
   }
   in_parts_ = renderer_->renders_in_parts(*scene_, camera, settings);
   if (!in_parts_) renderer_->set_scene(*scene_);
 }
 
-void FrameRenderer::load_mapped_whole() {
-  merged_ = mapped_->load();
+void FrameRenderer::load_file_whole() {
+  merged_ = file_in_parts_->load();
   scene_ = &merged_;
-  mapped_ = nullptr;
+  file_in_parts_ = nullptr;
 }
 
 RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& base_settings,
@@ -88,7 +88,7 @@ RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& ba
   const GaussianScene& scene = lod_ ? lod_scene_ : *scene_;
   RenderImage image;
   if (renderer_) {
-    image = mapped_               ? renderer_->render(*mapped_, camera, settings)
+    image = file_in_parts_        ? renderer_->render(*file_in_parts_, camera, settings)
             : instances_          ? renderer_->render(*instances_, camera, settings)
             : !in_parts_ && !lod_ ? renderer_->render(camera, settings)
                                   : renderer_->render(scene, camera, settings);

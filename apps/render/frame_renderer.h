@@ -11,9 +11,9 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
 #include "tilesplat/lod_set.h"
-#include "tilesplat/mapped_ply.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/scene_in_parts.h"
 
 namespace tilesplat::render_app {
 
@@ -41,9 +41,9 @@ class FrameRenderer {
   // A scene file's placed copies: under --memory-budget, when some move, or when their frame does not fit
   // the device (decide_holding merges them into merged_ otherwise).
   const SceneInstances* instances_;
-  // A binary PLY read part by part (--read-in-parts, or a large one): taken by every frame in parts, or
-  // loaded into merged_ when its frame fits the device.
-  const MappedPly* mapped_;
+  // A binary PLY or an SPZ read part by part (--read-in-parts, or a large one): taken by every frame in
+  // parts, or loaded into merged_ when its frame fits the device.
+  const SceneInParts* file_in_parts_;
   GaussianScene merged_;
   const cli::LoadedLodSet* lod_;     // a LOD set drawn under --splat-budget
   LodSelection lod_selection_;
@@ -54,7 +54,7 @@ class FrameRenderer {
   // The first frame's choice: the scene set once, or taken by each frame (in parts where it does not fit).
   void decide_holding(const Camera& camera, const RenderSettings& settings);
   // The PLY read part by part, loaded into merged_ and drawn from there.
-  void load_mapped_whole();
+  void load_file_whole();
 
   bool in_parts_ = false;  // --memory-budget, or a frame that does not fit the device
   bool decided_ = false;

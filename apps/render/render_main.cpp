@@ -428,8 +428,8 @@ int run(int argc, char** argv) {
   // unless some move (each time of a shutter places them anew).
   const cli::SceneHolding holding =
       !options.reference ? cli::SceneHolding::kInstances : cli::SceneHolding::kInstancesIfMoving;
-  const cli::PlyReading ply =
-      options.read_in_parts ? cli::PlyReading::kInParts : cli::PlyReading::kInPartsWhenLarge;
+  const cli::PartReading ply =
+      options.read_in_parts ? cli::PartReading::kInParts : cli::PartReading::kInPartsWhenLarge;
   cli::LoadedScene loaded = sequence ? cli::load_scene_file(options.common.scene, options.common.strict,
                                                             kProgram, holding, options.common.lod, ply)
                                      : cli::load_scene_and_camera(options.common, kProgram, holding, ply);

@@ -229,7 +229,8 @@ RenderImage Renderer::render(const SceneInstances& scene, const Camera& camera,
       PartSource(scene), [&] { set_scene(merge_instances(scene)); }, camera, settings, *this);
 }
 
-RenderImage Renderer::render(const MappedPly& scene, const Camera& camera, const RenderSettings& settings) {
+RenderImage Renderer::render(const SceneInParts& scene, const Camera& camera,
+                             const RenderSettings& settings) {
   return impl_->render_scene(
       PartSource(scene), [&] { set_scene(scene.load()); }, camera, settings, *this);
 }
@@ -244,7 +245,7 @@ bool Renderer::renders_in_parts(const SceneInstances& scene, const Camera& camer
   return impl_->needs_parts(PartSource(scene), camera, settings);
 }
 
-bool Renderer::renders_in_parts(const MappedPly& scene, const Camera& camera,
+bool Renderer::renders_in_parts(const SceneInParts& scene, const Camera& camera,
                                 const RenderSettings& settings) {
   return impl_->needs_parts(PartSource(scene), camera, settings);
 }

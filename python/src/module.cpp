@@ -25,12 +25,12 @@
 #include "tilesplat/image.h"
 #include "tilesplat/lens.h"
 #include "tilesplat/lod_set.h"
-#include "tilesplat/mapped_ply.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
+#include "tilesplat/scene_in_parts.h"
 #include "tilesplat/shutter.h"
 #include "tilesplat/version.h"
 
@@ -303,36 +303,42 @@ void bind(nb::module_& m) {
           },
           "t"_a = 0.0, "The merged scene with every model where it is at time t in [0, 1].");
 
-  // --- a binary PLY read part by part
-  nb::class_<MappedPly>(
-      m, "MappedPly",
-      "A binary PLY opened to be read part by part: only the Gaussians' positions are held, and "
-      "Renderer.render(camera, mapped_ply=..., memory_budget=...) decodes each part from the file as it is "
-      "drawn, the frame of load_scene's scene to the bit (docs/big-scenes.md, \"Read part by part\").")
+  // --- a binary PLY or an SPZ read part by part
+  nb::class_<SceneInParts>(
+      m, "SceneInParts",
+      "A binary PLY or an SPZ opened to be read part by part: the Gaussians' positions are held (and an "
+      "SPZ's own packed bytes), and Renderer.render(camera, in_parts=..., memory_budget=...) decodes each "
+      "part as it is drawn, the frame of load_scene's scene to the bit (docs/big-scenes.md, \"Read part by "
+      "part\"). MappedPly is its earlier name.")
       .def(
           "__init__",
-          [](MappedPly* self, const std::filesystem::path& path, bool strict) {
+          [](SceneInParts* self, const std::filesystem::path& path, bool strict) {
             check_exists(path, "scene");
             LoadOptions options;
             options.strict = strict;
             nb::gil_scoped_release release;
-            new (self) MappedPly(MappedPly::open(path, options));
+            new (self) SceneInParts(SceneInParts::open(path, options));
           },
           "path"_a, "strict"_a = false,
-          "Opens a binary PLY (an ASCII or a compressed one is refused: load_scene reads those whole).")
-      .def_prop_ro("size", &MappedPly::size, "the Gaussians")
-      .def_prop_ro("sh_degree", &MappedPly::sh_degree, "0 to 3")
+          "Opens a binary PLY or an SPZ (an ASCII or a compressed PLY and the other formats are refused: "
+          "load_scene reads those whole).")
+      .def_prop_ro("size", &SceneInParts::size, "the Gaussians")
+      .def_prop_ro("sh_degree", &SceneInParts::sh_degree, "0 to 3")
+      .def_static("whole_scene_bytes", &SceneInParts::whole_scene_bytes, "path"_a,
+                  "The bytes load_scene's arrays would take for the file, from its header alone (0 for a "
+                  "file SceneInParts does not open).")
       .def(
           "load",
-          [](const MappedPly& scene) {
+          [](const SceneInParts& scene) {
             nb::gil_scoped_release release;
             return scene.load();
           },
           "The whole scene, as load_scene reads it.")
-      .def("__repr__", [](const MappedPly& scene) {
-        return "<tilesplat.MappedPly " + std::to_string(scene.size()) + " Gaussians (SH" +
+      .def("__repr__", [](const SceneInParts& scene) {
+        return "<tilesplat.SceneInParts " + std::to_string(scene.size()) + " Gaussians (SH" +
                std::to_string(scene.sh_degree()) + ")>";
       });
+  m.attr("MappedPly") = m.attr("SceneInParts");
 
   // --- level-of-detail sets
   nb::class_<LodSelection>(m, "LodSelection", "The level each chunk of a LOD set is drawn at for one camera.")
@@ -771,7 +777,7 @@ void bind(nb::module_& m) {
              const GaussianScene* scene, uint64_t memory_budget, const LodSet* lod_set, uint64_t splat_budget,
              const SceneInstances* instances, const std::optional<std::array<int, 4>>& region,
              const std::string& stochastic_sampler, bool stochastic_accumulate, bool accumulate_samples,
-             const MappedPly* mapped_ply) {
+             const SceneInParts* mapped_ply, const SceneInParts* in_parts) {
             RenderSettings settings = make_settings(
                 sort, depth, splat_count, accuracy, antialiasing, compositor, stochastic_frames, seed,
                 background, reuse_lists, near_plane, max_alpha, lens, shutter, memory_budget);
@@ -782,17 +788,20 @@ void bind(nb::module_& m) {
             settings.stochastic.accumulate = stochastic_accumulate;
             settings.accumulate_samples = accumulate_samples;
             if (region) settings.region = {(*region)[0], (*region)[1], (*region)[2], (*region)[3]};
+            if (mapped_ply && in_parts)
+              throw std::invalid_argument("render takes in_parts or mapped_ply (its earlier name), not both");
+            if (mapped_ply) in_parts = mapped_ply;
             if (int(scene != nullptr) + int(lod_set != nullptr) + int(instances != nullptr) +
-                    int(mapped_ply != nullptr) >
+                    int(in_parts != nullptr) >
                 1)
-              throw std::invalid_argument("render takes one of scene, lod_set and instances (or mapped_ply)");
+              throw std::invalid_argument("render takes one of scene, lod_set and instances (or in_parts)");
             if (splat_budget > 0 && !lod_set)
               throw std::invalid_argument("splat_budget applies to a lod_set");
             settings.splat_budget = splat_budget;
             nb::gil_scoped_release release;
             if (lod_set) return self.renderer->render(*lod_set, camera, settings);
             if (instances) return self.renderer->render(*instances, camera, settings);
-            if (mapped_ply) return self.renderer->render(*mapped_ply, camera, settings);
+            if (in_parts) return self.renderer->render(*in_parts, camera, settings);
             return scene ? self.renderer->render(*scene, camera, settings)
                          : self.renderer->render(camera, settings);
           },
@@ -803,14 +812,14 @@ void bind(nb::module_& m) {
           "shutter"_a = nb::none(), "scene"_a = nb::none(), "memory_budget"_a = 0, "lod_set"_a = nb::none(),
           "splat_budget"_a = 0, "instances"_a = nb::none(), "region"_a = nb::none(),
           "stochastic_sampler"_a = "hash", "stochastic_accumulate"_a = false, "accumulate_samples"_a = false,
-          "mapped_ply"_a = nb::none(),
+          "mapped_ply"_a = nb::none(), "in_parts"_a = nb::none(),
           "Renders the scene from `camera`: the one set_scene uploaded, or `scene`, which replaces it and is "
           "rendered within memory_budget bytes of device memory (0: the device's own limits), "
           "in depth-ordered parts into the same image where the whole frame would need more "
           "(docs/big-scenes.md); a LodSet `lod_set`: level 0, or under splat_budget the levels this camera "
           "calls for (LodSet.select); SceneInstances `instances`, whose moving models blur under an open "
-          "shutter (with or without its end_camera); or a MappedPly `mapped_ply`, in parts decoded from its "
-          "file as they are drawn. "
+          "shutter (with or without its end_camera); or a SceneInParts `in_parts` (`mapped_ply`, its "
+          "earlier name), in parts decoded as they are drawn. "
           "region (x, y, width, height) renders only those pixels, each the whole frame's to the bit, into "
           "an image of that size (RenderSettings::region). "
           "Keyword arguments are RenderSettings' fields: accuracy is a mode "

@@ -287,6 +287,26 @@ def test_a_ply_read_part_by_part_is_the_loaded_scenes_frame(playbot_renderer):
     assert renderer.validation_messages == 0
 
 
+def test_an_spz_read_part_by_part_is_the_loaded_scenes_frame(shared_scenes):
+    # A renderer of its own: a budget counts every buffer a renderer holds, and the shared one's have grown.
+    renderer = tilesplat.Renderer(validation=True)
+    path = shared_scenes / "formats" / "playbot_lod6_1873_sh2.v4.spz"
+    scene = tilesplat.load_scene(path)
+    in_parts = tilesplat.SceneInParts(path)
+    assert tilesplat.MappedPly is tilesplat.SceneInParts  # the earlier name
+    assert in_parts.size == scene.size and in_parts.sh_degree == scene.sh_degree
+    assert tilesplat.SceneInParts.whole_scene_bytes(path) == scene.size * (11 + 3 * 9) * 4
+    assert np.array_equal(in_parts.load().sh, scene.sh)
+    camera = tilesplat.Camera.orbit(scene, 160, 90, azimuth_deg=30)
+    parts = renderer.render(camera, in_parts=in_parts, memory_budget=1300 << 10)
+    assert renderer.last_frame_stats["scene_parts"] > 1
+    whole = renderer.render(camera, scene=scene)
+    assert np.array_equal(parts.rgba, whole.rgba) and np.array_equal(parts.depth, whole.depth)
+    with pytest.raises(ValueError, match="not both"):
+        renderer.render(camera, in_parts=in_parts, mapped_ply=in_parts)
+    assert renderer.validation_messages == 0
+
+
 def test_a_lod_set_by_level_and_under_a_splat_budget(playbot_renderer):
     _, renderer = playbot_renderer
     lods = tilesplat.LodSet(REPO / "tests" / "data" / "playbot_lod_set" / "lod-meta.json")

@@ -10,8 +10,9 @@ named "overview" looks at the whole grid from above the front edge.
 tilesplat reads the capture once however many copies name it (docs/big-scenes.md).
 
 With --merged-ply FILE.ply it also writes the placed copies as one PLY of distinct Gaussians at SH degree 0 (the
-scene file's merge, its colour bands dropped): a big single file, for measuring what reading one costs. That
-needs the tilesplat Python module (python/README.md) and numpy.
+scene file's merge, its colour bands dropped): a big single file, for measuring what reading one costs. With
+--merged-spz FILE.spz it writes them as one SPZ (version 3, gzip) at the capture's SH degree, quantized as SPZ
+quantizes. Both need the tilesplat Python module (python/README.md) and numpy.
 """
 
 import argparse
@@ -30,6 +31,7 @@ def main():
     parser.add_argument("--height", type=int, default=1080, help="its height (default 1080)")
     parser.add_argument("-o", "--output", required=True, help="the scene file to write (.json)")
     parser.add_argument("--merged-ply", help="also write the merged copies as one SH0 binary PLY")
+    parser.add_argument("--merged-spz", help="also write the merged copies as one SPZ (version 3)")
     args = parser.parse_args()
     if not 1 <= args.copies <= 100000:
         sys.exit(f"make_copies_scene: --copies must be 1 to 100000, got {args.copies}")
@@ -68,6 +70,8 @@ def main():
     print(f"make_copies_scene: {args.copies} copies of {args.model} on a {side}x{side} grid -> {args.output}")
     if args.merged_ply:
         write_merged_ply(args.output, args.merged_ply)
+    if args.merged_spz:
+        write_merged_spz(args.output, args.merged_spz)
 
 
 def write_merged_ply(scene_file, path):
@@ -90,6 +94,67 @@ def write_merged_ply(scene_file, path):
             rows = np.concatenate([np.asarray(c[first:first + step], np.float32) for c in columns], axis=1)
             f.write(np.ascontiguousarray(rows, "<f4").tobytes())
     print(f"make_copies_scene: {n:,} Gaussians (SH0) -> {path}")
+
+
+def write_merged_spz(scene_file, path, fractional_bits=12):
+    """The scene file's copies, merged by tilesplat, as one SPZ version 3: a gzip stream of a 16-byte header
+    and the attributes one after another (the layout engine/src/scene/spz_reader.cpp reads), each written
+    a few million Gaussians at a time. SPZ's axes are RUB, the engine's RDF: y and z flip, and with them the
+    quaternions' y and z and the SH bands of odd parity in y and z."""
+    import gzip
+    import struct
+
+    import numpy as np
+    import tilesplat
+
+    scene = tilesplat.load_scene(scene_file)
+    n, degree = scene.size, scene.sh_degree
+    flip = np.array([1, -1, -1], np.float64)
+    sh_flip = np.array([-1, -1, 1, -1, 1, 1, -1, 1, -1, 1, -1, -1, 1, -1, 1], np.float64)[:(degree + 1) ** 2 - 1]
+    step = 1 << 22
+
+    def quantized(values, scale, offset):
+        return np.clip(np.rint(np.asarray(values, np.float64) * scale + offset), 0, 255).astype(np.uint8)
+
+    def positions(a, b):
+        fixed = np.rint(np.asarray(scene.positions[a:b], np.float64) * flip * (1 << fractional_bits))
+        if np.abs(fixed).max(initial=0) >= 1 << 23:
+            sys.exit(f"make_copies_scene: positions past +-{2 ** (23 - fractional_bits)} do not fit SPZ's 24 bits")
+        fixed = fixed.astype(np.int64) & 0xFFFFFF
+        return np.stack([fixed & 0xFF, (fixed >> 8) & 0xFF, fixed >> 16], axis=-1).astype(np.uint8)
+
+    def alphas(a, b):
+        return quantized(1 / (1 + np.exp(-np.asarray(scene.opacity_logits[a:b], np.float64))), 255, 0)
+
+    def colours(a, b):
+        return quantized(scene.sh[a:b, 0, :], 0.15 * 255, 0.5 * 255)
+
+    def scales(a, b):
+        return quantized(scene.log_scales[a:b], 16, 160)
+
+    def rotations(a, b):
+        q = np.asarray(scene.rotations[a:b], np.float64)  # w x y z, unit
+        xyzw = np.concatenate([q[:, 1:] * flip, q[:, :1]], axis=1)
+        largest = np.abs(xyzw).argmax(axis=1)
+        xyzw *= np.where(xyzw[np.arange(len(xyzw)), largest] < 0, -1, 1)[:, None]
+        packed = largest.astype(np.uint64)
+        for j in range(4):  # the three smaller ones in order, each a sign and 9 bits of |v| / sqrt(1/2)
+            v = xyzw[:, j]
+            field = (np.rint(np.minimum(np.abs(v) / math.sqrt(0.5), 1) * 511).astype(np.uint64) |
+                     (v < 0).astype(np.uint64) << np.uint64(9))
+            packed = np.where(largest == j, packed, packed << np.uint64(10) | field)
+        return packed.astype("<u4")
+
+    def sh(a, b):
+        rest = np.asarray(scene.sh[a:b, 1:, :], np.float64) * sh_flip[None, :, None]
+        return quantized(rest, 128, 128)
+
+    with gzip.open(path, "wb", compresslevel=1) as f:
+        f.write(struct.pack("<IIIBBBB", 0x5053474E, 3, n, degree, fractional_bits, 0, 0))
+        for attribute in [positions, alphas, colours, scales, rotations] + ([sh] if degree > 0 else []):
+            for first in range(0, n, step):
+                f.write(np.ascontiguousarray(attribute(first, min(n, first + step))).tobytes())
+    print(f"make_copies_scene: {n:,} Gaussians (SH{degree}) -> {path} ({os.path.getsize(path):,} bytes)")
 
 
 if __name__ == "__main__":

@@ -12,7 +12,7 @@
 #include "frame/image_regions.h"
 #include "host_resources.h"
 #include "passes/projection_pass.h"
-#include "scene/mapped_ply_rows.h"
+#include "scene/part_rows.h"
 #include "sort/parallel_radix_sort.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/sort.h"
@@ -39,7 +39,7 @@ uint32_t depth_key(double depth, int key_bits) {
 
 PartSource::PartSource(const GaussianScene& scene) : scene_(&scene), size_(scene.size()) {}
 
-PartSource::PartSource(const MappedPly& scene) : mapped_(scene.rows_.get()), size_(scene.size()) {}
+PartSource::PartSource(const SceneInParts& scene) : mapped_(scene.rows_.get()), size_(scene.size()) {}
 
 PartSource::PartSource(const SceneInstances& scene, double time) : instances_(&scene) {
   for (const SceneInstances::Instance& instance : scene.instances) {

@@ -19,10 +19,10 @@
 
 #include "scene/scene_merge.h"
 #include "tilesplat/camera.h"
-#include "tilesplat/mapped_ply.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
+#include "tilesplat/scene_in_parts.h"
 
 namespace tilesplat {
 
@@ -36,11 +36,12 @@ constexpr double kDepthMarginFloat32 = 2e-6;
 // The Gaussians a scene in parts draws from: one GaussianScene; the placed copies of a SceneInstances,
 // numbered as in their merged scene (merge_instances), whose parts it places one Gaussian at a time (so
 // that a scene of many copies is never held whole), each copy where it is at `time`
-// (SceneInstances::Instance::at); or a MappedPly, whose parts are decoded from its file.
+// (SceneInstances::Instance::at); or a SceneInParts, whose parts are decoded from its file (a PLY) or packed
+// bytes (an SPZ).
 class PartSource {
  public:
   explicit PartSource(const GaussianScene& scene);
-  explicit PartSource(const MappedPly& scene);
+  explicit PartSource(const SceneInParts& scene);
   explicit PartSource(const SceneInstances& scene, double time = 0);
 
   size_t size() const { return size_; }
@@ -54,7 +55,7 @@ class PartSource {
  private:
   const GaussianScene* scene_ = nullptr;
   const SceneInstances* instances_ = nullptr;
-  const detail::MappedPlyRows* mapped_ = nullptr;
+  const detail::PartRows* mapped_ = nullptr;
   std::vector<size_t>
       first_;  // instances: each instance's first Gaussian in the merged scene, then the total
   std::vector<ModelTransform> transforms_;  // instances: each one's at the time

@@ -102,7 +102,7 @@ GaussianScene read_any(std::span<const std::byte> data, const std::string& name,
       return file ? detail::read_ply_file(file->contents, name, options, report)
                   : parse_ply(data, name, options, report);
     case Container::kSpz:
-      return detail::read_spz(data, name, options, report);
+      return detail::read_spz(data, name, options, report, file ? &file->contents : nullptr);
     case Container::kZip:
       return detail::read_sog_zip(data, name, options, report);
     case Container::kGlb:

@@ -39,8 +39,9 @@ GaussianScene read_splat(std::span<const std::byte> data, std::string_view name,
 
 // Niantic .spz: versions 2 and 3 (gzip, or the same bytes uncompressed) and 4 (zstd streams).
 bool is_spz(std::span<const std::byte> data);  // the NGSP magic, or a gzip stream
+// `file`, where given, is where `data` is mapped from: its pages are let go of as they are decompressed.
 GaussianScene read_spz(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
-                       LoadReport* report);
+                       LoadReport* report, FileContents* file = nullptr);
 
 // PlayCanvas SOG: a zip of meta.json and WebP images, or meta.json with the images beside it.
 GaussianScene read_sog_zip(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
