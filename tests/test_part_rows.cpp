@@ -49,15 +49,7 @@ void expect_parts_are_loaded(const std::filesystem::path& path) {
   for (uint32_t i = 3; i < loaded.size(); i += 7) every_seventh.push_back(i);
   for (const std::vector<uint32_t>& indices : {every_seventh, first_and_last, none}) {
     SCOPED_TRACE(std::to_string(indices.size()) + " Gaussians");
-    const GaussianScene part = source.gather(indices);
-    const GaussianScene expected = pick(loaded, indices);
-    EXPECT_EQ(part.sh_degree, expected.sh_degree);
-    EXPECT_EQ(part.positions, expected.positions);
-    EXPECT_EQ(part.log_scales, expected.log_scales);
-    EXPECT_EQ(part.rotations, expected.rotations);
-    EXPECT_EQ(part.opacity_logits, expected.opacity_logits);
-    EXPECT_EQ(part.sh, expected.sh);
-    EXPECT_EQ(part.normals, expected.normals);
+    testing::expect_identical_scenes(source.gather(indices), pick(loaded, indices));
   }
 }
 

@@ -281,16 +281,8 @@ enum class Rotations { kNearly, kExactly };
 void expect_same_scene(const GaussianScene& actual, const GaussianScene& expected, const std::string& label,
                        Rotations rotations = Rotations::kNearly) {
   SCOPED_TRACE(label);
-  EXPECT_EQ(actual.sh_degree, expected.sh_degree);
-  EXPECT_EQ(actual.positions, expected.positions);
-  EXPECT_EQ(actual.log_scales, expected.log_scales);
-  EXPECT_EQ(actual.opacity_logits, expected.opacity_logits);
-  EXPECT_EQ(actual.sh, expected.sh);
-  EXPECT_EQ(actual.normals, expected.normals);
-  if (rotations == Rotations::kExactly) {
-    EXPECT_EQ(actual.rotations, expected.rotations);
-    return;
-  }
+  testing::expect_identical_scenes(actual, expected, rotations == Rotations::kExactly);
+  if (rotations == Rotations::kExactly) return;
   ASSERT_EQ(actual.rotations.size(), expected.rotations.size());
   for (size_t i = 0; i < actual.rotations.size(); ++i)
     EXPECT_FLOAT_EQ(actual.rotations[i], expected.rotations[i]) << i;

@@ -413,16 +413,6 @@ TEST(SceneFormatsMemory, ParseSceneReadsTheSameBytesAsLoadScene) {
 // ---------------------------------------------------------------------------------------------
 // SceneInParts on an SPZ: the packed bytes held, any part decoded from them as load_scene decodes it.
 
-void expect_same_arrays(const GaussianScene& actual, const GaussianScene& expected, const std::string& what) {
-  EXPECT_EQ(actual.sh_degree, expected.sh_degree) << what;
-  EXPECT_EQ(actual.positions, expected.positions) << what;
-  EXPECT_EQ(actual.log_scales, expected.log_scales) << what;
-  EXPECT_EQ(actual.rotations, expected.rotations) << what;
-  EXPECT_EQ(actual.opacity_logits, expected.opacity_logits) << what;
-  EXPECT_EQ(actual.sh, expected.sh) << what;
-  EXPECT_EQ(actual.normals, expected.normals) << what;
-}
-
 void expect_in_parts_is_loaded(const fs::path& path) {
   SCOPED_TRACE(path.filename().string());
   LoadReport loaded_report, in_parts_report;
@@ -437,7 +427,7 @@ void expect_in_parts_is_loaded(const fs::path& path) {
     EXPECT_EQ(in_parts.bounds().max[a], bounds.max[a]);
   }
   EXPECT_EQ(in_parts.bounds().radius, bounds.radius);
-  expect_same_arrays(in_parts.load(), loaded, "load");
+  testing::expect_identical_scenes(in_parts.load(), loaded);
   EXPECT_EQ(in_parts_report.format, loaded_report.format);
   EXPECT_EQ(in_parts_report.version, loaded_report.version);
   EXPECT_EQ(in_parts_report.gaussians_in_file, loaded_report.gaussians_in_file);

@@ -168,6 +168,18 @@ void replay_fuzz_regressions(const std::string& reader, size_t at_least,
   }
 }
 
+void expect_identical_scenes(const GaussianScene& actual, const GaussianScene& expected, bool rotations) {
+  EXPECT_EQ(actual.sh_degree, expected.sh_degree);
+  EXPECT_EQ(actual.positions, expected.positions);
+  EXPECT_EQ(actual.log_scales, expected.log_scales);
+  if (rotations) {
+    EXPECT_EQ(actual.rotations, expected.rotations);
+  }
+  EXPECT_EQ(actual.opacity_logits, expected.opacity_logits);
+  EXPECT_EQ(actual.sh, expected.sh);
+  EXPECT_EQ(actual.normals, expected.normals);
+}
+
 float max_abs_difference(const std::vector<float>& a, const std::vector<float>& b) {
   float most = 0;
   for (size_t i = 0; i < a.size(); ++i) most = std::max(most, std::abs(a[i] - b[i]));

@@ -73,6 +73,11 @@ CutoffAwareDifference compare_allowing_cutoff_flips(const RenderImage& gpu, cons
 
 // The largest |a[i] - b[i]| over two arrays of the same length (0 for empty ones).
 float max_abs_difference(const std::vector<float>& a, const std::vector<float>& b);
+
+// Expects two scenes to hold the same Gaussians, bit for bit: every array and the SH degree (the rotations
+// unless `rotations` is false, for a caller that compares them to a tolerance).
+void expect_identical_scenes(const GaussianScene& actual, const GaussianScene& expected,
+                             bool rotations = true);
 // The usual bounds: agreeing pixels within `max_abs` (colour and alpha), at most one pixel in 1,000
 // flipped, each by one splat and by less than 1/64 (a splat's whole contribution stays below that at
 // the cut-offs only because the transmittance left there is small).
