@@ -621,26 +621,33 @@ TEST(CliRender, APlyReadInPartsIsTheSameImage) {
   EXPECT_FALSE(fs::exists(out / "ascii.exr"));
 }
 
-// An SPZ read in parts: held in its packed bytes, each part decoded from them; the same EXR.
-TEST(CliRender, AnSpzReadInPartsIsTheSameImage) {
+// An SPZ or a SOG read in parts: held in its packed bytes or texels, each part decoded from them; the same
+// EXR.
+TEST(CliRender, AnSpzOrASogReadInPartsIsTheSameImage) {
   TILESPLAT_REQUIRE_SHARED_SCENES();
   const auto out = fresh_output_dir();
-  const fs::path spz = tilesplat::testing::shared_scenes() / "formats" / "playbot_lod6_1873_sh2.v4.spz";
-  auto render = [&](const std::vector<std::string>& extra, const std::string& name) {
-    std::vector<std::string> args = {spz.string(),         "--width", "160", "--height", "90", "-o",
-                                     (out / name).string()};
-    args.insert(args.end(), extra.begin(), extra.end());
-    return run_exe(kRenderExe, args);
-  };
-  ASSERT_EQ(render({}, "whole.exr").exit_code, 0);
-  const auto parts = render({"--read-in-parts", "--memory-budget", "1300K", "--stats"}, "parts.exr");
-  ASSERT_EQ(parts.exit_code, 0) << parts.err;
-  EXPECT_FALSE(contains(parts.out, "scene parts                         1\n")) << parts.out;
-  EXPECT_TRUE(contains(parts.err, "1,873 Gaussians (SH2), read in parts from its packed bytes")) << parts.err;
-  const tilesplat::RenderImage whole = tilesplat::read_exr(out / "whole.exr");
-  const tilesplat::RenderImage image = tilesplat::read_exr(out / "parts.exr");
-  EXPECT_EQ(image.rgba, whole.rgba);
-  EXPECT_EQ(image.depth, whole.depth);
+  const fs::path formats = tilesplat::testing::shared_scenes() / "formats";
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"playbot_lod6_1873_sh2.v4.spz", "its packed bytes"},
+      {"playbot_lod6_1873_sh2.sog", "its images' texels"}};
+  for (const auto& [file, held] : files) {
+    SCOPED_TRACE(file);
+    auto render = [&](const std::vector<std::string>& extra, const std::string& name) {
+      std::vector<std::string> args = {(formats / file).string(), "--width", "160", "--height", "90", "-o",
+                                       (out / name).string()};
+      args.insert(args.end(), extra.begin(), extra.end());
+      return run_exe(kRenderExe, args);
+    };
+    ASSERT_EQ(render({}, "whole.exr").exit_code, 0);
+    const auto parts = render({"--read-in-parts", "--memory-budget", "1300K", "--stats"}, "parts.exr");
+    ASSERT_EQ(parts.exit_code, 0) << parts.err;
+    EXPECT_FALSE(contains(parts.out, "scene parts                         1\n")) << parts.out;
+    EXPECT_TRUE(contains(parts.err, "1,873 Gaussians (SH2), read in parts from " + held)) << parts.err;
+    const tilesplat::RenderImage whole = tilesplat::read_exr(out / "whole.exr");
+    const tilesplat::RenderImage image = tilesplat::read_exr(out / "parts.exr");
+    EXPECT_EQ(image.rgba, whole.rgba);
+    EXPECT_EQ(image.depth, whole.depth);
+  }
 }
 
 TEST(CliRender, AntialiasingFlagSetsTheFootprintFilter) {

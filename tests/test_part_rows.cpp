@@ -1,6 +1,6 @@
 // A scene read part by part (SceneInParts) gives each part the Gaussians load_scene reads, bit for bit:
 // the gathers the renderer's parts make (frame/scene_parts.h PartSource), ascending and scattered through
-// the file, from a binary PLY's mapped rows and from an SPZ's packed bytes.
+// the file, from a binary PLY's mapped rows, an SPZ's packed bytes and a SOG's texels.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -61,6 +61,9 @@ TEST(PartRows, EachPartIsTheLoadedScenesGaussians) {
                                  "playcanvas_test_64_sh3.v4.spz", "playcanvas_test_64_sh3.v3.spz"})
     expect_parts_are_loaded(formats / file);
   expect_parts_are_loaded(testing::shared_scenes() / "biker_152746.spz");
+  for (const std::string file : {"playbot_lod6_1873_sh2.sog", "playcanvas_test_64_sh3.sog",
+                                 "playbot_lod6_1873_sh2_sog_unbundled/meta.json"})
+    expect_parts_are_loaded(formats / file);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -411,7 +412,8 @@ TEST(SceneFormatsMemory, ParseSceneReadsTheSameBytesAsLoadScene) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// SceneInParts on an SPZ: the packed bytes held, any part decoded from them as load_scene decodes it.
+// SceneInParts on an SPZ or a SOG: the packed bytes or texels held, any part decoded from them as load_scene
+// decodes it.
 
 void expect_in_parts_is_loaded(const fs::path& path) {
   SCOPED_TRACE(path.filename().string());
@@ -432,26 +434,32 @@ void expect_in_parts_is_loaded(const fs::path& path) {
   EXPECT_EQ(in_parts_report.version, loaded_report.version);
   EXPECT_EQ(in_parts_report.gaussians_in_file, loaded_report.gaussians_in_file);
   EXPECT_EQ(in_parts_report.ignored_properties, loaded_report.ignored_properties);
+  EXPECT_EQ(in_parts_report.dropped, loaded_report.dropped);
+  EXPECT_EQ(in_parts_report.summary(), loaded_report.summary());
   // Any part of it: test_part_rows.cpp (the renderer's parts gather them).
   // Read in parts is chosen by the Gaussians' size as floats: the header's count at its SH degree.
   EXPECT_EQ(SceneInParts::whole_scene_bytes(path),
-            loaded.size() * (11 + 3 * size_t(loaded.sh_coefficients())) * sizeof(float));
+            loaded_report.gaussians_in_file * (11 + 3 * size_t(loaded.sh_coefficients())) * sizeof(float));
 }
 
-TEST(SceneInPartsSpz, HoldsTheGaussiansLoadSceneReads) {
+TEST(SceneInPartsFormats, HoldsTheGaussiansLoadSceneReads) {
   TILESPLAT_REQUIRE_SHARED_SCENES();
   const fs::path formats = testing::shared_scenes() / "formats";
   for (const std::string file : {"playbot_lod6_1873_sh2.v4.spz", "playbot_lod6_1873_sh2.v3.spz",
                                  "playcanvas_test_64_sh3.v4.spz", "playcanvas_test_64_sh3.v3.spz"})
     expect_in_parts_is_loaded(formats / file);
   expect_in_parts_is_loaded(testing::shared_scenes() / "biker_152746.spz");  // SH degree 0
-  // Versions 2 and 3 may be stored uncompressed: the same bytes without gzip.
+  for (const std::string file : {"playbot_lod6_1873_sh2.sog", "playcanvas_test_64_sh3.sog",
+                                 "playbot_lod6_1873_sh2_sog_unbundled/meta.json"})
+    expect_in_parts_is_loaded(formats / file);
+  expect_in_parts_is_loaded(testing::shared_scenes() / "playbot_lod0_500000.sog");
+  // SPZ versions 2 and 3 may be stored uncompressed: the same bytes without gzip.
   expect_in_parts_is_loaded(
       write_file("plain.v3.spz", gunzip(read_file(formats / "playcanvas_test_64_sh3.v3.spz"))));
   // A binary PLY's size is its floats; a file neither PLY nor SPZ, or missing, tells nothing.
   const fs::path ply = testing::shared_scenes() / "playbot_lod0_500000_sh2.ply";
   EXPECT_EQ(SceneInParts::whole_scene_bytes(ply), fs::file_size(ply));
-  EXPECT_EQ(SceneInParts::whole_scene_bytes(formats / "playbot_lod6_1873_sh2.sog"), 0u);
+  EXPECT_EQ(SceneInParts::whole_scene_bytes(formats / "playbot_lod6_1873_sh2.glb"), 0u);
   EXPECT_EQ(SceneInParts::whole_scene_bytes(testing::temp_dir() / "no_such.spz"), 0u);
 }
 
@@ -483,6 +491,34 @@ TEST_F(FormatErrors, AnSpzInPartsRefusesWhatLoadSceneRefuses) {
   put_u32(v5, 4, 5);
   const fs::path unknown = write_file("v5_in_parts.spz", v5);
   EXPECT_EQ(message([&] { SceneInParts::open(unknown); }), message([&] { load_scene(unknown); }));
+}
+
+// A SOG whose codebook holds a value no float holds: its Gaussians dropped as load_scene drops them (or,
+// strict, refused with its message), read in parts as read whole.
+TEST_F(FormatErrors, ASogInPartsDropsWhatLoadSceneDrops) {
+  ZipEntries entries = read_zip(formats_ / "playbot_lod6_1873_sh2.sog");
+  nlohmann::json meta = nlohmann::json::parse(entry(entries, "meta.json"));
+  for (size_t b = 0; b < 256; b += 2) meta["scales"]["codebook"][b] = 1e39;  // past float's range
+  entry(entries, "meta.json") = meta.dump();
+  const fs::path path = write_zip("overflowing.sog", entries);
+  LoadReport loaded_report;
+  const size_t kept = load_scene(path, {}, &loaded_report).size();
+  ASSERT_GT(loaded_report.dropped, 0u);
+  ASSERT_GT(kept, 0u);
+  expect_in_parts_is_loaded(path);
+  LoadOptions strict;
+  strict.strict = true;
+  auto message = [](auto&& read) {
+    try {
+      read();
+    } catch (const SceneError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  const std::string refused = message([&] { load_scene(path, strict); });
+  EXPECT_NE(refused.find("strict mode"), std::string::npos) << refused;
+  EXPECT_EQ(message([&] { SceneInParts::open(path, strict); }), refused);
 }
 
 // The float64 reference found it: denormal quaternions are the identity, as float32 normalization

@@ -250,12 +250,11 @@ TEST(SceneParts, APlyReadPartByPartIsTheWholeFrame) {
   EXPECT_EQ(parts_renderer().validation_messages(), 0u);
 }
 
-// An SPZ read part by part (SceneInParts): held in its packed bytes, each part decoded from them as it is
-// drawn, the frame the loaded SPZ renders, bit for bit.
-TEST(SceneParts, AnSpzReadPartByPartIsTheWholeFrame) {
-  TILESPLAT_REQUIRE_SHARED_SCENES();
+// An SPZ or a SOG read part by part (SceneInParts): held in its packed bytes or texels, each part decoded
+// from them as it is drawn, the frame the loaded file renders, bit for bit.
+void expect_in_parts_is_whole_frame(const std::filesystem::path& path) {
+  SCOPED_TRACE(path.filename().string());
   const BigScene& big = big_scene();
-  const std::filesystem::path path = testing::shared_scenes() / "formats" / "playbot_lod0_500000_sh2.v4.spz";
   const GaussianScene loaded = load_scene(path);
   const SceneInParts in_parts = SceneInParts::open(path);
   ASSERT_EQ(in_parts.size(), loaded.size());
@@ -271,6 +270,12 @@ TEST(SceneParts, AnSpzReadPartByPartIsTheWholeFrame) {
   EXPECT_EQ(parts_renderer().last_frame_stats().gaussians, loaded.size());
   expect_bit_identical(parts, whole, "read in parts");
   EXPECT_EQ(parts_renderer().validation_messages(), 0u);
+}
+
+TEST(SceneParts, AnSpzOrASogReadPartByPartIsTheWholeFrame) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  expect_in_parts_is_whole_frame(testing::shared_scenes() / "formats" / "playbot_lod0_500000_sh2.v4.spz");
+  expect_in_parts_is_whole_frame(testing::shared_scenes() / "playbot_lod0_500000.sog");
 }
 
 // A scene file's instances are the scene load_described_scene merges, each file read once.

@@ -81,11 +81,12 @@ void load_lod_set(LoadedScene& loaded, const LodOptions& options, const LoadOpti
   loaded.lod = std::move(lod);
 }
 
-// Whether `path` is a binary PLY or an SPZ that `reading` reads part by part: always, or when its
+// Whether `path` is a binary PLY, an SPZ or a SOG that `reading` reads part by part: always, or when its
 // Gaussians as floats would take more than half of the host's memory.
 bool reads_in_parts(const fs::path& path, PartReading reading) {
-  if (reading == PartReading::kWhole || !(has_extension(path, ".ply") || has_extension(path, ".spz")))
-    return false;
+  const bool readable_in_parts = has_extension(path, ".ply") || has_extension(path, ".spz") ||
+                                 has_extension(path, ".sog") || path.filename() == "meta.json";
+  if (reading == PartReading::kWhole || !readable_in_parts) return false;
   if (reading == PartReading::kInParts) return true;
   const uint64_t bytes = SceneInParts::whole_scene_bytes(path);
   const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
@@ -293,7 +294,9 @@ std::string describe_scene(const LoadedScene& loaded) {
   if (loaded.in_parts)
     return group_thousands(loaded.in_parts->size()) + " Gaussians (SH" +
            std::to_string(loaded.in_parts->sh_degree()) + "), read in parts from " +
-           (loaded.report.format == "spz" ? "its packed bytes" : "the file");
+           (loaded.report.format == "spz"             ? "its packed bytes"
+            : loaded.report.format.starts_with("sog") ? "its images' texels"
+                                                      : "the file");
   if (!loaded.instances) return describe_scene(loaded.scene);
   return group_thousands(loaded.gaussians()) + " Gaussians (SH" +
          std::to_string(loaded.instances->sh_degree) + "), " +

@@ -27,8 +27,8 @@ namespace tilesplat::cli {
 // at each time of a shutter, docs/effects.md).
 enum class SceneHolding { kMerged, kInstances, kInstancesIfMoving };
 
-// How a binary PLY or an SPZ is held: read whole (load_scene), or read part by part as the frames draw it
-// (SceneInParts: its positions held, and an SPZ's packed bytes), always or when its Gaussians as floats
+// How a binary PLY, an SPZ or a SOG is held: read whole (load_scene), or read part by part as the frames draw
+// it (SceneInParts: its positions held, and an SPZ's packed bytes), always or when its Gaussians as floats
 // would take more than half of the host's memory (tilesplat-render, --read-in-parts).
 enum class PartReading { kWhole, kInPartsWhenLarge, kInParts };
 
@@ -50,7 +50,7 @@ struct LoadedScene {
   // as SceneHolding::kInstances, placed in `instances` (and `scene` is empty).
   std::optional<SceneDescription> description;
   std::optional<SceneInstances> instances;
-  // Set when a binary PLY or an SPZ is read part by part (PartReading): `scene` is empty.
+  // Set when a binary PLY, an SPZ or a SOG is read part by part (PartReading): `scene` is empty.
   std::optional<SceneInParts> in_parts;
   // Set when the SCENE is a LOD set: `scene` holds its level lod->level, or nothing under a splat budget.
   std::optional<LoadedLodSet> lod;

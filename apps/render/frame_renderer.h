@@ -41,8 +41,8 @@ class FrameRenderer {
   // A scene file's placed copies: under --memory-budget, when some move, or when their frame does not fit
   // the device (decide_holding merges them into merged_ otherwise).
   const SceneInstances* instances_;
-  // A binary PLY or an SPZ read part by part (--read-in-parts, or a large one): taken by every frame in
-  // parts, or loaded into merged_ when its frame fits the device.
+  // A binary PLY, an SPZ or a SOG read part by part (--read-in-parts, or a large one): taken by every frame
+  // in parts, or loaded into merged_ when its frame fits the device.
   const SceneInParts* file_in_parts_;
   GaussianScene merged_;
   const cli::LoadedLodSet* lod_;     // a LOD set drawn under --splat-budget

@@ -210,9 +210,10 @@ void add_render_options(cli::ArgParser& parser, RenderOptions& options) {
       "in parts; ");
   parser.add_switch(
       "--read-in-parts",
-      "read a binary PLY or an SPZ part by part as the frame draws it, never whole as floats: only the "
-      "Gaussians' positions stay on the host, and an SPZ's own packed bytes (a scene whose floats would "
-      "take more than half of the host's memory is read so without it); the frames are the same, to the bit",
+      "read a binary PLY, an SPZ or a SOG part by part as the frame draws it, never whole as floats: only "
+      "the Gaussians' positions stay on the host, and an SPZ's packed bytes or a SOG's texels (a scene whose "
+      "floats would take more than half of the host's memory is read so without it); the frames are the "
+      "same, to the bit",
       &options.read_in_parts);
   cli::add_splat_budget_option(parser, options.common);
   parser.add_value("--region", "X,Y,WxH",

@@ -66,7 +66,7 @@ struct RenderOptions {
   ShutterFlags shutter;
   bool stats = false;
   uint64_t memory_budget = 0;  // --memory-budget: RenderSettings::memory_budget (0: the device's limits)
-  bool read_in_parts = false;  // --read-in-parts: a binary PLY or SPZ read part by part (else when large)
+  bool read_in_parts = false;  // --read-in-parts: a PLY, SPZ or SOG read in parts (else when large)
   PixelRegion region;          // --region: RenderSettings::region (whole: the image)
   // Many frames in one run.
   std::string views;      // --views: a selection of the camera set's views

@@ -303,11 +303,12 @@ void bind(nb::module_& m) {
           },
           "t"_a = 0.0, "The merged scene with every model where it is at time t in [0, 1].");
 
-  // --- a binary PLY or an SPZ read part by part
+  // --- a binary PLY, an SPZ or a SOG read part by part
   nb::class_<SceneInParts>(
       m, "SceneInParts",
-      "A binary PLY or an SPZ opened to be read part by part: the Gaussians' positions are held (and an "
-      "SPZ's own packed bytes), and Renderer.render(camera, in_parts=..., memory_budget=...) decodes each "
+      "A binary PLY, an SPZ or a SOG opened to be read part by part: the Gaussians' positions are held (and "
+      "an SPZ's packed bytes or a SOG's texels), and Renderer.render(camera, in_parts=..., "
+      "memory_budget=...) decodes each "
       "part as it is drawn, the frame of load_scene's scene to the bit (docs/big-scenes.md, \"Read part by "
       "part\"). MappedPly is its earlier name.")
       .def(
@@ -320,7 +321,8 @@ void bind(nb::module_& m) {
             new (self) SceneInParts(SceneInParts::open(path, options));
           },
           "path"_a, "strict"_a = false,
-          "Opens a binary PLY or an SPZ (an ASCII or a compressed PLY and the other formats are refused: "
+          "Opens a binary PLY, an SPZ or a SOG (an ASCII or a compressed PLY and the other formats are "
+          "refused: "
           "load_scene reads those whole).")
       .def_prop_ro("size", &SceneInParts::size, "the Gaussians")
       .def_prop_ro("sh_degree", &SceneInParts::sh_degree, "0 to 3")

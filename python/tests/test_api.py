@@ -287,7 +287,7 @@ def test_a_ply_read_part_by_part_is_the_loaded_scenes_frame(playbot_renderer):
     assert renderer.validation_messages == 0
 
 
-def test_an_spz_read_part_by_part_is_the_loaded_scenes_frame(shared_scenes):
+def test_an_spz_or_a_sog_read_part_by_part_is_the_loaded_scenes_frame(shared_scenes):
     # A renderer of its own: a budget counts every buffer a renderer holds, and the shared one's have grown.
     renderer = tilesplat.Renderer(validation=True)
     path = shared_scenes / "formats" / "playbot_lod6_1873_sh2.v4.spz"
@@ -304,6 +304,11 @@ def test_an_spz_read_part_by_part_is_the_loaded_scenes_frame(shared_scenes):
     assert np.array_equal(parts.rgba, whole.rgba) and np.array_equal(parts.depth, whole.depth)
     with pytest.raises(ValueError, match="not both"):
         renderer.render(camera, in_parts=in_parts, mapped_ply=in_parts)
+    sog = shared_scenes / "formats" / "playbot_lod6_1873_sh2.sog"
+    sog_whole = renderer.render(camera, scene=tilesplat.load_scene(sog))
+    sog_parts = renderer.render(camera, in_parts=tilesplat.SceneInParts(sog), memory_budget=1300 << 10)
+    assert renderer.last_frame_stats["scene_parts"] > 1
+    assert np.array_equal(sog_parts.rgba, sog_whole.rgba)
     assert renderer.validation_messages == 0
 
 

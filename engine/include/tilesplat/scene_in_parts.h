@@ -18,29 +18,33 @@ class PartRows;
 }  // namespace detail
 class PartSource;
 
-/// A binary 3DGS PLY (little or big endian) or a Niantic SPZ (versions 2 to 4) opened for reading part by
-/// part. Opening reads the file once and keeps the Gaussians' positions (12 bytes each) and their bounds;
-/// Renderer::render(SceneInParts, ...) then decodes each part's Gaussians as the part is drawn:
+/// A binary 3DGS PLY (little or big endian), a Niantic SPZ (versions 2 to 4) or a PlayCanvas SOG (bundled or
+/// its meta.json; versions 1 and 2) opened for reading part by part. Opening reads the file once and keeps
+/// the Gaussians' positions (12 bytes each) and their bounds; Renderer::render(SceneInParts, ...) then
+/// decodes each part's Gaussians as the part is drawn:
 /// - a PLY is mapped and read in blocks let go of as they are decoded; each part's rows are decoded from the
 ///   file, whose pages are let go of again;
 /// - an SPZ, compressed as a whole and so not readable in place, is held decompressed in its own quantized
 ///   layout (past the positions, 10 to 56 bytes a Gaussian by SH degree, against 44 to 224 as floats), and
-///   each part is decoded from that.
+///   each part is decoded from that;
+/// - a SOG, whose images are compressed as wholes too, is held as their texels (past the positions, 16 bytes
+///   a Gaussian and the SH palette once), each part decoded from those.
 ///
 /// The Gaussians are load_scene's, bit for bit (those with non-finite values dropped or, strict, refused,
 /// as it does), so the frames are too. The file must not change while it is open. Copies share it.
 class TILESPLAT_API SceneInParts {
  public:
-  /// Opens `path`, a binary PLY or an SPZ by its content. Throws SceneError naming the file for one that is
-  /// missing, malformed or truncated, or in another format (an ASCII or a compressed PLY, a SOG, ...: those
-  /// are read whole by load_scene). `report`, where given, gets what load_scene would report.
+  /// Opens `path`, a binary PLY, an SPZ or a SOG by its content. Throws SceneError naming the file for one
+  /// that is missing, malformed or truncated, or in another format (an ASCII or a compressed PLY, a glTF,
+  /// ...: those are read whole by load_scene). `report`, where given, gets what load_scene would report.
   static SceneInParts open(const std::filesystem::path& path, const LoadOptions& options = {},
                            LoadReport* report = nullptr);
 
   /// The bytes of the arrays load_scene would fill for the file at `path`, told from its header alone: for
   /// choosing between load_scene and open (tilesplat-render reads a scene in parts when they would take
   /// more than half of the host's memory). A binary PLY's rows are its floats: its size. 0 for a file
-  /// open refuses or that cannot be read (load_scene then says why).
+  /// open refuses, a version 1 SOG (whose SH degree only its palette image tells) or a file that cannot be
+  /// read (load_scene then says why).
   static uint64_t whole_scene_bytes(const std::filesystem::path& path);
 
   size_t size() const;           ///< the Gaussians, as load_scene would give them

@@ -14,6 +14,7 @@
 
 #include "scene/ply_rows.h"
 #include "scene/scene_reading.h"
+#include "scene/sog_packed.h"
 #include "scene/spz_packed.h"
 #include "tilesplat/scene.h"
 
@@ -70,6 +71,19 @@ class SpzPartRows final : public PartRows {
 
  private:
   SpzPacked packed_;
+};
+
+// A SOG, held as its images' texels (SogPacked). Gaussians with a non-finite value (a meta.json's ranges
+// and codebooks can hold values no float holds) are dropped, or refused, as load_scene drops them.
+class SogPartRows final : public PartRows {
+ public:
+  SogPartRows(SogPacked packed, std::string_view name, const LoadOptions& options, LoadReport* report);
+  GaussianScene gather(std::span<const uint32_t> indices) const override;
+
+ private:
+  SogPacked packed_;
+  std::vector<uint32_t> kept_;  // each Gaussian's index in the file, where some were dropped (else empty)
+  std::vector<float> kept_positions_;  // their positions (else packed_'s are the Gaussians')
 };
 
 }  // namespace tilesplat::detail

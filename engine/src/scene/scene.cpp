@@ -56,22 +56,6 @@ Container container_of(std::span<const std::byte> data) {
   return Container::kUnknown;
 }
 
-// Reads a file that `referrer` names, resolved beside it; only plain relative names are followed.
-detail::FileLoader sibling_loader(const std::filesystem::path& referrer) {
-  return [referrer](const std::string& name) {
-    if (!detail::is_path_beside(name))
-      detail::fail(referrer.string(), "it names the file '" + name + "', which is not a path beside it");
-    const std::filesystem::path path = referrer.parent_path() / name;
-    detail::FileContents contents;
-    try {
-      detail::open_scene_file(path, contents);
-    } catch (const SceneError& error) {
-      detail::fail(referrer.string(), "it names '" + name + "', which cannot be read (" + error.what() + ")");
-    }
-    return std::vector<unsigned char>(contents.data(), contents.data() + contents.size());
-  };
-}
-
 // A LOD set's finest level, the whole capture (tilesplat/lod_set.h picks other levels).
 GaussianScene read_lod_set_level0(std::string_view text, const std::filesystem::path& path,
                                   const LoadOptions& options, LoadReport* report) {
@@ -96,7 +80,7 @@ GaussianScene read_any(std::span<const std::byte> data, const std::string& name,
                        const LoadOptions& options, LoadReport* report) {
   const std::filesystem::path* path = file ? &file->path : nullptr;
   const detail::FileLoader no_files;
-  const detail::FileLoader files = path ? sibling_loader(*path) : no_files;
+  const detail::FileLoader files = path ? detail::sibling_loader(*path) : no_files;
   switch (container_of(data)) {
     case Container::kPly:
       return file ? detail::read_ply_file(file->contents, name, options, report)

@@ -95,6 +95,52 @@ GaussianScene SpzPartRows::gather(std::span<const uint32_t> indices) const {
   return scene;
 }
 
+SogPartRows::SogPartRows(SogPacked packed, std::string_view name, const LoadOptions& options,
+                         LoadReport* report)
+    : packed_(std::move(packed)) {
+  // Decoded once, a block at a time, to find the Gaussians finish_scene would drop.
+  NonFiniteTally tally(name, options);
+  constexpr size_t kBlock = size_t(1) << 20;
+  std::vector<size_t> dropped;
+  for (size_t first = 0; first < packed_.size(); first += kBlock) {
+    const GaussianScene block = packed_.decode_range(first, std::min(packed_.size(), first + kBlock));
+    for (size_t i : non_finite_gaussians(block, first, tally)) dropped.push_back(first + i);
+  }
+  if (!dropped.empty()) {
+    for (size_t i = 0, next_dropped = 0; i < packed_.size(); ++i) {
+      if (next_dropped < dropped.size() && dropped[next_dropped] == i) {
+        ++next_dropped;
+        continue;
+      }
+      kept_.push_back(uint32_t(i));
+      kept_positions_.insert(kept_positions_.end(), packed_.positions().begin() + std::ptrdiff_t(3 * i),
+                             packed_.positions().begin() + std::ptrdiff_t(3 * i + 3));
+    }
+  }
+  set_positions(dropped.empty() ? std::span<const float>(packed_.positions()) : kept_positions_);
+  sh_degree_ = packed_.sh_degree();
+  if (report) {
+    LoadReport found;  // what finish_scene reports
+    found.format = packed_.format();
+    found.version = packed_.version();
+    found.gaussians_in_file = packed_.size();
+    found.dropped = tally.dropped();
+    found.dropped_by_property = tally.take();
+    *report = std::move(found);
+  }
+}
+
+GaussianScene SogPartRows::gather(std::span<const uint32_t> indices) const {
+  std::vector<uint32_t> in_file;
+  if (!kept_.empty()) {
+    in_file.reserve(indices.size());
+    for (uint32_t i : indices) in_file.push_back(kept_[i]);
+  }
+  GaussianScene scene = packed_.decode(kept_.empty() ? indices : std::span<const uint32_t>(in_file));
+  normalize_rotations(scene);  // the rest of finish_scene
+  return scene;
+}
+
 }  // namespace detail
 
 SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOptions& options,
@@ -104,14 +150,22 @@ SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOpt
     detail::open_scene_file(path, contents);
     const std::span<const std::byte> bytes = contents.bytes();
     const bool ply = bytes.size() >= 3 && std::memcmp(bytes.data(), "ply", 3) == 0;
+    const std::string name = path.string();
     if (!ply && detail::is_spz(bytes))
-      return SceneInParts(
-          std::make_shared<const detail::SpzPartRows>(contents, path.string(), options, report));
+      return SceneInParts(std::make_shared<const detail::SpzPartRows>(contents, name, options, report));
+    if (!ply && bytes.size() >= 4 && std::memcmp(bytes.data(), "PK\x03\x04", 4) == 0)
+      return SceneInParts(std::make_shared<const detail::SogPartRows>(
+          detail::SogPacked::from_zip(bytes, name), name, options, report));
+    const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    if (!ply && detail::is_sog_meta(text))
+      return SceneInParts(std::make_shared<const detail::SogPartRows>(
+          detail::SogPacked::from_meta(text, name, detail::sibling_loader(path)), name, options, report));
     if (!ply && !bytes.empty())
-      detail::fail(path.string(),
-                   "not a PLY file (it does not start with the 'ply' magic line) nor an SPZ: only these two "
-                   "are read part by part; load_scene reads the others whole");
-  }  // the SPZ's file is let go of once decompressed; a PLY is mapped again, to be read as it is drawn
+      detail::fail(
+          name,
+          "not a PLY file (it does not start with the 'ply' magic line), an SPZ or a SOG: only these "
+          "are read part by part; load_scene reads the others whole");
+  }  // an SPZ's or a SOG's file is let go of once decoded; a PLY is mapped again, to be read as it is drawn
   return SceneInParts(std::make_shared<const detail::MappedPlyRows>(path, options, report));
 }
 
@@ -121,10 +175,23 @@ uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
     detail::open_scene_file(path, contents);
     const std::span<const std::byte> bytes = contents.bytes();
     if (bytes.size() >= 3 && std::memcmp(bytes.data(), "ply", 3) == 0) return bytes.size();
-    if (!detail::is_spz(bytes)) return 0;
-    const detail::SpzCounts counts = detail::read_spz_counts(bytes, path.string());
-    const uint64_t floats = 11 + 3 * uint64_t((counts.sh_degree + 1) * (counts.sh_degree + 1));
-    return uint64_t(counts.count) * floats * sizeof(float);
+    auto floats_of = [](size_t count, int sh_degree) {
+      return uint64_t(count) * (11 + 3 * uint64_t((sh_degree + 1) * (sh_degree + 1))) * sizeof(float);
+    };
+    const std::string name = path.string();
+    if (detail::is_spz(bytes)) {
+      const detail::SpzCounts counts = detail::read_spz_counts(bytes, name);
+      return floats_of(counts.count, counts.sh_degree);
+    }
+    detail::SogCounts counts;
+    if (bytes.size() >= 4 && std::memcmp(bytes.data(), "PK\x03\x04", 4) == 0) {
+      counts = detail::read_sog_zip_counts(bytes, name);
+    } else {
+      const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+      if (!detail::is_sog_meta(text)) return 0;
+      counts = detail::read_sog_meta_counts(text, name);
+    }
+    return floats_of(counts.count, counts.sh_degree);
   } catch (const SceneError&) {
     return 0;
   }

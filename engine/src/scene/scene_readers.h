@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <functional>
 #include <span>
 #include <string>
@@ -21,6 +22,9 @@ namespace tilesplat::detail {
 using FileLoader = std::function<std::vector<unsigned char>(const std::string& name)>;
 
 class FileContents;  // scene/scene_reading.h
+
+// Reads a file that `referrer` names, resolved beside it; only plain relative names are followed.
+FileLoader sibling_loader(const std::filesystem::path& referrer);
 
 // A 3DGS PLY from an open file: parse_ply, letting go of the file's pages as the vertex rows are decoded
 // (FileContents::release_before), so that a big file and its decoded arrays are never both resident.

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <system_error>
 
+#include "scene/scene_readers.h"
+
 #if __has_include(<sys/mman.h>) && __has_include(<unistd.h>)
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -101,6 +103,21 @@ void open_scene_file(const std::filesystem::path& path, FileContents& contents) 
   if (std::filesystem::is_directory(status)) fail(name, "cannot open: is a directory, not a file");
   if (!std::filesystem::is_regular_file(status)) fail(name, "cannot open: not a regular file");
   if (const std::string error = contents.open(path); !error.empty()) fail(name, error);
+}
+
+FileLoader sibling_loader(const std::filesystem::path& referrer) {
+  return [referrer](const std::string& name) {
+    if (!is_path_beside(name))
+      fail(referrer.string(), "it names the file '" + name + "', which is not a path beside it");
+    const std::filesystem::path path = referrer.parent_path() / name;
+    FileContents contents;
+    try {
+      open_scene_file(path, contents);
+    } catch (const SceneError& error) {
+      fail(referrer.string(), "it names '" + name + "', which cannot be read (" + error.what() + ")");
+    }
+    return std::vector<unsigned char>(contents.data(), contents.data() + contents.size());
+  };
 }
 
 bool is_path_beside(const std::string& name) {
@@ -221,21 +238,34 @@ bool all_finite(const float* values, size_t n) {
 
 }  // namespace
 
-void finish_scene(GaussianScene& scene, std::string_view name, const LoadOptions& options, std::string format,
-                  std::string version, LoadReport* report) {
+std::vector<size_t> non_finite_gaussians(const GaussianScene& scene, size_t first, NonFiniteTally& tally) {
   const size_t count = scene.size();
   const size_t sh_stride = 3 * static_cast<size_t>(scene.sh_coefficients());
-  NonFiniteTally tally(name, options);
-  size_t kept = 0;
+  std::vector<size_t> found;
   for (size_t i = 0; i < count; ++i) {
     const bool finite =
         all_finite(scene.positions.data() + 3 * i, 3) && all_finite(scene.log_scales.data() + 3 * i, 3) &&
         all_finite(scene.rotations.data() + 4 * i, 4) && std::isfinite(scene.opacity_logits[i]) &&
         all_finite(scene.sh.data() + sh_stride * i, sh_stride);
-    if (!finite) {
-      float value = 0;
-      const std::string property = first_non_finite(scene, i, &value);
-      tally.record(i, property, value);
+    if (finite) continue;
+    float value = 0;
+    const std::string property = first_non_finite(scene, i, &value);
+    tally.record(first + i, property, value);
+    found.push_back(i);
+  }
+  return found;
+}
+
+void finish_scene(GaussianScene& scene, std::string_view name, const LoadOptions& options, std::string format,
+                  std::string version, LoadReport* report) {
+  const size_t count = scene.size();
+  const size_t sh_stride = 3 * static_cast<size_t>(scene.sh_coefficients());
+  NonFiniteTally tally(name, options);
+  const std::vector<size_t> dropped = non_finite_gaussians(scene, 0, tally);
+  size_t kept = 0;
+  for (size_t i = 0, next_dropped = 0; i < count; ++i) {
+    if (next_dropped < dropped.size() && dropped[next_dropped] == i) {
+      ++next_dropped;
       continue;
     }
     if (kept != i) {

@@ -112,6 +112,10 @@ class NonFiniteTally {
   std::vector<DroppedProperty> by_property_;
 };
 
+// Records each Gaussian of `scene` with a non-finite value in `tally` (which throws in strict mode), as
+// Gaussian `first + i` of its file, and returns their indices in `scene`, ascending.
+std::vector<size_t> non_finite_gaussians(const GaussianScene& scene, size_t first, NonFiniteTally& tally);
+
 // Unit quaternions, w first. A quaternion whose components are all below FLT_MIN in magnitude
 // (zero or denormal) becomes the identity, as float32 normalization makes it in gsplat and the
 // original CUDA rasterizer, and as projection.comp and the float64 reference treat it. Others are

@@ -25,19 +25,13 @@
 
 #include "scene/scene_readers.h"
 #include "scene/scene_reading.h"
+#include "scene/sog_packed.h"
 
 namespace tilesplat::detail {
-namespace {
 
 using nlohmann::json;
 
-struct Image {
-  int width = 0;
-  int height = 0;
-  std::vector<unsigned char> rgba;
-  const unsigned char* texel(size_t i) const { return rgba.data() + 4 * i; }
-};
-
+// Reads meta.json and its images into a SogPacked (a friend of it).
 class SogDecoder {
  public:
   SogDecoder(std::string_view name, const FileLoader& load) : name_(name), load_(load) {}
@@ -46,7 +40,7 @@ class SogDecoder {
 
   // Decodes one lossless WebP of the meta's `files`, checking it holds at least `min_texels` and at
   // most `max_texels` texels before decoding (a huge declared size is refused, not allocated).
-  Image image(const std::string& file, size_t min_texels, size_t max_texels) const {
+  SogImage image(const std::string& file, size_t min_texels, size_t max_texels) const {
     const std::vector<unsigned char> bytes = load_(file);
     WebPBitstreamFeatures features;
     if (WebPGetFeatures(bytes.data(), bytes.size(), &features) != VP8_STATUS_OK)
@@ -56,7 +50,7 @@ class SogDecoder {
     if (texels < min_texels || texels > max_texels)
       fail(file + ": a " + std::to_string(features.width) + "x" + std::to_string(features.height) +
            " image, the wrong size for " + std::to_string(min_texels) + " entries");
-    Image result;
+    SogImage result;
     result.width = features.width;
     result.height = features.height;
     result.rgba.resize(4 * texels);
@@ -99,10 +93,12 @@ class SogDecoder {
     return value.get<double>();
   }
 
-  GaussianScene decode(const json& meta) const {
+  SogPacked decode(const json& meta) const {
+    SogPacked packed;
     const bool v2 = meta.contains("version");
     if (v2 && !(meta["version"].is_number_integer() && meta["version"].get<int64_t>() == 2))
       fail("meta.json: unsupported SOG version " + meta["version"].dump() + " (supported: 1, 2)");
+    packed.version_ = v2 ? "2" : "1";
     const json& means = member(meta, "means", "the meta");
     double declared = 0;
     if (v2) {
@@ -121,73 +117,130 @@ class SogDecoder {
       fail("meta.json: " + std::to_string(count) + " Gaussians are more than a WebP image can hold");
     const size_t max_texels = count + 4 * kMaxSide;
 
-    int sh_degree = 0;
     const json* sh_n = meta.contains("shN") ? &meta["shN"] : nullptr;
-    Image centroids, labels;
-    size_t palette = 0;
     if (sh_n) {
       if (v2) {
         const double bands = number(*sh_n, "bands", "shN");
         if (bands != 1 && bands != 2 && bands != 3) fail("meta.json: shN.bands must be 1, 2 or 3");
-        sh_degree = static_cast<int>(bands);
+        packed.sh_degree_ = static_cast<int>(bands);
         const double entries = number(*sh_n, "count", "shN");
         if (!(entries >= 0 && entries <= 65536)) fail("meta.json: shN.count must be 0..65536");
-        palette = static_cast<size_t>(entries);
+        packed.palette_ = static_cast<size_t>(entries);
       }
-      labels = image(file(*sh_n, 1, "shN"), count, max_texels);
+      packed.labels_ = image(file(*sh_n, 1, "shN"), count, max_texels);
       // The palette's image: 64 entries a row, each K texels; its width tells version 1 the degree.
-      centroids = image(file(*sh_n, 0, "shN"), 1, 64 * 15 * (65536 / 64 + 1));
+      packed.centroids_ = image(file(*sh_n, 0, "shN"), 1, 64 * 15 * (65536 / 64 + 1));
+      const SogImage& centroids = packed.centroids_;
       if (!v2) {
-        sh_degree = centroids.width == 192 ? 1 : centroids.width == 512 ? 2 : centroids.width == 960 ? 3 : 0;
-        if (sh_degree == 0)
+        const int degree = centroids.width == 192   ? 1
+                           : centroids.width == 512 ? 2
+                           : centroids.width == 960 ? 3
+                                                    : 0;
+        if (degree == 0)
           fail(file(*sh_n, 0, "shN") + ": width " + std::to_string(centroids.width) +
                " is not a palette of 1, 2 or 3 SH bands (192, 512 or 960)");
-        palette =
-            static_cast<size_t>(centroids.width / ((sh_degree + 1) * (sh_degree + 1) - 1)) * centroids.height;
+        packed.sh_degree_ = degree;
+        packed.palette_ =
+            static_cast<size_t>(centroids.width / ((degree + 1) * (degree + 1) - 1)) * centroids.height;
       }
-      const int rest = (sh_degree + 1) * (sh_degree + 1) - 1;
+      const int rest = (packed.sh_degree_ + 1) * (packed.sh_degree_ + 1) - 1;
       if (centroids.width != 64 * rest)
         fail(file(*sh_n, 0, "shN") + ": width " + std::to_string(centroids.width) + " does not match " +
-             std::to_string(sh_degree) + " SH bands (" + std::to_string(64 * rest) + ")");
+             std::to_string(packed.sh_degree_) + " SH bands (" + std::to_string(64 * rest) + ")");
+      packed.sh_values_ = sh_values(*sh_n, v2);
     }
 
-    // The means first: their images prove the count before the scene is sized by it.
-    const Image low = image(file(means, 0, "means"), count, max_texels);
-    const Image high = image(file(means, 1, "means"), count, max_texels);
-    GaussianScene scene;
-    allocate_scene(scene, count, sh_degree);
-    decode_means(means, low, high, count, scene);
-    decode_quats(meta, count, max_texels, scene);
-    decode_scales_and_colours(meta, v2, count, max_texels, scene);
-    if (sh_n) decode_sh(*sh_n, v2, centroids, labels, palette, scene);
-    return scene;
+    // The means first: their images prove the count before anything is sized by it.
+    {
+      const SogImage low = image(file(means, 0, "means"), count, max_texels);
+      const SogImage high = image(file(means, 1, "means"), count, max_texels);
+      packed.positions_ = decode_means(means, low, high, count);
+    }
+    packed.quats_ = image(file(member(meta, "quats", "the meta"), 0, "quats"), count, max_texels);
+    const json& scales = member(meta, "scales", "the meta");
+    const json& sh0 = member(meta, "sh0", "the meta");
+    packed.scales_ = image(file(scales, 0, "scales"), count, max_texels);
+    packed.colours_ = image(file(sh0, 0, "sh0"), count, max_texels);
+    if (v2) {
+      const std::vector<float> scale_book = codebook(scales, "scales");
+      const std::vector<float> colour_book = codebook(sh0, "sh0");
+      for (size_t b = 0; b < 256; ++b) {
+        for (size_t a = 0; a < 3; ++a) {
+          packed.scale_values_[a][b] = scale_book[b];
+          packed.colour_values_[a][b] = colour_book[b];
+        }
+        packed.colour_values_[3][b] = static_cast<float>(clamped_logit(static_cast<double>(b) / 255.0));
+      }
+    } else {
+      // Version 1: per-channel linear ranges; sh0's fourth channel is the opacity logit itself.
+      const std::vector<double> scale_min = numbers(scales, "mins", 3, "scales");
+      const std::vector<double> scale_max = numbers(scales, "maxs", 3, "scales");
+      const std::vector<double> colour_min = numbers(sh0, "mins", 4, "sh0");
+      const std::vector<double> colour_max = numbers(sh0, "maxs", 4, "sh0");
+      for (size_t b = 0; b < 256; ++b) {
+        for (size_t a = 0; a < 3; ++a)
+          packed.scale_values_[a][b] =
+              to_float(scale_min[a] + (scale_max[a] - scale_min[a]) * (static_cast<double>(b) / 255.0));
+        for (size_t a = 0; a < 4; ++a)
+          packed.colour_values_[a][b] =
+              to_float(colour_min[a] + (colour_max[a] - colour_min[a]) * (static_cast<double>(b) / 255.0));
+      }
+    }
+    return packed;
   }
 
  private:
-  void decode_means(const json& means, const Image& low, const Image& high, size_t count,
-                    GaussianScene& scene) const {
+  std::vector<float> decode_means(const json& means, const SogImage& low, const SogImage& high,
+                                  size_t count) const {
     const std::vector<double> mins = numbers(means, "mins", 3, "means");
     const std::vector<double> maxs = numbers(means, "maxs", 3, "means");
+    std::vector<float> positions(3 * count);
     for (size_t i = 0; i < count; ++i)
       for (size_t a = 0; a < 3; ++a) {
         const double range = maxs[a] - mins[a] != 0 ? maxs[a] - mins[a] : 1.0;
         const double quantized = low.texel(i)[a] | (high.texel(i)[a] << 8);
         const double u = mins[a] + range * (quantized / 65535.0);
         const double magnitude = std::exp(std::fabs(u)) - 1.0;
-        scene.positions[3 * i + a] = to_float(u < 0 ? -magnitude : magnitude);
+        positions[3 * i + a] = to_float(u < 0 ? -magnitude : magnitude);
       }
+    return positions;
   }
 
-  void decode_quats(const json& meta, size_t count, size_t max_texels, GaussianScene& scene) const {
-    const Image quats = image(file(member(meta, "quats", "the meta"), 0, "quats"), count, max_texels);
-    for (size_t i = 0; i < count; ++i) {
-      const unsigned char* t = quats.texel(i);
-      float* q = scene.rotations.data() + 4 * i;
-      if (t[3] < 252) {  // not a smallest-three tag: the reference decoders take the identity
-        q[0] = 1;
-        q[1] = q[2] = q[3] = 0;
-        continue;
-      }
+  // The SH rest's 256 values: version 2's codebook, version 1's linear range.
+  std::array<float, 256> sh_values(const json& sh_n, bool v2) const {
+    std::array<float, 256> values{};
+    if (v2) {
+      const std::vector<float> book = codebook(sh_n, "shN");
+      std::copy(book.begin(), book.end(), values.begin());
+      return values;
+    }
+    const double low = number(sh_n, "mins", "shN");
+    const double high = number(sh_n, "maxs", "shN");
+    for (size_t b = 0; b < 256; ++b)
+      values[b] = to_float(low + (high - low) * (static_cast<double>(b) / 255.0));
+    return values;
+  }
+
+  std::string_view name_;
+  const FileLoader& load_;
+};
+
+template <typename IndexOf>
+GaussianScene SogPacked::decode_each(size_t count, IndexOf index_of) const {
+  GaussianScene scene;
+  allocate_scene(scene, count, sh_degree_);
+  const size_t rest = static_cast<size_t>(scene.sh_coefficients()) - 1;
+  const size_t stride = 3 * (rest + 1);
+  for (size_t out = 0; out < count; ++out) {
+    const size_t i = index_of(out);
+    std::copy_n(positions_.data() + 3 * i, 3, scene.positions.data() + 3 * out);
+
+    const unsigned char* t = quats_.texel(i);
+    float* q = scene.rotations.data() + 4 * out;
+    if (t[3] < 252) {  // not a smallest-three tag: the reference decoders take the identity
+      q[0] = 1;
+      q[1] = q[2] = q[3] = 0;
+    } else {
       const size_t largest = t[3] - 252u;
       double wxyz[4] = {0, 0, 0, 0};
       double sum = 0;
@@ -199,75 +252,39 @@ class SogDecoder {
       wxyz[largest] = std::sqrt(std::max(0.0, 1.0 - sum));
       for (size_t j = 0; j < 4; ++j) q[j] = static_cast<float>(wxyz[j]);
     }
-  }
 
-  void decode_scales_and_colours(const json& meta, bool v2, size_t count, size_t max_texels,
-                                 GaussianScene& scene) const {
-    const json& scales = member(meta, "scales", "the meta");
-    const json& sh0 = member(meta, "sh0", "the meta");
-    const Image scale_image = image(file(scales, 0, "scales"), count, max_texels);
-    const Image colour_image = image(file(sh0, 0, "sh0"), count, max_texels);
-    const size_t stride = 3 * static_cast<size_t>(scene.sh_coefficients());
-    if (v2) {
-      const std::vector<float> scale_book = codebook(scales, "scales");
-      const std::vector<float> colour_book = codebook(sh0, "sh0");
-      for (size_t i = 0; i < count; ++i) {
-        for (size_t a = 0; a < 3; ++a) {
-          scene.log_scales[3 * i + a] = scale_book[scale_image.texel(i)[a]];
-          scene.sh[stride * i + a] = colour_book[colour_image.texel(i)[a]];
-        }
-        scene.opacity_logits[i] = static_cast<float>(clamped_logit(colour_image.texel(i)[3] / 255.0));
-      }
-      return;
+    const unsigned char* scale = scales_.texel(i);
+    const unsigned char* colour = colours_.texel(i);
+    for (size_t a = 0; a < 3; ++a) {
+      scene.log_scales[3 * out + a] = scale_values_[a][scale[a]];
+      scene.sh[stride * out + a] = colour_values_[a][colour[a]];
     }
-    // Version 1: per-channel linear ranges; sh0's fourth channel is the opacity logit itself.
-    const std::vector<double> scale_min = numbers(scales, "mins", 3, "scales");
-    const std::vector<double> scale_max = numbers(scales, "maxs", 3, "scales");
-    const std::vector<double> colour_min = numbers(sh0, "mins", 4, "sh0");
-    const std::vector<double> colour_max = numbers(sh0, "maxs", 4, "sh0");
-    for (size_t i = 0; i < count; ++i) {
-      for (size_t a = 0; a < 3; ++a) {
-        scene.log_scales[3 * i + a] =
-            to_float(scale_min[a] + (scale_max[a] - scale_min[a]) * (scale_image.texel(i)[a] / 255.0));
-        scene.sh[stride * i + a] =
-            to_float(colour_min[a] + (colour_max[a] - colour_min[a]) * (colour_image.texel(i)[a] / 255.0));
-      }
-      scene.opacity_logits[i] =
-          to_float(colour_min[3] + (colour_max[3] - colour_min[3]) * (colour_image.texel(i)[3] / 255.0));
+    scene.opacity_logits[out] = colour_values_[3][colour[3]];
+
+    if (rest == 0) continue;
+    const size_t label = labels_.texel(i)[0] | (labels_.texel(i)[1] << 8);
+    if (label >= palette_) continue;  // no palette entry: zero, as the reference decoders leave it
+    const size_t row = label / 64;
+    float* sh = scene.sh.data() + stride * out + 3;
+    for (size_t j = 0; j < rest; ++j) {
+      const size_t column = (label % 64) * rest + j;
+      if (row >= static_cast<size_t>(centroids_.height)) break;
+      const unsigned char* c = centroids_.texel(row * static_cast<size_t>(centroids_.width) + column);
+      for (size_t k = 0; k < 3; ++k) sh[3 * j + k] = sh_values_[c[k]];
     }
   }
+  return scene;
+}
 
-  void decode_sh(const json& sh_n, bool v2, const Image& centroids, const Image& labels, size_t palette,
-                 GaussianScene& scene) const {
-    const size_t count = scene.size();
-    const size_t rest = static_cast<size_t>(scene.sh_coefficients()) - 1;
-    const size_t stride = 3 * (rest + 1);
-    std::vector<float> book(256);
-    if (v2) {
-      book = codebook(sh_n, "shN");
-    } else {
-      const double low = number(sh_n, "mins", "shN");
-      const double high = number(sh_n, "maxs", "shN");
-      for (size_t b = 0; b < 256; ++b)
-        book[b] = to_float(low + (high - low) * (static_cast<double>(b) / 255.0));
-    }
-    for (size_t i = 0; i < count; ++i) {
-      const size_t label = labels.texel(i)[0] | (labels.texel(i)[1] << 8);
-      float* out = scene.sh.data() + stride * i + 3;
-      if (label >= palette) continue;  // no palette entry: zero, as the reference decoders leave it
-      const size_t row = label / 64;
-      for (size_t j = 0; j < rest; ++j) {
-        const size_t column = (label % 64) * rest + j;
-        if (row >= static_cast<size_t>(centroids.height)) break;
-        const unsigned char* t = centroids.texel(row * static_cast<size_t>(centroids.width) + column);
-        for (size_t c = 0; c < 3; ++c) out[3 * j + c] = book[t[c]];
-      }
-    }
-  }
+GaussianScene SogPacked::decode(std::span<const uint32_t> indices) const {
+  return decode_each(indices.size(), [&](size_t k) { return size_t(indices[k]); });
+}
 
-  std::string_view name_;
-  const FileLoader& load_;
-};
+GaussianScene SogPacked::decode_range(size_t first, size_t end) const {
+  return decode_each(end - first, [first](size_t k) { return first + k; });
+}
+
+namespace {
 
 json parse_meta(std::string_view text, std::string_view name) {
   json meta = json::parse(text.begin(), text.end(), nullptr, false);
@@ -342,25 +359,67 @@ bool is_sog_meta(std::string_view json_text) {
   return meta.is_object() && meta.contains("means") && meta.contains("quats");
 }
 
-GaussianScene read_sog_meta(std::string_view meta_json, std::string_view name, const FileLoader& load_image,
-                            const LoadOptions& options, LoadReport* report) {
+SogCounts read_sog_meta_counts(std::string_view meta_json, std::string_view name) {
   const json meta = parse_meta(meta_json, name);
-  GaussianScene scene = SogDecoder(name, load_image).decode(meta);
-  finish_scene(scene, name, options, "sog (unbundled)", meta.contains("version") ? "2" : "1", report);
-  return scene;
+  const auto whole_number = [&](const json* value, double most) {
+    if (!value || !value->is_number() || !(value->get<double>() >= 0 && value->get<double>() <= most))
+      fail(name, "meta.json: not a version 2 count");
+    return static_cast<size_t>(value->get<double>());
+  };
+  if (!meta.contains("version")) fail(name, "meta.json: version 1 does not declare its SH degree");
+  SogCounts counts;
+  counts.count = whole_number(meta.contains("count") ? &meta["count"] : nullptr, 4294967295.0);
+  if (meta.contains("shN"))
+    counts.sh_degree = int(whole_number(meta["shN"].contains("bands") ? &meta["shN"]["bands"] : nullptr, 3));
+  return counts;
 }
 
-GaussianScene read_sog_zip(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
-                           LoadReport* report) {
+SogCounts read_sog_zip_counts(std::span<const std::byte> data, std::string_view name) {
+  const ZipArchive archive(data, name);
+  if (!archive.contains("meta.json")) fail(name, "a zip without meta.json, not a SOG archive");
+  const std::vector<unsigned char> text = archive.read("meta.json", 64u << 20);
+  return read_sog_meta_counts(std::string_view(reinterpret_cast<const char*>(text.data()), text.size()),
+                              name);
+}
+
+SogPacked SogPacked::from_meta(std::string_view meta_json, std::string_view name,
+                               const FileLoader& load_image) {
+  SogPacked packed = SogDecoder(name, load_image).decode(parse_meta(meta_json, name));
+  packed.format_ = "sog (unbundled)";
+  return packed;
+}
+
+SogPacked SogPacked::from_zip(std::span<const std::byte> data, std::string_view name) {
   const ZipArchive archive(data, name);
   if (!archive.contains("meta.json")) fail(name, "a zip without meta.json, not a SOG archive");
   const std::vector<unsigned char> text = archive.read("meta.json", 64u << 20);
   const json meta =
       parse_meta(std::string_view(reinterpret_cast<const char*>(text.data()), text.size()), name);
   const FileLoader load = [&](const std::string& entry) { return archive.read(entry, kMaxEntry); };
-  GaussianScene scene = SogDecoder(name, load).decode(meta);
-  finish_scene(scene, name, options, "sog", meta.contains("version") ? "2" : "1", report);
+  SogPacked packed = SogDecoder(name, load).decode(meta);
+  packed.format_ = "sog";
+  return packed;
+}
+
+namespace {
+
+GaussianScene read_packed(const SogPacked& packed, std::string_view name, const LoadOptions& options,
+                          LoadReport* report) {
+  GaussianScene scene = packed.decode_range(0, packed.size());
+  finish_scene(scene, name, options, packed.format(), packed.version(), report);
   return scene;
+}
+
+}  // namespace
+
+GaussianScene read_sog_meta(std::string_view meta_json, std::string_view name, const FileLoader& load_image,
+                            const LoadOptions& options, LoadReport* report) {
+  return read_packed(SogPacked::from_meta(meta_json, name, load_image), name, options, report);
+}
+
+GaussianScene read_sog_zip(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
+                           LoadReport* report) {
+  return read_packed(SogPacked::from_zip(data, name), name, options, report);
 }
 
 }  // namespace tilesplat::detail
