@@ -467,22 +467,15 @@ TEST(SceneInPartsFormats, HoldsTheGaussiansLoadSceneReads) {
 // version 3 and a version 4 file, an unknown version. A file too short to be told an SPZ is not a PLY
 // (MappedPlyErrors).
 TEST_F(FormatErrors, AnSpzInPartsRefusesWhatLoadSceneRefuses) {
-  auto message = [](auto&& read) {
-    try {
-      read();
-    } catch (const SceneError& error) {
-      return std::string(error.what());
-    }
-    return std::string("no error");
-  };
   for (const std::string file : {"playcanvas_test_64_sh3.v4.spz", "playcanvas_test_64_sh3.v3.spz"}) {
     const std::string bytes = original(file);
     size_t refused = 0, cuts = 0;
     for (size_t length = 4; length < bytes.size(); length += 37) {  // from the magic on: an SPZ by content
       const fs::path cut = write_file("cut_in_parts.spz", bytes.substr(0, length));
-      const std::string expected = message([&] { load_scene(cut); });
-      EXPECT_EQ(message([&] { SceneInParts::open(cut); }), expected) << file << " cut to " << length;
-      refused += expected != "no error";  // a gzip stream cut in its trailer still holds every Gaussian
+      const std::string expected = testing::error_of<SceneError>([&] { load_scene(cut); });
+      EXPECT_EQ(testing::error_of<SceneError>([&] { SceneInParts::open(cut); }), expected)
+          << file << " cut to " << length;
+      refused += expected != "(no exception)";  // a gzip stream cut in its trailer still holds every Gaussian
       ++cuts;
     }
     EXPECT_GE(refused + 2, cuts) << file;
@@ -490,7 +483,8 @@ TEST_F(FormatErrors, AnSpzInPartsRefusesWhatLoadSceneRefuses) {
   std::string v5 = original("playcanvas_test_64_sh3.v4.spz");
   put_u32(v5, 4, 5);
   const fs::path unknown = write_file("v5_in_parts.spz", v5);
-  EXPECT_EQ(message([&] { SceneInParts::open(unknown); }), message([&] { load_scene(unknown); }));
+  EXPECT_EQ(testing::error_of<SceneError>([&] { SceneInParts::open(unknown); }),
+            testing::error_of<SceneError>([&] { load_scene(unknown); }));
 }
 
 // A SOG whose codebook holds a value no float holds: its Gaussians dropped as load_scene drops them (or,
@@ -508,17 +502,9 @@ TEST_F(FormatErrors, ASogInPartsDropsWhatLoadSceneDrops) {
   expect_in_parts_is_loaded(path);
   LoadOptions strict;
   strict.strict = true;
-  auto message = [](auto&& read) {
-    try {
-      read();
-    } catch (const SceneError& error) {
-      return std::string(error.what());
-    }
-    return std::string("no error");
-  };
-  const std::string refused = message([&] { load_scene(path, strict); });
+  const std::string refused = testing::error_of<SceneError>([&] { load_scene(path, strict); });
   EXPECT_NE(refused.find("strict mode"), std::string::npos) << refused;
-  EXPECT_EQ(message([&] { SceneInParts::open(path, strict); }), refused);
+  EXPECT_EQ(testing::error_of<SceneError>([&] { SceneInParts::open(path, strict); }), refused);
 }
 
 // The float64 reference found it: denormal quaternions are the identity, as float32 normalization

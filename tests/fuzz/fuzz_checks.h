@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <span>
 #include <string>
 #include <vector>
@@ -27,6 +28,21 @@ inline bool all_finite(const std::vector<float>& values) {
   for (const float value : values)
     if (!std::isfinite(value)) return false;
   return true;
+}
+
+// Two readings of one file hold the same Gaussians, bit for bit.
+inline void check_same_gaussians(const tilesplat::GaussianScene& a, const tilesplat::GaussianScene& b) {
+  const auto same = [](const std::vector<float>& x, const std::vector<float>& y) {
+    return x.size() == y.size() &&
+           (x.empty() || std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0);
+  };
+  FUZZ_CHECK(a.sh_degree == b.sh_degree);
+  FUZZ_CHECK(same(a.positions, b.positions));
+  FUZZ_CHECK(same(a.log_scales, b.log_scales));
+  FUZZ_CHECK(same(a.rotations, b.rotations));
+  FUZZ_CHECK(same(a.opacity_logits, b.opacity_logits));
+  FUZZ_CHECK(same(a.sh, b.sh));
+  FUZZ_CHECK(same(a.normals, b.normals));
 }
 
 // A loaded scene: consistent array sizes, finite values, unit quaternions, report counts that add up.

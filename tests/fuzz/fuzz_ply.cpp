@@ -18,11 +18,6 @@
 
 namespace {
 
-bool same_floats(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() &&
-         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
-}
-
 // The rows every one, non-finite ones dropped, then gathered as a MappedPly gathers a part: parse_ply's
 // scene, or a SceneError (PlyRows refuses ASCII and compressed PLYs, which parse_ply reads).
 void check_rows(const uint8_t* data, size_t size) {
@@ -46,13 +41,7 @@ void check_rows(const uint8_t* data, size_t size) {
     }
     const tilesplat::GaussianScene parts = rows.decode(kept);
     FUZZ_CHECK(whole.has_value());  // read part by part only what parse_ply reads
-    FUZZ_CHECK(parts.sh_degree == whole->sh_degree);
-    FUZZ_CHECK(same_floats(parts.positions, whole->positions));
-    FUZZ_CHECK(same_floats(parts.log_scales, whole->log_scales));
-    FUZZ_CHECK(same_floats(parts.rotations, whole->rotations));
-    FUZZ_CHECK(same_floats(parts.opacity_logits, whole->opacity_logits));
-    FUZZ_CHECK(same_floats(parts.sh, whole->sh));
-    FUZZ_CHECK(same_floats(parts.normals, whole->normals));
+    tilesplat::fuzz::check_same_gaussians(parts, *whole);
   } catch (const tilesplat::SceneError&) {
   }
 }

@@ -5,7 +5,6 @@
 // decoded from the texels alone) and report are read_sog_zip's, bit for bit. See tests/fuzz/README.md.
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <optional>
 #include <vector>
 
@@ -15,11 +14,6 @@
 #include "scene/sog_packed.h"
 
 namespace {
-
-bool same_floats(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() &&
-         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0);
-}
 
 void check_in_parts(const uint8_t* data, size_t size) {
   const auto bytes = std::as_bytes(std::span(data, size));
@@ -37,13 +31,7 @@ void check_in_parts(const uint8_t* data, size_t size) {
     FUZZ_CHECK(rows.size() == whole->size());
     FUZZ_CHECK(report.dropped == whole_report.dropped);
     FUZZ_CHECK(report.gaussians_in_file == whole_report.gaussians_in_file);
-    const tilesplat::GaussianScene parts = rows.load();
-    FUZZ_CHECK(parts.sh_degree == whole->sh_degree);
-    FUZZ_CHECK(same_floats(parts.positions, whole->positions));
-    FUZZ_CHECK(same_floats(parts.log_scales, whole->log_scales));
-    FUZZ_CHECK(same_floats(parts.rotations, whole->rotations));
-    FUZZ_CHECK(same_floats(parts.opacity_logits, whole->opacity_logits));
-    FUZZ_CHECK(same_floats(parts.sh, whole->sh));
+    tilesplat::fuzz::check_same_gaussians(rows.load(), *whole);
   } catch (const tilesplat::SceneError&) {
     FUZZ_CHECK(!whole.has_value());
   }
