@@ -199,9 +199,10 @@ class TILESPLAT_API Renderer {
   /// from the camera then. A closed shutter renders the copies where they are at time 0.
   RenderImage render(const SceneInstances& scene, const Camera& camera, const RenderSettings& settings = {});
   /// The same for a binary PLY, an SPZ or a SOG opened part by part (SceneInParts::open): in parts, each
-  /// part's Gaussians are decoded as the part is drawn (from the PLY's file, from the SPZ's packed bytes), so
-  /// the scene is never held whole as floats on the host (only its positions); whole, it is loaded
-  /// (SceneInParts::load) and set. The frame is the one the scene load_scene reads renders, bit for bit.
+  /// part's Gaussians are decoded as the part is drawn (from the PLY's file, the SPZ's packed bytes, the
+  /// SOG's texels), so the scene is never held whole as floats on the host (only its positions); whole, it is
+  /// loaded (SceneInParts::load) and set. The frame is the one the scene load_scene reads renders, bit for
+  /// bit.
   RenderImage render(const SceneInParts& scene, const Camera& camera, const RenderSettings& settings = {});
   /// Whether render(scene, camera, settings) renders this frame in parts: with settings.memory_budget,
   /// when the whole frame would need more; without one, when it would not fit the device (a buffer

@@ -49,7 +49,7 @@ class TILESPLAT_API SceneInParts {
 
   size_t size() const;           ///< the Gaussians, as load_scene would give them
   int sh_degree() const;         ///< 0 to 3
-  bool has_normals() const;      ///< whether the file carries nx, ny, nz (a PLY's; an SPZ has none)
+  bool has_normals() const;      ///< whether the file carries nx, ny, nz (a PLY's; an SPZ or a SOG has none)
   const Bounds& bounds() const;  ///< compute_bounds of the scene load_scene would give
   /// The whole scene, as load_scene reads it (for a frame that fits: the renderer's set_scene).
   GaussianScene load() const;

@@ -1,6 +1,6 @@
 // What a SceneInParts holds: each Gaussian's position (the depth order and the bounds need them all) and
-// the means to decode any part of the Gaussians, from a mapped PLY's rows or an SPZ's packed bytes. The
-// renderer's parts (frame/scene_parts.h) read positions for the depth order and gather each part.
+// the means to decode any part of the Gaussians, from a mapped PLY's rows, an SPZ's packed bytes or a SOG's
+// texels. The renderer's parts (frame/scene_parts.h) read positions for the depth order and gather each part.
 #pragma once
 
 #include <array>
@@ -35,17 +35,25 @@ class PartRows {
     return {positions_[3 * i], positions_[3 * i + 1], positions_[3 * i + 2]};
   }
   // Gaussians `indices` (ascending) as a scene of their own, as load_scene gives them. From any thread.
-  virtual GaussianScene gather(std::span<const uint32_t> indices) const = 0;
+  GaussianScene gather(std::span<const uint32_t> indices) const;
   GaussianScene load() const;
 
  protected:
-  // Set by the reader: the positions it keeps (x, y, z of each Gaussian) and what it learnt of the file.
+  // The file's Gaussians `in_file` (ascending), as load_scene decodes them, before it drops any.
+  virtual GaussianScene decode(std::span<const uint32_t> in_file) const = 0;
+  // Set by the reader: the positions of the Gaussians it keeps (x, y, z of each), and what it learnt of the
+  // file. `dropped` (ascending) are the file's Gaussians load_scene drops for non-finite values, of
+  // `in_file`; the others are numbered in order.
   void set_positions(std::span<const float> positions);
+  void set_dropped(size_t in_file, std::span<const size_t> dropped);
+  // Gaussian i's index in the file.
+  size_t in_file(size_t i) const { return kept_.empty() ? i : kept_[i]; }
   int sh_degree_ = 0;
   bool has_normals_ = false;
 
  private:
   std::span<const float> positions_;
+  std::vector<uint32_t> kept_;  // each Gaussian's index in the file, where some were dropped (else empty)
   Bounds bounds_;
 };
 
@@ -53,23 +61,22 @@ class PartRows {
 class MappedPlyRows final : public PartRows {
  public:
   MappedPlyRows(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report);
-  GaussianScene gather(std::span<const uint32_t> indices) const override;
 
  private:
+  GaussianScene decode(std::span<const uint32_t> in_file) const override;
   FileContents contents_;
   std::unique_ptr<PlyRows> rows_;
   std::vector<float> positions_;
-  std::vector<uint64_t> kept_rows_;  // each Gaussian's row, where some rows were dropped (else empty)
-  mutable std::mutex decoding_;      // one part decoded at a time (the file's pages are let go of after)
+  mutable std::mutex decoding_;  // one part decoded at a time (the file's pages are let go of after)
 };
 
 // An SPZ, held decompressed in its own quantized layout (SpzPacked); the file itself is let go of.
 class SpzPartRows final : public PartRows {
  public:
   SpzPartRows(FileContents& contents, std::string_view name, const LoadOptions& options, LoadReport* report);
-  GaussianScene gather(std::span<const uint32_t> indices) const override;
 
  private:
+  GaussianScene decode(std::span<const uint32_t> in_file) const override;
   SpzPacked packed_;
 };
 
@@ -78,12 +85,11 @@ class SpzPartRows final : public PartRows {
 class SogPartRows final : public PartRows {
  public:
   SogPartRows(SogPacked packed, std::string_view name, const LoadOptions& options, LoadReport* report);
-  GaussianScene gather(std::span<const uint32_t> indices) const override;
 
  private:
+  GaussianScene decode(std::span<const uint32_t> in_file) const override;
   SogPacked packed_;
-  std::vector<uint32_t> kept_;  // each Gaussian's index in the file, where some were dropped (else empty)
-  std::vector<float> kept_positions_;  // their positions (else packed_'s are the Gaussians')
+  std::vector<float> kept_positions_;  // where some were dropped (else packed_'s are the Gaussians')
 };
 
 }  // namespace tilesplat::detail

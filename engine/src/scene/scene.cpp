@@ -37,25 +37,6 @@ double median(std::vector<double> values) {
 
 namespace {
 
-enum class Container { kPly, kSpz, kZip, kGlb, kJson, kUnknown };
-
-Container container_of(std::span<const std::byte> data) {
-  const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
-  const auto starts_with = [&](std::string_view magic) {
-    return data.size() >= magic.size() && std::memcmp(bytes, magic.data(), magic.size()) == 0;
-  };
-  if (starts_with("ply\n") || starts_with("ply\r\n")) return Container::kPly;
-  if (starts_with("PK\x03\x04")) return Container::kZip;
-  if (starts_with("glTF")) return Container::kGlb;
-  if (detail::is_spz(data)) return Container::kSpz;
-  for (size_t i = 0; i < data.size(); ++i) {
-    const char c = static_cast<char>(bytes[i]);
-    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') continue;
-    return c == '{' ? Container::kJson : Container::kUnknown;
-  }
-  return Container::kUnknown;
-}
-
 // A LOD set's finest level, the whole capture (tilesplat/lod_set.h picks other levels).
 GaussianScene read_lod_set_level0(std::string_view text, const std::filesystem::path& path,
                                   const LoadOptions& options, LoadReport* report) {
@@ -81,17 +62,17 @@ GaussianScene read_any(std::span<const std::byte> data, const std::string& name,
   const std::filesystem::path* path = file ? &file->path : nullptr;
   const detail::FileLoader no_files;
   const detail::FileLoader files = path ? detail::sibling_loader(*path) : no_files;
-  switch (container_of(data)) {
-    case Container::kPly:
+  switch (detail::container_of(data)) {
+    case detail::Container::kPly:
       return file ? detail::read_ply_file(file->contents, name, options, report)
                   : parse_ply(data, name, options, report);
-    case Container::kSpz:
+    case detail::Container::kSpz:
       return detail::read_spz(data, name, options, report, file ? &file->contents : nullptr);
-    case Container::kZip:
+    case detail::Container::kZip:
       return detail::read_sog_zip(data, name, options, report);
-    case Container::kGlb:
+    case detail::Container::kGlb:
       return detail::read_gltf(data, name, files, options, report);
-    case Container::kJson: {
+    case detail::Container::kJson: {
       const std::string_view text(reinterpret_cast<const char*>(data.data()), data.size());
       if (detail::is_lod_index(text)) {
         if (!path) detail::fail(name, "a LOD set index: its chunks are files, read it with load_scene");
@@ -103,7 +84,7 @@ GaussianScene read_any(std::span<const std::byte> data, const std::string& name,
       }
       return detail::read_gltf(data, name, files, options, report);
     }
-    case Container::kUnknown:
+    case detail::Container::kUnknown:
       break;
   }
   if (lowercase(std::filesystem::path(name).extension().string()) == ".splat")

@@ -1,13 +1,13 @@
 // SceneInParts: a scene file read once to learn its Gaussians' positions, then part by part as frames draw
 // it. A binary PLY's pages are let go of after each block of the first read and after each part: the file's
-// bytes never stay resident, only the positions (12 bytes a Gaussian) and the part being decoded. An SPZ,
-// compressed as a whole, cannot be read in place: it is held decompressed in its own quantized layout, a
-// quarter of its Gaussians' size as floats, and each part is decoded from that.
+// bytes never stay resident, only the positions (12 bytes a Gaussian) and the part being decoded. An SPZ or a
+// SOG, compressed as a whole, cannot be read in place: it is held in its own quantized layout (an SPZ's
+// packed bytes, a SOG's texels), a quarter or less of its Gaussians' size as floats, and each part decoded
+// from that.
 #include "tilesplat/scene_in_parts.h"
 
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <numeric>
 
 #include "scene/part_rows.h"
@@ -19,6 +19,26 @@ namespace detail {
 void PartRows::set_positions(std::span<const float> positions) {
   positions_ = positions;
   bounds_ = bounds_of_positions(positions);
+}
+
+void PartRows::set_dropped(size_t in_file, std::span<const size_t> dropped) {
+  kept_.clear();
+  if (dropped.empty()) return;
+  kept_.reserve(in_file - dropped.size());
+  for (size_t i = 0, next_dropped = 0; i < in_file; ++i) {
+    if (next_dropped < dropped.size() && dropped[next_dropped] == i) {
+      ++next_dropped;
+      continue;
+    }
+    kept_.push_back(uint32_t(i));
+  }
+}
+
+GaussianScene PartRows::gather(std::span<const uint32_t> indices) const {
+  if (kept_.empty()) return decode(indices);
+  std::vector<uint32_t> in_file(indices.size());
+  for (size_t k = 0; k < indices.size(); ++k) in_file[k] = kept_[indices[k]];
+  return decode(in_file);
 }
 
 GaussianScene PartRows::load() const {
@@ -45,17 +65,7 @@ MappedPlyRows::MappedPlyRows(const std::filesystem::path& path, const LoadOption
                       decoded.positions.begin() + std::ptrdiff_t(3 * kept));
     contents_.release_all();
   }
-  if (!dropped.empty()) {
-    kept_rows_.reserve(rows - dropped.size());
-    size_t next_dropped = 0;
-    for (size_t row = 0; row < rows; ++row) {
-      if (next_dropped < dropped.size() && dropped[next_dropped] == row) {
-        ++next_dropped;
-        continue;
-      }
-      kept_rows_.push_back(row);
-    }
-  }
+  set_dropped(rows, dropped);
   set_positions(positions_);
   sh_degree_ = rows_->sh_degree();
   has_normals_ = rows_->has_normals();
@@ -63,10 +73,8 @@ MappedPlyRows::MappedPlyRows(const std::filesystem::path& path, const LoadOption
   if (report) *report = std::move(found);
 }
 
-GaussianScene MappedPlyRows::gather(std::span<const uint32_t> indices) const {
-  std::vector<uint64_t> rows(indices.size());
-  for (size_t i = 0; i < indices.size(); ++i)
-    rows[i] = kept_rows_.empty() ? indices[i] : kept_rows_[indices[i]];
+GaussianScene MappedPlyRows::decode(std::span<const uint32_t> in_file) const {
+  const std::vector<uint64_t> rows(in_file.begin(), in_file.end());
   const std::lock_guard<std::mutex> lock(decoding_);
   GaussianScene scene = rows_->decode(rows);
   contents_.release_all();
@@ -89,8 +97,8 @@ SpzPartRows::SpzPartRows(FileContents& contents, std::string_view name, const Lo
   }
 }
 
-GaussianScene SpzPartRows::gather(std::span<const uint32_t> indices) const {
-  GaussianScene scene = packed_.decode(indices);
+GaussianScene SpzPartRows::decode(std::span<const uint32_t> in_file) const {
+  GaussianScene scene = packed_.decode(in_file);
   normalize_rotations(scene);  // the rest of read_spz's finish_scene: nothing in an SPZ is non-finite
   return scene;
 }
@@ -98,26 +106,27 @@ GaussianScene SpzPartRows::gather(std::span<const uint32_t> indices) const {
 SogPartRows::SogPartRows(SogPacked packed, std::string_view name, const LoadOptions& options,
                          LoadReport* report)
     : packed_(std::move(packed)) {
-  // Decoded once, a block at a time, to find the Gaussians finish_scene would drop.
+  // The Gaussians finish_scene would drop: only a position or a table value past float's range makes one
+  // non-finite, so they are looked for, decoding each once a block at a time, only where there is such a
+  // value.
   NonFiniteTally tally(name, options);
-  constexpr size_t kBlock = size_t(1) << 20;
   std::vector<size_t> dropped;
-  for (size_t first = 0; first < packed_.size(); first += kBlock) {
-    const GaussianScene block = packed_.decode_range(first, std::min(packed_.size(), first + kBlock));
-    for (size_t i : non_finite_gaussians(block, first, tally)) dropped.push_back(first + i);
-  }
-  if (!dropped.empty()) {
-    for (size_t i = 0, next_dropped = 0; i < packed_.size(); ++i) {
-      if (next_dropped < dropped.size() && dropped[next_dropped] == i) {
-        ++next_dropped;
-        continue;
-      }
-      kept_.push_back(uint32_t(i));
-      kept_positions_.insert(kept_positions_.end(), packed_.positions().begin() + std::ptrdiff_t(3 * i),
-                             packed_.positions().begin() + std::ptrdiff_t(3 * i + 3));
+  constexpr size_t kBlock = size_t(1) << 20;
+  if (!packed_.all_values_finite())
+    for (size_t first = 0; first < packed_.size(); first += kBlock) {
+      const GaussianScene block = packed_.decode_range(first, std::min(packed_.size(), first + kBlock));
+      for (size_t i : non_finite_gaussians(block, first, tally)) dropped.push_back(first + i);
     }
+  set_dropped(packed_.size(), dropped);
+  if (dropped.empty()) {
+    set_positions(packed_.positions());
+  } else {
+    const std::vector<float>& all = packed_.positions();
+    for (size_t i = 0; i < packed_.size() - dropped.size(); ++i)
+      kept_positions_.insert(kept_positions_.end(), all.begin() + std::ptrdiff_t(3 * in_file(i)),
+                             all.begin() + std::ptrdiff_t(3 * in_file(i) + 3));
+    set_positions(kept_positions_);
   }
-  set_positions(dropped.empty() ? std::span<const float>(packed_.positions()) : kept_positions_);
   sh_degree_ = packed_.sh_degree();
   if (report) {
     LoadReport found;  // what finish_scene reports
@@ -130,13 +139,8 @@ SogPartRows::SogPartRows(SogPacked packed, std::string_view name, const LoadOpti
   }
 }
 
-GaussianScene SogPartRows::gather(std::span<const uint32_t> indices) const {
-  std::vector<uint32_t> in_file;
-  if (!kept_.empty()) {
-    in_file.reserve(indices.size());
-    for (uint32_t i : indices) in_file.push_back(kept_[i]);
-  }
-  GaussianScene scene = packed_.decode(kept_.empty() ? indices : std::span<const uint32_t>(in_file));
+GaussianScene SogPartRows::decode(std::span<const uint32_t> in_file) const {
+  GaussianScene scene = packed_.decode(in_file);
   normalize_rotations(scene);  // the rest of finish_scene
   return scene;
 }
@@ -149,52 +153,67 @@ SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOpt
     detail::FileContents contents;
     detail::open_scene_file(path, contents);
     const std::span<const std::byte> bytes = contents.bytes();
-    const bool ply = bytes.size() >= 3 && std::memcmp(bytes.data(), "ply", 3) == 0;
-    const std::string name = path.string();
-    if (!ply && detail::is_spz(bytes))
-      return SceneInParts(std::make_shared<const detail::SpzPartRows>(contents, name, options, report));
-    if (!ply && bytes.size() >= 4 && std::memcmp(bytes.data(), "PK\x03\x04", 4) == 0)
-      return SceneInParts(std::make_shared<const detail::SogPartRows>(
-          detail::SogPacked::from_zip(bytes, name), name, options, report));
     const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-    if (!ply && detail::is_sog_meta(text))
-      return SceneInParts(std::make_shared<const detail::SogPartRows>(
-          detail::SogPacked::from_meta(text, name, detail::sibling_loader(path)), name, options, report));
-    if (!ply && !bytes.empty())
-      detail::fail(
-          name,
-          "not a PLY file (it does not start with the 'ply' magic line), an SPZ or a SOG: only these "
-          "are read part by part; load_scene reads the others whole");
-  }  // an SPZ's or a SOG's file is let go of once decoded; a PLY is mapped again, to be read as it is drawn
+    const std::string name = path.string();
+    switch (detail::container_of(bytes)) {
+      case detail::Container::kPly:
+        break;  // mapped again below, to be read as it is drawn
+      case detail::Container::kSpz:
+        return SceneInParts(std::make_shared<const detail::SpzPartRows>(contents, name, options, report));
+      case detail::Container::kZip:
+        return SceneInParts(std::make_shared<const detail::SogPartRows>(
+            detail::SogPacked::from_zip(bytes, name), name, options, report));
+      case detail::Container::kJson:
+        if (detail::is_sog_meta(text))
+          return SceneInParts(std::make_shared<const detail::SogPartRows>(
+              detail::SogPacked::from_meta(text, name, detail::sibling_loader(path)), name, options, report));
+        [[fallthrough]];
+      case detail::Container::kGlb:
+      case detail::Container::kUnknown:
+        if (!bytes.empty())
+          detail::fail(
+              name,
+              "not a PLY file (it does not start with the 'ply' magic line), an SPZ or a SOG: only these "
+              "are read part by part; load_scene reads the others whole");
+        break;  // empty: the PLY reader says so
+    }
+  }  // an SPZ's or a SOG's file is let go of once decoded
   return SceneInParts(std::make_shared<const detail::MappedPlyRows>(path, options, report));
 }
 
 uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
+  const auto floats_of = [](size_t count, int sh_degree) {
+    return uint64_t(count) * (11 + 3 * uint64_t((sh_degree + 1) * (sh_degree + 1))) * sizeof(float);
+  };
   try {
     detail::FileContents contents;
     detail::open_scene_file(path, contents);
     const std::span<const std::byte> bytes = contents.bytes();
-    if (bytes.size() >= 3 && std::memcmp(bytes.data(), "ply", 3) == 0) return bytes.size();
-    auto floats_of = [](size_t count, int sh_degree) {
-      return uint64_t(count) * (11 + 3 * uint64_t((sh_degree + 1) * (sh_degree + 1))) * sizeof(float);
-    };
+    const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     const std::string name = path.string();
-    if (detail::is_spz(bytes)) {
-      const detail::SpzCounts counts = detail::read_spz_counts(bytes, name);
-      return floats_of(counts.count, counts.sh_degree);
+    switch (detail::container_of(bytes)) {
+      case detail::Container::kPly:
+        return bytes.size();  // a binary PLY's rows are its floats
+      case detail::Container::kSpz: {
+        const detail::SpzCounts counts = detail::read_spz_counts(bytes, name);
+        return floats_of(counts.count, counts.sh_degree);
+      }
+      case detail::Container::kZip: {
+        const detail::SogCounts counts = detail::read_sog_zip_counts(bytes, name);
+        return floats_of(counts.count, counts.sh_degree);
+      }
+      case detail::Container::kJson: {
+        if (!detail::is_sog_meta(text)) return 0;
+        const detail::SogCounts counts = detail::read_sog_meta_counts(text, name);
+        return floats_of(counts.count, counts.sh_degree);
+      }
+      case detail::Container::kGlb:
+      case detail::Container::kUnknown:
+        return 0;
     }
-    detail::SogCounts counts;
-    if (bytes.size() >= 4 && std::memcmp(bytes.data(), "PK\x03\x04", 4) == 0) {
-      counts = detail::read_sog_zip_counts(bytes, name);
-    } else {
-      const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-      if (!detail::is_sog_meta(text)) return 0;
-      counts = detail::read_sog_meta_counts(text, name);
-    }
-    return floats_of(counts.count, counts.sh_degree);
   } catch (const SceneError&) {
-    return 0;
   }
+  return 0;
 }
 
 size_t SceneInParts::size() const {

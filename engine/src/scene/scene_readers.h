@@ -23,6 +23,11 @@ using FileLoader = std::function<std::vector<unsigned char>(const std::string& n
 
 class FileContents;  // scene/scene_reading.h
 
+// The container a file's first bytes name: the reader they call for (load_scene, SceneInParts). A JSON
+// object may be a glTF, a SOG's meta.json or a LOD set's index; kUnknown may still be a headerless .splat.
+enum class Container { kPly, kSpz, kZip, kGlb, kJson, kUnknown };
+Container container_of(std::span<const std::byte> data);
+
 // Reads a file that `referrer` names, resolved beside it; only plain relative names are followed.
 FileLoader sibling_loader(const std::filesystem::path& referrer);
 

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <system_error>
 
 #include "scene/scene_readers.h"
@@ -103,6 +104,23 @@ void open_scene_file(const std::filesystem::path& path, FileContents& contents) 
   if (std::filesystem::is_directory(status)) fail(name, "cannot open: is a directory, not a file");
   if (!std::filesystem::is_regular_file(status)) fail(name, "cannot open: not a regular file");
   if (const std::string error = contents.open(path); !error.empty()) fail(name, error);
+}
+
+Container container_of(std::span<const std::byte> data) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
+  const auto starts_with = [&](std::string_view magic) {
+    return data.size() >= magic.size() && std::memcmp(bytes, magic.data(), magic.size()) == 0;
+  };
+  if (starts_with("ply\n") || starts_with("ply\r\n")) return Container::kPly;
+  if (starts_with("PK\x03\x04")) return Container::kZip;
+  if (starts_with("glTF")) return Container::kGlb;
+  if (is_spz(data)) return Container::kSpz;
+  for (size_t i = 0; i < data.size(); ++i) {
+    const char c = static_cast<char>(bytes[i]);
+    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') continue;
+    return c == '{' ? Container::kJson : Container::kUnknown;
+  }
+  return Container::kUnknown;
 }
 
 FileLoader sibling_loader(const std::filesystem::path& referrer) {

@@ -47,6 +47,9 @@ class SogPacked {
   const std::string& format() const { return format_; }    // "sog" or "sog (unbundled)"
   const std::string& version() const { return version_; }  // "1" or "2"
   const std::vector<float>& positions() const { return positions_; }
+  // Whether every position and every value a channel's texel can pick is finite: then no Gaussian is
+  // (rotations always are), and finish_scene drops none.
+  bool all_values_finite() const;
 
   // Gaussians `indices` (any order) as the SOG readers decode them, before finish_scene (which may drop
   // non-finite ones: a meta.json's ranges and codebooks can hold values no float holds).

@@ -276,6 +276,15 @@ GaussianScene SogPacked::decode_each(size_t count, IndexOf index_of) const {
   return scene;
 }
 
+bool SogPacked::all_values_finite() const {
+  const auto finite = [](const auto& values) {
+    return std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); });
+  };
+  return finite(positions_) && finite(sh_values_) &&
+         std::all_of(scale_values_.begin(), scale_values_.end(), finite) &&
+         std::all_of(colour_values_.begin(), colour_values_.end(), finite);
+}
+
 GaussianScene SogPacked::decode(std::span<const uint32_t> indices) const {
   return decode_each(indices.size(), [&](size_t k) { return size_t(indices[k]); });
 }
