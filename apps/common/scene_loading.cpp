@@ -96,7 +96,7 @@ bool reads_in_parts(const fs::path& path, PartReading reading) {
 }  // namespace
 
 LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view program, SceneHolding holding,
-                            const LodOptions& lod, PartReading ply) {
+                            const LodOptions& lod, PartReading reading) {
   LoadedScene loaded;
   loaded.path = path;
   require_input_file(loaded.path, "scene");
@@ -119,7 +119,7 @@ LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view 
         loaded.instances = load_scene_instances(*loaded.description, load_options, &loaded.report);
       else
         loaded.scene = load_described_scene(*loaded.description, load_options, &loaded.report);
-    } else if (reads_in_parts(loaded.path, ply)) {
+    } else if (reads_in_parts(loaded.path, reading)) {
       loaded.in_parts = SceneInParts::open(loaded.path, load_options, &loaded.report);
     } else {
       loaded.scene = load_scene(loaded.path, load_options, &loaded.report);
@@ -248,8 +248,8 @@ SceneViews camera_views(const CommonOptions& options, const LoadedScene& loaded)
 }
 
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program,
-                                  SceneHolding holding, PartReading ply) {
-  LoadedScene loaded = load_scene_file(options.scene, options.strict, program, holding, options.lod, ply);
+                                  SceneHolding holding, PartReading reading) {
+  LoadedScene loaded = load_scene_file(options.scene, options.strict, program, holding, options.lod, reading);
   const SceneViews cameras = camera_views(options, loaded);
   NamedCamera named;
   if (!cameras.views.empty()) {

@@ -28,8 +28,8 @@ namespace tilesplat::cli {
 enum class SceneHolding { kMerged, kInstances, kInstancesIfMoving };
 
 // How a binary PLY, an SPZ or a SOG is held: read whole (load_scene), or read part by part as the frames draw
-// it (SceneInParts: its positions held, and an SPZ's packed bytes), always or when its Gaussians as floats
-// would take more than half of the host's memory (tilesplat-render, --read-in-parts).
+// it (SceneInParts: its positions held, and an SPZ's packed bytes or a SOG's texels), always or when its
+// Gaussians as floats would take more than half of the host's memory (tilesplat-render, --read-in-parts).
 enum class PartReading { kWhole, kInPartsWhenLarge, kInParts };
 
 // A LOD set the SCENE names (lod-meta.json): the index, and how the run draws it.
@@ -73,14 +73,14 @@ struct LoadedScene {
 // out-of-range --view throws UsageError naming the file and its number of views.
 LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view program,
                                   SceneHolding holding = SceneHolding::kMerged,
-                                  PartReading ply = PartReading::kWhole);
+                                  PartReading reading = PartReading::kWhole);
 
 // The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
 // load_scene_file fills path, scene, description, report and load_ms only.
 // A LOD set is read as `lod` says; `lod` given for any other scene is a UsageError.
 LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program,
                             SceneHolding holding = SceneHolding::kMerged, const LodOptions& lod = {},
-                            PartReading ply = PartReading::kWhole);
+                            PartReading reading = PartReading::kWhole);
 
 // The views a scene file brings ("cameras") and the file that names them (the cameras.json it
 // refers to, else the scene file). No views for a .ply, or a scene file without cameras.

@@ -428,11 +428,11 @@ int run(int argc, char** argv) {
   // unless some move (each time of a shutter places them anew).
   const cli::SceneHolding holding =
       !options.reference ? cli::SceneHolding::kInstances : cli::SceneHolding::kInstancesIfMoving;
-  const cli::PartReading ply =
+  const cli::PartReading reading =
       options.read_in_parts ? cli::PartReading::kInParts : cli::PartReading::kInPartsWhenLarge;
   cli::LoadedScene loaded = sequence ? cli::load_scene_file(options.common.scene, options.common.strict,
-                                                            kProgram, holding, options.common.lod, ply)
-                                     : cli::load_scene_and_camera(options.common, kProgram, holding, ply);
+                                                            kProgram, holding, options.common.lod, reading)
+                                     : cli::load_scene_and_camera(options.common, kProgram, holding, reading);
   std::vector<Frame> frames;
   if (sequence) {
     frames = plan_sequence(parser, options, loaded);
