@@ -182,9 +182,6 @@ SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOpt
 }
 
 uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
-  const auto floats_of = [](size_t count, int sh_degree) {
-    return uint64_t(count) * (11 + 3 * uint64_t((sh_degree + 1) * (sh_degree + 1))) * sizeof(float);
-  };
   try {
     detail::FileContents contents;
     detail::open_scene_file(path, contents);
@@ -194,19 +191,12 @@ uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
     switch (detail::container_of(bytes)) {
       case detail::Container::kPly:
         return bytes.size();  // a binary PLY's rows are its floats
-      case detail::Container::kSpz: {
-        const detail::SpzCounts counts = detail::read_spz_counts(bytes, name);
-        return floats_of(counts.count, counts.sh_degree);
-      }
-      case detail::Container::kZip: {
-        const detail::SogCounts counts = detail::read_sog_zip_counts(bytes, name);
-        return floats_of(counts.count, counts.sh_degree);
-      }
-      case detail::Container::kJson: {
-        if (!detail::is_sog_meta(text)) return 0;
-        const detail::SogCounts counts = detail::read_sog_meta_counts(text, name);
-        return floats_of(counts.count, counts.sh_degree);
-      }
+      case detail::Container::kSpz:
+        return detail::read_spz_counts(bytes, name).scene_bytes();
+      case detail::Container::kZip:
+        return detail::read_sog_zip_counts(bytes, name).scene_bytes();
+      case detail::Container::kJson:
+        return detail::is_sog_meta(text) ? detail::read_sog_meta_counts(text, name).scene_bytes() : 0;
       case detail::Container::kGlb:
       case detail::Container::kUnknown:
         return 0;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <span>
@@ -22,6 +23,17 @@ namespace tilesplat::detail {
 using FileLoader = std::function<std::vector<unsigned char>(const std::string& name)>;
 
 class FileContents;  // scene/scene_reading.h
+
+// What a file's header declares (SPZ's, a SOG's meta.json): its Gaussians and their SH degree, for sizing a
+// read before it is made (SceneInParts::whole_scene_bytes).
+struct DeclaredCounts {
+  size_t count = 0;
+  int sh_degree = 0;
+  // The bytes of the GaussianScene arrays such a file fills.
+  uint64_t scene_bytes() const {
+    return uint64_t(count) * (11 + 3 * uint64_t((sh_degree + 1) * (sh_degree + 1))) * sizeof(float);
+  }
+};
 
 // The container a file's first bytes name: the reader they call for (load_scene, SceneInParts). A JSON
 // object may be a glTF, a SOG's meta.json or a LOD set's index; kUnknown may still be a headerless .splat.

@@ -26,14 +26,10 @@ struct SogImage {
   const unsigned char* texel(size_t i) const { return rgba.data() + 4 * i; }
 };
 
-// What a version 2 meta.json declares: its Gaussians and their SH degree. A version 1 meta.json does not
-// say its degree (its palette image's width does): SceneError, as for a malformed one.
-struct SogCounts {
-  size_t count = 0;
-  int sh_degree = 0;
-};
-SogCounts read_sog_zip_counts(std::span<const std::byte> data, std::string_view name);
-SogCounts read_sog_meta_counts(std::string_view meta_json, std::string_view name);
+// What a version 2 meta.json declares. A version 1 meta.json does not say its SH degree (its palette image's
+// width does): SceneError, as for a malformed one.
+DeclaredCounts read_sog_zip_counts(std::span<const std::byte> data, std::string_view name);
+DeclaredCounts read_sog_meta_counts(std::string_view meta_json, std::string_view name);
 
 class SogPacked {
  public:

@@ -368,7 +368,7 @@ bool is_sog_meta(std::string_view json_text) {
   return meta.is_object() && meta.contains("means") && meta.contains("quats");
 }
 
-SogCounts read_sog_meta_counts(std::string_view meta_json, std::string_view name) {
+DeclaredCounts read_sog_meta_counts(std::string_view meta_json, std::string_view name) {
   const json meta = parse_meta(meta_json, name);
   const auto whole_number = [&](const json* value, double most) {
     if (!value || !value->is_number() || !(value->get<double>() >= 0 && value->get<double>() <= most))
@@ -376,14 +376,14 @@ SogCounts read_sog_meta_counts(std::string_view meta_json, std::string_view name
     return static_cast<size_t>(value->get<double>());
   };
   if (!meta.contains("version")) fail(name, "meta.json: version 1 does not declare its SH degree");
-  SogCounts counts;
+  DeclaredCounts counts;
   counts.count = whole_number(meta.contains("count") ? &meta["count"] : nullptr, 4294967295.0);
   if (meta.contains("shN"))
     counts.sh_degree = int(whole_number(meta["shN"].contains("bands") ? &meta["shN"]["bands"] : nullptr, 3));
   return counts;
 }
 
-SogCounts read_sog_zip_counts(std::span<const std::byte> data, std::string_view name) {
+DeclaredCounts read_sog_zip_counts(std::span<const std::byte> data, std::string_view name) {
   const ZipArchive archive(data, name);
   if (!archive.contains("meta.json")) fail(name, "a zip without meta.json, not a SOG archive");
   const std::vector<unsigned char> text = archive.read("meta.json", 64u << 20);

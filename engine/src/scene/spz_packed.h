@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "scene/scene_readers.h"
 #include "tilesplat/scene.h"
 
 namespace tilesplat::detail {
@@ -20,13 +21,8 @@ class FileContents;  // scene/scene_reading.h
 // What a LoadReport lists as ignored for an SPZ whose extension flag is set.
 inline constexpr const char* kSpzExtensionsIgnored = "SPZ extension records (flag 0x2)";
 
-// What an SPZ's header declares: its Gaussians and their SH degree.
-struct SpzCounts {
-  size_t count = 0;
-  int sh_degree = 0;
-};
 // Reads only the header (inflating its 16 bytes from a gzip stream); throws SceneError as SpzPacked does.
-SpzCounts read_spz_counts(std::span<const std::byte> data, std::string_view name);
+DeclaredCounts read_spz_counts(std::span<const std::byte> data, std::string_view name);
 
 class SpzPacked {
  public:

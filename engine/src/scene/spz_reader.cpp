@@ -275,7 +275,7 @@ SpzPacked::SpzPacked(std::span<const std::byte> data, std::string_view name, Fil
   }
 }
 
-SpzCounts read_spz_counts(std::span<const std::byte> data, std::string_view name) {
+DeclaredCounts read_spz_counts(std::span<const std::byte> data, std::string_view name) {
   const std::span<const unsigned char> bytes(reinterpret_cast<const unsigned char*>(data.data()),
                                              data.size());
   unsigned char header_bytes[kLegacyHeaderSize];
