@@ -7,7 +7,8 @@
 # python3-dev and python3-venv build and test the Python package; python3-torch (Debian's CPU build) runs
 # gsplat's PyTorch functions, which python/run_tests.sh holds tilesplat.rasterization() to.
 # doxygen builds the API reference (the docs target and its test); file is what cpack -G DEB asks
-# to find the binaries whose library dependencies it lists.
+# to find the binaries whose library dependencies it lists. ccache lets .ci/run compile the engine once
+# for the build, the Python wheel and the installed shared library (the build itself does not need it).
 # --fuzz adds clang and its compiler-rt (libFuzzer) for tests/fuzz/run.sh; the normal build needs neither.
 # --cluster adds Slurm (slurm-wlm: slurmctld, slurmd, sbatch) and munge for tests/cluster/slurm_test.sh,
 # which runs a one-node cluster of its own; nothing is configured or started here.
@@ -52,7 +53,7 @@ mesa25() {
 pkgs=(
   build-essential cmake ninja-build pkg-config
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
-  glslang-tools spirv-tools doxygen file
+  glslang-tools spirv-tools doxygen file ccache
   libglm-dev libglfw3-dev libopenexr-dev libpng-dev nlohmann-json3-dev libcli11-dev
   zlib1g-dev libzstd-dev libwebp-dev libzip-dev libssl-dev
   libgtest-dev googletest
