@@ -147,13 +147,18 @@ GaussianScene SogPartRows::decode(std::span<const uint32_t> in_file) const {
 
 }  // namespace detail
 
+namespace {
+std::string_view as_text(std::span<const std::byte> bytes) {  // a meta.json's
+  return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+}
+}  // namespace
+
 SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOptions& options,
                                 LoadReport* report) {
   {
     detail::FileContents contents;
     detail::open_scene_file(path, contents);
     const std::span<const std::byte> bytes = contents.bytes();
-    const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     const std::string name = path.string();
     switch (detail::container_of(bytes)) {
       case detail::Container::kPly:
@@ -164,9 +169,10 @@ SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOpt
         return SceneInParts(std::make_shared<const detail::SogPartRows>(
             detail::SogPacked::from_zip(bytes, name), name, options, report));
       case detail::Container::kJson:
-        if (detail::is_sog_meta(text))
+        if (detail::is_sog_meta(as_text(bytes)))
           return SceneInParts(std::make_shared<const detail::SogPartRows>(
-              detail::SogPacked::from_meta(text, name, detail::sibling_loader(path)), name, options, report));
+              detail::SogPacked::from_meta(as_text(bytes), name, detail::sibling_loader(path)), name, options,
+              report));
         [[fallthrough]];
       case detail::Container::kGlb:
       case detail::Container::kUnknown:
@@ -186,7 +192,6 @@ uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
     detail::FileContents contents;
     detail::open_scene_file(path, contents);
     const std::span<const std::byte> bytes = contents.bytes();
-    const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
     const std::string name = path.string();
     switch (detail::container_of(bytes)) {
       case detail::Container::kPly:
@@ -196,7 +201,9 @@ uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
       case detail::Container::kZip:
         return detail::read_sog_zip_counts(bytes, name).scene_bytes();
       case detail::Container::kJson:
-        return detail::is_sog_meta(text) ? detail::read_sog_meta_counts(text, name).scene_bytes() : 0;
+        return detail::is_sog_meta(as_text(bytes))
+                   ? detail::read_sog_meta_counts(as_text(bytes), name).scene_bytes()
+                   : 0;
       case detail::Container::kGlb:
       case detail::Container::kUnknown:
         return 0;
