@@ -3,7 +3,8 @@
 # replays every committed regression input (tests/fuzz/regressions/READER/), then fuzzes each reader
 # for SECONDS, seeded with a few Gaussians cut from every PLY in the shared scenes and scenes/.
 #
-#   bash tests/fuzz/run.sh [SECONDS]     (default 60; env: TILESPLAT_SHARED_SCENES, FUZZ_BUILD_DIR, FUZZ_CXX)
+#   bash tests/fuzz/run.sh [SECONDS]     (default 60; env: TILESPLAT_SHARED_SCENES, FUZZ_BUILD_DIR, FUZZ_CXX,
+#                                         FUZZ_JOBS: readers fuzzed at once, default the cores)
 #
 # libFuzzer's output goes to BUILD/fuzz_READER.log. On a finding (crash, sanitizer report, an
 # exception other than SceneError, a timeout, more than 2 GB of memory) it prints the log's tail and
@@ -78,31 +79,34 @@ stalled() {  # stalled FUZZER ARTIFACT_DIR
     "$1" -timeout=10 -rss_limit_mb=2048 "${found[0]}" >/dev/null 2>&1
 }
 
-status=0
-for reader in "${readers[@]}"; do
-  fuzzer="$build/tests/fuzz/fuzz_$reader"
-  regressions="tests/fuzz/regressions/$reader"
-  log="$build/fuzz_$reader.log"
-  artifacts="$build/artifacts/$reader/"
+# fuzz_reader READER: replays READER's regression inputs, then fuzzes it for SECONDS; prints what it
+# found and fails on a finding.
+fuzz_reader() {
+  local reader="$1"
+  local fuzzer="$build/tests/fuzz/fuzz_$reader"
+  local regressions="tests/fuzz/regressions/$reader"
+  local log="$build/fuzz_$reader.log"
+  local artifacts="$build/artifacts/$reader/"
   rm -rf "$artifacts"
   mkdir -p "$regressions" "$build/corpus/$reader" "$build/seeds/$reader" "$artifacts"
   # Each regression input once, whole (no -max_len), no mutation.
+  local inputs
   mapfile -t inputs < <(find "$regressions" -type f | sort)
   if [ ${#inputs[@]} -gt 0 ] &&
      ! "$fuzzer" -timeout=10 -rss_limit_mb=2048 "${inputs[@]}" >"$build/regressions_$reader.log" 2>&1; then
     findings "$build/regressions_$reader.log"
     echo "fuzz: FAILED: a regression input of $regressions crashes fuzz_$reader again"
-    status=1
-    continue
+    return 1
   fi
   echo "fuzz: $reader: ${#inputs[@]} regression inputs replay cleanly"
   # New inputs go to the first directory (BUILD/corpus, kept between local runs), never to the seeds
   # or the committed regressions.
-  dict=()
+  local dict=()
   [ -f "tests/fuzz/$reader.dict" ] && dict=(-dict="tests/fuzz/$reader.dict")
   if "$fuzzer" "${fuzz_flags[@]}" -max_len="$(max_len "$reader")" -max_total_time="$seconds" -print_final_stats=1 \
        "${dict[@]}" -artifact_prefix="$artifacts" \
        "$build/corpus/$reader" "$build/seeds/$reader" "$regressions" >"$log" 2>&1; then
+    local runs cov
     runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
     cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1)
     echo "fuzz: $reader: ${seconds}s, ${runs:-?} inputs, $cov, no findings (log: $log)"
@@ -113,6 +117,29 @@ for reader in "${readers[@]}"; do
     echo "fuzz: FAILED: fuzz_$reader found a problem; the input is in $artifacts:"
     ls -l "$artifacts"
     echo "fuzz: reproduce with: $fuzzer ${artifacts}FILE ; once fixed, copy the file to $regressions/"
+    return 1
+  fi
+}
+
+# The readers are fuzzed side by side, one a core (libFuzzer runs one process on one core; FUZZ_JOBS
+# sets how many at once): each still gets its SECONDS. Each one's messages are printed, in the readers'
+# order, once it is done; its exit status is kept in a file, so that none can be lost.
+jobs_at_once="${FUZZ_JOBS:-$(nproc)}"
+for reader in "${readers[@]}"; do
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs_at_once" ]; do sleep 1; done
+  rm -f "$build/fuzz_$reader.status"
+  (
+    status=0
+    fuzz_reader "$reader" >"$build/fuzz_$reader.out" 2>&1 || status=$?
+    echo "$status" >"$build/fuzz_$reader.status"
+  ) &
+done
+wait
+status=0
+for reader in "${readers[@]}"; do
+  cat "$build/fuzz_$reader.out"
+  if [ "$(cat "$build/fuzz_$reader.status" 2>/dev/null)" != 0 ]; then
+    echo "fuzz: $reader: failed (exit status $(cat "$build/fuzz_$reader.status" 2>/dev/null || echo unknown))"
     status=1
   fi
 done
