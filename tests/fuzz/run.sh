@@ -126,7 +126,7 @@ fuzz_reader() {
 # order, once it is done; its exit status is kept in a file, so that none can be lost.
 jobs_at_once="${FUZZ_JOBS:-$(nproc)}"
 for reader in "${readers[@]}"; do
-  while [ "$(jobs -rp | wc -l)" -ge "$jobs_at_once" ]; do sleep 1; done
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs_at_once" ]; do wait -n || true; done  # until one is done
   rm -f "$build/fuzz_$reader.status"
   (
     status=0
@@ -138,8 +138,9 @@ wait
 status=0
 for reader in "${readers[@]}"; do
   cat "$build/fuzz_$reader.out"
-  if [ "$(cat "$build/fuzz_$reader.status" 2>/dev/null)" != 0 ]; then
-    echo "fuzz: $reader: failed (exit status $(cat "$build/fuzz_$reader.status" 2>/dev/null || echo unknown))"
+  reader_status=$(cat "$build/fuzz_$reader.status" 2>/dev/null || echo unknown)
+  if [ "$reader_status" != 0 ]; then
+    echo "fuzz: $reader: failed (exit status $reader_status)"
     status=1
   fi
 done
