@@ -46,6 +46,16 @@ TEST(ReferenceOrder, GpuResortingFollowsTheReferencesWindow) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// The re-sorting composite's two layouts (a pixel an invocation as on GPUs, a 16-pixel column as on
+// CPU drivers) offer every pixel the same splats in the same order: the same image bit for bit,
+// depth and splat counts included, with every window slot in use.
+TEST(ReferenceOrder, GpuResortingLayoutsAgreeBitForBit) {
+  RenderSettings settings;
+  settings.accuracy.resort_window = 16;
+  testing::expect_composite_layouts_identical(load_scene(testing::bundled_playbot()), playbot_view(240, 135),
+                                              settings);
+}
+
 // Centre-depth order is 32 dB from the exact ray order on playbot; a window of 16 comes within 40 dB.
 TEST(ReferenceOrder, TheWindowApproachesTheExactRayOrder) {
   Renderer& renderer = testing::validated_renderer();

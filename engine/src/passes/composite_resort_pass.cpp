@@ -2,6 +2,7 @@
 
 #include <bit>
 
+#include "passes/tile_coverage.h"
 #include "shader_io.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/reference.h"
@@ -13,10 +14,19 @@ using shader_io::CompositeResortPush;  // composite_resort.comp's push constants
 static_assert(sizeof(CompositeResortPush) <= 128, "Vulkan guarantees 128 bytes of push constants");
 }  // namespace
 
-// One pixel an invocation everywhere: its window lives in registers. On lavapipe 4 pixels an
-// invocation (fewer reads of each staged splat, as CompositePass does with 16) measured 1.4x
-// slower than 1 on playbot_lod3 at 480x270: four windows spill.
-CompositeResortPass::CompositeResortPass(vk::Context& ctx) : ctx_(ctx), pixels_per_invocation_(1) {}
+// The layouts of CompositePass: one pixel an invocation on GPUs, a 16-pixel column on CPU drivers,
+// where each staged splat is then read once per column and offered only to the rows it reaches
+// (TILESPLAT_COMPOSITE_PIXELS other than 1 picks the column, 1 the GPU layout).
+CompositeResortPass::CompositeResortPass(vk::Context& ctx)
+    : ctx_(ctx), pixels_per_invocation_(composite_pixels_per_invocation(ctx) == 1 ? 1 : kTileSize) {}
+
+uint32_t CompositeResortPass::max_tile_splats() const {
+  if (!ctx_.is_cpu_device()) return 0xffffffffu;
+  // llvmpipe ends an invocation after 65535 loop iterations in all (composite_pass.cpp). A column
+  // spends at most ~560 per batch of 256 splats (staging 16, listing 32, two bands of 256), one
+  // pixel an invocation ~260 per batch.
+  return pixels_per_invocation_ == 1 ? 32768u : 16384u;
+}
 
 void CompositeResortPass::record(VkCommandBuffer cmd, const CompositeInputs& in, const vk::Buffer& ray_depth,
                                  const Camera& camera, uint32_t window, VkDeviceAddress counters) {
@@ -25,16 +35,17 @@ void CompositeResortPass::record(VkCommandBuffer cmd, const CompositeInputs& in,
   auto it = pipelines_.find(variant);
   if (it == pipelines_.end())
     it = pipelines_
-             .emplace(variant,
-                      vk::ComputePipeline(ctx_, "composite_resort", sizeof(CompositeResortPush),
-                                          {{0, variant.write_depth ? 1u : 0u},
-                                           {1, variant.write_count ? 1u : 0u},
-                                           {2, pixels_per_invocation_},
-                                           {3, kTileSize / pixels_per_invocation_},
-                                           {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
-                                           {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
-                                           {7, variant.window},
-                                           {8, std::bit_cast<uint32_t>(variant.cutoffs.max_alpha)}}))
+             .emplace(variant, vk::ComputePipeline(
+                                   ctx_, "composite_resort", sizeof(CompositeResortPush),
+                                   {{0, variant.write_depth ? 1u : 0u},
+                                    {1, variant.write_count ? 1u : 0u},
+                                    {2, pixels_per_invocation_},
+                                    {3, kTileSize / pixels_per_invocation_},
+                                    {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
+                                    {5, std::bit_cast<uint32_t>(coverage_alpha_inv(variant.cutoffs.alpha))},
+                                    {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
+                                    {7, variant.window},
+                                    {8, std::bit_cast<uint32_t>(variant.cutoffs.max_alpha)}}))
              .first;
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);

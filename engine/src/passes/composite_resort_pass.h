@@ -19,8 +19,8 @@ class CompositeResortPass {
               const Camera& camera, uint32_t window, VkDeviceAddress counters);
   // The longest tile list this pass blends on this device; a longer one is written to
   // FrameCounters::max_tile_pairs (and the frame is refused). Unlimited except on CPU drivers,
-  // where llvmpipe cuts a shader short after 65535 loop iterations (~130 per batch of 128 here).
-  uint32_t max_tile_splats() const { return ctx_.is_cpu_device() ? 32768u : 0xffffffffu; }
+  // where llvmpipe cuts a shader short after 65535 loop iterations.
+  uint32_t max_tile_splats() const;
 
  private:
   vk::Context& ctx_;
