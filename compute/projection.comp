@@ -57,6 +57,10 @@ layout(constant_id = 12) const bool FILE_NORMALS = false;
 // The camera model (tilesplat::CameraModel): 0 pinhole, 1 OpenCV, 2 fisheye, 3 orthographic, 4
 // equirectangular. The pinhole's code is the only code of the default pipeline.
 layout(constant_id = 13) const uint CAMERA_MODEL = 0;
+// Radial sorting (AccuracyModes::SortDepth::kDistance): the depth key is the centre's distance from the
+// camera, not its z; a turn in place keeps every distance, so it keeps the order. Only the pinhole and
+// OpenCV cameras set it: the other models' depth is already the distance, or, orthographic, has none.
+layout(constant_id = 14) const bool DISTANCE_KEY = false;
 const uint MODEL_PINHOLE = 0, MODEL_OPENCV = 1, MODEL_FISHEYE = 2, MODEL_ORTHOGRAPHIC = 3, MODEL_EQUIRECTANGULAR = 4;
 // Records per Gaussian (camera_models::seam_copies): the equirectangular camera draws a splat a second
 // time a period to the side, so that one across the +-180 degree seam shows on both edges. Gaussian i's
@@ -360,7 +364,9 @@ bool project_centre(real3 t, uint seam_copy, out real2 mean, out real3 j0, out r
 }
 
 // Returns the tiles touched (0 = culled) and fills the splat record of Gaussian i's copy `seam_copy`.
-uint project(uint i, uint seam_copy, out vec4 record[SPLAT_VEC4S], out uvec2 rect) {
+// `sort_depth`: what the depth sort orders the record by (its view depth, or the distance: DISTANCE_KEY).
+uint project(uint i, uint seam_copy, out vec4 record[SPLAT_VEC4S], out uvec2 rect, out float sort_depth) {
+  sort_depth = 0.0;  // a culled record's: it sorts last whatever this is
   real3 world = real3(position_of(i));
   real3 rel = world - real3(to_real(camera_word(CAMERA_CENTRE)), to_real(camera_word(CAMERA_CENTRE + 1)), to_real(camera_word(CAMERA_CENTRE + 2)));
   realmat3 W;  // column-major: W[c][r] = rotation[r][c]
@@ -485,6 +491,7 @@ uint project(uint i, uint seam_copy, out vec4 record[SPLAT_VEC4S], out uvec2 rec
   // The mean is stored as float hi + lo so that (pixel - mean) in the composite stays accurate.
   vec2 mean_lo = vec2(mean - real2(mean_hi));
   record[0] = vec4(mean_hi, float(depth), opacity);
+  sort_depth = float(DISTANCE_KEY ? length(t) : depth);
   record[1] = vec4(vec3(c / det, -b / det, a / det), mean_lo.x);
   record[2] = vec4(colour, mean_lo.y);
   record[3] = cov_det;
@@ -517,13 +524,15 @@ void main() {
     uint i = j - seam_copy * pc.count;
     vec4 record[SPLAT_VEC4S];
     uvec2 rect;
-    touched = project(i, seam_copy, record, rect);
+    float sort_depth;
+    touched = project(i, seam_copy, record, rect, sort_depth);
     write_projected(j, record, rect, touched > 0);
     write_tile_count(j, touched);
-    // View depth > near > 0, so its IEEE bits order like unsigned integers; their top 24 bits too.
+    // The sort depth (view depth > near > 0, or a distance > 0), so its IEEE bits order like unsigned
+    // integers; their top 24 bits too.
     // 16-bit keys are made by depth_quantize.comp once the visible range is known: here the float
     // bits. Culled Gaussians touch no tile; they sort last only to keep the visible ones together.
-    uint depth_bits = floatBitsToUint(record[0].z);
+    uint depth_bits = floatBitsToUint(sort_depth);
     uint key = DEPTH_KEY_BITS == 24 ? depth_bits >> 8 : depth_bits;
     write_depth_pair(j, touched > 0 ? key : (DEPTH_KEY_BITS == 24 ? 0xffffffu : 0xffffffffu));
     depth_near = touched > 0 ? depth_bits : 0xffffffffu;

@@ -112,6 +112,8 @@ void validate(const AccuracyModes& m) {
     fail("alpha_cutoff must be in (0, 0.99], not " + format_value(m.alpha_cutoff));
   if (m.resort_window != 0 && (m.resort_window < 2 || m.resort_window > 16))
     fail("resort_window must be 0 (off) or 2 to 16, not " + std::to_string(m.resort_window));
+  if (m.sort_depth != AccuracyModes::SortDepth::kView && m.sort_depth != AccuracyModes::SortDepth::kDistance)
+    fail("unknown sort depth");
   if (m.extent != AccuracyModes::Extent::kSigma3 && m.extent != AccuracyModes::Extent::kOpacityAware)
     fail("unknown extent");
   if (m.tile_test != AccuracyModes::TileTest::kEllipse && m.tile_test != AccuracyModes::TileTest::kSquare)
@@ -122,6 +124,7 @@ std::string to_string(const AccuracyModes& m) {
   const AccuracyModes reference;
   std::vector<std::string> parts;
   if (m.depth_key_bits != reference.depth_key_bits) parts.push_back("depth" + std::to_string(m.depth_key_bits));
+  if (m.sort_depth == AccuracyModes::SortDepth::kDistance) parts.push_back("radial");
   if (m.extent == AccuracyModes::Extent::kOpacityAware) parts.push_back("opacity-extent");
   if (m.tile_test == AccuracyModes::TileTest::kSquare) parts.push_back("square-tiles");
   if (m.sh_degree_cap != reference.sh_degree_cap) parts.push_back("sh" + std::to_string(m.sh_degree_cap));
@@ -152,6 +155,8 @@ AccuracyModes parse_accuracy_modes(const std::string& text) {
     if (token == "reference") {
     } else if (token == "depth32" || token == "depth24" || token == "depth16") {
       m.depth_key_bits = std::stoi(token.substr(5));
+    } else if (token == "radial") {
+      m.sort_depth = AccuracyModes::SortDepth::kDistance;
     } else if (token == "opacity-extent") {
       m.extent = AccuracyModes::Extent::kOpacityAware;
     } else if (token == "square-tiles") {
@@ -174,7 +179,8 @@ AccuracyModes parse_accuracy_modes(const std::string& text) {
       m.resort_window = parse_int(token, token.substr(6));
     } else {
       bad(token,
-          "unknown; known: reference, depth24, depth16, opacity-extent, square-tiles, sh0..sh3, fp16-sh, "
+          "unknown; known: reference, depth24, depth16, radial, opacity-extent, square-tiles, sh0..sh3, "
+          "fp16-sh, "
           "fp16-cov, t-cutoff=X, alpha-cutoff=X, resortN, fp16-blend");
     }
     if (end == text.size()) break;

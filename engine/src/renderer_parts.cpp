@@ -116,7 +116,7 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
   double pairs_per_gaussian = kFirstPairsPerGaussian;
   size_t capacity = part_capacity(budget, costs, 0, pairs_per_gaussian, device);  // or a clear error
   const auto order_start = std::chrono::steady_clock::now();
-  const DepthOrder order(scene, camera, settings.near_plane, settings.accuracy.depth_key_bits,
+  const DepthOrder order(scene, camera, settings.near_plane, settings.accuracy,
                          ctx.features().shader_float64 ? kDepthMarginFloat64 : kDepthMarginFloat32);
   const std::chrono::duration<double, std::milli> order_time = std::chrono::steady_clock::now() - order_start;
 

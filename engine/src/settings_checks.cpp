@@ -61,6 +61,12 @@ void check_camera_model(const RenderSettings& settings, const Camera& camera) {
     throw std::invalid_argument("per-pixel re-sorting (resort" +
                                 std::to_string(settings.accuracy.resort_window) +
                                 ") needs a pinhole camera, not " + camera_model_name(camera.model));
+  // An orthographic camera's centre is at infinity: every distance from it is the same infinite one.
+  if (camera_models::drawn_model(camera) == CameraModel::kOrthographic &&
+      settings.accuracy.sort_depth == AccuracyModes::SortDepth::kDistance)
+    throw std::invalid_argument(
+        "radial sorting orders by the distance from the camera's centre, and an orthographic camera has none "
+        "(it looks from infinitely far): sort by view depth");
 }
 
 void check_region(const RenderSettings& settings, const Camera& camera) {

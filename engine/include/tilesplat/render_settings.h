@@ -27,6 +27,17 @@ struct AccuracyModes {
   /// linearly over the frame's visible depth range (two digits fewer; near-coincident splats tie
   /// and fall back to index order, which pops).
   int depth_key_bits = 32;
+  /// What the depth sort orders the splats by.
+  enum class SortDepth {
+    kView,      ///< the centre's view depth z (reference; the fisheye and panorama cameras: its distance)
+    kDistance,  ///< the centre's distance from the camera (radial, as Spark sorts): a camera turning in place
+                ///< keeps every distance, so the blending order cannot pop under a turn
+  };
+  /// The depth the splats sort by (reference: view depth). kDistance changes the pinhole and OpenCV cameras'
+  /// order only (the fisheye and panorama cameras already sort by distance); the orthographic camera, at
+  /// no finite distance, refuses it, and so does the stochastic compositor, which sorts nothing. Depth
+  /// images still average view depth.
+  SortDepth sort_depth = SortDepth::kView;
   /// How far from its mean a splat reaches, in standard deviations of its major axis.
   enum class Extent {
     kSigma3,        ///< 3 sigma (reference)
@@ -61,7 +72,7 @@ struct AccuracyModes {
 
 /// "reference", or the modes that differ from it joined by '+', e.g. "depth16+sh1+t-cutoff=0.001".
 TILESPLAT_API std::string to_string(const AccuracyModes& modes);
-/// The inverse of to_string. Tokens: reference, depth24, depth16, opacity-extent, square-tiles,
+/// The inverse of to_string. Tokens: reference, depth24, depth16, radial, opacity-extent, square-tiles,
 /// sh0..sh3, fp16-sh, fp16-cov, t-cutoff=X, alpha-cutoff=X (X a number or a fraction like 1/64),
 /// resortN or resort=N, fp16-blend. Throws std::invalid_argument naming the bad token.
 TILESPLAT_API AccuracyModes parse_accuracy_modes(const std::string& text);

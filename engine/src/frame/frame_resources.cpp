@@ -252,7 +252,10 @@ CompositePass::HostSurface FrameResources::host_surface(const RenderSettings& se
   if (host_view_depth.size() > 0) surface.view_depth = &host_view_depth;
   if (host_surface_depth.size() > 0) surface.surface_depth = &host_surface_depth;
   surface.surface_alpha = settings.host->alpha_threshold;
-  surface.exact_depth_order = settings.accuracy.depth_key_bits == 32;
+  // A pixel may stop at its first splat behind the host's surface only when the splats come in exact view
+  // depth order: not with shortened keys, nor sorted by distance.
+  surface.exact_depth_order = settings.accuracy.depth_key_bits == 32 &&
+                              settings.accuracy.sort_depth == AccuracyModes::SortDepth::kView;
   return surface;
 }
 

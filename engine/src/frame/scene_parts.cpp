@@ -22,10 +22,11 @@ namespace tilesplat {
 namespace {
 
 // The depth the projection sorts by: the distance for the models that project by direction (fisheye,
-// panorama), the view z for the others (projection.comp, project_centre).
-bool sorts_by_distance(const Camera& camera) {
+// panorama) and in radial sorting, the view z otherwise (projection.comp, project_centre and DISTANCE_KEY).
+bool sorts_by_distance(const Camera& camera, AccuracyModes::SortDepth sort_depth) {
   const CameraModel model = camera_models::drawn_model(camera);
-  return model == CameraModel::kFisheye || model == CameraModel::kEquirectangular;
+  return model == CameraModel::kFisheye || model == CameraModel::kEquirectangular ||
+         sort_depth == AccuracyModes::SortDepth::kDistance;
 }
 
 // A depth's key as the projection forms it: the float's bits (positive floats order as integers),
@@ -102,10 +103,11 @@ struct DepthBounds {
 // threads than on one).
 class GaussianDepths {
  public:
-  GaussianDepths(const PartSource& scene, const Camera& camera, double relative_margin)
+  GaussianDepths(const PartSource& scene, const Camera& camera, AccuracyModes::SortDepth sort_depth,
+                 double relative_margin)
       : scene_(&scene),
         camera_(camera),
-        distance_(sorts_by_distance(camera)),
+        distance_(sorts_by_distance(camera, sort_depth)),
         centre_size_(std::abs(camera.position[0]) + std::abs(camera.position[1]) +
                      std::abs(camera.position[2])),
         relative_margin_(relative_margin) {}
@@ -130,13 +132,14 @@ class GaussianDepths {
 
 }  // namespace
 
-DepthOrder::DepthOrder(const PartSource& scene, const Camera& camera, double near_plane, int depth_key_bits,
-                       double relative_margin, unsigned threads) {
+DepthOrder::DepthOrder(const PartSource& scene, const Camera& camera, double near_plane,
+                       const AccuracyModes& modes, double relative_margin, unsigned threads) {
+  const int depth_key_bits = modes.depth_key_bits;
   if (depth_key_bits != 24 && depth_key_bits != 32)
     throw std::invalid_argument("a scene in parts sorts by 24- or 32-bit depth keys, not " +
                                 std::to_string(depth_key_bits));
   const size_t n = scene.size();
-  const GaussianDepths depths(scene, camera, relative_margin);
+  const GaussianDepths depths(scene, camera, modes.sort_depth, relative_margin);
   // Tens of millions of Gaussians take seconds of host time here, before the first part: the work is
   // spread over the host's cores in contiguous ranges (host_resources.h), each kept in order, so the
   // order and the bounds are one thread's, bit for bit.

@@ -1,8 +1,9 @@
 // A scene rendered in parts that follow the frame's depth order (Renderer::render(scene, camera,
 // settings) under RenderSettings::memory_budget; renderer_parts.cpp runs them). The host sorts the
 // Gaussians once by the depth the GPU sorts them by (view z, or the distance for the fisheye and the
-// panorama); each part is then a run of consecutive Gaussians of that order, uploaded in scene order,
-// projected, sorted and composited like a frame, with each pixel's state carried from part to part.
+// panorama and in radial sorting); each part is then a run of consecutive Gaussians of that order, uploaded
+// in scene order, projected, sorted and composited like a frame, with each pixel's state carried from part to
+// part.
 //
 // The GPU sorts each part again by its own float keys and breaks ties by scene index, so a part may
 // end only where the host's order and the GPU's cannot disagree: where every Gaussian before the
@@ -66,12 +67,18 @@ class PartSource {
 class DepthOrder {
  public:
   // The Gaussians the GPU may draw (those clearly behind the near plane, or with non-finite depths,
-  // are left out), front to back. depth_key_bits is the frame's (24 or 32; std::invalid_argument
-  // otherwise); relative_margin kDepthMarginFloat64 or kDepthMarginFloat32, as the device projects.
-  // `threads`: the host threads it computes on; 0 for as many as the scene's size calls for, up to
-  // the host's cores (the result is the same for any).
-  DepthOrder(const PartSource& scene, const Camera& camera, double near_plane, int depth_key_bits,
+  // are left out), front to back by the frame's sort depth (`modes.sort_depth`) in its depth keys
+  // (`modes.depth_key_bits`: 24 or 32; std::invalid_argument otherwise); relative_margin
+  // kDepthMarginFloat64 or kDepthMarginFloat32, as the device projects. `threads`: the host threads it
+  // computes on; 0 for as many as the scene's size calls for, up to the host's cores (the result is the
+  // same for any).
+  DepthOrder(const PartSource& scene, const Camera& camera, double near_plane, const AccuracyModes& modes,
              double relative_margin, unsigned threads = 0);
+  // The view depth order in `depth_key_bits`-bit keys.
+  DepthOrder(const PartSource& scene, const Camera& camera, double near_plane, int depth_key_bits,
+             double relative_margin, unsigned threads = 0)
+      : DepthOrder(scene, camera, near_plane, AccuracyModes{.depth_key_bits = depth_key_bits},
+                   relative_margin, threads) {}
 
   size_t size() const { return order_.size(); }
   // The scene index of the Gaussian at `position` (< size()) of the order.

@@ -108,7 +108,8 @@ const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant&
                                                 {10, v.compensate_opacity},
                                                 {11, v.lighting},
                                                 {12, v.file_normals},
-                                                {13, v.camera_model}};
+                                                {13, v.camera_model},
+                                                {14, v.distance_key}};
     const char* shader = texel                            ? "projection_texel"
                          : ctx_.features().shader_float64 ? "projection"
                                                           : "projection_fp32";

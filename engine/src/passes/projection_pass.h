@@ -43,6 +43,7 @@ struct ProjectionVariant {
   bool square_tiles = false;
   float alpha_inv = 255.0f;
   uint32_t depth_key_bits = 32;
+  bool distance_key = false;  // key by the centre's distance, not its z (AccuracyModes::SortDepth::kDistance)
   bool ray_depth = false;  // write ProjectedBuffers::ray_depth
   uint32_t dilation_tenths = 3;  // the antialiasing mode's low-pass filter, in 0.1 px^2
   bool compensate_opacity = false;

@@ -3,6 +3,7 @@
 // rounded to float32, because the GPU sorts by float_bits(depth) and the reference must order
 // splats exactly as it does.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
@@ -174,20 +175,34 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
   // One record per Gaussian, two for the equirectangular camera (its seam copies, records n..2n - 1).
   const size_t records = n * camera_models::seam_copies(camera.model);
   std::vector<ProjectedGaussian> projected(records);
+  // What each record sorts by, as the projection keys it (projection.comp's sort_depth): the view depth
+  // (a fisheye's or panorama's distance), or in radial sorting the pinhole's and OpenCV camera's distance.
+  const CameraModel model = camera_models::drawn_model(camera);
+  const bool radial = settings.accuracy.sort_depth == AccuracyModes::SortDepth::kDistance &&
+                      (model == CameraModel::kPinhole || model == CameraModel::kOpenCV);
+  std::vector<float> sort_depth(records);
   parallel_chunks(records, 4096, [&](size_t begin, size_t end) {
-    for (size_t r = begin; r < end; ++r)
-      projected[r] =
-          reference::project(scene, r % std::max<size_t>(n, 1), camera, limits, settings.antialiasing,
-                             lighting, settings.near_plane, uint32_t(r / std::max<size_t>(n, 1)));
+    for (size_t r = begin; r < end; ++r) {
+      const size_t i = r % std::max<size_t>(n, 1);
+      projected[r] = reference::project(scene, i, camera, limits, settings.antialiasing, lighting,
+                                        settings.near_plane, uint32_t(r / std::max<size_t>(n, 1)));
+      double depth = projected[r].depth;
+      if (radial) {
+        const std::array<double, 3> t =
+            camera.to_camera({double(scene.positions[3 * i]), double(scene.positions[3 * i + 1]),
+                              double(scene.positions[3 * i + 2])});
+        depth = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+      }
+      sort_depth[r] = float(depth);
+    }
   });
 
   // Front to back by the float32 depth the GPU sorts on, ties by record index.
   std::vector<uint32_t> order;
   for (size_t i = 0; i < records; ++i)
     if (projected[i].visible) order.push_back(static_cast<uint32_t>(i));
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t lhs, uint32_t rhs) {
-    return static_cast<float>(projected[lhs].depth) < static_cast<float>(projected[rhs].depth);
-  });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t lhs, uint32_t rhs) { return sort_depth[lhs] < sort_depth[rhs]; });
 
   std::vector<Splat> splats(order.size());
   for (size_t s = 0; s < order.size(); ++s) {
