@@ -150,6 +150,20 @@ TEST(Viewer, ATurningCameraStreamsTheLevelsItCallsFor) {
   EXPECT_GE(difference.psnr_db, 100.0) << "max abs " << difference.max_abs;
 }
 
+// Radial sorting measures from the camera's centre: through --orthographic (no centre) it is a usage error
+// before any window, naming both flags.
+TEST(Viewer, RadialSortingRefusesTheOrthographicLens) {
+  REQUIRE_VIEWER();
+  std::vector<std::string> args = view_args(bundled_playbot(), bundled_playbot_cameras(), 2);
+  args.insert(args.end(), {"--orthographic", "3", "--no-mesh", "--mode", "radial"});
+  const ProcessResult radial = run_process("env -u DISPLAY ", kViewerExe, args);
+  EXPECT_EQ(radial.exit_code, 2) << radial.err;
+  EXPECT_NE(radial.err.find("radial sorting (--mode radial) measures from the camera's centre, which "
+                            "--orthographic does not have"),
+            std::string::npos)
+      << radial.err;
+}
+
 // --fisheye, --equirectangular (and key L's cycle) show the splats through another lens: the screenshot
 // is tilesplat-render's frame through the same lens. They need --no-mesh (the box and the grid are drawn
 // through a pinhole), and per-pixel re-sorting needs the pinhole: usage errors before any window.

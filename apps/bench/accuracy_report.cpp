@@ -47,6 +47,9 @@ std::vector<AccuracyModes> default_modes() {
       with({"resort4"}),
       with({"resort8"}),
       with({"resort16"}),
+      // Sorted by distance: the order a turn in place keeps (Spark's radial sort); alone and re-sorted.
+      with({"radial"}),
+      with({"radial", "resort16"}),
       // The raster compositor's half-precision blend (its report only: the others refuse it).
       with({"fp16-blend"}),
       // What a web viewer does: 16-bit depths, fp16 attributes, opacity-aware squares.

@@ -46,9 +46,11 @@ using tilesplat::viewer::WindowDevice;
 
 using namespace tilesplat::viewer;
 constexpr int kDefaultWindowWidth = 960;  // the height follows the view's aspect
-// What key M steps through: the reference; depth16, the web viewers' sort keys; resort8, per-pixel
-// re-sorting, more exact than the reference; and the web viewers' shortcuts all together.
-constexpr const char* kModeCycle[] = {"reference", "depth16", "resort8", "depth16+opacity-extent+fp16-sh+fp16-cov"};
+// What key M steps through: the reference; depth16, the web viewers' sort keys; radial, the order a turn
+// in place keeps; resort8, per-pixel re-sorting, more exact than the reference; and the web viewers'
+// shortcuts all together.
+constexpr const char* kModeCycle[] = {"reference", "depth16", "radial", "resort8",
+                                      "depth16+opacity-extent+fp16-sh+fp16-cov"};
 // What key C steps through: the tile compositor, the raster one (which draws no re-sorting: M skips
 // resort8 while it is on) and the stochastic one, whose frames add up while the view rests.
 constexpr std::array<tilesplat::Compositor, 3> kCompositorCycle = {
@@ -331,11 +333,12 @@ class Viewer {
     self(window).needs_render_ = true;
   }
 
-  // Whether the frame draws in `modes`: the compositor's rule, and per-pixel re-sorting through the
-  // pinhole alone.
+  // Whether the frame draws in `modes`: the compositor's rule, per-pixel re-sorting through the pinhole
+  // alone, and radial sorting through any lens but the orthographic one (no centre to measure from).
   bool draws(const tilesplat::AccuracyModes& modes) const {
     return tilesplat::compositor_draws(kCompositorCycle[compositor_], modes) &&
-           (modes.resort_window == 0 || !lenses_[lens_].enabled());
+           (modes.resort_window == 0 || !lenses_[lens_].enabled()) &&
+           (modes.sort_depth == tilesplat::AccuracyModes::SortDepth::kView || !lenses_[lens_].view_height);
   }
 
   // The next accuracy mode the frame draws (the reference always is one).

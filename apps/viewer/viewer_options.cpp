@@ -83,6 +83,10 @@ void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& optio
       options.common.modes.front().resort_window > 0)
     throw cli::UsageError("per-pixel re-sorting (--mode " + to_string(options.common.modes.front()) +
                           ") needs the pinhole camera");
+  if (options.camera_model.view_height && !options.common.modes.empty() &&
+      options.common.modes.front().sort_depth == AccuracyModes::SortDepth::kDistance)
+    throw cli::UsageError("radial sorting (--mode " + to_string(options.common.modes.front()) +
+                          ") measures from the camera's centre, which --orthographic does not have");
   if (!options.screenshot.empty()) {
     if (!cli::has_extension(options.screenshot, ".exr") && !cli::has_extension(options.screenshot, ".png"))
       throw cli::UsageError("--screenshot expects an .exr or .png file, got '" + options.screenshot + "'");
