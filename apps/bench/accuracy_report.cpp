@@ -49,6 +49,7 @@ std::vector<AccuracyModes> default_modes() {
       with({"resort16"}),
       // Sorted by distance: the order a turn in place keeps (Spark's radial sort); alone and re-sorted.
       with({"radial"}),
+      with({"radial", "resort4"}),
       with({"radial", "resort16"}),
       // The raster compositor's half-precision blend (its report only: the others refuse it).
       with({"fp16-blend"}),
