@@ -99,6 +99,18 @@ TEST(RadialSort, ATurnInPlaceKeepsTheOrderThatViewDepthSwaps) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// The bundled playbot_lod3, read once for the tests that render it.
+const GaussianScene& playbot() {
+  static const GaussianScene scene = load_scene(testing::bundled_playbot());
+  return scene;
+}
+
+RenderSettings radial_settings() {
+  RenderSettings settings;
+  settings.accuracy = radial();
+  return settings;
+}
+
 Camera playbot_view(int width, int height) {
   return resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, width, height);
 }
@@ -107,11 +119,10 @@ Camera playbot_view(int width, int height) {
 // 16-bit keys, quantized over the visible distances, it stays close to the 32-bit one.
 TEST(RadialSort, GpuMatchesTheReferenceOnATrainedScene) {
   Renderer& renderer = testing::validated_renderer();
-  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const GaussianScene& scene = playbot();
   renderer.set_scene(scene);
   const Camera camera = playbot_view(240, 135);
-  RenderSettings settings;
-  settings.accuracy = radial();
+  const RenderSettings settings = radial_settings();
   const RenderImage gpu = renderer.render(camera, settings);
   testing::expect_matches_reference(gpu, render_reference(scene, camera, settings), 2e-3, "radial");
 
@@ -132,14 +143,13 @@ TEST(RadialSort, GpuMatchesTheReferenceOnATrainedScene) {
 // distance, so radial leaves their images as they were.
 TEST(RadialSort, FollowsTheCameraModels) {
   Renderer& renderer = testing::validated_renderer();
-  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const GaussianScene& scene = playbot();
   renderer.set_scene(scene);
   const Camera pinhole = playbot_view(160, 90);
   Camera opencv = pinhole;
   opencv.model = CameraModel::kOpenCV;
   opencv.distortion = {0.05, -0.01, 0.001, 0.0005};
-  RenderSettings settings;
-  settings.accuracy = radial();
+  const RenderSettings settings = radial_settings();
   testing::expect_matches_reference(renderer.render(opencv, settings),
                                     render_reference(scene, opencv, settings), 2e-3, "radial, OpenCV camera");
   for (const Camera& camera : {fisheye_camera(pinhole, 180), equirectangular_camera(pinhole)}) {
@@ -158,8 +168,7 @@ TEST(RadialSort, FollowsTheCameraModels) {
 }
 
 TEST(RadialSort, TheStochasticCompositorRefusesIt) {
-  RenderSettings settings;
-  settings.accuracy = radial();
+  RenderSettings settings = radial_settings();
   settings.compositor = Compositor::kStochastic;
   EXPECT_FALSE(compositor_draws(Compositor::kStochastic, settings.accuracy));
   EXPECT_TRUE(compositor_draws(Compositor::kSorted, settings.accuracy));
@@ -176,11 +185,10 @@ TEST(RadialSort, TheStochasticCompositorRefusesIt) {
 // whole scene's, bit for bit.
 TEST(RadialSort, AScenesPartsFollowTheRadialOrder) {
   Renderer& renderer = testing::validated_renderer();
-  const GaussianScene scene = load_scene(testing::bundled_playbot());
+  const GaussianScene& scene = playbot();
   renderer.set_scene(scene);
   const Camera camera = playbot_view(240, 135);
-  RenderSettings settings;
-  settings.accuracy = radial();
+  const RenderSettings settings = radial_settings();
   const RenderImage whole = renderer.render(camera, settings);
   // A renderer of its own: the budget counts every buffer a renderer holds.
   RendererOptions options;
