@@ -135,6 +135,29 @@ TEST(HostDepth, TiltedPlaneThroughARealSceneMatchesTheReference) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// Radial sorting (AccuracyModes::SortDepth::kDistance) blends in distance order, where a splat behind the
+// host's surface may come before one in front of it: no pixel may stop at the first splat behind it, and
+// the cut image and its depth out stay the reference's in the same order.
+TEST(HostDepth, RadialSortingTestsEverySplatAgainstTheSurface) {
+  const Views& views = playbot_views();
+  auto& renderer = tilesplat::testing::validated_renderer();
+  renderer.set_scene(views.scene);
+  const DepthConvention convention = DepthConvention::from_projection(vulkan_projection(0.05, 200, false));
+  const Camera& camera = views.cameras.front();
+  const std::vector<float> plane = tilted_plane(views, camera, convention);
+  RenderSettings settings;
+  settings.accuracy.sort_depth = tilesplat::AccuracyModes::SortDepth::kDistance;
+  settings.host = HostDepth{convention, plane, true, 0.5f};
+  const tilesplat::RenderImage gpu = renderer.render(camera, settings);
+  const tilesplat::RenderImage reference = tilesplat::render_reference(views.scene, camera, settings);
+  tilesplat::testing::expect_matches_reference(gpu, reference, 2e-3, "host depth, radial sorting");
+  size_t differ = 0;
+  for (size_t i = 0; i < gpu.pixels(); ++i)
+    if (std::abs(gpu.host_depth[i] - reference.host_depth[i]) > 1e-6f) ++differ;
+  EXPECT_LE(differ, gpu.pixels() / 10000) << "pixels whose depth out differs from the reference";
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 // An OpenGL projection (y up, NDC depth in [-1, 1]) with near and far planes, column-major.
 std::array<double, 16> opengl_projection(double near, double far) {
   std::array<double, 16> p = vulkan_projection(near, far, false);

@@ -212,6 +212,19 @@ def test_the_float64_reference(playbot_renderer):
         tilesplat.render_reference(camera)
 
 
+def test_an_accuracy_mode_reaches_the_renderer_and_the_reference(playbot_renderer):
+    # radial: the depth sort by distance from the camera; the reference sorts the same way.
+    scene, renderer = playbot_renderer
+    camera = tilesplat.Camera.orbit(scene, 96, 54, azimuth_deg=30)
+    radial = renderer.render(camera, accuracy="radial")
+    assert tilesplat.compare_images(radial, tilesplat.render_reference(camera, scene=scene, accuracy="radial"))[
+        "psnr_db"
+    ] > 60
+    assert not np.array_equal(radial.rgba, renderer.render(camera).rgba)
+    with pytest.raises(ValueError, match="radiall"):
+        renderer.render(camera, accuracy="radiall")
+
+
 def test_a_scene_files_moving_models_blur_under_an_open_shutter(playbot_renderer):
     _, renderer = playbot_renderer
     instances = tilesplat.SceneInstances(REPO / "scenes" / "moving_playbots.json")
