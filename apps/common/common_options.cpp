@@ -197,9 +197,9 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
   }
 
   const std::string modes_help =
-      "reference, depth24, depth16, radial, opacity-extent, square-tiles, sh0..sh3, fp16-sh, fp16-cov, "
-      "t-cutoff=X, "
-      "alpha-cutoff=X (X a number or 1/64), resortN (2-16), fp16-blend (raster); combine with '+'";
+      "reference, depth24, depth16, radial, opacity-extent, square-tiles, sh0..sh3, fp16-sh, "
+      "fp16-cov, t-cutoff=X, alpha-cutoff=X (X a number or 1/64), resortN (2-16), fp16-blend (raster); "
+      "combine with '+'";
   auto parse_modes = [](const std::string& text) {
     try {
       return parse_accuracy_modes(std::string(trim(text)));

@@ -180,8 +180,7 @@ AccuracyModes parse_accuracy_modes(const std::string& text) {
     } else {
       bad(token,
           "unknown; known: reference, depth24, depth16, radial, opacity-extent, square-tiles, sh0..sh3, "
-          "fp16-sh, "
-          "fp16-cov, t-cutoff=X, alpha-cutoff=X, resortN, fp16-blend");
+          "fp16-sh, fp16-cov, t-cutoff=X, alpha-cutoff=X, resortN, fp16-blend");
     }
     if (end == text.size()) break;
   }

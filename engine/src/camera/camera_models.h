@@ -43,6 +43,13 @@ inline CameraModel drawn_model(const Camera& camera) {
   return camera.model;
 }
 
+// Whether the model's depth (CentreProjection::depth, what splats sort by) is the distance from the camera:
+// the models that project by direction (fisheye, panorama). The others' is the view z, which radial sorting
+// (AccuracyModes::SortDepth::kDistance) replaces with the distance.
+inline bool depth_is_distance(CameraModel model) {
+  return model == CameraModel::kFisheye || model == CameraModel::kEquirectangular;
+}
+
 // How many records each Gaussian projects to: 2 for the equirectangular camera, whose splats across the
 // +-180 degree seam are drawn again one period (2 pi fx) to the other side; 1 for the others.
 inline uint32_t seam_copies(CameraModel model) {

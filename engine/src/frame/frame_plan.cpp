@@ -74,9 +74,8 @@ std::optional<std::string> modes_refusal(Compositor compositor, const AccuracyMo
     return "stochastic compositor: " + resort +
            " re-orders depth-sorted lists, and this compositor sorts nothing: use the sorted compositor";
   if (modes.sort_depth == AccuracyModes::SortDepth::kDistance)
-    return "stochastic compositor: radial sorting orders the depth sort, which this compositor does not run "
-           "(it "
-           "keeps the nearest drawn splat by view depth): leave radial out";
+    return "stochastic compositor: radial sorting orders the depth sort, which this compositor does not "
+           "run (it keeps the nearest drawn splat by view depth): leave radial out";
   if (modes.depth_key_bits != 32)
     return "stochastic compositor: " + std::to_string(modes.depth_key_bits) +
            "-bit depth keys approximate the depth sort, which this compositor does not run (it compares full "
@@ -273,7 +272,7 @@ ProjectionVariant projection_variant(const RenderSettings& settings, const Scene
   v.depth_key_bits = uint32_t(modes.depth_key_bits);
   // The fisheye and panorama cameras' depth is already the distance (projection.comp, project_centre).
   v.distance_key = modes.sort_depth == AccuracyModes::SortDepth::kDistance &&
-                   (camera_model == CameraModel::kPinhole || camera_model == CameraModel::kOpenCV);
+                   !camera_models::depth_is_distance(camera_model);
   v.ray_depth = modes.resort_window > 0;
   v.lighting = settings.lighting.enabled();
   v.file_normals = v.lighting && scene.file_normals;

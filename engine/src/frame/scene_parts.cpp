@@ -24,8 +24,7 @@ namespace {
 // The depth the projection sorts by: the distance for the models that project by direction (fisheye,
 // panorama) and in radial sorting, the view z otherwise (projection.comp, project_centre and DISTANCE_KEY).
 bool sorts_by_distance(const Camera& camera, AccuracyModes::SortDepth sort_depth) {
-  const CameraModel model = camera_models::drawn_model(camera);
-  return model == CameraModel::kFisheye || model == CameraModel::kEquirectangular ||
+  return camera_models::depth_is_distance(camera_models::drawn_model(camera)) ||
          sort_depth == AccuracyModes::SortDepth::kDistance;
 }
 
