@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "tilesplat/camera.h"
+#include "tilesplat/render_settings.h"
 
 namespace tilesplat::camera_models {
 
@@ -48,6 +49,14 @@ inline CameraModel drawn_model(const Camera& camera) {
 // (AccuracyModes::SortDepth::kDistance) replaces with the distance.
 inline bool depth_is_distance(CameraModel model) {
   return model == CameraModel::kFisheye || model == CameraModel::kEquirectangular;
+}
+
+// Whether the depth sort keys a model's records by their distance from the camera where the model's own
+// depth is the view z: radial sorting through the pinhole or OpenCV camera (projection.comp's
+// DISTANCE_KEY; the float64 reference sorts the same way). The orthographic camera refuses radial sorting
+// before this is asked (check_camera_model).
+inline bool radial_replaces_depth(CameraModel model, AccuracyModes::SortDepth sort_depth) {
+  return sort_depth == AccuracyModes::SortDepth::kDistance && !depth_is_distance(model);
 }
 
 // How many records each Gaussian projects to: 2 for the equirectangular camera, whose splats across the

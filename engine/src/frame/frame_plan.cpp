@@ -270,9 +270,7 @@ ProjectionVariant projection_variant(const RenderSettings& settings, const Scene
   v.square_tiles = modes.tile_test == AccuracyModes::TileTest::kSquare;
   v.alpha_inv = coverage_alpha_inv(modes.alpha_cutoff);
   v.depth_key_bits = uint32_t(modes.depth_key_bits);
-  // The fisheye and panorama cameras' depth is already the distance (projection.comp, project_centre).
-  v.distance_key = modes.sort_depth == AccuracyModes::SortDepth::kDistance &&
-                   !camera_models::depth_is_distance(camera_model);
+  v.distance_key = camera_models::radial_replaces_depth(camera_model, modes.sort_depth);
   v.ray_depth = modes.resort_window > 0;
   v.lighting = settings.lighting.enabled();
   v.file_normals = v.lighting && scene.file_normals;

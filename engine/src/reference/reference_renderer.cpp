@@ -178,8 +178,8 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
   std::vector<ProjectedGaussian> projected(records);
   // What each record sorts by, as the projection keys it (projection.comp's sort_depth): the view depth
   // (a fisheye's or panorama's distance), or in radial sorting the pinhole's and OpenCV camera's distance.
-  const bool radial = settings.accuracy.sort_depth == AccuracyModes::SortDepth::kDistance &&
-                      !camera_models::depth_is_distance(camera_models::drawn_model(camera));
+  const bool radial =
+      camera_models::radial_replaces_depth(camera_models::drawn_model(camera), settings.accuracy.sort_depth);
   std::vector<float> sort_depth(records);
   parallel_chunks(records, 4096, [&](size_t begin, size_t end) {
     for (size_t r = begin; r < end; ++r) {
