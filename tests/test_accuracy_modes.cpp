@@ -241,6 +241,51 @@ TEST(AccuracyModes, CompositorDrawsIsTheRuleRenderHolds) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// camera_draws is the rule render() and render_reference() refuse by: each camera model against modes
+// it draws and not.
+TEST(AccuracyModes, CameraDrawsIsTheRuleRenderHolds) {
+  Renderer& renderer = testing::validated_renderer();
+  const GaussianScene scene = load_scene(testing::bundled_sh3());
+  renderer.set_scene(scene);
+  const Camera pinhole = orbit_camera(scene, 32, 24);
+  Camera undistorted = pinhole;
+  undistorted.model = CameraModel::kOpenCV;
+  Camera distorted = undistorted;
+  distorted.distortion = {0.05, -0.01, 0.001, 0.0005};
+  const std::vector<Camera> cameras = {pinhole,
+                                       undistorted,
+                                       distorted,
+                                       fisheye_camera(pinhole, 180),
+                                       orthographic_camera(pinhole, 3.0),
+                                       equirectangular_camera(pinhole)};
+  for (const Camera& camera : cameras)
+    for (const char* name : {"reference", "resort4", "radial", "radial+resort4"}) {
+      RenderSettings settings;
+      settings.accuracy = parse_accuracy_modes(name);
+      bool rendered = true, referenced = true;
+      try {
+        renderer.render(camera, settings);
+      } catch (const std::invalid_argument&) {
+        rendered = false;
+      }
+      try {
+        render_reference(scene, camera, settings);
+      } catch (const std::invalid_argument&) {
+        referenced = false;
+      }
+      const std::string what = std::string(camera_model_name(camera.model)) + " " + name;
+      EXPECT_EQ(camera_draws(camera, settings.accuracy), rendered) << what;
+      EXPECT_EQ(rendered, referenced) << what;
+    }
+  EXPECT_TRUE(camera_draws(undistorted, parse_accuracy_modes("resort4")));  // drawn as the pinhole
+  EXPECT_FALSE(camera_draws(distorted, parse_accuracy_modes("resort4")));
+  EXPECT_FALSE(camera_draws(fisheye_camera(pinhole, 180), parse_accuracy_modes("resort4")));
+  EXPECT_TRUE(camera_draws(equirectangular_camera(pinhole), parse_accuracy_modes("radial")));
+  EXPECT_FALSE(camera_draws(orthographic_camera(pinhole, 3.0), parse_accuracy_modes("radial")));
+  EXPECT_TRUE(camera_draws(orthographic_camera(pinhole, 3.0), parse_accuracy_modes("depth16")));
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 // The half-precision harmonics are packed by one dispatch that strides: a scene of SH degree 3 has 24
 // words a Gaussian to pack, and past 699,050 Gaussians more than lavapipe's 65,535 workgroups of 256
 // (which stopped the mode before). 720,000 Gaussians behind the camera come first, so that the 64 it

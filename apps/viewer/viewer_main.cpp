@@ -333,12 +333,10 @@ class Viewer {
     self(window).needs_render_ = true;
   }
 
-  // Whether the frame draws in `modes`: the compositor's rule, per-pixel re-sorting through the pinhole
-  // alone, and radial sorting through any lens but the orthographic one (no centre to measure from).
+  // Whether the frame draws in `modes`: the compositor's rule and the lens's (the library's own).
   bool draws(const tilesplat::AccuracyModes& modes) const {
     return tilesplat::compositor_draws(kCompositorCycle[compositor_], modes) &&
-           (modes.resort_window == 0 || !lenses_[lens_].enabled()) &&
-           (modes.sort_depth == tilesplat::AccuracyModes::SortDepth::kView || !lenses_[lens_].view_height);
+           tilesplat::camera_draws(camera(), modes);
   }
 
   // The next accuracy mode the frame draws (the reference always is one).

@@ -79,14 +79,16 @@ void check_viewer_flags(const cli::ArgParser& parser, const ViewerOptions& optio
                           std::string(options.camera_model.fisheye_fov_deg ? "--fisheye"
                                       : options.camera_model.view_height   ? "--orthographic"
                                                                            : "--equirectangular"));
-  if (options.camera_model.enabled() && !options.common.modes.empty() &&
-      options.common.modes.front().resort_window > 0)
-    throw cli::UsageError("per-pixel re-sorting (--mode " + to_string(options.common.modes.front()) +
-                          ") needs the pinhole camera");
-  if (options.camera_model.view_height && !options.common.modes.empty() &&
-      options.common.modes.front().sort_depth == AccuracyModes::SortDepth::kDistance)
-    throw cli::UsageError("radial sorting (--mode " + to_string(options.common.modes.front()) +
+  // The lens's rule (camera_draws) on the lens alone: no scene's camera is loaded yet.
+  if (!options.common.modes.empty() &&
+      !camera_draws(cli::camera_for_frame(options.camera_model, Camera{}), options.common.modes.front())) {
+    const AccuracyModes& modes = options.common.modes.front();
+    if (modes.resort_window > 0)
+      throw cli::UsageError("per-pixel re-sorting (--mode " + to_string(modes) +
+                            ") needs the pinhole camera");
+    throw cli::UsageError("radial sorting (--mode " + to_string(modes) +
                           ") measures from the camera's centre, which --orthographic does not have");
+  }
   if (!options.screenshot.empty()) {
     if (!cli::has_extension(options.screenshot, ".exr") && !cli::has_extension(options.screenshot, ".png"))
       throw cli::UsageError("--screenshot expects an .exr or .png file, got '" + options.screenshot + "'");

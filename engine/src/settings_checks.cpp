@@ -1,6 +1,7 @@
 #include "settings_checks.h"
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -56,17 +57,30 @@ void check_shutter(const RenderSettings& settings, const Camera& camera) {
         "(RenderSettings::host)");
 }
 
-void check_camera_model(const RenderSettings& settings, const Camera& camera) {
-  if (camera_models::drawn_model(camera) != CameraModel::kPinhole && settings.accuracy.resort_window > 0)
-    throw std::invalid_argument("per-pixel re-sorting (resort" +
-                                std::to_string(settings.accuracy.resort_window) +
-                                ") needs a pinhole camera, not " + camera_model_name(camera.model));
+namespace {
+
+// Why `camera` cannot draw in `modes`, or nothing: the one rule of camera_draws and check_camera_model.
+std::optional<std::string> camera_refusal(const Camera& camera, const AccuracyModes& modes) {
+  const CameraModel model = camera_models::drawn_model(camera);
+  if (model != CameraModel::kPinhole && modes.resort_window > 0)
+    return "per-pixel re-sorting (resort" + std::to_string(modes.resort_window) +
+           ") needs a pinhole camera, not " + camera_model_name(camera.model);
   // An orthographic camera's centre is at infinity: every distance from it is the same infinite one.
-  if (camera_models::drawn_model(camera) == CameraModel::kOrthographic &&
-      settings.accuracy.sort_depth == AccuracyModes::SortDepth::kDistance)
-    throw std::invalid_argument(
-        "radial sorting orders by the distance from the camera's centre, and an orthographic camera has none "
-        "(it looks from infinitely far): sort by view depth");
+  if (model == CameraModel::kOrthographic && modes.sort_depth == AccuracyModes::SortDepth::kDistance)
+    return "radial sorting orders by the distance from the camera's centre, and an orthographic camera has "
+           "none "
+           "(it looks from infinitely far): sort by view depth";
+  return std::nullopt;
+}
+
+}  // namespace
+
+bool camera_draws(const Camera& camera, const AccuracyModes& modes) {
+  return !camera_refusal(camera, modes).has_value();
+}
+
+void check_camera_model(const RenderSettings& settings, const Camera& camera) {
+  if (const auto why = camera_refusal(camera, settings.accuracy)) throw std::invalid_argument(*why);
 }
 
 void check_region(const RenderSettings& settings, const Camera& camera) {

@@ -16,8 +16,8 @@ void check_lens(const RenderSettings& settings, const Camera& camera);
 // RenderSettings::shutter, where a frame through it can be made: a valid shutter (validate(Shutter)), an
 // end camera of the camera's size, and no host depth. Throws std::invalid_argument.
 void check_shutter(const RenderSettings& settings, const Camera& camera);
-// What a camera model rules out: the per-pixel re-sorting (its rays are the pinhole's) needs
-// CameraModel::kPinhole. Throws std::invalid_argument.
+// What a camera model rules out (camera_draws): the per-pixel re-sorting (its rays are the pinhole's) needs
+// CameraModel::kPinhole, radial sorting a camera centre. Throws std::invalid_argument.
 void check_camera_model(const RenderSettings& settings, const Camera& camera);
 // RenderSettings::region: whole, or within the camera's image (validate(PixelRegion)), and not with a host's
 // depth, which is the whole image's. Throws std::invalid_argument.

@@ -148,6 +148,12 @@ TILESPLAT_API Compositor parse_compositor(const std::string& name);
 /// depth keys below 32 bits (it sorts nothing). Renderer::render throws std::invalid_argument, saying
 /// why, for the others.
 TILESPLAT_API bool compositor_draws(Compositor compositor, const AccuracyModes& modes);
+/// Whether `camera` draws frames in the accuracy `modes`: per-pixel re-sorting (AccuracyModes::resort_window)
+/// follows the pinhole's rays, so it needs a pinhole camera (an OpenCV camera without distortion is one);
+/// radial sorting (AccuracyModes::SortDepth::kDistance) measures from the camera's centre, which an
+/// orthographic camera does not have. Renderer::render and render_reference throw std::invalid_argument,
+/// saying why, for the others.
+TILESPLAT_API bool camera_draws(const Camera& camera, const AccuracyModes& modes);
 /// How the stochastic compositor draws each splat's threshold u at a pixel (it keeps the splat when
 /// u < alpha). Both are uniform on [0, 1) for each splat, pixel and frame, independent between splats,
 /// so both converge to the sorted image; they differ in how the frames of one render() spread.
