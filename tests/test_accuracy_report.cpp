@@ -5,7 +5,11 @@
 #include <cmath>
 
 #include "accuracy_report.h"
+#include "test_support.h"
 #include "tilesplat/camera.h"
+#include "tilesplat/image.h"
+#include "tilesplat/reference.h"
+#include "tilesplat/scene.h"
 
 namespace {
 
@@ -114,6 +118,49 @@ TEST(TurnCamera, TurnsAboutTheLineAndBack) {
   const Camera rolled = tilesplat::turn_camera(start, start.position, forward, 0.5);
   EXPECT_EQ(rolled.position, start.position);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(rolled.rotation[6 + k], forward[k], 1e-12);
+}
+
+// The view-consistency pair in the exact ray order: the report's figure is that pair's, rendered by the
+// float64 reference at twice the view's size and turned in place as the reference's own pair is.
+TEST(AccuracyReport, MeasuresTheExactRayOrdersViewConsistency) {
+  using namespace tilesplat;
+  const GaussianScene scene = load_scene(tilesplat::testing::bundled_sh3());
+  const Camera view = orbit_camera(scene, 64, 36);
+  accuracy::Options options;
+  options.modes = {AccuracyModes{}};
+  options.views = {view};
+  options.view_names = {"view 0"};
+  options.warmup = 0;
+  options.repeat = 1;
+  options.path_frames = 0;
+  options.consistency_angle = 0.05;
+  int steps = 0, total = 0;
+  const accuracy::SceneReport report = accuracy::measure_scene(
+      tilesplat::testing::validated_renderer(), scene, options, [&](int done, int of, const std::string&) {
+        steps = done;
+        total = of;
+      });
+  EXPECT_EQ(steps, total);
+  EXPECT_EQ(total, accuracy::work_units(options, scene.sh_degree));
+
+  const std::vector<Camera> turned =
+      camera_path(CameraPath::kPan, resize_camera(view, 128, 72), {}, 2, options.consistency_angle);
+  RenderSettings settings;
+  settings.splat_count = false;
+  auto pair_inconsistency = [&](ReferenceOrder order) {
+    return rotation_inconsistency(render_reference(scene, turned[0], settings, order), turned[0],
+                                  render_reference(scene, turned[1], settings, order), turned[1],
+                                  accuracy::kConsistencyBlock, accuracy::kConsistencyThreshold);
+  };
+  const TemporalDifference exact = pair_inconsistency(ReferenceOrder::kRayDepth);
+  const TemporalDifference centre = pair_inconsistency(ReferenceOrder::kSettings);
+  EXPECT_EQ(report.exact_order_inconsistency, exact.flicker_fraction);
+  EXPECT_EQ(report.exact_order_inconsistency_mean, exact.mean_abs);
+  EXPECT_EQ(report.reference_inconsistency_mean, centre.mean_abs);
+  // The two orders differ on this scene, so the figure is not the centre-depth order's again.
+  EXPECT_NE(exact.mean_abs, centre.mean_abs);
+  EXPECT_NE(accuracy::text_table(report).find("(in the exact ray order "), std::string::npos)
+      << accuracy::text_table(report);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -114,6 +115,11 @@ struct SceneReport {
   double consistency_angle = 0;  // radians; 0: not measured
   double reference_inconsistency = 0;       // the float64 reference's (centre-depth order: not 0)
   double reference_inconsistency_mean = 0;
+  // The same pair rendered by the float64 reference in the exact ray order (ReferenceOrder::kRayDepth); NaN
+  // where the view is not a pinhole's. Not 0 either: where two splats' ray depths cross within a pixel the
+  // blend order flips, an edge the turned view's resampling does not reproduce (docs/accuracy.md).
+  double exact_order_inconsistency = std::numeric_limits<double>::quiet_NaN();
+  double exact_order_inconsistency_mean = std::numeric_limits<double>::quiet_NaN();
   std::vector<ModeResult> modes;
 };
 
