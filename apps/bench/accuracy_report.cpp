@@ -223,26 +223,27 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
   };
   report.consistency_angle = turned.empty() ? 0 : options.consistency_angle;
   if (!turned.empty()) {
-    std::vector<RenderImage> pair;
-    for (size_t f = 0; f < turned.size(); ++f) {
-      pair.push_back(render_reference(scene, turned[f], reference_settings));
-      step("float64 reference, turned view " + std::to_string(f));
-    }
-    const TemporalDifference inconsistency = inconsistency_of(pair[0], pair[1]);
-    report.reference_inconsistency = inconsistency.flicker_fraction;
-    report.reference_inconsistency_mean = inconsistency.mean_abs;
-    // What the exact per-pixel order leaves (its rays are a pinhole's, as for the views above).
-    std::vector<RenderImage> exact_pair;
-    for (size_t f = 0; f < turned.size(); ++f) {
-      if (turned[f].model == CameraModel::kPinhole)
-        exact_pair.push_back(
-            render_reference(scene, turned[f], reference_settings, ReferenceOrder::kRayDepth));
-      step("float64 reference in exact ray order, turned view " + std::to_string(f));
-    }
-    if (exact_pair.size() == turned.size()) {
-      const TemporalDifference exact = inconsistency_of(exact_pair[0], exact_pair[1]);
-      report.exact_order_inconsistency = exact.flicker_fraction;
-      report.exact_order_inconsistency_mean = exact.mean_abs;
+    // The float64 reference's pair in `order`; none in the exact ray order, whose rays are a pinhole's, for
+    // another camera (as for the views above).
+    auto reference_pair_inconsistency = [&](ReferenceOrder order,
+                                            const std::string& what) -> std::optional<TemporalDifference> {
+      std::vector<RenderImage> pair;
+      for (size_t f = 0; f < turned.size(); ++f) {
+        if (order != ReferenceOrder::kRayDepth || turned[f].model == CameraModel::kPinhole)
+          pair.push_back(render_reference(scene, turned[f], reference_settings, order));
+        step(what + ", turned view " + std::to_string(f));
+      }
+      if (pair.size() != turned.size()) return std::nullopt;
+      return inconsistency_of(pair[0], pair[1]);
+    };
+    const TemporalDifference centre_order =
+        *reference_pair_inconsistency(ReferenceOrder::kSettings, "float64 reference");
+    report.reference_inconsistency = centre_order.flicker_fraction;
+    report.reference_inconsistency_mean = centre_order.mean_abs;
+    if (const auto exact =
+            reference_pair_inconsistency(ReferenceOrder::kRayDepth, "float64 reference in exact ray order")) {
+      report.exact_order_inconsistency = exact->flicker_fraction;
+      report.exact_order_inconsistency_mean = exact->mean_abs;
     }
   }
 
@@ -474,8 +475,7 @@ std::string markdown(const std::vector<SceneReport>& reports, const DeviceInfo& 
                        cli::format_number(100.0 * report.exact_order_inconsistency, 3) + "% (" +
                        cli::format_number(report.exact_order_inconsistency_mean, 6) +
                        "): not 0, since where two splats' ray depths cross within a pixel the blend order "
-                       "flips, "
-                       "an edge the turned view's resampling does not reproduce.");
+                       "flips, an edge the turned view's resampling does not reproduce.");
     md += "\n\n";
     md +=
         "| mode | GPU frame ms | vs reference | PSNR dB | SSIM | max abs | pairs | flicker % | excess change "

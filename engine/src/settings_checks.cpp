@@ -68,8 +68,7 @@ std::optional<std::string> camera_refusal(const Camera& camera, const AccuracyMo
   // An orthographic camera's centre is at infinity: every distance from it is the same infinite one.
   if (model == CameraModel::kOrthographic && modes.sort_depth == AccuracyModes::SortDepth::kDistance)
     return "radial sorting orders by the distance from the camera's centre, and an orthographic camera has "
-           "none "
-           "(it looks from infinitely far): sort by view depth";
+           "none (it looks from infinitely far): sort by view depth";
   return std::nullopt;
 }
 
