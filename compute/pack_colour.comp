@@ -1,7 +1,9 @@
 #version 460
 // Pack colour: the frame's float RGBA (premultiplied) into the texel layout of a host's colour image
 // that is not R32G32B32A32_SFLOAT, for render_to_image to copy. One invocation per pixel.
-//   FORMAT 0: R16G16B16A16_SFLOAT (round to nearest half; 8 bytes a texel)
+//   FORMAT 0: R16G16B16A16_SFLOAT (round to nearest half; 8 bytes a texel). A finite value past half's
+//             range becomes the largest finite half with its sign, never an infinity, and is counted in
+//             COUNTER_SATURATED (FrameStats::saturated).
 //   FORMAT 1: R8G8B8A8_UNORM and R8G8B8A8_SRGB (clamped to [0, 1], round(255 c); 4 bytes). The frame's
 //             colours are already sRGB-encoded display values (docs/colour.md), so an _SRGB image gets the
 //             same bytes: a host sampling it reads linear light, and a second encoding would wash it out.
@@ -18,6 +20,11 @@ void main() {
   uint i = pixel.y * pc.width + pixel.x;
   vec4 c = pc.rgba.v[i];
   if (FORMAT == 0) {
+    const float kHalfMax = 65504.0;
+    uvec4 past = uvec4(greaterThan(abs(c), vec4(kHalfMax)));
+    uint saturated = past.x + past.y + past.z + past.w;
+    if (saturated > 0u) atomicAdd(pc.counters.v[COUNTER_SATURATED], saturated);
+    c = clamp(c, vec4(-kHalfMax), vec4(kHalfMax));
     pc.packed.v[2 * i] = packHalf2x16(c.rg);
     pc.packed.v[2 * i + 1] = packHalf2x16(c.ba);
   } else {

@@ -68,7 +68,8 @@ TS_CONST uint COUNTER_DEPTH_MAX = 25;       // 16-bit depth keys (AccuracyModes:
 TS_CONST uint COUNTER_PAIRS_LOW = 26;       // the projection's own low word of the total, for its carries
 TS_CONST uint COUNTER_MAX_TILE_PAIRS = 27;  // the longest tile list over the composite's chunk size
 TS_CONST uint COUNTER_BIG_SPLATS = 28;      // 3 uints: splats listed for key_emission_big.comp (its dispatch)
-TS_CONST uint COUNTER_UINTS = 32;           // the block's size (one spare uint at the end)
+TS_CONST uint COUNTER_SATURATED = 31;       // colour values saturated to half's range (pack_colour.comp)
+TS_CONST uint COUNTER_UINTS = 32;           // the block's size
 
 // A sort's state block (SortState): the key count it sorts (set before the sort runs) and what the
 // sort derives from it on the GPU (its block count and the indirect dispatch of its per-block passes).
@@ -442,6 +443,7 @@ TS_PUSH_INSTANCE;
 TS_PUSH_CONSTANTS(PackColourPush) {
   TS_REF(Vec4Array) rgba;
   TS_REF(UintArray) packed;
+  TS_REF(UintArray) counters;  // COUNTER_SATURATED: values past half's range (FORMAT 0)
   uint width;
   uint height;
 }

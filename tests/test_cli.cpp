@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -984,6 +985,55 @@ TEST(CliBench, CsvAndJsonRecordTheBuildAndTheCommand) {
   ASSERT_GE(keys.size(), 3u);
   EXPECT_EQ(std::vector<std::string>(keys.begin(), keys.begin() + 3),
             (std::vector<std::string>{"tool", "tilesplat", "command"}));
+}
+
+// A scene whose colours are finite but far outside [0, 1] (SH DC 1e20: the issue-58 file): the EXR stays
+// finite in scene-linear float and half, the values past the type's range saturate to its largest finite
+// value, and the run says how many in one line on stderr, in --stats and in the header.
+TEST(CliRender, HugeColoursSaturateInTheExrAndAreReported) {
+  const auto out = fresh_output_dir();
+  std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\n";
+  for (const char* name : {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "opacity", "scale_0", "scale_1",
+                           "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
+    ply += std::string("property float ") + name + "\n";
+  ply += "end_header\n"
+         "-0.3 0 3 0.5 0.5 0.5 4 -1.5 -1.5 -1.5 1 0 0 0\n"
+         "0 0 3.03 1e20 1e20 1e20 4 -1.5 -1.5 -1.5 1 0 0 0\n"
+         "0.3 0 3.06 400 400 400 4 -1.5 -1.5 -1.5 1 0 0 0\n";
+  const fs::path scene = out / "huge_colours.ply";
+  std::ofstream(scene) << ply;
+  for (const bool half : {false, true}) {
+    SCOPED_TRACE(half ? "half" : "float");
+    const fs::path exr = out / (half ? "half.exr" : "float.exr");
+    std::vector<std::string> args = {scene.string(), "--width", "64", "--height", "48", "--fov", "60", "--stats",
+                                     "-o", exr.string()};
+    if (half) args.push_back("--half");
+    const auto result = run_exe(kRenderExe, args);
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const tilesplat::StoredExr stored = tilesplat::read_exr_as_stored(exr);
+    uint64_t at_largest = 0;
+    const float largest = half ? 65504.0f : std::numeric_limits<float>::max();
+    for (const float v : stored.image.rgba) {
+      ASSERT_TRUE(std::isfinite(v)) << v;
+      at_largest += std::abs(v) == largest;
+    }
+    EXPECT_GT(at_largest, 0u);
+    const std::string count = std::to_string(at_largest);
+    EXPECT_TRUE(contains(result.err, exr.string() + ": " + count + " values (")) << result.err;
+    EXPECT_TRUE(contains(result.err, std::string("past the range of ") + (half ? "half" : "float"))) << result.err;
+    EXPECT_TRUE(contains(result.out, "saturated values")) << result.out;
+    EXPECT_TRUE(contains(result.out, count)) << result.out;
+    const auto attributes = tilesplat::read_exr_string_attributes(exr);
+    ASSERT_TRUE(attributes.count(tilesplat::kSaturatedAttribute)) << "the header records it";
+    EXPECT_TRUE(contains(attributes.at(tilesplat::kSaturatedAttribute), half ? "(half)" : "(float)"));
+  }
+  // The display values hold the frame as it is: nothing saturates, nothing is said.
+  const fs::path display = out / "display.exr";
+  const auto result = run_exe(kRenderExe, {scene.string(), "--width", "64", "--height", "48", "--exr-colour",
+                                           "display", "-o", display.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_FALSE(contains(result.err, "saturated")) << result.err;
+  EXPECT_FALSE(tilesplat::read_exr_string_attributes(display).count(tilesplat::kSaturatedAttribute));
 }
 
 TEST(CliRender, ExrRecordsTheBuildAndTheCommand) {

@@ -770,6 +770,76 @@ TEST_F(HostApplication, RendersIntoHalfAndEightBitColourImages) {
   EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
 }
 
+// A frame with colours far outside [0, 1] (a splat of SH DC 1e20 beside ordinary ones; finite in memory)
+// copied into the host's images (issue 58): the half image holds the largest finite half (65,504) with the
+// value's sign where the value passes half's range, never an infinity, and FrameStats::saturated counts
+// those values; the 8-bit images clamp to [0, 1] as UNORM does; the float image is the frame itself.
+TEST_F(HostApplication, HugeColoursSaturateInTheHostsHalfImageAndAreCounted) {
+  constexpr uint32_t kWidth = 64, kHeight = 48;
+  GaussianScene scene;
+  for (int i = 0; i < 3; ++i) {
+    const float dc = i == 1 ? 1e20f : 0.5f;
+    scene.positions.insert(scene.positions.end(), {0.3f * float(i - 1), 0.0f, 3.0f + 0.03f * float(i)});
+    scene.log_scales.insert(scene.log_scales.end(), {-1.5f, -1.5f, -1.5f});
+    scene.rotations.insert(scene.rotations.end(), {1, 0, 0, 0});
+    scene.opacity_logits.push_back(1.5f);
+    scene.sh.insert(scene.sh.end(), {dc, dc, dc});
+  }
+  const Camera camera = testing::axis_camera(int(kWidth), int(kHeight), 60);
+  make_staging(VkDeviceSize(kWidth) * kHeight * 16);
+  auto renderer = create_renderer(external());
+  renderer->set_scene(scene);
+  const std::vector<float> expected = renderer->render(camera).rgba;
+  size_t past_half = 0;
+  for (const float value : expected) {
+    ASSERT_TRUE(std::isfinite(value));
+    past_half += std::abs(value) > 65504.0f;
+  }
+  ASSERT_GT(past_half, 0u) << "the case must pass half's range";
+  auto half_to_float = [](uint16_t h) {
+    const int exponent = (h >> 10) & 0x1f, mantissa = h & 0x3ff;
+    if (exponent == 0x1f) return mantissa ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
+    const float magnitude =
+        exponent == 0 ? std::ldexp(float(mantissa), -24) : std::ldexp(float(mantissa | 0x400), exponent - 25);
+    return (h & 0x8000) ? -magnitude : magnitude;
+  };
+  for (const VkFormat format : {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R8G8B8A8_UNORM,
+                                VK_FORMAT_R32G32B32A32_SFLOAT}) {
+    const Image image = make_image(format, 0, kWidth, kHeight);
+    render_to_image(*renderer, camera, {}, {image.image, kWidth, kHeight, format, VK_IMAGE_LAYOUT_UNDEFINED});
+    const SaturatedValues saturated = renderer->last_frame_stats().saturated;
+    read_image(image.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL, kWidth, kHeight);
+    for (size_t i = 0; i < expected.size(); ++i) {
+      const float value = expected[i];
+      if (format == VK_FORMAT_R16G16B16A16_SFLOAT) {
+        const float stored = half_to_float(static_cast<const uint16_t*>(staging_data)[i]);
+        ASSERT_TRUE(std::isfinite(stored)) << "value " << i << " (" << value << ")";
+        if (std::abs(value) > 65504.0f)
+          ASSERT_EQ(stored, std::copysign(65504.0f, value)) << "value " << i;
+        else
+          ASSERT_LE(std::abs(stored - value), std::max(std::abs(value) * 0x1p-11f, 0x1p-25f)) << "value " << i;
+      } else if (format == VK_FORMAT_R8G8B8A8_UNORM) {
+        const int stored = static_cast<const uint8_t*>(staging_data)[i];
+        ASSERT_LE(std::abs(stored - 255.0 * std::clamp(double(value), 0.0, 1.0)), 0.5 + 1e-3) << "value " << i;
+      } else {
+        ASSERT_EQ(static_cast<const float*>(staging_data)[i], value) << "value " << i;
+      }
+    }
+    const uint64_t want = format == VK_FORMAT_R16G16B16A16_SFLOAT ? past_half : 0;
+    EXPECT_EQ(saturated.total(), want) << "format " << format << ": " << saturated.describe();
+  }
+  // A frame without waiting counts the same once it is waited for.
+  const Image image = make_image(VK_FORMAT_R16G16B16A16_SFLOAT, 0, kWidth, kHeight);
+  render_to_image(*renderer, camera, {},
+                  {image.image, kWidth, kHeight, VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_LAYOUT_UNDEFINED}, nullptr,
+                  HostFrameSync{});
+  wait_for_frame(*renderer);
+  EXPECT_EQ(renderer->last_frame_stats().saturated.total(), past_half);
+  renderer.reset();
+  release_host_objects();
+  EXPECT_EQ(messages, 0) << "validation messages on the host's instance";
+}
+
 // Depth of field a sample a frame, as a window shows a still view converging
 // (RenderSettings::accumulate_samples): frames submitted without waiting (HostFrameSync), each adding one
 // lens sample on the device, leave in the host's image the mean that render() makes of the same samples.

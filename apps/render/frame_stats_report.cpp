@@ -38,6 +38,10 @@ void print_frame_stats(const tilesplat::FrameStats& stats, const tilesplat::Devi
   print_row("scene parts", std::to_string(stats.scene_parts), "");
   print_row("depth order", cli::format_fixed(stats.depth_order_ms, 1), "ms");
   print_row("image bands", std::to_string(stats.image_bands), "");
+  // Values stored as their type's largest finite value instead of an infinity (image.h, SaturatedValues).
+  print_row("saturated values", std::to_string(stats.saturated.total()), "");
+  for (const auto& [channel, count] : stats.saturated.channels)
+    print_row("  saturated " + channel, std::to_string(count), "");
   print_row("peak resident memory", mib(cli::peak_memory_bytes()), "MiB");
 }
 

@@ -276,8 +276,9 @@ struct FrameWriter {
   tilesplat::ExrWriteOptions exr;
   tilesplat::PreviewOptions preview;
 
-  // Writes the EXR, then the preview (a preview must never exist without the image it previews).
-  void write(const Frame& frame, const tilesplat::RenderImage& image) const {
+  // Writes the EXR, then the preview (a preview must never exist without the image it previews). Returns
+  // the values the EXR saturated (write_exr), which it reports on stderr in one line.
+  tilesplat::SaturatedValues write(const Frame& frame, const tilesplat::RenderImage& image) const {
     tilesplat::ExrWriteOptions options = exr;
     options.camera = frame.camera;  // worldToCamera, worldToNDC and the exact camera
     options.display_width = frame.camera.width;  // a region's display window (--region)
@@ -287,17 +288,25 @@ struct FrameWriter {
       options.attributes["viewIndex"] = std::to_string(*frame.view_index);
       options.attributes["viewName"] = frame.view_name;
     }
+    tilesplat::SaturatedValues saturated;
     try {
-      tilesplat::write_exr(frame.exr, image, options);
+      saturated = tilesplat::write_exr(frame.exr, image, options);
     } catch (const std::exception& error) {
       throw std::runtime_error(write_failure(frame.exr, error));
     }
-    if (frame.png.empty()) return;
-    try {
-      tilesplat::write_png_preview(frame.png, image, preview);
-    } catch (const std::exception& error) {
-      throw std::runtime_error(write_failure(frame.png, error));
+    if (saturated.total() > 0)
+      cli::print_warning(kProgram, frame.exr.string() + ": " + saturated.describe() + " past the range of " +
+                                       (options.half ? "half" : "float") +
+                                       " stored as its largest finite value (the header's " +
+                                       tilesplat::kSaturatedAttribute + " records them)");
+    if (!frame.png.empty()) {
+      try {
+        tilesplat::write_png_preview(frame.png, image, preview);
+      } catch (const std::exception& error) {
+        throw std::runtime_error(write_failure(frame.png, error));
+      }
     }
+    return saturated;
   }
 };
 
@@ -538,9 +547,11 @@ int run(int argc, char** argv) {
   FrameRenderer renderer(options, loaded);
   writer.exr.attributes["sortStrategy"] = renderer.sort_strategy(settings);
   const tilesplat::RenderImage image = renderer.render(frame.camera, settings);
+  const tilesplat::SaturatedValues saturated = writer.write(frame, image);
   std::string timing;
   if (const tilesplat::Renderer* gpu = renderer.gpu()) {
-    const tilesplat::FrameStats& stats = gpu->last_frame_stats();
+    tilesplat::FrameStats stats = gpu->last_frame_stats();
+    stats.saturated += saturated;  // the file's, for --stats
     timing = "GPU " + cli::format_fixed(stats.gpu_ms, 2) + " ms, frame " +
              cli::format_fixed(stats.cpu_ms, 2) + " ms";
     if (options.stats) print_frame_stats(stats, gpu->device_info());
@@ -553,9 +564,9 @@ int run(int argc, char** argv) {
     if (options.stats) {
       print_row("cpu reference", cli::format_fixed(renderer.cpu_ms(), 3), "ms");
       print_row("gaussians", std::to_string(loaded.gaussians()), "");
+      print_row("saturated values", std::to_string(saturated.total()), "");
     }
   }
-  writer.write(frame, image);
   std::string written = options.output;
   if (!options.png.empty()) written += ", " + options.png;
 

@@ -137,6 +137,13 @@ RenderSettings make_settings(const std::string& sort, bool depth, bool splat_cou
   return settings;
 }
 
+// SaturatedValues as {channel: count}.
+nb::dict saturated_dict(const SaturatedValues& saturated) {
+  nb::dict out;
+  for (const auto& [channel, count] : saturated.channels) out[channel.c_str()] = count;
+  return out;
+}
+
 nb::dict stats_dict(const FrameStats& stats) {
   nb::dict out;
   nb::list passes;
@@ -160,6 +167,7 @@ nb::dict stats_dict(const FrameStats& stats) {
   out["image_bands"] = stats.image_bands;  // bands of rows of an image past the device
   out["peak_device_bytes"] = stats.peak_device_bytes;
   out["depth_order_ms"] = stats.depth_order_ms;
+  out["saturated"] = saturated_dict(stats.saturated);  // channel -> values saturated (FrameStats::saturated)
   return out;
 }
 
@@ -648,13 +656,16 @@ void bind(nb::module_& m) {
                                                std::array{ExrCompression::kZip, ExrCompression::kPiz,
                                                           ExrCompression::kDwaa, ExrCompression::kNone});
             options.camera = camera;
-            write_exr(path, image, options);
+            return saturated_dict(write_exr(path, image, options));
           },
           "path"_a, "half"_a = false, "compression"_a = "zip", "camera"_a = nb::none(),
           "empty_depth"_a = kFarDepth,
           "Writes the image as tilesplat-render does: R G B A, Z and 'splats', scene-linear, atomically; Z "
           "is "
-          "empty_depth where no splat was blended (default: far, behind everything, as the app writes).")
+          "empty_depth where no splat was blended (default: far, behind everything, as the app writes). "
+          "A finite value past the range of its channel's type (float, or half with half=True) is stored as "
+          "that type's largest finite value, never as inf; returns {channel: values saturated so}, empty "
+          "when none were.")
       .def(
           "write_png",
           [](const RenderImage& image, const std::filesystem::path& path, double exposure_stops,

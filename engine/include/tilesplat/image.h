@@ -32,6 +32,26 @@ struct RenderImage {
   size_t pixels() const { return size_t(width) * size_t(height); }
 };
 
+/// Finite values that an output could not hold as they were: past the range of the type they were stored
+/// as (a scene-linear float of a colour far above 1, a half above 65,504), each stored as the largest finite
+/// value of that type with its sign, never as an infinity (docs/colour.md, "Saturation"). Counted per
+/// channel, keyed by the channel's name in its output ("R", "G", "B", "A", "Z", ...).
+struct SaturatedValues {
+  std::map<std::string, uint64_t> channels;  ///< channel name -> values saturated in it (none listed: 0)
+
+  /// The values saturated over every channel.
+  TILESPLAT_API uint64_t total() const;
+  /// "71241 values (R 23747, G 23747, B 23747)", or "none".
+  TILESPLAT_API std::string describe() const;
+  /// Adds another output's counts, channel by channel.
+  TILESPLAT_API SaturatedValues& operator+=(const SaturatedValues& other);
+};
+
+/// The EXR header attribute in which write_exr() records its SaturatedValues when any value saturated:
+/// a string, "R 23747 G 23747 B 23747 (float)" (the channels' counts, then the type they saturated in).
+/// Absent from a file in which nothing saturated.
+inline constexpr const char* kSaturatedAttribute = "tilesplatSaturated";
+
 /// What a render's colours are, and what the files hold (docs/colour.md). A 3DGS model is trained so that its
 /// blended colour reproduces the photographs' 8-bit sRGB values: RenderImage::rgba holds those display values
 /// (sRGB-encoded, Rec.709 primaries, D65), as every viewer shows them. Linear light is their sRGB decoding.
@@ -57,9 +77,12 @@ TILESPLAT_API double linear_to_srgb(double linear);
 /// An image's R G B A (premultiplied) converted between encodings, each pixel on its own: to scene-linear
 /// A * decode(C / A), back A * encode(L / A); a pixel with A <= 0 (or A not finite) is taken as opaque (its
 /// colour converted as it is). `opaque` takes every pixel as opaque, for a file written without alpha or with
-/// A = 1. Depth, counts and alpha are untouched. Converting to the same encoding copies.
+/// A = 1. Depth, counts and alpha are untouched. Converting to the same encoding copies. A finite colour
+/// whose conversion passes float's range (decoding a display value above about 1e16) saturates to the
+/// largest finite float with its sign, counted per channel ("R", "G", "B") in `saturated` when given.
 TILESPLAT_API std::vector<float> convert_colours(const std::vector<float>& rgba, ColourEncoding from,
-                                                 ColourEncoding to, bool opaque = false);
+                                                 ColourEncoding to, bool opaque = false,
+                                                 SaturatedValues* saturated = nullptr);
 
 /// OpenEXR's compression methods that write_exr() offers.
 enum class ExrCompression {
@@ -125,8 +148,12 @@ TILESPLAT_API void write_file_atomically(const std::filesystem::path& path, std:
 /// "tilesplatBuildType" (when set); then options.attributes.
 /// Atomic: the image goes to a temporary file beside `path` that is renamed over it only once
 /// complete, so a failure never leaves a partial file. Throws std::runtime_error naming the file.
-TILESPLAT_API void write_exr(const std::filesystem::path& path, const RenderImage& image,
-                             const ExrWriteOptions& options = {});
+/// No finite value becomes an infinity in the file: one past the range of its channel's type (a colour
+/// decoded to scene-linear past float's, any value past half's 65,504 with options.half) is stored as that
+/// type's largest finite value with its sign. Returns what saturated so, per channel, which the file records
+/// too (kSaturatedAttribute) when any did.
+TILESPLAT_API SaturatedValues write_exr(const std::filesystem::path& path, const RenderImage& image,
+                                        const ExrWriteOptions& options = {});
 
 /// Reads an EXR's R G B A (A = 1 when absent), Z and "splats" (each when present), any pixel type
 /// converted, any data window origin. The colours come back as a render holds them (display values): a file

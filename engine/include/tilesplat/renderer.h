@@ -97,6 +97,12 @@ struct FrameStats {
   /// Host time spent ordering the scene by depth before its parts (on the host's cores; 0 for a whole
   /// scene). Over several bands or samples, the sum.
   double depth_order_ms = 0;
+  /// Finite values that the frame's outputs could not hold, each stored as the largest finite value of its
+  /// type with its sign instead of an infinity: render_to_image into an R16G16B16A16_SFLOAT image counts the
+  /// colours past half's range (channel "host image RGBA"); render() returns floats, which hold every
+  /// value, and leaves it empty. Files are written after the frame: write_exr() returns its own counts, which
+  /// tilesplat-render adds here for --stats.
+  SaturatedValues saturated;
 };
 
 /// The Vulkan device a renderer runs on, and the limits that shape its passes.

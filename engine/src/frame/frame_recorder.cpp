@@ -228,14 +228,18 @@ void FrameRecorder::record_host_depth_in(VkCommandBuffer cmd, const ExternalDept
 void FrameRecorder::record_copies_to_images(VkCommandBuffer cmd, const RenderSettings& settings,
                                             FrameResources& res, const ExternalImage& target,
                                             const ExternalDepthImage* depth_image) {
-  // The colour: as it is for RGBA32F, else packed into the image's texel format first (pack_colour.comp).
+  // The colour: as it is for RGBA32F, else packed into the image's texel format first (pack_colour.comp),
+  // which counts the values it saturates from zero (a frame on reused lists clears no counters).
   const vk::Buffer* source = &res.outputs.rgba;
+  vkCmdFillBuffer(cmd, res.counters.handle(), offsetof(FrameCounters, saturated), sizeof(uint32_t), 0);
+  vk::barrier(cmd);
   if (target.format != VK_FORMAT_R32G32B32A32_SFLOAT) {
     const VkDeviceSize bytes =
         VkDeviceSize(target.width) * target.height * PackColourPass::texel_bytes(target.format);
     if (res.packed_colour.size() < bytes)
       res.packed_colour = vk::Buffer(ctx_, bytes, vk::MemoryUse::Device, "packed colour (render_to_image)");
-    pack_colour_.record(cmd, target.format, res.outputs.rgba, res.packed_colour, target.width, target.height);
+    pack_colour_.record(cmd, target.format, res.outputs.rgba, res.packed_colour, res.counters.address(),
+                        target.width, target.height);
     vk::barrier(cmd);  // the packing's writes before the copy's reads
     source = &res.packed_colour;
   }

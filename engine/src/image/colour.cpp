@@ -1,9 +1,12 @@
 // The sRGB transfer function and the conversion of premultiplied images between the trained display
 // values and scene-linear light (docs/colour.md).
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
+#include "image/saturate.h"
 #include "tilesplat/image.h"
 
 namespace tilesplat {
@@ -33,10 +36,11 @@ double linear_to_srgb(double linear) {
 }
 
 std::vector<float> convert_colours(const std::vector<float>& rgba, ColourEncoding from, ColourEncoding to,
-                                   bool opaque) {
+                                   bool opaque, SaturatedValues* saturated) {
   std::vector<float> converted = rgba;
   if (from == to) return converted;
   const auto transfer = to == ColourEncoding::kSceneLinear ? srgb_to_linear : linear_to_srgb;
+  std::array<uint64_t, 3> past_float{};  // per channel: conversions that passed float's range
   for (size_t pixel = 0; pixel + 3 < converted.size(); pixel += 4) {
     // The transfer function applies to a colour, not to a premultiplied value: divide by the coverage,
     // convert, multiply again. A pixel without coverage (or opaque) has its colour as it is.
@@ -44,10 +48,36 @@ std::vector<float> convert_colours(const std::vector<float>& rgba, ColourEncodin
     const bool divide = !opaque && alpha > 0.0 && alpha < 1.0;
     for (size_t c = 0; c < 3; ++c) {
       const double value = converted[pixel + c];
-      converted[pixel + c] = static_cast<float>(divide ? alpha * transfer(value / alpha) : transfer(value));
+      converted[pixel + c] =
+          detail::saturate_to_float(divide ? alpha * transfer(value / alpha) : transfer(value), past_float[c]);
     }
   }
+  if (saturated)
+    for (size_t c = 0; c < 3; ++c)
+      if (past_float[c] > 0) saturated->channels[std::string(1, "RGB"[c])] += past_float[c];
   return converted;
+}
+
+uint64_t SaturatedValues::total() const {
+  uint64_t sum = 0;
+  for (const auto& [name, count] : channels) sum += count;
+  return sum;
+}
+
+std::string SaturatedValues::describe() const {
+  if (total() == 0) return "none";
+  std::string list;
+  for (const auto& [name, count] : channels) {
+    if (count == 0) continue;
+    if (!list.empty()) list += ", ";
+    list += name + " " + std::to_string(count);
+  }
+  return std::to_string(total()) + (total() == 1 ? " value (" : " values (") + list + ")";
+}
+
+SaturatedValues& SaturatedValues::operator+=(const SaturatedValues& other) {
+  for (const auto& [name, count] : other.channels) channels[name] += count;
+  return *this;
 }
 
 }  // namespace tilesplat

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "image/atomic_file.h"
+#include "image/saturate.h"
 #include "tilesplat/image.h"
 #include "tilesplat/version.h"
 
@@ -198,6 +199,16 @@ void add_string_attributes(Imf::Header& header, const ExrWriteOptions& options) 
   for (const auto& [name, value] : options.attributes) header.insert(name, Imf::StringAttribute(value));
 }
 
+// kSaturatedAttribute's value: "R 23747 G 23747 B 23747 (half)".
+std::string saturation_record(const SaturatedValues& saturated, bool half) {
+  std::string record;
+  for (const auto& [name, count] : saturated.channels) {
+    if (count == 0) continue;
+    record += name + " " + std::to_string(count) + " ";
+  }
+  return record + (half ? "(half)" : "(float)");
+}
+
 std::string channel_names(const Imf::ChannelList& channels) {
   std::string names;
   for (auto channel = channels.begin(); channel != channels.end(); ++channel) {
@@ -288,18 +299,21 @@ auto with_exr_file_named_in_errors(const std::filesystem::path& path, const Read
 
 }  // namespace
 
-void write_exr(const std::filesystem::path& path, const RenderImage& image, const ExrWriteOptions& options) {
+SaturatedValues write_exr(const std::filesystem::path& path, const RenderImage& image,
+                          const ExrWriteOptions& options) {
   check_writable_image(path, image);
   check_attributes(path, image, options);
 
   // What the file holds where the options change the image: the colours in the encoding asked for
   // (a file without A, or with A = 1, is opaque, so its colours convert as they are), A = 1 for an
-  // opaque frame, and the far value in Z where nothing was blended.
+  // opaque frame, and the far value in Z where nothing was blended. A decoded colour past float's range
+  // saturates (convert_colours), counted.
+  SaturatedValues saturated;
   const bool opaque = options.opaque_alpha || !options.alpha;
   const std::vector<float>* rgba = &image.rgba;
   std::vector<float> stored_rgba;
   if (opaque || options.colour != ColourEncoding::kSrgbDisplay) {
-    stored_rgba = convert_colours(image.rgba, ColourEncoding::kSrgbDisplay, options.colour, opaque);
+    stored_rgba = convert_colours(image.rgba, ColourEncoding::kSrgbDisplay, options.colour, opaque, &saturated);
     if (options.opaque_alpha)
       for (size_t i = 3; i < stored_rgba.size(); i += 4) stored_rgba[i] = 1.0f;
     rgba = &stored_rgba;
@@ -313,11 +327,19 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
     depth = &depth_with_empty;
   }
 
+  // Half colours: a value past half's range (a display value above about 113 decodes past 65,504 of
+  // linear light) is stored as the largest finite half, counted per channel, never as an infinity.
   const Imf::PixelType colour_type = options.half ? Imf::HALF : Imf::FLOAT;
   std::vector<Imath::half> rgba_half;
   if (options.half) {
     rgba_half.reserve(rgba->size());
-    for (const float value : *rgba) rgba_half.emplace_back(value);
+    std::array<uint64_t, 4> past_half{};
+    for (size_t i = 0; i < rgba->size(); ++i)
+      rgba_half.push_back(detail::saturate_to_half((*rgba)[i], past_half[i % 4]));
+    // Every colour that saturated as a float saturates as a half too: the half counts replace them.
+    saturated = {};
+    for (size_t c = 0; c < kColourChannels.size(); ++c)
+      if (past_half[c] > 0 && (c < 3 || options.alpha)) saturated.channels[kColourChannels[c]] = past_half[c];
   }
   const char* colour_data = options.half ? reinterpret_cast<const char*>(rgba_half.data())
                                          : reinterpret_cast<const char*>(rgba->data());
@@ -338,6 +360,8 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
     // The transfer function beside the primaries, by the Color Interop Forum's identifier.
     header.insert(kColourInteropAttribute, Imf::StringAttribute(to_string(options.colour)));
     if (options.camera) add_camera_attributes(header, *options.camera);
+    if (saturated.total() > 0)
+      header.insert(kSaturatedAttribute, Imf::StringAttribute(saturation_record(saturated, options.half)));
     const Imath::Box2i data_window = header.dataWindow();
 
     Imf::FrameBuffer frame;
@@ -368,6 +392,7 @@ void write_exr(const std::filesystem::path& path, const RenderImage& image, cons
     file.setFrameBuffer(frame);
     file.writePixels(image.height);  // the data window's rows
   });
+  return saturated;
 }
 
 StoredExr read_exr_as_stored(const std::filesystem::path& path) {

@@ -34,7 +34,7 @@ struct FrameCounters {
   uint32_t pairs_low;       // the projection's running low word of the total (for its carries)
   uint32_t max_tile_pairs;  // the longest tile list, when longer than the composite's chunk (else 0)
   uint32_t big_splats[3];   // indirect dispatch of key_emission_big.comp: splats listed, 1, 1
-  uint32_t reserved;
+  uint32_t saturated;       // colour values pack_colour.comp saturated to half's range (render_to_image)
 
   uint64_t wanted_intersections() const { return uint64_t(intersections_high) << 32 | intersections; }
 };
@@ -45,6 +45,7 @@ TS_COUNTER_AT(intersections, COUNTER_INTERSECTIONS);
 TS_COUNTER_AT(intersections_high, COUNTER_PAIRS_HIGH);
 TS_COUNTER_AT(overflow, COUNTER_OVERFLOW);
 TS_COUNTER_AT(visible, COUNTER_VISIBLE);
+TS_COUNTER_AT(saturated, COUNTER_SATURATED);
 TS_COUNTER_AT(ranges_args, COUNTER_RANGES_ARGS);
 TS_COUNTER_AT(depth_sort, COUNTER_DEPTH_SORT);
 TS_COUNTER_AT(tile_sort, COUNTER_TILE_SORT);

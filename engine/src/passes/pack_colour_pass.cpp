@@ -36,14 +36,15 @@ uint32_t PackColourPass::texel_bytes(VkFormat format) {
 }
 
 void PackColourPass::record(VkCommandBuffer cmd, VkFormat format, const vk::Buffer& rgba,
-                            const vk::Buffer& packed, uint32_t width, uint32_t height) {
+                            const vk::Buffer& packed, VkDeviceAddress counters, uint32_t width,
+                            uint32_t height) {
   auto it = pipelines_.find(format);
   if (it == pipelines_.end())
     it = pipelines_
              .emplace(format, vk::ComputePipeline(ctx_, "pack_colour", sizeof(PackColourPush),
                                                   {{0, shader_format(format)}}))
              .first;
-  it->second.bind(cmd, PackColourPush{rgba.address(), packed.address(), width, height});
+  it->second.bind(cmd, PackColourPush{rgba.address(), packed.address(), counters, width, height});
   it->second.dispatch(cmd, vk::div_ceil(width, 16), vk::div_ceil(height, 16));
 }
 

@@ -14,9 +14,10 @@ class PackColourPass {
   explicit PackColourPass(vk::Context& ctx) : ctx_(ctx) {}
   // Bytes a texel of `format` takes; 0 for a format the pass does not pack.
   static uint32_t texel_bytes(VkFormat format);
-  // Records the packing of `rgba` (vec4 per pixel) into `packed` (texel_bytes(format) per pixel).
+  // Records the packing of `rgba` (vec4 per pixel) into `packed` (texel_bytes(format) per pixel). The values
+  // saturated to half's range are added to COUNTER_SATURATED of `counters`.
   void record(VkCommandBuffer cmd, VkFormat format, const vk::Buffer& rgba, const vk::Buffer& packed,
-              uint32_t width, uint32_t height);
+              VkDeviceAddress counters, uint32_t width, uint32_t height);
 
  private:
   vk::Context& ctx_;
