@@ -21,6 +21,15 @@ namespace {
 
 #define HOST_CHECK(call) ASSERT_EQ((call), VK_SUCCESS) << #call
 
+// An IEEE half's bits as a float (infinities and NaN included).
+float half_to_float(uint16_t h) {
+  const int exponent = (h >> 10) & 0x1f, mantissa = h & 0x3ff;
+  float magnitude = exponent == 0 ? std::ldexp(float(mantissa), -24) : std::ldexp(float(mantissa | 0x400), exponent - 25);
+  if (exponent == 0x1f)
+    magnitude = mantissa ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
+  return (h & 0x8000) ? -magnitude : magnitude;
+}
+
 VKAPI_ATTR VkBool32 VKAPI_CALL count_messages(VkDebugUtilsMessageSeverityFlagBitsEXT,
                                               VkDebugUtilsMessageTypeFlagsEXT,
                                               const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
@@ -734,12 +743,6 @@ TEST_F(HostApplication, RendersIntoHalfAndEightBitColourImages) {
   auto renderer = create_renderer(external());
   renderer->set_scene(scene);
   const std::vector<float> expected = renderer->render(camera).rgba;
-  auto half_to_float = [](uint16_t h) {
-    const int exponent = (h >> 10) & 0x1f, mantissa = h & 0x3ff;
-    const float magnitude =
-        exponent == 0 ? std::ldexp(float(mantissa), -24) : std::ldexp(float(mantissa | 0x400), exponent - 25);
-    return (h & 0x8000) ? -magnitude : magnitude;
-  };
   for (const VkFormat format :
        {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_R8G8B8A8_SRGB}) {
     const Image image = make_image(format, 0, kWidth, kHeight);
@@ -796,13 +799,6 @@ TEST_F(HostApplication, HugeColoursSaturateInTheHostsHalfImageAndAreCounted) {
     past_half += std::abs(value) > 65504.0f;
   }
   ASSERT_GT(past_half, 0u) << "the case must pass half's range";
-  auto half_to_float = [](uint16_t h) {
-    const int exponent = (h >> 10) & 0x1f, mantissa = h & 0x3ff;
-    if (exponent == 0x1f) return mantissa ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
-    const float magnitude =
-        exponent == 0 ? std::ldexp(float(mantissa), -24) : std::ldexp(float(mantissa | 0x400), exponent - 25);
-    return (h & 0x8000) ? -magnitude : magnitude;
-  };
   for (const VkFormat format : {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R8G8B8A8_UNORM,
                                 VK_FORMAT_R32G32B32A32_SFLOAT}) {
     const Image image = make_image(format, 0, kWidth, kHeight);

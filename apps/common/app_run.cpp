@@ -23,6 +23,15 @@ void print_warning(std::string_view program, std::string_view message) {
   std::fputs(line.c_str(), stderr);
 }
 
+void print_saturation_warning(std::string_view program, const std::filesystem::path& exr,
+                              const tilesplat::SaturatedValues& saturated, bool half) {
+  if (saturated.total() == 0) return;
+  print_warning(program, exr.string() + ": " + saturated.describe() + " past the range of " +
+                             (half ? "half" : "float") +
+                             " stored as its largest finite value (the header's " +
+                             tilesplat::kSaturatedAttribute + " records them)");
+}
+
 int run_app(std::string_view program, const std::function<int()>& body) {
   try {
     return body();

@@ -1,8 +1,11 @@
 // How an app ends: one line "PROGRAM: error: MESSAGE" on stderr and the exit codes of arg_parser.h.
 #pragma once
 
+#include <filesystem>
 #include <functional>
 #include <string_view>
+
+#include "tilesplat/image.h"
 
 namespace tilesplat::cli {
 
@@ -12,5 +15,9 @@ int run_app(std::string_view program, const std::function<int()>& body);
 void print_error(std::string_view program, std::string_view message);
 void print_warning(std::string_view program, std::string_view message);
 bool stderr_is_terminal();
+// The one warning line for an EXR in which values saturated (write_exr's SaturatedValues; nothing when none
+// did): how many, in which channels, past which type, and that the header records them.
+void print_saturation_warning(std::string_view program, const std::filesystem::path& exr,
+                              const tilesplat::SaturatedValues& saturated, bool half);
 
 }  // namespace tilesplat::cli

@@ -294,11 +294,7 @@ struct FrameWriter {
     } catch (const std::exception& error) {
       throw std::runtime_error(write_failure(frame.exr, error));
     }
-    if (saturated.total() > 0)
-      cli::print_warning(kProgram, frame.exr.string() + ": " + saturated.describe() + " past the range of " +
-                                       (options.half ? "half" : "float") +
-                                       " stored as its largest finite value (the header's " +
-                                       tilesplat::kSaturatedAttribute + " records them)");
+    cli::print_saturation_warning(kProgram, frame.exr, saturated, options.half);
     if (!frame.png.empty()) {
       try {
         tilesplat::write_png_preview(frame.png, image, preview);

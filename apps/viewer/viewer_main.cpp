@@ -521,7 +521,7 @@ void write_screenshot(const fs::path& path, tilesplat::Renderer& renderer, Viewe
     // Empty pixels far away; over a background, an opaque frame (as tilesplat-render writes them).
     exr.empty_depth = tilesplat::kFarDepth;
     exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
-    tilesplat::write_exr(path, image, exr);
+    cli::print_saturation_warning(kProgram, path, tilesplat::write_exr(path, image, exr), exr.half);
   }
 }
 
