@@ -387,6 +387,53 @@ TEST(Stochastic, AlphaDepthAndCountOutputs) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// The stratified sampler's strata, checked directly rather than through a dB gain: one splat covering the
+// image with the same alpha at every pixel (a Gaussian 1000 times the view's width: alpha varies by 1e-7),
+// rendered with N frames. Its thresholds at a pixel over the N frames fall one in each stratum [k/N,
+// (k+1)/N), so an alpha in the middle of stratum k is passed by exactly k or k + 1 of them: the pixel's
+// coverage (its alpha, the fraction of frames the splat was kept) is within 1/(2N) of alpha at every pixel,
+// and the image's mean coverage within 1/N of it. The hash sampler's coverage, binomial, strays past the
+// half stratum at many pixels: the check can tell the two apart.
+TEST(Stochastic, StratifiedThresholdsFallOneInEachStratumOfTheFrames) {
+  Renderer& renderer = testing::validated_renderer();
+  const Camera camera = testing::axis_camera(64, 48, 50);
+  for (const uint32_t frames : {16u, 64u}) {
+    for (const uint32_t stratum : {0u, frames / 3, frames - 2}) {  // below the alpha cap of 0.99
+      const double alpha = (stratum + 0.5) / frames;
+      GaussianScene scene;
+      scene.positions = {0, 0, 5};
+      scene.log_scales = {8, 8, 8};  // a sigma of 3000 units at depth 5
+      scene.rotations = {1, 0, 0, 0};
+      scene.opacity_logits = {float(std::log(alpha / (1 - alpha)))};
+      scene.sh = {1.77f, 1.77f, 1.77f};  // white: 0.5 + C0 * 1.77 = 1.0
+      renderer.set_scene(scene);
+      for (const StochasticSampler sampler : {StochasticSampler::kStratified, StochasticSampler::kHash}) {
+        RenderSettings settings = stochastic(frames, 7);
+        settings.stochastic.sampler = sampler;
+        const RenderImage image = renderer.render(camera, settings);
+        size_t past_half_stratum = 0;
+        double mean = 0;
+        for (size_t p = 0; p < image.pixels(); ++p) {
+          const double coverage = image.rgba[4 * p + 3];
+          mean += coverage;
+          past_half_stratum += std::abs(coverage - alpha) > 0.5 / frames + 1e-6;
+        }
+        mean /= double(image.pixels());
+        std::printf("[ measure  ] %-10s %2u frames, alpha %.4f: mean coverage %.5f, %zu of %zu pixels past half a "
+                    "stratum\n",
+                    to_string(sampler).c_str(), frames, alpha, mean, past_half_stratum, image.pixels());
+        if (sampler == StochasticSampler::kStratified) {
+          EXPECT_EQ(past_half_stratum, 0u) << frames << " frames, alpha " << alpha;
+          EXPECT_NEAR(mean, alpha, 1.0 / frames);
+        } else if (stratum > 0 && stratum + 1 < frames) {
+          EXPECT_GT(past_half_stratum, image.pixels() / 10) << "the hash sampler is not stratified";
+        }
+      }
+    }
+  }
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 // llvmpipe cuts a shader invocation after 65535 loop iterations: a tile list of 70k splats is tested
 // in chunks, each sample carrying its nearest kept splat between them. The nearest, opaque splats
 // are the last 10k of the list (binned lists keep index order), so a truncated list would show the

@@ -114,6 +114,38 @@ def test_what_it_does_not_do_is_said():
         tilesplat.rasterization(**{**inputs, "opacities": [1.5]})
 
 
+@pytest.mark.parametrize("change, message", [
+    (dict(far_plane=float("nan")), "far_plane must be beyond near_plane"),
+    (dict(far_plane=0.005), "far_plane must be beyond near_plane"),
+    (dict(near_plane=float("nan")), "near_plane must be a positive finite number"),
+    (dict(near_plane=0.0), "near_plane must be a positive finite number"),
+    (dict(Ks=[[[10.0, 0.5, 4], [0, 10, 4], [0, 0, 1]]]), "Ks must be pinhole intrinsics"),
+    (dict(Ks=[[[10.0, 0, 4], [0, 10, 4], [0, 0, 2]]]), "Ks must be pinhole intrinsics"),
+    (dict(Ks=[[[-10.0, 0, 4], [0, 10, 4], [0, 0, 1]]]), "Ks must have positive focal lengths"),
+    (dict(Ks=np.eye(3)[None].repeat(2, axis=0)), r"Ks must have the shape \(1, 3, 3\)"),
+    (dict(Ks=np.eye(3)), r"Ks must have the shape \(1, 3, 3\)"),
+    (dict(scales=[[0.0, 1, 1]]), "scales must be positive"),
+    (dict(scales=[[-1.0, 1, 1]]), "scales must be positive"),
+    (dict(backgrounds=np.zeros((2, 3))), r"backgrounds must have the shape \(1, 3\)"),
+    (dict(backgrounds=np.zeros(3)), r"backgrounds must have the shape \(1, 3\)"),
+    (dict(width=0), "width must be a positive integer"),
+    (dict(width=-8), "width must be a positive integer"),
+    (dict(height=0), "height must be a positive integer"),
+    (dict(height=8.5), "height must be a positive integer"),
+    (dict(colors=np.ones((1, 3, 3)), sh_degree=1), "colors holds 3 SH coefficients, sh_degree 1 needs 4"),
+    (dict(colors=np.ones((1, 1, 3)), sh_degree=3), "colors holds 1 SH coefficients, sh_degree 3 needs 16"),
+])
+def test_bad_arguments_are_refused_naming_them(change, message):
+    """Each a ValueError naming the argument, before any rendering: never an empty image."""
+    inputs = dict(means=[[0.0, 0, 2]], quats=[[1.0, 0, 0, 0]], scales=np.full((1, 3), 0.5), opacities=[0.5],
+                  colors=np.ones((1, 3)), viewmats=np.eye(4)[None], Ks=[[[10.0, 0, 4], [0, 10, 4], [0, 0, 1]]],
+                  width=8, height=8)
+    colors, _, _ = tilesplat.rasterization(**inputs)  # the unchanged call draws
+    assert colors.shape == (1, 8, 8, 3) and colors.max() > 0
+    with pytest.raises(ValueError, match=message):
+        tilesplat.rasterization(**{**inputs, **change})
+
+
 def test_a_batch_of_cameras_costs_less_than_separate_calls(playbot):
     scene, _ = playbot
     inputs = gsplat_inputs(scene)

@@ -147,6 +147,14 @@ def rasterization(means, quats, scales, opacities, colors, viewmats, Ks, width, 
     if rasterize_mode not in _RASTERIZE_MODES:
         raise ValueError(f"rasterize_mode must be classic or antialiased, got {rasterize_mode!r}")
 
+    for name, size in (("width", width), ("height", height)):
+        if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or size <= 0:
+            raise ValueError(f"{name} must be a positive integer, got {size!r}")
+    if not np.isfinite(near_plane) or near_plane <= 0:
+        raise ValueError(f"near_plane must be a positive finite number, got {near_plane!r}")
+    if np.isnan(far_plane) or far_plane <= near_plane:
+        raise ValueError(f"far_plane must be beyond near_plane ({near_plane!r}), got {far_plane!r}")
+
     tensors_in = _is_tensor(means)
     tensor_inputs = (means, quats, scales, opacities, colors, viewmats, Ks, backgrounds)
     means = _array("means", means, (None, 3))
@@ -157,6 +165,12 @@ def rasterization(means, quats, scales, opacities, colors, viewmats, Ks, width, 
     viewmats = _array("viewmats", viewmats, (None, 4, 4), np.float64)
     cameras = viewmats.shape[0]
     Ks = _array("Ks", Ks, (cameras, 3, 3), np.float64)
+    # A pinhole's intrinsics: focal lengths and principal point only (tilesplat's camera has no skew).
+    if (Ks[:, 0, 1] != 0).any() or (Ks[:, 1, 0] != 0).any() or (Ks[:, 2] != [0, 0, 1]).any():
+        raise ValueError("Ks must be pinhole intrinsics [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]: a non-zero skew "
+                         "(K[0, 1]) or another last row is not supported")
+    if (Ks[:, 0, 0] <= 0).any() or (Ks[:, 1, 1] <= 0).any():
+        raise ValueError("Ks must have positive focal lengths (K[0, 0], K[1, 1])")
     if (scales <= 0).any():
         raise ValueError("scales must be positive")
     if ((opacities < 0) | (opacities > 1)).any():
