@@ -10,6 +10,8 @@
 #   3. a test that fails                         -> step tests fails
 #   4. the cluster's package setup fails         -> step cluster-setup fails (run with CI_STEPS, so that
 #      the half hour of steps before it is not repeated)
+#   5. a test that hangs                         -> step tests fails, the test named as a timeout after its
+#      limit (TILESPLAT_TEST_TIMEOUT), not the whole run killed (CI_STEPS: configure, build, tests)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 shared="$(cd "$root/.." && pwd)/shared"
@@ -29,7 +31,7 @@ expect_failure() {
     echo "prove: case $name: .ci/run exited 0" >&2
     exit 1
   fi
-  if ! grep -q -E "^$failing_step +[0-9-]+ +FAILED" "$log"; then
+  if ! grep -q -E "^$failing_step +[0-9-]+ +[0-9-]+ +FAILED" "$log"; then
     tail -n 20 "$log"
     echo "prove: case $name: .ci/run failed (exit $status), but not at step '$failing_step'" >&2
     exit 1
@@ -61,6 +63,22 @@ sed -i 's|  --cluster) pkgs+=(slurm-wlm munge) ;;|  --cluster) echo "setup: deli
 grep -q "deliberately broken" "$clone/cmake/setup-deps.sh"
 expect_failure broken-cluster-setup cluster-setup "$clone" CI_STEPS="shared-scenes cluster-setup slurm"
 
+git -C "$clone" checkout -q -- cmake/setup-deps.sh
+
+# 5. A test that never ends: ctest stops it at its limit and names it; the step fails, the run goes on to
+# its summary. The limit is lowered to 20 s for the proof (300 s in CI).
+cat >>"$clone/tests/test_sha256.cpp" <<'TEST'
+TEST(DeliberatelyHung, NeverEnds) { for (;;) std::this_thread::sleep_for(std::chrono::seconds(1)); }
+TEST
+sed -i '1i #include <chrono>\n#include <thread>' "$clone/tests/test_sha256.cpp"
+sed -i 's/^set(TILESPLAT_TEST_TIMEOUT 300 /set(TILESPLAT_TEST_TIMEOUT 20 /' "$clone/tests/CMakeLists.txt"
+rm -f "$clone/build/CMakeCache.txt"
+expect_failure hung-test tests "$clone" CI_STEPS="shared-scenes configure build tests"
+grep -q -E "DeliberatelyHung.NeverEnds .*\*\*\*Timeout" "$scratch/hung-test.log" ||
+  { echo "prove: case hung-test: ctest did not name the hung test as a timeout" >&2; exit 1; }
+results+=("case hung-test: $(grep -m1 -E 'DeliberatelyHung.NeverEnds .*Timeout' "$scratch/hung-test.log" | tr -s '. ')")
+git -C "$clone" checkout -q -- tests/test_sha256.cpp tests/CMakeLists.txt
+
 echo
 printf '%s\n' "${results[@]}"
-echo "prove: all 4 deliberate breakages made .ci/run fail at the step that broke"
+echo "prove: all 5 deliberate breakages made .ci/run fail at the step that broke"
