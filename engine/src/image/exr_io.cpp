@@ -17,6 +17,7 @@
 
 #include <array>
 #include <climits>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
@@ -199,6 +200,17 @@ void add_string_attributes(Imf::Header& header, const ExrWriteOptions& options) 
   for (const auto& [name, value] : options.attributes) header.insert(name, Imf::StringAttribute(value));
 }
 
+// A float stored as OpenEXR's half: past +-65504 (HALF_MAX; half rounds 65520 and above to an infinity)
+// the largest finite half with the value's sign, counted in `saturated` (image/saturate.h's rule).
+Imath::half saturate_to_half(float value, uint64_t& saturated) {
+  constexpr float kMax = 65504.0f;
+  if (std::abs(value) > kMax) {
+    ++saturated;
+    return Imath::half(std::copysign(kMax, value));
+  }
+  return Imath::half(value);
+}
+
 // kSaturatedAttribute's value: "R 23747 G 23747 B 23747 (half)".
 std::string saturation_record(const SaturatedValues& saturated, bool half) {
   std::string record;
@@ -335,7 +347,7 @@ SaturatedValues write_exr(const std::filesystem::path& path, const RenderImage& 
     rgba_half.reserve(rgba->size());
     std::array<uint64_t, 4> past_half{};
     for (size_t i = 0; i < rgba->size(); ++i)
-      rgba_half.push_back(detail::saturate_to_half((*rgba)[i], past_half[i % 4]));
+      rgba_half.push_back(saturate_to_half((*rgba)[i], past_half[i % 4]));
     // Every colour that saturated as a float saturates as a half too: the half counts replace them.
     saturated = {};
     for (size_t c = 0; c < kColourChannels.size(); ++c)
