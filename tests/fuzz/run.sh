@@ -15,10 +15,10 @@ cd "$(dirname "$0")/../.."
 seconds="${1:-60}"
 build="${FUZZ_BUILD_DIR:-build-fuzz}"
 scenes="${TILESPLAT_SHARED_SCENES:-$(cd .. && pwd)/shared/scenes}"
-readers=(ply splat spz sog compressed_ply gltf cameras scene_file lod_set)
+readers=(ply splat spz sog compressed_ply gltf cameras scene_file lod_set scene_in_parts)
 fuzz_flags=(-timeout=10 -rss_limit_mb=2048)
 max_len() {  # a SOG zip or a GLB of 64 Gaussians with SH3 is about 20 kB; the rest fit in 16 kB
-  case "$1" in sog | gltf | lod_set) echo 65536 ;; *) echo 16384 ;; esac
+  case "$1" in sog | gltf | lod_set | scene_in_parts) echo 65536 ;; *) echo 16384 ;; esac
 }
 
 mkdir -p "$build"
@@ -54,6 +54,9 @@ seed spz "$scenes/train_3pts.spz" "$scenes/formats/playcanvas_test_64_sh3.v3.spz
 seed sog "$scenes/formats/playcanvas_test_64_sh3.sog"
 seed compressed_ply "$scenes/playcanvas_test_64.compressed.ply" "$scenes/formats/playcanvas_test_64_sh3.compressed.ply"
 seed gltf "$scenes/formats/playcanvas_test_64_sh3.glb"
+# The part-by-part reader's dispatch: a few of the PLY seeds, and an SPZ and a SOG.
+seed scene_in_parts "$scenes/formats/playcanvas_test_64_sh3.v4.spz" "$scenes/formats/playcanvas_test_64_sh3.sog" \
+  $(find "$build/seeds/ply" -type f | sort | head -n 8)
 # LOD set indexes: splat-transform's own (its chunk files are not beside the harness's folder: the index
 # parses, its loads fail) and the valid indexes over the harness's c.ply in regressions/lod_set/.
 seed lod_set tests/data/playbot_lod_set/lod-meta.json
