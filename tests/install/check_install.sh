@@ -7,7 +7,8 @@
 #   - a consumer using add_subdirectory, with no C++ standard of its own, building no tilesplat tests;
 #   - every example's image equal, to the bit, to tilesplat-render's of the same view;
 #   - a Debian package (cpack -G DEB) of the shared build, installed with apt-get and used by an
-#     example built against /usr, then removed (as root, which CI is);
+#     example built against /usr, then removed (as root, which CI is, or through sudo): where it cannot
+#     be installed (no root, or another tilesplat installed), the check fails;
 #   - the example sort strategy (examples/custom_sort) built against each install, as a program that
 #     checks itself against the built-in radix sort and as a plugin of the installed tilesplat-bench.
 # usage: tests/install/check_install.sh BUILD_DIR   (a built static build with tests, as .ci/run makes)
@@ -25,13 +26,22 @@ compare=$build/tests/tilesplat_compare_exr
   -o "$work/expected.exr" >/dev/null 2>&1
 
 configure() { cmake -G Ninja -DCMAKE_BUILD_TYPE=Release "$@" >"$work/configure.log" 2>&1 || { cat "$work/configure.log"; return 1; }; }
+# Builds quietly, but a failed build shows the compiler's output (the last 200 lines of it).
+build() {
+  local dir=$1 log="$work/build-$(basename "$1").log"
+  cmake --build "$dir" -j"$jobs" >"$log" 2>&1 || {
+    echo "building $dir failed:"
+    tail -n 200 "$log"
+    return 1
+  }
+}
 
 # Builds and runs both examples against the package in $1, and compares their images.
 check_examples() {
   local prefix=$1 label=$2
   for example in render_exr vulkan_host; do
     configure -S "$root/examples/$example" -B "$work/$label-$example" -DCMAKE_PREFIX_PATH="$prefix"
-    cmake --build "$work/$label-$example" -j"$jobs" >/dev/null
+    build "$work/$label-$example"
     "$work/$label-$example/$example" "$scene" "$cameras" 1 320 180 "$work/$label-$example.exr"
     "$compare" "$work/expected.exr" "$work/$label-$example.exr"
   done
@@ -42,7 +52,7 @@ check_examples() {
 check_custom_sort() {
   local prefix=$1 label=$2
   configure -S "$root/examples/custom_sort" -B "$work/$label-custom_sort" -DCMAKE_PREFIX_PATH="$prefix"
-  cmake --build "$work/$label-custom_sort" -j"$jobs" >/dev/null
+  build "$work/$label-custom_sort"
   "$work/$label-custom_sort/custom_sort" "$scene" 320 180
   "$prefix/bin/tilesplat-bench" "$scene" --sort-plugin "$work/$label-custom_sort/libserial_radix_sort.so" \
     --sort radix,serial-radix --width 320 --height 180 --warmup 0 --repeat 1 >"$work/plugin-bench.txt" 2>&1
@@ -67,11 +77,15 @@ c++ -std=c++20 -O2 "$root/examples/render_exr/main.cpp" -o "$work/pkg-config-ren
 "$compare" "$work/expected.exr" "$work/pkg-config.exr"
 
 echo "== shared library: build, install, move, find_package =="
-# Position-independent as .ci/run's build is, whose objects ccache then reuses.
-configure -S "$root" -B "$work/build-shared" -DBUILD_SHARED_LIBS=ON -DTILESPLAT_BUILD_TESTS=OFF \
+# Position-independent as .ci/run's build is, whose objects ccache then reuses; built inside the checkout
+# (build-install-shared/, ignored by git) so that ccache, whose base directory is the checkout, finds the
+# same relative paths from one clone to the next.
+shared_build="$root/build-install-shared"
+rm -rf "$shared_build"
+configure -S "$root" -B "$shared_build" -DBUILD_SHARED_LIBS=ON -DTILESPLAT_BUILD_TESTS=OFF \
   -DTILESPLAT_BUILD_VIEWER=OFF -DCMAKE_POSITION_INDEPENDENT_CODE=ON
-cmake --build "$work/build-shared" -j"$jobs" >/dev/null
-cmake --install "$work/build-shared" --prefix "$work/installed-shared" >/dev/null
+build "$shared_build"
+cmake --install "$shared_build" --prefix "$work/installed-shared" >/dev/null
 mv "$work/installed-shared" "$work/shared"
 check_examples "$work/shared" shared
 check_custom_sort "$work/shared" shared
@@ -90,27 +104,39 @@ fi
 "$work/shared/bin/tilesplat-render" --version
 
 echo "== Debian package: cpack, apt-get install, an example against /usr =="
-(cd "$work/build-shared" && cpack -G DEB >"$work/cpack.log" 2>&1) || { cat "$work/cpack.log"; exit 1; }
-deb=$(ls "$work"/build-shared/tilesplat_*.deb)
+(cd "$shared_build" && cpack -G DEB >"$work/cpack.log" 2>&1) || { cat "$work/cpack.log"; exit 1; }
+deb=$(ls "$shared_build"/tilesplat_*.deb)
 echo "$(basename "$deb"): $(dpkg-deb -f "$deb" Depends)"
+# The check is of the package installed: where it cannot be installed, the check fails (it never passes
+# on a package it did not install and use).
+SUDO=""
 if [[ $(id -u) -ne 0 ]]; then
-  echo "not root: the package is built but not installed"
-elif dpkg-query -W -f="\${Status}" tilesplat 2>/dev/null | grep -q "install ok installed"; then
-  echo "a tilesplat package is installed already: not replacing it"
-else
-  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$deb" >"$work/apt.log" 2>&1 || { cat "$work/apt.log"; exit 1; }
-  # Purged on any failure below too (|| true: under set -e a failing trap command sets the exit status).
-  trap 'apt-get purge -y -qq tilesplat >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
-  tilesplat-render --version
-  configure -S "$root/examples/render_exr" -B "$work/deb-render_exr"  # no prefix path: the package in /usr
-  cmake --build "$work/deb-render_exr" -j"$jobs" >/dev/null
-  ldd "$work/deb-render_exr/render_exr" | grep libtilesplat
-  "$work/deb-render_exr/render_exr" "$scene" "$cameras" 1 320 180 "$work/deb.exr"
-  "$compare" "$work/expected.exr" "$work/deb.exr"
-  apt-get purge -y -qq tilesplat >/dev/null
-  trap 'rm -rf "$work"' EXIT
-  echo "package installed, used and removed"
+  sudo -n true 2>/dev/null || { echo "cannot install $deb: not root, and no sudo without a password"; exit 1; }
+  SUDO="sudo -n"
 fi
+version=$(dpkg-deb -f "$deb" Version)
+if installed=$(dpkg-query -W -f='${Status} ${Version}' tilesplat 2>/dev/null) && [[ $installed == "install ok installed"* ]]; then
+  # This check's own package left by a run that was killed before its cleanup: removed, then installed
+  # anew. Any other tilesplat is someone's: the check will not replace it.
+  if [[ ${installed##* } != "$version" ]]; then
+    echo "cannot install $deb: tilesplat ${installed##* } is installed on this machine (remove it first)"
+    exit 1
+  fi
+  echo "removing tilesplat $version left installed by an earlier check"
+  $SUDO apt-get purge -y -qq tilesplat >/dev/null
+fi
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "$deb" >"$work/apt.log" 2>&1 || { cat "$work/apt.log"; exit 1; }
+# Purged on any failure below too (|| true: under set -e a failing trap command sets the exit status).
+trap '$SUDO apt-get purge -y -qq tilesplat >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
+tilesplat-render --version
+configure -S "$root/examples/render_exr" -B "$work/deb-render_exr"  # no prefix path: the package in /usr
+build "$work/deb-render_exr"
+ldd "$work/deb-render_exr/render_exr" | grep libtilesplat
+"$work/deb-render_exr/render_exr" "$scene" "$cameras" 1 320 180 "$work/deb.exr"
+"$compare" "$work/expected.exr" "$work/deb.exr"
+$SUDO apt-get purge -y -qq tilesplat >/dev/null
+trap 'rm -rf "$work"' EXIT
+echo "package installed, used and removed"
 
 echo "== public headers include no OpenEXR, glm or JSON, and Vulkan only in vulkan_interop.h =="
 # (sort_strategy.h, the extension point for GPU sorts, reaches Vulkan through vulkan_interop.h.)
@@ -130,7 +156,7 @@ fi
 
 echo "== add_subdirectory consumer, no C++ standard of its own =="
 configure -S "$root/tests/install/subproject" -B "$work/subproject" -DTILESPLAT_SOURCE_DIR="$root"
-cmake --build "$work/subproject" -j"$jobs" >/dev/null
+build "$work/subproject"
 "$work/subproject/render_exr" "$scene" "$cameras" 1 320 180 "$work/subproject.exr"
 "$compare" "$work/expected.exr" "$work/subproject.exr"
 echo "install check passed"

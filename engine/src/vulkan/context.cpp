@@ -120,6 +120,7 @@ Context::Context(const ContextOptions& options) {
 }
 
 Context::Context(const ExternalVulkanDevice& borrowed) : owns_handles_(false) {
+  keep_libraries_loaded_under_sanitizers();  // the host's instance loaded the driver and its layers
   if (!borrowed.instance || !borrowed.physical_device || !borrowed.device || !borrowed.queue)
     throw std::invalid_argument("borrowed Vulkan device: instance, physical device, device and queue are required");
   instance_ = borrowed.instance;

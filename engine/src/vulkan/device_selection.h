@@ -11,6 +11,10 @@ namespace tilesplat::vk {
 
 inline constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
+// Under AddressSanitizer only (a no-op otherwise): every library loaded now, the Vulkan driver and layers
+// among them, stays loaded for the life of the process (device_selection.cpp says why). Called once an
+// instance exists: by create_bare_instance, and by a context on a host's instance.
+void keep_libraries_loaded_under_sanitizers();
 // An instance of API 1.2; with `validation`, the Khronos layer and debug utils (throws when the layer
 // is not installed).
 VkInstance create_bare_instance(bool validation);
