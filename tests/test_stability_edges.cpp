@@ -84,6 +84,20 @@ size_t non_finite(const std::vector<float>& values) {
   return count;
 }
 
+// Each value within the type's rounding of what it must hold (float: the conversion's own rounding; half:
+// 11 bits).
+void expect_values(const std::vector<float>& stored, const std::vector<double>& expected, double relative,
+                   const std::string& what) {
+  ASSERT_EQ(stored.size(), expected.size()) << what;
+  size_t wrong = 0;
+  for (size_t i = 0; i < stored.size(); ++i) {
+    const double tolerance = std::abs(expected[i]) * relative + 0x1p-24;  // half's subnormal spacing
+    if (std::abs(double(stored[i]) - expected[i]) > tolerance && wrong++ < 5)
+      ADD_FAILURE() << what << ": value " << i << " is " << stored[i] << ", expected " << expected[i];
+  }
+  EXPECT_EQ(wrong, 0u) << what;
+}
+
 class EdgeOutputs : public ::testing::TestWithParam<EdgeCase> {
  protected:
   void SetUp() override {
@@ -145,46 +159,33 @@ class EdgeOutputs : public ::testing::TestWithParam<EdgeCase> {
     return expected;
   }
 
+  // The scene-linear EXR of `options` (float or half, its largest finite value `largest`, its rounding
+  // `relative`): each value the independent decoding, saturated where past `largest` and counted as
+  // expected; `must_saturate` says whether the case passes that range at all.
+  void expect_scene_linear_exr(const std::string& type, const ExrWriteOptions& options, double largest,
+                               double relative, bool must_saturate) {
+    SaturatedValues saturated, expected_saturated;
+    const StoredExr stored = write_and_read("linear_" + type + ".exr", options, saturated);
+    EXPECT_EQ(stored.encoding, ColourEncoding::kSceneLinear);
+    const std::vector<double> expected = expected_values(ColourEncoding::kSceneLinear, largest, expected_saturated);
+    expect_values(stored.image.rgba, expected, relative, "scene-linear " + type);
+    EXPECT_EQ(saturated.channels, expected_saturated.channels) << saturated.describe();
+    EXPECT_EQ(saturated.total() > 0, must_saturate) << saturated.describe();
+    std::printf("[ measure  ] %-22s scene-linear %s: %s saturated\n", GetParam().name.c_str(), type.c_str(),
+                saturated.describe().c_str());
+  }
+
   RenderImage frame_;
   fs::path dir_;
   uint64_t messages_ = 0;
 };
 
-// Each value within the type's rounding of what it must hold (float: the conversion's own rounding; half:
-// 11 bits).
-void expect_values(const std::vector<float>& stored, const std::vector<double>& expected, double relative,
-                   const std::string& what) {
-  ASSERT_EQ(stored.size(), expected.size()) << what;
-  size_t wrong = 0;
-  for (size_t i = 0; i < stored.size(); ++i) {
-    const double tolerance = std::abs(expected[i]) * relative + 0x1p-24;  // half's subnormal spacing
-    if (std::abs(double(stored[i]) - expected[i]) > tolerance && wrong++ < 5)
-      ADD_FAILURE() << what << ": value " << i << " is " << stored[i] << ", expected " << expected[i];
-  }
-  EXPECT_EQ(wrong, 0u) << what;
-}
-
 TEST_P(EdgeOutputs, SceneLinearFloatExrIsFiniteAndSaturatesPastFloat) {
-  SaturatedValues saturated, expected_saturated;
-  const StoredExr stored = write_and_read("linear_float.exr", {}, saturated);
-  EXPECT_EQ(stored.encoding, ColourEncoding::kSceneLinear);
-  const std::vector<double> expected = expected_values(ColourEncoding::kSceneLinear, kFloatMax, expected_saturated);
-  expect_values(stored.image.rgba, expected, 1e-6, "scene-linear float");
-  EXPECT_EQ(saturated.channels, expected_saturated.channels) << saturated.describe();
-  EXPECT_EQ(saturated.total() > 0, GetParam().past_float) << saturated.describe();
-  std::printf("[ measure  ] %-22s scene-linear float: %s saturated\n", GetParam().name.c_str(),
-              saturated.describe().c_str());
+  expect_scene_linear_exr("float", {}, kFloatMax, 1e-6, GetParam().past_float);
 }
 
 TEST_P(EdgeOutputs, SceneLinearHalfExrIsFiniteAndSaturatesPastHalf) {
-  SaturatedValues saturated, expected_saturated;
-  const StoredExr stored = write_and_read("linear_half.exr", {.half = true}, saturated);
-  const std::vector<double> expected = expected_values(ColourEncoding::kSceneLinear, kHalfMax, expected_saturated);
-  expect_values(stored.image.rgba, expected, 0x1p-11, "scene-linear half");
-  EXPECT_EQ(saturated.channels, expected_saturated.channels) << saturated.describe();
-  EXPECT_EQ(saturated.total() > 0, GetParam().past_half) << saturated.describe();
-  std::printf("[ measure  ] %-22s scene-linear half: %s saturated\n", GetParam().name.c_str(),
-              saturated.describe().c_str());
+  expect_scene_linear_exr("half", {.half = true}, kHalfMax, 0x1p-11, GetParam().past_half);
 }
 
 TEST_P(EdgeOutputs, DisplayExrIsTheFrameItself) {
