@@ -65,14 +65,15 @@ uint64_t SaturatedValues::total() const {
 }
 
 std::string SaturatedValues::describe() const {
-  if (total() == 0) return "none";
+  const uint64_t sum = total();
+  if (sum == 0) return "none";
   std::string list;
   for (const auto& [name, count] : channels) {
     if (count == 0) continue;
     if (!list.empty()) list += ", ";
     list += name + " " + std::to_string(count);
   }
-  return std::to_string(total()) + (total() == 1 ? " value (" : " values (") + list + ")";
+  return std::to_string(sum) + (sum == 1 ? " value (" : " values (") + list + ")";
 }
 
 SaturatedValues& SaturatedValues::operator+=(const SaturatedValues& other) {
