@@ -4,6 +4,7 @@
 // cannot render so is a clear error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -55,8 +56,7 @@ const BigScene& big_scene() {
 }
 constexpr uint64_t kSmallBudget = 8ull << 20;
 
-// The renderer of the frames in parts, apart from the one of the whole frames: a renderer's sort
-// strategies keep the buffers its largest frame grew, and the budget counts everything it holds.
+// The renderer of the frames in parts, apart from the one of the whole frames.
 Renderer& parts_renderer() {
   static std::unique_ptr<Renderer> renderer = [] {
     RendererOptions options;
@@ -102,7 +102,6 @@ TEST(SceneParts, EveryExactSortIsTheWholeFrameBitForBit) {
 TEST(SceneParts, BudgetIsHeldAndReported) {
   TILESPLAT_REQUIRE_SHARED_SCENES();
   const BigScene& big = big_scene();
-  // A renderer of its own: the budget counts every buffer a renderer holds, the other strategies' too.
   RendererOptions options;
   options.validation = true;
   const std::unique_ptr<Renderer> renderer = Renderer::create(options);
@@ -120,6 +119,36 @@ TEST(SceneParts, BudgetIsHeldAndReported) {
   // counters, a few hundred bytes, are not in the estimate).
   EXPECT_LE(stats.peak_device_bytes, kSmallBudget + kSmallBudget / 100)
       << stats.peak_device_bytes << " bytes at the peak";
+}
+
+// A renderer that drew large frames with every strategy before (each strategy keeping the buffers its
+// largest frame grew) still renders a frame under a budget within it: the frame lets go of what it does
+// not use.
+TEST(SceneParts, ABudgetedFrameLetsGoOfWhatEarlierFramesLeft) {
+  TILESPLAT_REQUIRE_SHARED_SCENES();
+  const BigScene& big = big_scene();
+  RendererOptions options;
+  options.validation = true;
+  const std::unique_ptr<Renderer> renderer = Renderer::create(options);
+  renderer->set_scene(big.scene);
+  const Camera large = resize_camera(big.camera, 960, 540);
+  uint64_t most_held = 0;
+  for (const std::string& sort : sort_strategies()) {
+    RenderSettings settings;
+    settings.sort = sort;
+    renderer->render(large, settings);
+    most_held = std::max(most_held, renderer->last_frame_stats().device_bytes);
+  }
+  ASSERT_GT(most_held, kSmallBudget);  // what the budget would otherwise count
+  RenderSettings settings;
+  settings.memory_budget = kSmallBudget;
+  const RenderImage parts = renderer->render(big.scene, big.camera, settings);
+  const FrameStats& stats = renderer->last_frame_stats();
+  EXPECT_GE(stats.scene_parts, 16);
+  EXPECT_LE(stats.peak_device_bytes, kSmallBudget + kSmallBudget / 100)
+      << stats.peak_device_bytes << " bytes at the peak";
+  expect_bit_identical(parts, parts_renderer().render(big.scene, big.camera, settings), "after large frames");
+  EXPECT_EQ(renderer->validation_messages(), 0u);
 }
 
 TEST(SceneParts, EffectsAndOutputsThatApplyAreTheWholeFrame) {

@@ -112,6 +112,9 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
   const bool wide_keys = sort(sort_name).frame_plan() == FrameSortPlan::kTileDepthPairs;
   validate_scene_parts(settings, sort_name);
   const uint64_t budget = parts_memory_budget(settings);
+  // The budget counts what the renderer holds, and the strategies used before keep the scratch their
+  // largest frames grew: all but this frame's go (made again, by sort(), when a frame asks for them).
+  std::erase_if(sorts, [&](const auto& entry) { return entry.first != sort_name; });
   const DeviceCapacity device = device_capacity();
   double pairs_per_gaussian = kFirstPairsPerGaussian;
   size_t capacity = part_capacity(budget, costs, 0, pairs_per_gaussian, device);  // or a clear error
