@@ -69,7 +69,8 @@ TS_CONST uint COUNTER_PAIRS_LOW = 26;       // the projection's own low word of 
 TS_CONST uint COUNTER_MAX_TILE_PAIRS = 27;  // the longest tile list over the composite's chunk size
 TS_CONST uint COUNTER_BIG_SPLATS = 28;      // 3 uints: splats listed for key_emission_big.comp (its dispatch)
 TS_CONST uint COUNTER_SATURATED = 31;       // colour values saturated to half's range (pack_colour.comp)
-TS_CONST uint COUNTER_UINTS = 32;           // the block's size
+TS_CONST uint COUNTER_SATURATED_MEAN = 32;  // linear colours saturated to float's (sample_accumulate.comp)
+TS_CONST uint COUNTER_UINTS = 33;           // the block's size
 
 // A sort's state block (SortState): the key count it sorts (set before the sort runs) and what the
 // sort derives from it on the GPU (its block count and the indirect dispatch of its per-block passes).
@@ -428,7 +429,9 @@ TS_PUSH_CONSTANTS(SampleAccumulatePush) {
   TS_REF(Vec4Array) rgba;    // the sample frame's colour, replaced by the mean's
   TS_REF(FloatArray) depth;  // its depth, likewise (when write_depth)
   TS_REF(UintArray) count;   // its splat counts, likewise (when write_count)
-  TS_REF(Vec4Array) sums;    // two halves of 2 vec4 a pixel: linear RGBA, (alpha * depth, count, -, -)
+  TS_REF(Vec4Array) sums;    // two halves of 2 vec4 a pixel: (mean linear RGB, sum of alpha), (sums of
+                             // alpha * depth and count, -, -)
+  TS_REF(UintArray) counters;  // COUNTER_SATURATED_MEAN: linear colours past float's range
   uint pixels;
   uint samples_before;  // samples in the sums already: the half read is samples_before % 2
   uint write_depth;

@@ -276,6 +276,68 @@ TEST(StabilityEdgeCases, DepthCaseLiesPastHalfsRange) {
   EXPECT_GT(deepest, kHalfMax);
 }
 
+// Lens samples accumulated on the GPU (RenderSettings::accumulate_samples, sample_accumulate.comp) of
+// colours whose linear values pass float's range: each mean is finite, and the colours past it are
+// saturated and counted (FrameStats::saturated); colours that fit (and negative ones, which the blend
+// clamps to black) count nothing and equal the host's mean of the same samples (LinearFrameMean, in one
+// call). Where the linear colour passed float's range the two saturate alike but not at the same point
+// (the shader the colour, the host the premultiplied value in double), so there both are only finite and
+// at least the display value of float's largest linear colour.
+TEST(StabilityEdgeCases, AccumulatedSamplesOfHugeColoursAreFiniteAndCounted) {
+  Renderer& renderer = testing::validated_renderer();
+  const uint64_t messages = renderer.validation_messages();
+  const Camera camera = testing::axis_camera(64, 48, 60);
+  const double largest_display = 1.055 * std::pow(kFloatMax, 1 / 2.4) - 0.055;  // about 1.2e16
+  const struct {
+    float dc;
+    bool past_float;
+  } cases[] = {{1e20f, true}, {1e30f, true}, {-1e20f, false}, {0.8f, false}};
+  for (const auto& c : cases) {
+    char what_text[32];
+    std::snprintf(what_text, sizeof(what_text), "dc %g", double(c.dc));
+    const std::string what = what_text;
+    renderer.set_scene(three_splats(c.dc, 2.0));
+    RenderSettings settings;
+    settings.lens = {
+        .aperture_diameter = 0.02, .focus_distance = 2.0, .samples = 3, .pattern = SamplePattern::kSobol};
+    const RenderImage host_mean = renderer.render(camera, settings);  // the host's float64 mean
+    EXPECT_EQ(non_finite(host_mean.rgba), 0u) << what;
+    settings.accumulate_samples = true;
+    settings.lens.samples = 1;
+    RenderImage accumulated;
+    for (int call = 0; call < 3; ++call) {
+      accumulated = renderer.render(camera, settings);
+      const SaturatedValues& saturated = renderer.last_frame_stats().saturated;
+      EXPECT_EQ(non_finite(accumulated.rgba), 0u) << what << ", call " << call;
+      if (!c.past_float) {
+        EXPECT_EQ(saturated.total(), 0u) << what << ": " << saturated.describe();
+      } else {
+        EXPECT_EQ(saturated.channels.size(), 1u) << what << ": " << saturated.describe();
+        EXPECT_GT(saturated.channels.count("linear sample mean RGB"), 0u) << what << ", call " << call;
+      }
+    }
+    ASSERT_EQ(renderer.last_frame_stats().accumulated_samples, 3u);
+    size_t compared = 0, saturated_values = 0;
+    std::vector<float> fits, fits_host;
+    for (size_t i = 0; i < accumulated.rgba.size(); ++i) {
+      const double alpha = host_mean.rgba[i - i % 4 + 3];
+      if (i % 4 != 3 && host_mean.rgba[i] > 1e15 * std::max(alpha, 1e-30)) {  // decoded past about 1e36
+        ++saturated_values;
+        EXPECT_GE(accumulated.rgba[i], 0.99 * alpha * largest_display) << what << ": value " << i;
+        continue;
+      }
+      fits.push_back(accumulated.rgba[i]);
+      fits_host.push_back(host_mean.rgba[i]);
+      ++compared;
+    }
+    EXPECT_EQ(saturated_values > 0, c.past_float) << what;
+    expect_values(fits, std::vector<double>(fits_host.begin(), fits_host.end()), 2e-5, what);
+    std::printf("[ measure  ] %s: %zu values equal the host's mean, %zu saturated\n", what.c_str(), compared,
+                saturated_values);
+  }
+  EXPECT_EQ(renderer.validation_messages(), messages);
+}
+
 TEST(SaturatedValues, CountsPerChannelAndDescribesThem) {
   SaturatedValues a;
   EXPECT_EQ(a.total(), 0u);

@@ -186,6 +186,7 @@ void Renderer::Impl::end_frame(const FrameStart& start, const FrameCounters& fra
   stats.sort_strategy = start.plan.sort.name;
   stats.gaussians = resources.scene.count;
   stats.visible = frame.visible;
+  stats.saturated = frame.saturation();
   stats.intersections = frame.tile_sort.count;
   stats.sort_fallbacks = start.sorter->stall_fallbacks() - start.fallbacks_before;
   stats.device_bytes = device_bytes();

@@ -24,13 +24,6 @@ VkResult wait_for_value(VkDevice device, VkSemaphore timeline, uint64_t value) {
   return vkWaitSemaphores(device, &wait, UINT64_MAX);
 }
 
-// What pack_colour.comp saturated of a frame copied into a host's image (FrameStats::saturated).
-SaturatedValues host_image_saturation(const FrameCounters& frame) {
-  SaturatedValues saturated;
-  if (frame.saturated > 0) saturated.channels["host image RGBA"] = frame.saturated;
-  return saturated;
-}
-
 }  // namespace
 
 Renderer::Impl::~Impl() {
@@ -106,7 +99,6 @@ void Renderer::Impl::wait_for_submitted_frame() {
     chunks = needed;
   }
   end_frame(frame_info.start, frame, std::move(passes), lists_whole);
-  stats.saturated = host_image_saturation(frame);
 }
 
 std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device,
@@ -125,7 +117,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     r.recorder.record_copies_to_images(cmd, frame.settings, r.resources, target, nullptr);
   });
-  r.stats.saturated = host_image_saturation(r.resources.frame_counters());
+  r.stats.saturated = r.resources.frame_counters().saturation();
   r.stats.cpu_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -141,7 +133,7 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
     r.recorder.record_copies_to_images(cmd, frame.settings, r.resources, target, &depth);
   });
-  r.stats.saturated = host_image_saturation(r.resources.frame_counters());
+  r.stats.saturated = r.resources.frame_counters().saturation();
   r.stats.cpu_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

@@ -176,7 +176,7 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
     }
     case FramePass::kAccumulateSamples:
       vk::barrier(cmd);  // the composite's outputs (the raster composite's resolve) before the sums read them
-      sample_accumulate_.record(cmd, res.outputs, res.sample_sums,
+      sample_accumulate_.record(cmd, res.outputs, res.sample_sums, res.counters,
                                 {.samples_before = plan.sample_sums->before,
                                  .write_depth = r.settings.depth,
                                  .write_count = r.settings.splat_count,

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "shader_io.h"
+#include "tilesplat/image.h"
 
 namespace tilesplat {
 
@@ -35,8 +36,17 @@ struct FrameCounters {
   uint32_t max_tile_pairs;  // the longest tile list, when longer than the composite's chunk (else 0)
   uint32_t big_splats[3];   // indirect dispatch of key_emission_big.comp: splats listed, 1, 1
   uint32_t saturated;       // colour values pack_colour.comp saturated to half's range (render_to_image)
+  uint32_t saturated_mean;  // linear colours sample_accumulate.comp saturated to float's range
 
   uint64_t wanted_intersections() const { return uint64_t(intersections_high) << 32 | intersections; }
+  // What the frame's passes saturated (FrameStats::saturated): sample_accumulate.comp the linear colours of
+  // accumulated samples, pack_colour.comp those of a frame copied into a host's image.
+  SaturatedValues saturation() const {
+    SaturatedValues values;
+    if (saturated_mean > 0) values.channels["linear sample mean RGB"] = saturated_mean;
+    if (saturated > 0) values.channels["host image RGBA"] = saturated;
+    return values;
+  }
 };
 // The shaders' indices (shader_io.h), field by field.
 #define TS_COUNTER_AT(field, index) static_assert(offsetof(FrameCounters, field) == shader_io::index * 4, #field)
@@ -46,6 +56,7 @@ TS_COUNTER_AT(intersections_high, COUNTER_PAIRS_HIGH);
 TS_COUNTER_AT(overflow, COUNTER_OVERFLOW);
 TS_COUNTER_AT(visible, COUNTER_VISIBLE);
 TS_COUNTER_AT(saturated, COUNTER_SATURATED);
+TS_COUNTER_AT(saturated_mean, COUNTER_SATURATED_MEAN);
 TS_COUNTER_AT(ranges_args, COUNTER_RANGES_ARGS);
 TS_COUNTER_AT(depth_sort, COUNTER_DEPTH_SORT);
 TS_COUNTER_AT(tile_sort, COUNTER_TILE_SORT);

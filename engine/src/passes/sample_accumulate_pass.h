@@ -20,7 +20,9 @@ class SampleAccumulatePass {
     bool write_depth = false, write_count = false;
     bool opaque = false;  // blended over a background (LinearFrameMean's over_background)
   };
-  void record(VkCommandBuffer cmd, const OutputBuffers& out, const vk::Buffer& sums, const Frame& frame);
+  // Linear colours past float's range are saturated and counted into COUNTER_SATURATED_MEAN of `counters`.
+  void record(VkCommandBuffer cmd, const OutputBuffers& out, const vk::Buffer& sums, const vk::Buffer& counters,
+              const Frame& frame);
 
  private:
   vk::Context& ctx_;
