@@ -42,7 +42,7 @@ TEST_P(SceneFuzzRegressions, EveryInputLoadsOrNamesItsProblem) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Readers, SceneFuzzRegressions,
-                         ::testing::Values("splat", "spz", "sog", "compressed_ply", "gltf"));
+                         ::testing::Values("splat", "ksplat", "spz", "sog", "compressed_ply", "gltf"));
 
 }  // namespace
 }  // namespace tilesplat

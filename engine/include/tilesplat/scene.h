@@ -59,7 +59,8 @@ struct DroppedProperty {
 /// What a reader found and did, for a caller that wants to tell the user (tilesplat-info prints it).
 struct TILESPLAT_API LoadReport {
   /// The format as the reader found it from the content: "ply binary_little_endian", "ply ascii",
-  /// "compressed ply", "splat", "spz", "sog", "sog (unbundled)", "glb", "gltf".
+  /// "compressed ply", "splat", "spz", "sog", "sog (unbundled)", "glb", "gltf", "ksplat level 0 (float32)" (and
+  /// levels 1 and 2, with their layouts).
   std::string format;
   std::string version;           ///< the format's version where it has one ("1.0", "3", "2", ...), else empty
   size_t gaussians_in_file = 0;  ///< Gaussians the file holds, dropped ones included
@@ -82,7 +83,8 @@ TILESPLAT_API GaussianScene parse_ply(std::span<const std::byte> data, std::stri
 /// structure), with the extension only deciding for .splat, the one format without a header:
 ///   .ply (binary or ASCII), PlayCanvas compressed .ply, antimatter15 .splat, Niantic .spz
 ///   (versions 2, 3 and 4), PlayCanvas SOG version 2 (and 1) as a .sog zip or an unbundled
-///   meta.json beside its WebP images, glTF 2.0 (.glb or .gltf) with KHR_gaussian_splatting.
+///   meta.json beside its WebP images, glTF 2.0 (.glb or .gltf) with KHR_gaussian_splatting,
+///   GaussianSplats3D .ksplat (compression levels 0, 1 and 2; told by its header, which has no magic).
 /// Every reader yields the same GaussianScene (trainer's activations and axes; see docs/formats.md)
 /// and shares one post-processing step: non-finite values dropped (or rejected, strict), quaternions
 /// normalized, a quaternion of zero or denormal components the identity. Throws SceneError naming

@@ -175,6 +175,7 @@ SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOpt
               report));
         [[fallthrough]];
       case detail::Container::kGlb:
+      case detail::Container::kKsplat:
       case detail::Container::kUnknown:
         if (!bytes.empty())
           detail::fail(
@@ -205,6 +206,7 @@ uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
                    ? detail::read_sog_meta_counts(as_text(bytes), name).scene_bytes()
                    : 0;
       case detail::Container::kGlb:
+      case detail::Container::kKsplat:
       case detail::Container::kUnknown:
         return 0;
     }

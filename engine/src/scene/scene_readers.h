@@ -37,7 +37,7 @@ struct DeclaredCounts {
 
 // The container a file's first bytes name: the reader they call for (load_scene, SceneInParts). A JSON
 // object may be a glTF, a SOG's meta.json or a LOD set's index; kUnknown may still be a headerless .splat.
-enum class Container { kPly, kSpz, kZip, kGlb, kJson, kUnknown };
+enum class Container { kPly, kSpz, kZip, kGlb, kJson, kKsplat, kUnknown };
 Container container_of(std::span<const std::byte> data);
 
 // Reads a file that `referrer` names, resolved beside it; only plain relative names are followed.
@@ -57,6 +57,12 @@ GaussianScene read_compressed_ply(const PlyBytes& ply, const PlyHeader& header, 
 // antimatter15 .splat: 32 bytes a Gaussian, no header.
 GaussianScene read_splat(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
                          LoadReport* report);
+
+// GaussianSplats3D .ksplat: a 4096-byte header, 1024 bytes a section, then the sections' buckets and splats
+// at compression level 0 (float32), 1 (float16) or 2 (float16, 8-bit SH).
+bool is_ksplat(std::span<const std::byte> data);  // version 0.x, the header's unused bytes zero
+GaussianScene read_ksplat(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
+                          LoadReport* report);
 
 // Niantic .spz: versions 2 and 3 (gzip, or the same bytes uncompressed) and 4 (zstd streams).
 bool is_spz(std::span<const std::byte> data);  // the NGSP magic, or a gzip stream

@@ -115,6 +115,7 @@ Container container_of(std::span<const std::byte> data) {
   if (starts_with("PK\x03\x04")) return Container::kZip;
   if (starts_with("glTF")) return Container::kGlb;
   if (is_spz(data)) return Container::kSpz;
+  if (is_ksplat(data)) return Container::kKsplat;
   for (size_t i = 0; i < data.size(); ++i) {
     const char c = static_cast<char>(bytes[i]);
     if (c == ' ' || c == '\t' || c == '\r' || c == '\n') continue;
