@@ -46,6 +46,13 @@ def test_every_format_loads(shared_scenes):
         # within a centimetre in the file.
         distances = np.linalg.norm(reference.positions[:, None, :] - scene.positions[None, :, :], axis=2)
         assert distances.min(axis=1).max() < 0.01, name
+    # GaussianSplats3D's .ksplat at each compression level (its own generator's files, tests/data/ksplat).
+    ksplats = REPO / "tests" / "data" / "ksplat"
+    for level in range(3):
+        scene = tilesplat.load_scene(ksplats / f"playcanvas_test_64_sh3_l{level}_sh2.ksplat")
+        assert scene.size == reference.size and scene.sh_degree == 2, level
+        distances = np.linalg.norm(reference.positions[:, None, :] - scene.positions[None, :, :], axis=2)
+        assert distances.min(axis=1).max() < 1e-4, level
     scene_file = tilesplat.load_scene(REPO / "scenes" / "two_playbots.json")
     assert scene_file.size == 2 * tilesplat.load_scene(BUNDLED_PLAYBOT).size
 
