@@ -81,11 +81,12 @@ void load_lod_set(LoadedScene& loaded, const LodOptions& options, const LoadOpti
   loaded.lod = std::move(lod);
 }
 
-// Whether `path` is a binary PLY, an SPZ or a SOG that `reading` reads part by part: always, or when its
-// Gaussians as floats would take more than half of the host's memory.
+// Whether `path` is a binary PLY, an SPZ, a SOG or a .ksplat that `reading` reads part by part: always, or when
+// its Gaussians as floats would take more than half of the host's memory.
 bool reads_in_parts(const fs::path& path, PartReading reading) {
   const bool readable_in_parts = has_extension(path, ".ply") || has_extension(path, ".spz") ||
-                                 has_extension(path, ".sog") || path.filename() == "meta.json";
+                                 has_extension(path, ".sog") || has_extension(path, ".ksplat") ||
+                                 path.filename() == "meta.json";
   if (reading == PartReading::kWhole || !readable_in_parts) return false;
   if (reading == PartReading::kInParts) return true;
   const uint64_t bytes = SceneInParts::whole_scene_bytes(path);

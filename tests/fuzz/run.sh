@@ -57,6 +57,7 @@ seed compressed_ply "$scenes/playcanvas_test_64.compressed.ply" "$scenes/formats
 seed gltf "$scenes/formats/playcanvas_test_64_sh3.glb"
 # The part-by-part reader's dispatch: a few of the PLY seeds, and an SPZ and a SOG.
 seed scene_in_parts "$scenes/formats/playcanvas_test_64_sh3.v4.spz" "$scenes/formats/playcanvas_test_64_sh3.sog" \
+  tests/data/ksplat/playcanvas_test_64_sh3_l1_sh2.ksplat \
   $(find "$build/seeds/ply" -type f | sort | head -n 8)
 # LOD set indexes: splat-transform's own (its chunk files are not beside the harness's folder: the index
 # parses, its loads fail) and the valid indexes over the harness's c.ply in regressions/lod_set/.

@@ -206,7 +206,7 @@ class TILESPLAT_API Renderer {
   /// frames at the shutter's times, each with every copy where it is then (merge_instances(scene, t)) seen
   /// from the camera then. A closed shutter renders the copies where they are at time 0.
   RenderImage render(const SceneInstances& scene, const Camera& camera, const RenderSettings& settings = {});
-  /// The same for a binary PLY, an SPZ or a SOG opened part by part (SceneInParts::open): in parts, each
+  /// The same for a binary PLY, an SPZ, a SOG or a .ksplat opened part by part (SceneInParts::open): in parts, each
   /// part's Gaussians are decoded as the part is drawn (from the PLY's file, the SPZ's packed bytes, the
   /// SOG's texels), so the scene is never held whole as floats on the host (only its positions); whole, it is
   /// loaded (SceneInParts::load) and set. The frame is the one the scene load_scene reads renders, bit for
@@ -223,7 +223,7 @@ class TILESPLAT_API Renderer {
   /// The same for a scene file's placed copies, measured as their merged scene.
   bool renders_in_parts(const SceneInstances& scene, const Camera& camera,
                         const RenderSettings& settings = {});
-  /// The same for a binary PLY, an SPZ or a SOG opened part by part.
+  /// The same for a binary PLY, an SPZ, a SOG or a .ksplat opened part by part.
   bool renders_in_parts(const SceneInParts& scene, const Camera& camera, const RenderSettings& settings = {});
   /// A level-of-detail set from this camera: under RenderSettings::splat_budget the levels select_lod_levels
   /// chooses for it, else level 0 whole; then as render(scene, camera, settings), in parts under a memory

@@ -34,7 +34,7 @@ class PartSource;
 /// as it does), so the frames are too. The file must not change while it is open. Copies share it.
 class TILESPLAT_API SceneInParts {
  public:
-  /// Opens `path`, a binary PLY, an SPZ or a SOG by its content. Throws SceneError naming the file for one
+  /// Opens `path`, a binary PLY, an SPZ, a SOG or a .ksplat by its content. Throws SceneError naming the file for one
   /// that is missing, malformed or truncated, or in another format (an ASCII or a compressed PLY, a glTF,
   /// ...: those are read whole by load_scene). `report`, where given, gets what load_scene would report.
   static SceneInParts open(const std::filesystem::path& path, const LoadOptions& options = {},
@@ -49,7 +49,7 @@ class TILESPLAT_API SceneInParts {
 
   size_t size() const;           ///< the Gaussians, as load_scene would give them
   int sh_degree() const;         ///< 0 to 3
-  bool has_normals() const;      ///< whether the file carries nx, ny, nz (a PLY's; an SPZ or a SOG has none)
+  bool has_normals() const;      ///< whether the file carries nx, ny, nz (a PLY's; the other formats have none)
   const Bounds& bounds() const;  ///< compute_bounds of the scene load_scene would give
   /// The whole scene, as load_scene reads it (for a frame that fits: the renderer's set_scene).
   GaussianScene load() const;

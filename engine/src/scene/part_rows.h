@@ -9,9 +9,11 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <vector>
 
+#include "scene/ksplat_packed.h"
 #include "scene/ply_rows.h"
 #include "scene/scene_reading.h"
 #include "scene/sog_packed.h"
@@ -78,6 +80,20 @@ class SpzPartRows final : public PartRows {
  private:
   GaussianScene decode(std::span<const uint32_t> in_file) const override;
   SpzPacked packed_;
+};
+
+// A .ksplat, mapped: each part's splats decoded from the file where they lie (KsplatPacked), the positions
+// decoded once. Gaussians with a non-finite value (a NaN or a zero scale at level 0) are dropped, or refused,
+// as load_scene drops them.
+class KsplatPartRows final : public PartRows {
+ public:
+  KsplatPartRows(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report);
+
+ private:
+  GaussianScene decode(std::span<const uint32_t> in_file) const override;
+  FileContents contents_;
+  std::optional<KsplatPacked> packed_;
+  std::vector<float> positions_;
 };
 
 // A SOG, held as its images' texels (SogPacked). Gaussians with a non-finite value (a meta.json's ranges

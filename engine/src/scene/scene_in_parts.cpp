@@ -103,6 +103,51 @@ GaussianScene SpzPartRows::decode(std::span<const uint32_t> in_file) const {
   return scene;
 }
 
+KsplatPartRows::KsplatPartRows(const std::filesystem::path& path, const LoadOptions& options,
+                               LoadReport* report) {
+  open_scene_file(path, contents_);
+  const std::string name = path.string();
+  packed_.emplace(contents_.bytes(), name);
+  if (packed_->size() > UINT32_MAX)
+    fail(name, std::to_string(packed_->size()) + " splats: a scene read in parts holds at most 2^32 - 1");
+  // The positions, and the Gaussians finish_scene would drop, a block at a time.
+  NonFiniteTally tally(name, options);
+  std::vector<size_t> dropped;
+  constexpr size_t kBlock = size_t(1) << 20;
+  for (size_t first = 0; first < packed_->size(); first += kBlock) {
+    const GaussianScene block = packed_->decode_range(first, std::min(packed_->size(), first + kBlock));
+    const std::vector<size_t> bad = non_finite_gaussians(block, first, tally);
+    size_t next_bad = 0;
+    for (size_t i = 0; i < block.size(); ++i) {
+      if (next_bad < bad.size() && bad[next_bad] == i) {
+        dropped.push_back(first + i);
+        ++next_bad;
+        continue;
+      }
+      positions_.insert(positions_.end(), block.positions.begin() + std::ptrdiff_t(3 * i),
+                        block.positions.begin() + std::ptrdiff_t(3 * i + 3));
+    }
+  }
+  set_dropped(packed_->size(), dropped);
+  set_positions(positions_);
+  sh_degree_ = packed_->sh_degree();
+  if (report) {
+    LoadReport found;  // what read_ksplat reports
+    found.format = packed_->format();
+    found.version = packed_->version();
+    found.gaussians_in_file = packed_->size();
+    found.dropped = dropped.size();
+    found.dropped_by_property = tally.take();
+    *report = std::move(found);
+  }
+}
+
+GaussianScene KsplatPartRows::decode(std::span<const uint32_t> in_file) const {
+  GaussianScene scene = packed_->decode(in_file);
+  normalize_rotations(scene);  // the rest of read_ksplat's finish_scene (the dropped ones are not asked for)
+  return scene;
+}
+
 SogPartRows::SogPartRows(SogPacked packed, std::string_view name, const LoadOptions& options,
                          LoadReport* report)
     : packed_(std::move(packed)) {
@@ -174,14 +219,15 @@ SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOpt
               detail::SogPacked::from_meta(as_text(bytes), name, detail::sibling_loader(path)), name, options,
               report));
         [[fallthrough]];
-      case detail::Container::kGlb:
       case detail::Container::kKsplat:
+        return SceneInParts(std::make_shared<const detail::KsplatPartRows>(path, options, report));
+      case detail::Container::kGlb:
       case detail::Container::kUnknown:
         if (!bytes.empty())
           detail::fail(
               name,
-              "not a PLY file (it does not start with the 'ply' magic line), an SPZ or a SOG: only these "
-              "are read part by part; load_scene reads the others whole");
+              "not a PLY file (it does not start with the 'ply' magic line), an SPZ, a SOG or a .ksplat: only "
+              "these are read part by part; load_scene reads the others whole");
         break;  // empty: the PLY reader says so
     }
   }  // an SPZ's or a SOG's file is let go of once decoded
@@ -205,8 +251,9 @@ uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
         return detail::is_sog_meta(as_text(bytes))
                    ? detail::read_sog_meta_counts(as_text(bytes), name).scene_bytes()
                    : 0;
-      case detail::Container::kGlb:
       case detail::Container::kKsplat:
+        return detail::KsplatPacked(bytes, name).counts().scene_bytes();
+      case detail::Container::kGlb:
       case detail::Container::kUnknown:
         return 0;
     }
