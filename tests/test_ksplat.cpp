@@ -219,49 +219,36 @@ INSTANTIATE_TEST_SUITE_P(Levels, KsplatFiles,
                                   std::to_string(param_info.param[1]);
                          });
 
-// One SceneError naming the file and saying each of `phrases`.
-void expect_error(const fs::path& path, std::initializer_list<std::string> phrases) {
-  SCOPED_TRACE(path.filename().string());
-  try {
-    load_scene(path);
-    ADD_FAILURE() << "loaded without an error";
-  } catch (const SceneError& error) {
-    const std::string message = error.what();
-    EXPECT_TRUE(message.starts_with(path.string())) << message;
-    for (const std::string& phrase : phrases) EXPECT_NE(message.find(phrase), std::string::npos) << message;
-  }
-}
-
 void put_u32(std::string& bytes, size_t at, uint32_t value) { std::memcpy(bytes.data() + at, &value, 4); }
 void put_u16(std::string& bytes, size_t at, uint16_t value) { std::memcpy(bytes.data() + at, &value, 2); }
 
 TEST(Ksplat, DamagedFilesAreRefusedNamingThePart) {
   const std::string good = read_bytes(ksplat_file(1, 2));
   ASSERT_GT(good.size(), 5120u);
-  expect_error(write_file("header.ksplat", good.substr(0, 1000)), {"less than its 4096-byte header"});
-  expect_error(write_file("sections.ksplat", good.substr(0, 4500)), {"section headers"});
-  expect_error(write_file("splats.ksplat", good.substr(0, good.size() - 7)), {"section 0", "truncated"});
+  testing::expect_scene_error(write_file("header.ksplat", good.substr(0, 1000)), {"less than its 4096-byte header"});
+  testing::expect_scene_error(write_file("sections.ksplat", good.substr(0, 4500)), {"section headers"});
+  testing::expect_scene_error(write_file("splats.ksplat", good.substr(0, good.size() - 7)), {"section 0", "truncated"});
   std::string version = good;
   version[1] = 0;
-  expect_error(write_file("version.ksplat", version), {"version 0.0"});
+  testing::expect_scene_error(write_file("version.ksplat", version), {"version 0.0"});
   std::string level = good;
   put_u16(level, 20, 3);
-  expect_error(write_file("level.ksplat", level), {"compression level 3"});
+  testing::expect_scene_error(write_file("level.ksplat", level), {"compression level 3"});
   std::string degree = good;
   put_u16(degree, 4096 + 40, 3);
-  expect_error(write_file("degree.ksplat", degree), {"section 0", "SH degree 3"});
+  testing::expect_scene_error(write_file("degree.ksplat", degree), {"section 0", "SH degree 3"});
   std::string buckets = good;
   put_u32(buckets, 4096 + 32, 1000);  // full buckets
-  expect_error(write_file("buckets.ksplat", buckets), {"section 0", "buckets"});
+  testing::expect_scene_error(write_file("buckets.ksplat", buckets), {"section 0", "buckets"});
   std::string count = good;
   put_u32(count, 12, 65);
-  expect_error(write_file("count.ksplat", count), {"declares 65 splats"});
+  testing::expect_scene_error(write_file("count.ksplat", count), {"declares 65 splats"});
   std::string block = good;
   put_u32(block, 4096 + 16, 0);
-  expect_error(write_file("block.ksplat", block), {"block size"});
+  testing::expect_scene_error(write_file("block.ksplat", block), {"block size"});
   // A zeroed file has no version: not a ksplat by its content, and refused as one by its extension.
-  expect_error(write_file("zeros.ksplat", std::string(good.size(), '\0')), {"version 0.0"});
-  expect_error(write_file("zeros.bin", std::string(good.size(), '\0')), {"unrecognized scene format"});
+  testing::expect_scene_error(write_file("zeros.ksplat", std::string(good.size(), '\0')), {"version 0.0"});
+  testing::expect_scene_error(write_file("zeros.bin", std::string(good.size(), '\0')), {"unrecognized scene format"});
 }
 
 // Any single flipped byte gives a scene or one SceneError, never a crash (the fuzzer goes further).

@@ -195,19 +195,6 @@ fs::path write_file(const std::string& name, const std::string& bytes) {
   return path;
 }
 
-// One SceneError that names the file and says each of `phrases`.
-void expect_error(const fs::path& path, std::initializer_list<std::string> phrases) {
-  SCOPED_TRACE(path.filename().string());
-  try {
-    load_scene(path);
-    ADD_FAILURE() << "loaded without an error";
-  } catch (const SceneError& error) {
-    const std::string message = error.what();
-    EXPECT_TRUE(message.starts_with(path.string())) << message;
-    for (const std::string& phrase : phrases) EXPECT_NE(message.find(phrase), std::string::npos) << message;
-  }
-}
-
 std::string gzip(const std::string& data) {
   z_stream stream{};
   deflateInit2(&stream, 9, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY);
@@ -292,57 +279,57 @@ class FormatErrors : public ::testing::Test {
 
 TEST_F(FormatErrors, TruncatedFiles) {
   const std::string v4 = original("playcanvas_test_64_sh3.v4.spz");
-  expect_error(write_file("cut.v4.spz", v4.substr(0, v4.size() / 2)), {"runs past the end"});
-  expect_error(write_file("cut_header.v4.spz", v4.substr(0, 20)), {"truncated SPZ version 4 header"});
+  testing::expect_scene_error(write_file("cut.v4.spz", v4.substr(0, v4.size() / 2)), {"runs past the end"});
+  testing::expect_scene_error(write_file("cut_header.v4.spz", v4.substr(0, 20)), {"truncated SPZ version 4 header"});
   const std::string v3 = original("playcanvas_test_64_sh3.v3.spz");
-  expect_error(write_file("cut.v3.spz", v3.substr(0, v3.size() / 2)), {"gzip stream", "64 Gaussians"});
+  testing::expect_scene_error(write_file("cut.v3.spz", v3.substr(0, v3.size() / 2)), {"gzip stream", "64 Gaussians"});
   const std::string compressed = original("playcanvas_test_64_sh3.compressed.ply");
-  expect_error(write_file("cut.compressed.ply", compressed.substr(0, compressed.size() - 100)),
+  testing::expect_scene_error(write_file("cut.compressed.ply", compressed.substr(0, compressed.size() - 100)),
                {"truncated"});
   const std::string glb = original("playcanvas_test_64_sh3.glb");
-  expect_error(write_file("cut.glb", glb.substr(0, glb.size() - 64)), {"truncated GLB"});
+  testing::expect_scene_error(write_file("cut.glb", glb.substr(0, glb.size() - 64)), {"truncated GLB"});
   const std::string sog = original("playcanvas_test_64_sh3.sog");
-  expect_error(write_file("cut.sog", sog.substr(0, sog.size() / 2)), {"not a readable zip"});
+  testing::expect_scene_error(write_file("cut.sog", sog.substr(0, sog.size() / 2)), {"not a readable zip"});
   const std::string splat = read_file(testing::shared_scenes() / "train_3pts.splat");
-  expect_error(write_file("cut.splat", splat.substr(0, splat.size() - 5)), {"not a multiple of 32"});
+  testing::expect_scene_error(write_file("cut.splat", splat.substr(0, splat.size() - 5)), {"not a multiple of 32"});
 }
 
 TEST_F(FormatErrors, WrongMagicAndUnknownVersions) {
   std::string v4 = original("playcanvas_test_64_sh3.v4.spz");
   std::string bad_magic = v4;
   bad_magic[3] = 'X';
-  expect_error(write_file("magic.spz", bad_magic), {"unrecognized scene format"});
+  testing::expect_scene_error(write_file("magic.spz", bad_magic), {"unrecognized scene format"});
   std::string v5 = v4;
   put_u32(v5, 4, 5);
-  expect_error(write_file("v5.spz", v5), {"unsupported SPZ version 5"});
+  testing::expect_scene_error(write_file("v5.spz", v5), {"unsupported SPZ version 5"});
   std::string inner = gunzip(original("playcanvas_test_64_sh3.v3.spz"));
   put_u32(inner, 4, 9);
-  expect_error(write_file("v9.spz", gzip(inner)), {"unsupported SPZ version 9"});
+  testing::expect_scene_error(write_file("v9.spz", gzip(inner)), {"unsupported SPZ version 9"});
   std::string glb = original("playcanvas_test_64_sh3.glb");
   put_u32(glb, 4, 3);
-  expect_error(write_file("v3.glb", glb), {"unsupported GLB version 3"});
+  testing::expect_scene_error(write_file("v3.glb", glb), {"unsupported GLB version 3"});
   ZipEntries sog = read_zip(formats_ / "playcanvas_test_64_sh3.sog");
   std::string& meta = entry(sog, "meta.json");
   meta.replace(meta.find("\"version\":2"), 11, "\"version\":7");
-  expect_error(write_zip("v7.sog", sog), {"unsupported SOG version 7"});
+  testing::expect_scene_error(write_zip("v7.sog", sog), {"unsupported SOG version 7"});
 }
 
 TEST_F(FormatErrors, CountsThatDisagreeWithTheData) {
   std::string v4 = original("playcanvas_test_64_sh3.v4.spz");
   put_u32(v4, 8, 65);
-  expect_error(write_file("count.v4.spz", v4), {"65 Gaussians need"});
+  testing::expect_scene_error(write_file("count.v4.spz", v4), {"65 Gaussians need"});
   std::string compressed = original("playcanvas_test_64_sh3.compressed.ply");
   const size_t at = compressed.find("element vertex 64");
   compressed.replace(at, 17, "element vertex 65");
-  expect_error(write_file("count.compressed.ply", compressed), {"65 Gaussians"});
+  testing::expect_scene_error(write_file("count.compressed.ply", compressed), {"65 Gaussians"});
   ZipEntries sog = read_zip(formats_ / "playcanvas_test_64_sh3.sog");
   std::string& meta = entry(sog, "meta.json");
   meta.replace(meta.find("\"count\":64"), 10, "\"count\":9999");
-  expect_error(write_zip("count.sog", sog), {"wrong size for 9999"});
+  testing::expect_scene_error(write_zip("count.sog", sog), {"wrong size for 9999"});
   std::string glb = original("playcanvas_test_64_sh3.glb");
   const size_t count = glb.find("\"count\":64");
   glb.replace(count, 10, "\"count\":99");
-  expect_error(write_file("count.glb", glb), {"run past the end"});
+  testing::expect_scene_error(write_file("count.glb", glb), {"run past the end"});
 }
 
 TEST_F(FormatErrors, SogContainersAndImages) {
@@ -350,33 +337,33 @@ TEST_F(FormatErrors, SogContainersAndImages) {
   ZipEntries no_meta;
   for (const auto& e : sog)
     if (e.first != "meta.json") no_meta.push_back(e);
-  expect_error(write_zip("no_meta.sog", no_meta), {"without meta.json"});
+  testing::expect_scene_error(write_zip("no_meta.sog", no_meta), {"without meta.json"});
 
   // A WebP of the wrong size: the 64-Gaussian scene's means in the 1873-Gaussian scene.
   ZipEntries wrong = read_zip(formats_ / "playbot_lod6_1873_sh2.sog");
   entry(wrong, "means_l.webp") = entry(sog, "means_l.webp");
-  expect_error(write_zip("wrong_size.sog", wrong), {"means_l.webp", "wrong size"});
+  testing::expect_scene_error(write_zip("wrong_size.sog", wrong), {"means_l.webp", "wrong size"});
   ZipEntries not_webp = sog;
   entry(not_webp, "quats.webp") = "not an image";
-  expect_error(write_zip("not_webp.sog", not_webp), {"quats.webp", "not a WebP"});
+  testing::expect_scene_error(write_zip("not_webp.sog", not_webp), {"quats.webp", "not a WebP"});
 
   // Unbundled, with one image missing.
   const fs::path folder = testing::temp_dir() / "unbundled";
   fs::remove_all(folder);
   fs::copy(formats_ / "playbot_lod6_1873_sh2_sog_unbundled", folder);
   fs::remove(folder / "scales.webp");
-  expect_error(folder / "meta.json", {"scales.webp", "cannot be read"});
+  testing::expect_scene_error(folder / "meta.json", {"scales.webp", "cannot be read"});
 }
 
 TEST_F(FormatErrors, DecompressionBombsAreRefusedBeforeAllocating) {
   // SPZ v3: a 16-byte header declaring 2^31 Gaussians, gzipped to a few dozen bytes.
   std::string header = gunzip(original("playcanvas_test_64_sh3.v3.spz")).substr(0, 16);
   put_u32(header, 8, 1u << 31);
-  expect_error(write_file("bomb.v3.spz", gzip(header + std::string(4096, '\0'))), {"refusing to decompress"});
+  testing::expect_scene_error(write_file("bomb.v3.spz", gzip(header + std::string(4096, '\0'))), {"refusing to decompress"});
   // SPZ v4: the same count in a 200-byte file; its TOC's sizes agree with the count.
   std::string v4 = original("playcanvas_test_64_sh3.v4.spz");
   put_u32(v4, 8, 1u << 31);
-  expect_error(write_file("bomb.v4.spz", v4), {"declares"});
+  testing::expect_scene_error(write_file("bomb.v4.spz", v4), {"declares"});
   // A zip entry whose headers declare 2 GiB for 1 MiB of deflated zeros (about 1 kB).
   ZipEntries sog = read_zip(formats_ / "playcanvas_test_64_sh3.sog");
   entry(sog, "means_l.webp") = std::string(1u << 20, '\0');
@@ -393,7 +380,7 @@ TEST_F(FormatErrors, DecompressionBombsAreRefusedBeforeAllocating) {
     ++patched;
   }
   ASSERT_EQ(patched, 2u);
-  expect_error(write_file("bomb.sog", zip), {"means_l.webp", "refusing to decompress"});
+  testing::expect_scene_error(write_file("bomb.sog", zip), {"means_l.webp", "refusing to decompress"});
 }
 
 TEST(SceneFormatsMemory, ParseSceneReadsTheSameBytesAsLoadScene) {

@@ -186,4 +186,16 @@ float max_abs_difference(const std::vector<float>& a, const std::vector<float>& 
   return most;
 }
 
+void expect_scene_error(const std::filesystem::path& path, std::initializer_list<std::string> phrases) {
+  SCOPED_TRACE(path.filename().string());
+  try {
+    load_scene(path);
+    ADD_FAILURE() << "loaded without an error";
+  } catch (const SceneError& error) {
+    const std::string message = error.what();
+    EXPECT_TRUE(message.starts_with(path.string())) << message;
+    for (const std::string& phrase : phrases) EXPECT_NE(message.find(phrase), std::string::npos) << message;
+  }
+}
+
 }  // namespace tilesplat::testing

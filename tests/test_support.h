@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <exception>
 #include <filesystem>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <vector>
@@ -41,6 +42,9 @@ void replay_fuzz_regressions(const std::string& reader, size_t at_least,
 
 // A directory unique to the running test for temporary files (removed by the OS, not by tests).
 std::filesystem::path temp_dir();
+
+// Expects load_scene(path) to throw one SceneError that names the file and says each of `phrases`.
+void expect_scene_error(const std::filesystem::path& path, std::initializer_list<std::string> phrases);
 
 // One renderer per test binary with the Khronos validation layer on (the layer being absent
 // is itself a failure). Tests assert validation_messages() == 0 after rendering.

@@ -45,6 +45,26 @@ inline void check_same_gaussians(const tilesplat::GaussianScene& a, const tilesp
   FUZZ_CHECK(same(a.normals, b.normals));
 }
 
+// Gaussians `indices` of `scene`, in that order, as a scene of their own (what a part holds).
+inline tilesplat::GaussianScene gaussians_at(const tilesplat::GaussianScene& scene,
+                                             std::span<const uint32_t> indices) {
+  tilesplat::GaussianScene part;
+  part.sh_degree = scene.sh_degree;
+  const size_t sh = 3 * static_cast<size_t>(scene.sh_coefficients());
+  const auto copy = [](const std::vector<float>& from, std::vector<float>& to, size_t i, size_t per) {
+    to.insert(to.end(), from.begin() + std::ptrdiff_t(i * per), from.begin() + std::ptrdiff_t((i + 1) * per));
+  };
+  for (const uint32_t i : indices) {
+    copy(scene.positions, part.positions, i, 3);
+    copy(scene.log_scales, part.log_scales, i, 3);
+    copy(scene.rotations, part.rotations, i, 4);
+    copy(scene.opacity_logits, part.opacity_logits, i, 1);
+    copy(scene.sh, part.sh, i, sh);
+    if (scene.has_normals()) copy(scene.normals, part.normals, i, 3);
+  }
+  return part;
+}
+
 // A loaded scene: consistent array sizes, finite values, unit quaternions, report counts that add up.
 inline void check_scene(const tilesplat::GaussianScene& scene, const tilesplat::LoadReport& report) {
   const size_t n = scene.size();
