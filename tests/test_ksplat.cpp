@@ -271,6 +271,21 @@ TEST(Ksplat, FlippedBytesLoadOrFailCleanly) {
   EXPECT_GT(refused, 0u);
 }
 
+// Read part by part, a .ksplat is told by its header like the rest: a JSON that is no SOG meta.json (a glTF)
+// is still refused as a format read whole, not taken for a .ksplat.
+TEST(Ksplat, PartByPartTakesOnlyAKsplatForOne) {
+  const fs::path gltf = write_file("scene.gltf", R"({"asset": {"version": "2.0"}})");
+  try {
+    SceneInParts::open(gltf);
+    ADD_FAILURE() << "a glTF opened part by part";
+  } catch (const SceneError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("only these are read part by part"), std::string::npos) << message;
+    EXPECT_EQ(message.find("not a whole .ksplat"), std::string::npos) << message;
+  }
+  EXPECT_EQ(SceneInParts::open(ksplat_file(0, 0)).size(), 64u);
+}
+
 TEST(Ksplat, ChosenByContentWhateverTheName) {
   const std::string good = read_bytes(ksplat_file(0, 0));
   LoadReport report;
