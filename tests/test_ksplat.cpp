@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "process_support.h"
 #include "test_support.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/image.h"
@@ -35,11 +36,6 @@ constexpr double kShC0 = 0.28209479177387814;
 fs::path ksplat_file(int level, int sh_degree) {
   return kKsplatDir / ("playcanvas_test_64_sh3_l" + std::to_string(level) + "_sh" + std::to_string(sh_degree) +
                        ".ksplat");
-}
-
-std::string read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 fs::path write_file(const std::string& name, const std::string& bytes) {
@@ -93,7 +89,7 @@ TEST_P(KsplatFiles, EachGaussianIsItsSourceAsTheGeneratorQuantizesIt) {
   ASSERT_EQ(scene.sh_degree, sh_degree);
   // Level 2's 8-bit SH span the range in the file's header (the generator's minimum and maximum of the
   // source's SH beyond DC), floored to 255 steps: a value outside it is clamped.
-  const std::string bytes = read_bytes(ksplat_file(level, sh_degree));
+  const std::string bytes = testing::read_file(ksplat_file(level, sh_degree));
   float sh_min = 0, sh_max = 0;
   std::memcpy(&sh_min, bytes.data() + 36, 4);
   std::memcpy(&sh_max, bytes.data() + 40, 4);
@@ -223,7 +219,7 @@ void put_u32(std::string& bytes, size_t at, uint32_t value) { std::memcpy(bytes.
 void put_u16(std::string& bytes, size_t at, uint16_t value) { std::memcpy(bytes.data() + at, &value, 2); }
 
 TEST(Ksplat, DamagedFilesAreRefusedNamingThePart) {
-  const std::string good = read_bytes(ksplat_file(1, 2));
+  const std::string good = testing::read_file(ksplat_file(1, 2));
   ASSERT_GT(good.size(), 5120u);
   testing::expect_scene_error(write_file("header.ksplat", good.substr(0, 1000)), {"less than its 4096-byte header"});
   testing::expect_scene_error(write_file("sections.ksplat", good.substr(0, 4500)), {"section headers"});
@@ -253,7 +249,7 @@ TEST(Ksplat, DamagedFilesAreRefusedNamingThePart) {
 
 // Any single flipped byte gives a scene or one SceneError, never a crash (the fuzzer goes further).
 TEST(Ksplat, FlippedBytesLoadOrFailCleanly) {
-  const std::string good = read_bytes(ksplat_file(2, 2));
+  const std::string good = testing::read_file(ksplat_file(2, 2));
   size_t loaded = 0, refused = 0;
   for (size_t at = 0; at < good.size(); at += 37) {
     std::string flipped = good;
@@ -287,7 +283,7 @@ TEST(Ksplat, PartByPartTakesOnlyAKsplatForOne) {
 }
 
 TEST(Ksplat, ChosenByContentWhateverTheName) {
-  const std::string good = read_bytes(ksplat_file(0, 0));
+  const std::string good = testing::read_file(ksplat_file(0, 0));
   LoadReport report;
   const GaussianScene scene = load_scene(write_file("renamed.bin", good), {}, &report);
   EXPECT_EQ(scene.size(), 64u);

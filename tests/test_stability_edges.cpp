@@ -37,8 +37,8 @@ GaussianScene three_splats(float dc, double depth) {
   const double spread = 0.1 * depth;  // the row spans the same pixels at any depth
   const float log_scale = float(std::log(0.05 * depth));
   for (int i = 0; i < 3; ++i) {
-    scene.positions.insert(scene.positions.end(),
-                           {float(spread * (i - 1)), float(0.02 * depth * (i - 1)), float(depth * (1 + 0.01 * std::abs(i - 1)))});
+    scene.positions.insert(scene.positions.end(), {float(spread * (i - 1)), float(0.02 * depth * (i - 1)),
+                                                   float(depth * (1 + 0.01 * std::abs(i - 1)))});
     scene.log_scales.insert(scene.log_scales.end(), {log_scale, log_scale, log_scale});
     scene.rotations.insert(scene.rotations.end(), {1, 0, 0, 0});
     scene.opacity_logits.push_back(4.0f);  // alpha 0.98: a DC of 400 decodes past half at the centre

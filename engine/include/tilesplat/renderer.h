@@ -100,7 +100,7 @@ struct FrameStats {
   /// Finite values that the frame's outputs could not hold, each stored as the largest finite value of its
   /// type with its sign instead of an infinity: render_to_image into an R16G16B16A16_SFLOAT image counts the
   /// colours past half's range (channel "host image RGBA"); a frame of accumulated samples
-  /// (RenderSettings::accumulate_samples) counts the linear colours, of a sample or of the samples' sum, past
+  /// (RenderSettings::accumulate_samples) counts the linear colours, of a sample or of the samples' mean, past
   /// float's range (channel "linear sample mean RGB"). Otherwise render() returns floats, which hold every
   /// value, and leaves it empty. Files are written after the frame: write_exr() returns its own counts, which
   /// tilesplat-render adds here for --stats.

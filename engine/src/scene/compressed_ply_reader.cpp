@@ -23,7 +23,6 @@ namespace tilesplat::detail {
 namespace {
 
 constexpr size_t kChunkSize = 256;
-constexpr double kShC0 = 0.28209479177387814;
 
 const PlyElement* find_element(const PlyHeader& header, std::string_view name) {
   for (const PlyElement& element : header.elements)

@@ -31,7 +31,6 @@ namespace {
 using nlohmann::json;
 
 constexpr std::string_view kPrefix = "KHR_gaussian_splatting:";
-constexpr double kShC0 = 0.28209479177387814;
 // Sign of each SH basis function (k = 1..15) when x and y flip: its parity in x and y, (-1)^k.
 constexpr float kFlipSh[15] = {-1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1};
 

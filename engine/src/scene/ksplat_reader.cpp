@@ -21,7 +21,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <string>
 #include <vector>
 
@@ -35,7 +34,6 @@ namespace {
 constexpr size_t kHeaderBytes = 4096;
 constexpr size_t kSectionHeaderBytes = 1024;
 constexpr size_t kUsedHeaderBytes = 44;  // words 0 to 10; the rest of the header is zero
-constexpr double kShC0 = 0.28209479177387814;
 constexpr double kDefaultShHalfRange = 1.5;  // GaussianSplats3D's SphericalHarmonics8BitCompressionRange / 2
 // A scale that float16 rounded to zero was below its smallest subnormal, 2^-24: it is read as half that.
 constexpr double kLogHalfUnderflow = -25 * 0.6931471805599453;
@@ -198,7 +196,7 @@ void KsplatPacked::decode_splat(size_t index, size_t i, GaussianScene& scene) co
     sh = splat + 24;
   }
   const size_t k_count = size_t(scene.sh_coefficients());
-  for (size_t c = 0; c < 3; ++c) scene.sh[i * k_count * 3 + c] = float((colour[c] / 255.0 - 0.5) / kShC0);
+  for (size_t c = 0; c < 3; ++c) scene.sh[i * k_count * 3 + c] = dc_of_colour_byte(colour[c]);
   scene.opacity_logits[i] = float(clamped_logit(colour[3] / 255.0));
   const int stored_k = (s.sh_degree + 1) * (s.sh_degree + 1);
   for (int k = 1; k < stored_k; ++k)

@@ -88,6 +88,13 @@ float to_float(double value);
 // become logits in the .splat, .spz and SOG reference decoders, so that no file yields an infinity.
 double clamped_logit(double p);
 
+// SH band 0's constant: a Gaussian's colour is 0.5 + kShC0 * dc (before the higher bands).
+inline constexpr double kShC0 = 0.28209479177387814;
+
+// The DC coefficient of an 8-bit display colour `byte` = (0.5 + kShC0 * dc) * 255, as .splat and .ksplat
+// store it.
+inline float dc_of_colour_byte(unsigned char byte) { return float((byte / 255.0 - 0.5) / kShC0); }
+
 // Sizes every array of `scene` for `count` Gaussians of `sh_degree` (no normals).
 void allocate_scene(GaussianScene& scene, size_t count, int sh_degree);
 

@@ -13,7 +13,6 @@ namespace tilesplat::detail {
 namespace {
 
 constexpr size_t kBytesPerGaussian = 32;
-constexpr double kShC0 = 0.28209479177387814;
 
 }  // namespace
 
@@ -36,7 +35,7 @@ GaussianScene read_splat(std::span<const std::byte> data, std::string_view name,
       // log(0) is -inf and a negative scale NaN: finish_scene drops such Gaussians.
       scene.log_scales[3 * i + a] =
           to_float(std::log(static_cast<double>(load_le<float>(record + 12 + 4 * a))));
-      scene.sh[3 * i + a] = static_cast<float>((record[24 + a] / 255.0 - 0.5) / kShC0);
+      scene.sh[3 * i + a] = dc_of_colour_byte(record[24 + a]);
     }
     scene.opacity_logits[i] = static_cast<float>(clamped_logit(record[27] / 255.0));
     for (size_t j = 0; j < 4; ++j)
