@@ -135,22 +135,8 @@ std::pair<json, std::vector<uint8_t>> make_gltf(const Encoding& encoding, const 
   return {gltf, bin};
 }
 
-void write_glb(const fs::path& path, const json& gltf, std::vector<uint8_t> bin) {
-  std::string text = gltf.dump();
-  while (text.size() % 4) text += ' ';
-  align4(bin);
-  std::vector<uint8_t> out;
-  append(out, uint32_t{0x46546c67});
-  append(out, uint32_t{2});
-  append(out, uint32_t(12 + 8 + text.size() + 8 + bin.size()));
-  append(out, uint32_t(text.size()));
-  append(out, uint32_t{0x4e4f534a});  // JSON
-  out.insert(out.end(), text.begin(), text.end());
-  append(out, uint32_t(bin.size()));
-  append(out, uint32_t{0x004e4942});  // BIN
-  out.insert(out.end(), bin.begin(), bin.end());
-  std::ofstream(path, std::ios::binary)
-      .write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()));
+void write_glb(const fs::path& path, const json& gltf, const std::vector<uint8_t>& bin) {
+  std::ofstream(path, std::ios::binary) << tilesplat::testing::glb_bytes(gltf.dump(), std::string(bin.begin(), bin.end()));
 }
 
 std::string base64(const std::vector<uint8_t>& bytes) {

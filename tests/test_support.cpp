@@ -54,6 +54,25 @@ Camera axis_camera(int width, int height, double focal) {
   return camera;
 }
 
+std::string glb_bytes(std::string json_text, std::string bin) {
+  while (json_text.size() % 4) json_text += ' ';
+  while (bin.size() % 4) bin += '\0';
+  std::string out;
+  const auto append = [&out](uint32_t value) {
+    for (int shift = 0; shift < 32; shift += 8) out += static_cast<char>((value >> shift) & 0xff);
+  };
+  append(0x46546c67);  // "glTF"
+  append(2);
+  append(static_cast<uint32_t>(12 + 8 + json_text.size() + 8 + bin.size()));
+  append(static_cast<uint32_t>(json_text.size()));
+  append(0x4e4f534a);  // "JSON"
+  out += json_text;
+  append(static_cast<uint32_t>(bin.size()));
+  append(0x004e4942);  // "BIN\0"
+  out += bin;
+  return out;
+}
+
 std::filesystem::path temp_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "tilesplat";

@@ -43,6 +43,9 @@ void replay_fuzz_regressions(const std::string& reader, size_t at_least,
 // A directory unique to the running test for temporary files (removed by the OS, not by tests).
 std::filesystem::path temp_dir();
 
+// A binary glTF (.glb) of `json_text` and `bin` (each padded to 4 bytes, as the GLB chunks must be).
+std::string glb_bytes(std::string json_text, std::string bin);
+
 // Expects load_scene(path) to throw one SceneError that names the file and says each of `phrases`.
 void expect_scene_error(const std::filesystem::path& path, std::initializer_list<std::string> phrases);
 

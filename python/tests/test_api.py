@@ -53,6 +53,11 @@ def test_every_format_loads(shared_scenes):
         assert scene.size == reference.size and scene.sh_degree == 2, level
         distances = np.linalg.norm(reference.positions[:, None, :] - scene.positions[None, :, :], axis=2)
         assert distances.min(axis=1).max() < 1e-4, level
+    # glTF with an SPZ stream, as each Khronos draft places it (tests/data/gltf_spz): SPZ's 12-bit position step.
+    for glb in sorted((REPO / "tests" / "data" / "gltf_spz").glob("*.glb")):
+        scene = tilesplat.load_scene(glb)
+        assert scene.size == reference.size and scene.sh_degree == 3, glb.name
+        assert np.abs(scene.positions - reference.positions).max() < 1.3e-4, glb.name
     scene_file = tilesplat.load_scene(REPO / "scenes" / "two_playbots.json")
     assert scene_file.size == 2 * tilesplat.load_scene(BUNDLED_PLAYBOT).size
 

@@ -54,7 +54,7 @@ seed ksplat tests/data/ksplat/playcanvas_test_64_sh3_l{0,1,2}_sh2.ksplat
 seed spz "$scenes/train_3pts.spz" "$scenes/formats/playcanvas_test_64_sh3.v3.spz" "$scenes/formats/playcanvas_test_64_sh3.v4.spz"
 seed sog "$scenes/formats/playcanvas_test_64_sh3.sog"
 seed compressed_ply "$scenes/playcanvas_test_64.compressed.ply" "$scenes/formats/playcanvas_test_64_sh3.compressed.ply"
-seed gltf "$scenes/formats/playcanvas_test_64_sh3.glb"
+seed gltf "$scenes/formats/playcanvas_test_64_sh3.glb" tests/data/gltf_spz/*.glb
 # The part-by-part reader's dispatch: a few of the PLY seeds, and an SPZ and a SOG.
 seed scene_in_parts "$scenes/formats/playcanvas_test_64_sh3.v4.spz" "$scenes/formats/playcanvas_test_64_sh3.sog" \
   tests/data/ksplat/playcanvas_test_64_sh3_l1_sh2.ksplat \

@@ -8,6 +8,13 @@
 // reader takes log(scale) and logit(opacity) back to the trainer's parameters. colorSpace
 // srgb_rec709_display is what trainers produce and the engine renders as it is.
 //
+// SPZ compression (Khronos drafts): the primitive's Gaussians are an SPZ stream in a bufferView instead of
+// its accessors. The draft's current name, KHR_gaussian_splatting_compression_spz_2, and its earlier one
+// without "_2" sit inside the primitive's KHR_gaussian_splatting extension; the first draft,
+// KHR_spz_compression, sits on the primitive itself. Each names the bufferView; the accessors then only
+// describe what the stream decodes to (their count must be its count). The stream is packed from glTF's
+// axes (the drafts require SPZ's LUF option), so decoded to SPZ's own RUB it lands where any .spz does.
+//
 // Axes: glTF is y up; the engine keeps the trainer's y down. As splat-transform and the PlayCanvas
 // engine do, the glTF scene is the trainer's turned 180 degrees about z, so x and y flip (positions,
 // quaternions, and SH coefficients by their parity in x and y). Node transforms (matrix or TRS) are
@@ -23,6 +30,7 @@
 #include "scene/gltf_container.h"
 #include "scene/scene_readers.h"
 #include "scene/scene_reading.h"
+#include "scene/spz_packed.h"
 #include "tilesplat/scene_description.h"
 
 namespace tilesplat::detail {
@@ -31,6 +39,11 @@ namespace {
 using nlohmann::json;
 
 constexpr std::string_view kPrefix = "KHR_gaussian_splatting:";
+constexpr const char* kSplatting = "KHR_gaussian_splatting";
+// The SPZ drafts: the two that extend KHR_gaussian_splatting, newest first, and the first, on the primitive.
+constexpr const char* kSpzInSplatting[] = {"KHR_gaussian_splatting_compression_spz_2",
+                                           "KHR_gaussian_splatting_compression_spz"};
+constexpr const char* kSpzOnPrimitive = "KHR_spz_compression";
 // Sign of each SH basis function (k = 1..15) when x and y flip: its parity in x and y, (-1)^k.
 constexpr float kFlipSh[15] = {-1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1, 1, -1};
 
@@ -61,11 +74,14 @@ class GltfReader {
     for (const auto& [mesh, world] : mesh_instances())
       for (const json& primitive :
            array_of(at(at(gltf_, "meshes", "glTF"), mesh, "meshes"), "primitives", "mesh")) {
-        if (!primitive.contains("extensions") || !primitive["extensions"].contains("KHR_gaussian_splatting"))
+        if (!primitive.contains("extensions") || !(primitive["extensions"].contains(kSplatting) ||
+                                                   primitive["extensions"].contains(kSpzOnPrimitive)))
           continue;
-        parts.push_back(place(read_primitive(primitive), world));
+        const std::optional<SpzStream> spz = spz_stream(primitive);
+        parts.push_back(place(spz ? read_spz_primitive(primitive, *spz) : read_primitive(primitive), world));
       }
     if (parts.empty()) fail("no mesh primitive with the KHR_gaussian_splatting extension");
+    if (!spz_versions_.empty()) *format += " (SPZ " + spz_versions_ + ")";
     if (parts.size() == 1) return std::move(parts.front());
     return merge_scenes(parts);
   }
@@ -106,9 +122,31 @@ class GltfReader {
       fail("unsupported glTF version " + version.dump() + " (supported: 2.x)");
     if (gltf_.contains("extensionsRequired"))
       for (const json& extension : gltf_["extensionsRequired"])
-        if (extension != "KHR_gaussian_splatting")
+        if (extension != kSplatting && extension != kSpzOnPrimitive && extension != kSpzInSplatting[0] &&
+            extension != kSpzInSplatting[1])
           fail("requires the glTF extension " + extension.dump() +
-               ", which this reader does not decode (it reads KHR_gaussian_splatting with plain accessors)");
+               ", which this reader does not decode (it reads KHR_gaussian_splatting with plain accessors "
+               "or an SPZ stream)");
+  }
+
+  // Where a primitive's SPZ stream is, if it has one.
+  struct SpzStream {
+    std::string extension;
+    size_t buffer_view = 0;
+  };
+  std::optional<SpzStream> spz_stream(const json& primitive) const {
+    const json& extensions = primitive["extensions"];
+    const auto view_of = [&](const json& extension, const char* name) {
+      if (!extension.is_object()) fail(std::string(name) + " is not an object");
+      return SpzStream{name, index(at(extension, "bufferView", name), std::string(name) + ".bufferView")};
+    };
+    if (extensions.contains(kSplatting) && extensions[kSplatting].is_object() &&
+        extensions[kSplatting].contains("extensions"))
+      for (const char* name : kSpzInSplatting)
+        if (extensions[kSplatting]["extensions"].contains(name))
+          return view_of(extensions[kSplatting]["extensions"][name], name);
+    if (extensions.contains(kSpzOnPrimitive)) return view_of(extensions[kSpzOnPrimitive], kSpzOnPrimitive);
+    return std::nullopt;
   }
 
   // (mesh, world matrix) for every node of the default scene (or of every root, without scenes).
@@ -154,8 +192,7 @@ class GltfReader {
     if (loaded_.size() <= i) loaded_.resize(i + 1);
     if (!description.contains("uri")) {
       if (!bin_) fail("buffer " + std::to_string(i) + " has no uri and the file no GLB binary chunk");
-      loaded_[i] = std::vector<unsigned char>(bin_->begin(), bin_->end());
-      return *loaded_[i];
+      return *bin_;  // the file's own bytes, not a copy
     }
     const json& uri_value = description["uri"];
     if (!uri_value.is_string()) fail("buffer " + std::to_string(i) + ": uri is not a string");
@@ -171,6 +208,20 @@ class GltfReader {
       loaded_[i] = load_buffer_(percent_decoded(name_, uri, i));
     }
     return *loaded_[i];
+  }
+
+  // The bytes of bufferView `i`, checked to lie inside its buffer; `user` names who asked, for errors.
+  std::span<const unsigned char> buffer_view(size_t i, const std::string& user) {
+    const json& view = at(array_of(gltf_, "bufferViews", "glTF"), i, "bufferViews");
+    const std::span<const unsigned char> data =
+        buffer(index(at(view, "buffer", "bufferView"), "bufferView.buffer"));
+    const size_t view_offset =
+        view.contains("byteOffset") ? index(view["byteOffset"], "bufferView.byteOffset") : 0;
+    const size_t view_length = index(at(view, "byteLength", "bufferView"), "bufferView.byteLength");
+    if (view_offset > data.size() || view_length > data.size() - view_offset)
+      fail("bufferView " + std::to_string(i) + " of " + user + " lies outside its buffer (" +
+           std::to_string(data.size()) + " bytes)");
+    return data.subspan(view_offset, view_length);
   }
 
   // An accessor's values as doubles, `components` per element; normalized integers mapped by the
@@ -210,19 +261,14 @@ class GltfReader {
       if (attribute == "POSITION") fail(where + " has no bufferView");
       return std::vector<double>(count * components);
     }
-    const json& view = at(array_of(gltf_, "bufferViews", "glTF"),
-                          index(a["bufferView"], where + ".bufferView"), "bufferViews");
-    const std::span<const unsigned char> data =
-        buffer(index(at(view, "buffer", "bufferView"), "bufferView.buffer"));
-    const size_t view_offset =
-        view.contains("byteOffset") ? index(view["byteOffset"], "bufferView.byteOffset") : 0;
-    const size_t view_length = index(at(view, "byteLength", "bufferView"), "bufferView.byteLength");
+    const size_t view_index = index(a["bufferView"], where + ".bufferView");
+    const std::span<const unsigned char> view_bytes = buffer_view(view_index, where);
+    const json& view = gltf_["bufferViews"][view_index];
+    const size_t view_length = view_bytes.size();
     const size_t element_size = size * components;
     const size_t stride =
         view.contains("byteStride") ? index(view["byteStride"], "bufferView.byteStride") : element_size;
     const size_t offset = a.contains("byteOffset") ? index(a["byteOffset"], where + ".byteOffset") : 0;
-    if (view_offset > data.size() || view_length > data.size() - view_offset)
-      fail("bufferView of " + where + " lies outside its buffer (" + std::to_string(data.size()) + " bytes)");
     if (stride < element_size)
       fail(where + ": byteStride " + std::to_string(stride) + " is smaller than an element");
     if (count > 0) {
@@ -233,7 +279,7 @@ class GltfReader {
              std::to_string(view_length) + " bytes); the file is truncated or the count is wrong");
     }
     std::vector<double> values(count * components);
-    const unsigned char* base = data.data() + view_offset + offset;
+    const unsigned char* base = view_bytes.data() + offset;
     for (size_t e = 0; e < count; ++e)
       for (size_t c = 0; c < components; ++c) {
         const unsigned char* p = base + e * stride + c * size;
@@ -332,6 +378,70 @@ class GltfReader {
     return scene;
   }
 
+  // A primitive whose Gaussians are an SPZ stream, in glTF's axes as read_primitive gives them.
+  GaussianScene read_spz_primitive(const json& primitive, const SpzStream& spz) {
+    const std::span<const unsigned char> bytes = buffer_view(spz.buffer_view, spz.extension);
+    const SpzPacked packed = unpack_spz(bytes, spz);
+    // What the primitive says the stream holds must be what it holds: a mismatch is a damaged file.
+    const auto expect_count = [&](size_t declared, const std::string& by) {
+      if (declared != packed.size())
+        fail(by + " says " + std::to_string(declared) + " Gaussians; the SPZ stream holds " +
+             std::to_string(packed.size()));
+    };
+    if (primitive.contains("attributes") && primitive["attributes"].contains("POSITION")) {
+      const json& accessor = at(array_of(gltf_, "accessors", "glTF"),
+                                index(primitive["attributes"]["POSITION"], "attribute POSITION"), "accessors");
+      expect_count(index(at(accessor, "count", "POSITION accessor"), "POSITION count"), "the POSITION accessor");
+    }
+    const json& extension = spz.extension == kSpzOnPrimitive ? primitive["extensions"][kSpzOnPrimitive]
+                                                             : json::object();
+    if (extension.contains("numPoints"))
+      expect_count(index(extension["numPoints"], "numPoints"), spz.extension + ".numPoints");
+    const std::string version = "v" + std::to_string(packed.version()) + " in " + spz.extension;
+    if (spz_versions_.find(version) == std::string::npos)
+      spz_versions_ += (spz_versions_.empty() ? "" : ", ") + version;
+    if (packed.has_extensions()) spz_ignored_extensions_ = true;
+    GaussianScene scene = packed.decode_all();
+    turn_about_z(scene);  // SPZ's decoding lands in the engine's axes; place() expects glTF's
+    return scene;
+  }
+
+  // The stream's SPZ reader, its errors told as this file's: "NAME: EXTENSION stream in bufferView N: what".
+  SpzPacked unpack_spz(std::span<const unsigned char> bytes, const SpzStream& spz) const {
+    try {
+      return SpzPacked(std::as_bytes(bytes), name_);
+    } catch (const SceneError& error) {
+      std::string what = error.what();
+      const std::string prefix = std::string(name_) + ": ";
+      if (what.starts_with(prefix)) what.erase(0, prefix.size());
+      fail(spz.extension + " stream in bufferView " + std::to_string(spz.buffer_view) + ": " + what);
+    }
+  }
+
+  // glTF's axes to the engine's and back: 180 degrees about z, so x and y flip (positions, quaternions,
+  // and SH coefficients by their parity in x and y).
+  static void turn_about_z(GaussianScene& scene) {
+    const size_t coefficients = static_cast<size_t>(scene.sh_coefficients());
+    for (size_t e = 0; e < scene.size(); ++e) {
+      scene.positions[3 * e] = -scene.positions[3 * e];
+      scene.positions[3 * e + 1] = -scene.positions[3 * e + 1];
+      // q_z(180) q = (-z, -y, x, w); the negation of that is the same rotation.
+      float* q = scene.rotations.data() + 4 * e;
+      const std::array<float, 4> old = {q[0], q[1], q[2], q[3]};
+      q[0] = old[3];
+      q[1] = old[2];
+      q[2] = -old[1];
+      q[3] = -old[0];
+      float* sh = scene.sh.data() + 3 * coefficients * e;
+      for (size_t k = 1; k < coefficients; ++k)
+        for (size_t c = 0; c < 3; ++c) sh[3 * k + c] *= kFlipSh[k - 1];
+    }
+  }
+
+ public:
+  bool spz_ignored_extensions() const { return spz_ignored_extensions_; }
+
+ private:
   // The node's world transform, then glTF's axes to the engine's (x and y flip).
   GaussianScene place(GaussianScene scene, const Matrix4& world) const {
     if (world != kIdentity) {
@@ -375,21 +485,7 @@ class GltfReader {
         fail(std::string("node transform: ") + error.what());
       }
     }
-    const size_t coefficients = static_cast<size_t>(scene.sh_coefficients());
-    for (size_t e = 0; e < scene.size(); ++e) {
-      scene.positions[3 * e] = -scene.positions[3 * e];
-      scene.positions[3 * e + 1] = -scene.positions[3 * e + 1];
-      // q_z(180) q = (-z, -y, x, w); the negation of that is the same rotation.
-      float* q = scene.rotations.data() + 4 * e;
-      const std::array<float, 4> old = {q[0], q[1], q[2], q[3]};
-      q[0] = old[3];
-      q[1] = old[2];
-      q[2] = -old[1];
-      q[3] = -old[0];
-      float* sh = scene.sh.data() + 3 * coefficients * e;
-      for (size_t k = 1; k < coefficients; ++k)
-        for (size_t c = 0; c < 3; ++c) sh[3 * k + c] *= kFlipSh[k - 1];
-    }
+    turn_about_z(scene);
     return scene;
   }
 
@@ -398,6 +494,8 @@ class GltfReader {
   json gltf_;
   std::optional<std::span<const unsigned char>> bin_;
   std::vector<std::optional<std::vector<unsigned char>>> loaded_;
+  std::string spz_versions_;  // "v3 in KHR_gaussian_splatting_compression_spz_2", ... as read
+  bool spz_ignored_extensions_ = false;
 };
 
 }  // namespace
@@ -409,6 +507,7 @@ GaussianScene read_gltf(std::span<const std::byte> data, std::string_view name, 
   std::string format;
   GaussianScene scene = reader.read(data, &format);
   finish_scene(scene, name, options, format, "2.0", report);
+  if (report && reader.spz_ignored_extensions()) report->ignored_properties.push_back(kSpzExtensionsIgnored);
   return scene;
 }
 
