@@ -74,6 +74,8 @@ GaussianScene read_any(std::span<const std::byte> data, const std::string& name,
       return detail::read_gltf(data, name, files, options, report);
     case detail::Container::kKsplat:
       return detail::read_ksplat(data, name, options, report);
+    case detail::Container::kRad:
+      return detail::read_rad(data, name, files, options, report);
     case detail::Container::kJson: {
       const std::string_view text(reinterpret_cast<const char*>(data.data()), data.size());
       if (detail::is_lod_index(text)) {
@@ -93,9 +95,9 @@ GaussianScene read_any(std::span<const std::byte> data, const std::string& name,
   if (extension == ".splat") return detail::read_splat(data, name, options, report);
   if (extension == ".ksplat") return detail::read_ksplat(data, name, options, report);  // its error says why
   if (data.empty()) detail::fail(name, "empty file, not a scene file");
-  detail::fail(name, "unrecognized scene format: not a PLY, compressed PLY, SPZ, SOG, glTF, GLB or ksplat file by "
-                     "its content (supported: .ply, .compressed.ply, .splat, .spz, .sog, SOG meta.json, .glb, "
-                     ".gltf, .ksplat; "
+  detail::fail(name, "unrecognized scene format: not a PLY, compressed PLY, SPZ, SOG, glTF, GLB, ksplat or RAD file "
+                     "by its content (supported: .ply, .compressed.ply, .splat, .spz, .sog, SOG meta.json, .glb, "
+                     ".gltf, .ksplat, .rad; "
                      "a headerless .splat file needs the .splat extension)");
 }
 

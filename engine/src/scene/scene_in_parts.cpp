@@ -222,6 +222,7 @@ SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOpt
               report));
         [[fallthrough]];
       case detail::Container::kGlb:
+      case detail::Container::kRad:
       case detail::Container::kUnknown:
         if (!bytes.empty())
           detail::fail(
@@ -254,6 +255,7 @@ uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
       case detail::Container::kKsplat:
         return detail::KsplatPacked(bytes, name).counts().scene_bytes();
       case detail::Container::kGlb:
+      case detail::Container::kRad:
       case detail::Container::kUnknown:
         return 0;
     }

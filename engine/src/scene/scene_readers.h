@@ -37,7 +37,7 @@ struct DeclaredCounts {
 
 // The container a file's first bytes name: the reader they call for (load_scene, SceneInParts). A JSON
 // object may be a glTF, a SOG's meta.json or a LOD set's index; kUnknown may still be a headerless .splat.
-enum class Container { kPly, kSpz, kZip, kGlb, kJson, kKsplat, kUnknown };
+enum class Container { kPly, kSpz, kZip, kGlb, kJson, kKsplat, kRad, kUnknown };
 Container container_of(std::span<const std::byte> data);
 
 // Reads a file that `referrer` names, resolved beside it; only plain relative names are followed.
@@ -63,6 +63,11 @@ GaussianScene read_splat(std::span<const std::byte> data, std::string_view name,
 bool is_ksplat(std::span<const std::byte> data);  // version 0.x, the header's unused bytes zero
 GaussianScene read_ksplat(std::span<const std::byte> data, std::string_view name, const LoadOptions& options,
                           LoadReport* report);
+
+// Spark 2 .rad (RAD0, or one RADC chunk): every splat, or a LOD tree's leaves; `load_chunk` reads the chunk
+// files a chunked one names (nullptr: such a file is an error).
+GaussianScene read_rad(std::span<const std::byte> data, std::string_view name, const FileLoader& load_chunk,
+                       const LoadOptions& options, LoadReport* report);
 
 // Niantic .spz: versions 2 and 3 (gzip, or the same bytes uncompressed) and 4 (zstd streams).
 bool is_spz(std::span<const std::byte> data);  // the NGSP magic, or a gzip stream

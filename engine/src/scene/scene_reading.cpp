@@ -8,6 +8,7 @@
 #include <cstring>
 #include <system_error>
 
+#include "scene/rad_file.h"
 #include "scene/scene_readers.h"
 
 #if __has_include(<sys/mman.h>) && __has_include(<unistd.h>)
@@ -116,6 +117,7 @@ Container container_of(std::span<const std::byte> data) {
   if (starts_with("glTF")) return Container::kGlb;
   if (is_spz(data)) return Container::kSpz;
   if (is_ksplat(data)) return Container::kKsplat;
+  if (is_rad(data)) return Container::kRad;
   for (size_t i = 0; i < data.size(); ++i) {
     const char c = static_cast<char>(bytes[i]);
     if (c == ' ' || c == '\t' || c == '\r' || c == '\n') continue;
