@@ -468,5 +468,54 @@ TEST(Rad, DamagedFilesAreRefusedNamingTheFileAndThePart) {
   EXPECT_GT(refused, 100u);
 }
 
+// tilesplat-render draws a level (--lod) or the cut a camera calls for under a budget (--splat-budget): the
+// library's cut for the camera the EXR records, rendered, is the file's image.
+TEST(RadCli, RendersALevelOrABudgetedCutAndTellsWhatItDrew) {
+  const fs::path rad = kRadDir / "playcanvas_test_64_sh3-lod.rad";
+  const fs::path out = testing::fresh_output_dir();
+  const auto render = [&](const std::vector<std::string>& extra, const std::string& name) {
+    std::vector<std::string> args = {rad.string(), "--cameras", testing::bundled_sh3_cameras().string(),
+                                     "--width", "160", "-o", (out / name).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return testing::run_process("", TILESPLAT_RENDER_EXE, args);
+  };
+  const SplatLodTree tree = SplatLodTree::open(rad);
+  const auto plain = render({}, "plain.exr");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const auto level0 = render({"--lod", "0"}, "level0.exr");
+  ASSERT_EQ(level0.exit_code, 0) << level0.err;
+  EXPECT_NE(level0.err.find("LOD tree of 90 splats (64 leaves, " + std::to_string(tree.levels()) +
+                            " levels, SH3), level 0: 64 Gaussians"),
+            std::string::npos)
+      << level0.err;
+  EXPECT_EQ(read_exr(out / "level0.exr").rgba, read_exr(out / "plain.exr").rgba);  // load_scene reads level 0
+  const auto all = render({"--splat-budget", "1000"}, "all.exr");
+  ASSERT_EQ(all.exit_code, 0) << all.err;
+  EXPECT_EQ(read_exr(out / "all.exr").rgba, read_exr(out / "level0.exr").rgba);
+
+  const auto some = render({"--splat-budget", "20", "--stats"}, "some.exr");
+  ASSERT_EQ(some.exit_code, 0) << some.err;
+  const std::optional<Camera> camera = read_exr_camera(out / "some.exr");
+  ASSERT_TRUE(camera);
+  const LodTreeCut cut = tree.select(*camera, 20);
+  EXPECT_NE(some.out.find("lod tree splats                    " + std::to_string(cut.nodes.size())), std::string::npos)
+      << some.out;
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(tree.load(cut.nodes));
+  EXPECT_GE(compare_images(read_exr(out / "some.exr"), renderer.render(*camera)).psnr_db, 100.0);
+  const auto level = render({"--lod", std::to_string(tree.levels() - 2)}, "coarse.exr");
+  ASSERT_EQ(level.exit_code, 0) << level.err;
+  // Coarser than the leaves: the image differs from level 0's, but it is the same scene.
+  const double coarse_psnr = compare_images(read_exr(out / "coarse.exr"), read_exr(out / "level0.exr")).psnr_db;
+  EXPECT_LT(coarse_psnr, 60.0);
+  EXPECT_GT(coarse_psnr, 10.0);
+
+  const auto no_level = render({"--lod", std::to_string(tree.levels())}, "no_level.exr");
+  EXPECT_NE(no_level.exit_code, 0);
+  EXPECT_NE(no_level.err.find("has " + std::to_string(tree.levels()) + " levels"), std::string::npos) << no_level.err;
+  EXPECT_FALSE(fs::exists(out / "no_level.exr"));
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
 }  // namespace
 }  // namespace tilesplat

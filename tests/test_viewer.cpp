@@ -115,6 +115,31 @@ TEST(Viewer, ASplatBudgetDrawsWhatTheRendererDraws) {
   EXPECT_GE(difference.psnr_db, 100.0) << "max abs " << difference.max_abs;
 }
 
+// A .rad LOD tree under a splat budget: the viewer draws the cut tilesplat-render draws for the same view.
+TEST(Viewer, ARadTreeUnderABudgetDrawsWhatTheRendererDraws) {
+  REQUIRE_VIEWER();
+  const std::optional<std::string> prefix = display_prefix();
+  if (!prefix) TILESPLAT_SKIP_OR_FAIL(kNoDisplay);
+  const fs::path out = fresh_output_dir();
+  const fs::path rad = fs::path(TILESPLAT_SOURCE_DIR) / "tests" / "data" / "rad" / "playcanvas_test_64_sh3-lod.rad";
+  std::vector<std::string> viewer_args = view_args(rad, tilesplat::testing::bundled_sh3_cameras(), 0);
+  viewer_args.insert(viewer_args.end(), {"--splat-budget", "20"});
+  std::vector<std::string> render_args = viewer_args;
+  viewer_args.insert(viewer_args.end(),
+                     {"--validation", "--frames", "2", "--screenshot", (out / "viewer.exr").string()});
+  render_args.insert(render_args.end(), {"-o", (out / "render.exr").string()});
+  const ProcessResult viewer = run_process(*prefix, kViewerExe, viewer_args);
+  ASSERT_EQ(viewer.exit_code, 0) << viewer.err;
+  EXPECT_NE(viewer.err.find("LOD tree of 90 splats"), std::string::npos) << viewer.err;
+  EXPECT_NE(viewer.err.find("tree cuts decoded"), std::string::npos) << viewer.err;
+  EXPECT_NE(viewer.err.find("validation: 0 messages"), std::string::npos) << viewer.err;
+  const ProcessResult render = run_process("", kRenderExe, render_args);
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  const tilesplat::ImageDifference difference = tilesplat::compare_images(
+      tilesplat::read_exr(out / "viewer.exr"), tilesplat::read_exr(out / "render.exr"));
+  EXPECT_GE(difference.psnr_db, 100.0) << "max abs " << difference.max_abs;
+}
+
 // --turn moves the camera every frame: under a splat budget the levels each camera calls for are read on
 // the streamer's thread while frames go on, and the EXR screenshot (its camera recorded in the file) is the
 // renderer's frame of the last camera's levels.

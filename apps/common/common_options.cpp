@@ -134,8 +134,8 @@ void add_common_options(ArgParser& parser, CommonOptions& options, SortChoice so
 
   parser.section("scene and device");
   parser.add_value("--lod", "N",
-                   "a LOD set (splat-transform's lod-meta.json): draw its level N, 0 the finest (default 0; "
-                   "docs/big-scenes.md)",
+                   "a LOD set (splat-transform's lod-meta.json) or a .rad LOD tree (Spark's build-lod): draw "
+                   "its level N, 0 the finest (default 0; docs/big-scenes.md)",
                    [&options](const std::string& text) {
                      options.lod.level = parse_int("--lod", text, 0, std::numeric_limits<int>::max());
                    });
@@ -308,8 +308,8 @@ Camera camera_for_frame(const CameraModelFlags& flags, const Camera& camera) {
 void add_splat_budget_option(ArgParser& parser, CommonOptions& options) {
   parser.add_value("--splat-budget", "N",
                    "a LOD set (lod-meta.json): draw at most N Gaussians a frame, each chunk at the level its "
-                   "size on screen calls for, chosen again for every frame's camera (docs/big-scenes.md; "
-                   "default: --lod's one level)",
+                   "size on screen calls for, chosen again for every frame's camera; a .rad LOD tree: the cut "
+                   "Spark's traversal makes for the camera (docs/big-scenes.md; default: --lod's one level)",
                    [&options](const std::string& text) {
                      const int budget = parse_int("--splat-budget", text, 1, std::numeric_limits<int>::max());
                      options.lod.splat_budget = static_cast<uint64_t>(budget);

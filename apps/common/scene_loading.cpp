@@ -53,11 +53,13 @@ size_t LoadedScene::gaussians() const {
   if (instances) return instances->size();
   if (in_parts) return in_parts->size();
   if (lod && lod->splat_budget > 0) return lod->set->level_size(0);
+  if (lod_tree && lod_tree->splat_budget > 0) return lod_tree->tree->level_nodes(0).size();
   return scene.size();
 }
 
 Bounds LoadedScene::bounds() const {
   if (lod) return lod->framing;
+  if (lod_tree) return lod_tree->framing;
   if (in_parts) return in_parts->bounds();
   return instances ? compute_bounds(*instances) : compute_bounds(scene);
 }
@@ -81,6 +83,25 @@ void load_lod_set(LoadedScene& loaded, const LodOptions& options, const LoadOpti
   loaded.lod = std::move(lod);
 }
 
+// The tree's level, or nothing under a splat budget (each frame cuts its own), and its framing.
+void load_lod_tree(LoadedScene& loaded, const LodOptions& options, const LoadOptions& load_options) {
+  auto tree = std::make_shared<SplatLodTree>(SplatLodTree::open(loaded.path));
+  LoadedLodTree lod;
+  lod.level = options.level.value_or(0);
+  lod.splat_budget = options.splat_budget;
+  if (lod.level >= tree->levels())
+    throw UsageError("--lod " + std::to_string(lod.level) + ": " + single_quoted(loaded.path.string()) + " has " +
+                     std::to_string(tree->levels()) + " levels (0 to " + std::to_string(tree->levels() - 1) + ")");
+  const GaussianScene leaves = tree->load_level(0, load_options);
+  lod.framing = compute_bounds(leaves);
+  if (lod.splat_budget == 0) loaded.scene = lod.level == 0 ? leaves : tree->load_level(lod.level, load_options);
+  loaded.report = LoadReport{.format = "rad LOD tree (" + std::to_string(tree->levels()) + " levels)",
+                             .version = "1",
+                             .gaussians_in_file = tree->nodes()};
+  lod.tree = std::move(tree);
+  loaded.lod_tree = std::move(lod);
+}
+
 // Whether `path` is a binary PLY, an SPZ, a SOG or a .ksplat that `reading` reads part by part: always, or when
 // its Gaussians as floats would take more than half of the host's memory.
 bool reads_in_parts(const fs::path& path, PartReading reading) {
@@ -102,9 +123,12 @@ LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view 
   loaded.path = path;
   require_input_file(loaded.path, "scene");
   const bool lod_set = is_lod_set(loaded.path);
-  if (!lod_set && (lod.level || lod.splat_budget > 0))
+  const bool lod_flags = lod.level || lod.splat_budget > 0;
+  const bool lod_tree = lod_flags && !lod_set && is_lod_tree(loaded.path);
+  if (!lod_set && !lod_tree && lod_flags)
     throw UsageError(std::string(lod.level ? "--lod" : "--splat-budget") +
-                     " needs a LOD set (lod-meta.json); " + single_quoted(path.string()) + " is not one");
+                     " needs a LOD set (lod-meta.json) or a .rad LOD tree; " + single_quoted(path.string()) +
+                     " is neither");
 
   const auto start = std::chrono::steady_clock::now();
   LoadOptions load_options;
@@ -112,6 +136,8 @@ LoadedScene load_scene_file(const fs::path& path, bool strict, std::string_view 
   try {
     if (lod_set) {
       load_lod_set(loaded, lod, load_options);
+    } else if (lod_tree) {
+      load_lod_tree(loaded, lod, load_options);
     } else if (is_scene_description(loaded.path)) {
       loaded.description = load_scene_description(loaded.path);
       const bool moving = std::any_of(loaded.description->models.begin(), loaded.description->models.end(),
@@ -291,6 +317,15 @@ std::string describe_scene(const LoadedScene& loaded) {
     if (loaded.lod->splat_budget > 0)
       return what + ", at most " + group_thousands(loaded.lod->splat_budget) + " a frame";
     return what + ", level " + std::to_string(loaded.lod->level) + ": " + describe_scene(loaded.scene);
+  }
+  if (loaded.lod_tree) {
+    const SplatLodTree& tree = *loaded.lod_tree->tree;
+    const std::string what = "LOD tree of " + group_thousands(tree.nodes()) + " splats (" +
+                             group_thousands(tree.level_nodes(0).size()) + " leaves, " +
+                             std::to_string(tree.levels()) + " levels, SH" + std::to_string(tree.sh_degree()) + ")";
+    if (loaded.lod_tree->splat_budget > 0)
+      return what + ", at most " + group_thousands(loaded.lod_tree->splat_budget) + " a frame";
+    return what + ", level " + std::to_string(loaded.lod_tree->level) + ": " + describe_scene(loaded.scene);
   }
   if (loaded.in_parts)
     return group_thousands(loaded.in_parts->size()) + " Gaussians (SH" +

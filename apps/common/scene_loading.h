@@ -14,6 +14,7 @@
 #include "tilesplat/camera.h"
 #include "tilesplat/lens.h"
 #include "tilesplat/lod_set.h"
+#include "tilesplat/lod_tree.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/scene_description.h"
@@ -42,6 +43,15 @@ struct LoadedLodSet {
   Bounds framing;
 };
 
+// A .rad LOD tree the SCENE names, drawn at one level (--lod, held in LoadedScene::scene) or under a splat
+// budget (each frame draws SplatLodTree::select's cut for its camera).
+struct LoadedLodTree {
+  std::shared_ptr<const SplatLodTree> tree;
+  int level = 0;
+  uint64_t splat_budget = 0;
+  Bounds framing;  // the leaves': every level and budget frames the same view
+};
+
 struct LoadedScene {
   std::filesystem::path path;
   GaussianScene scene;
@@ -54,6 +64,9 @@ struct LoadedScene {
   std::optional<SceneInParts> in_parts;
   // Set when the SCENE is a LOD set: `scene` holds its level lod->level, or nothing under a splat budget.
   std::optional<LoadedLodSet> lod;
+  // Set when the SCENE is a .rad LOD tree drawn with --lod or --splat-budget (without them it is read as
+  // any file: its leaves, in `scene`). `scene` holds the level, or nothing under a splat budget.
+  std::optional<LoadedLodTree> lod_tree;
   size_t gaussians() const;  // what a frame draws at most (under a splat budget: the finest level's size)
   Bounds bounds() const;     // what an orbit frames
   LoadReport report;
@@ -77,7 +90,7 @@ LoadedScene load_scene_and_camera(const CommonOptions& options, std::string_view
 
 // The parts of load_scene_and_camera, for an app that renders several cameras of a scene.
 // load_scene_file fills path, scene, description, report and load_ms only.
-// A LOD set is read as `lod` says; `lod` given for any other scene is a UsageError.
+// A LOD set or a .rad LOD tree is read as `lod` says; `lod` given for any other scene is a UsageError.
 LoadedScene load_scene_file(const std::filesystem::path& path, bool strict, std::string_view program,
                             SceneHolding holding = SceneHolding::kMerged, const LodOptions& lod = {},
                             PartReading reading = PartReading::kWhole);

@@ -14,6 +14,7 @@ FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScen
       instances_(loaded.instances ? &*loaded.instances : nullptr),
       file_in_parts_(loaded.in_parts ? &*loaded.in_parts : nullptr),
       lod_(loaded.lod && loaded.lod->splat_budget > 0 ? &*loaded.lod : nullptr),
+      lod_tree_(loaded.lod_tree && loaded.lod_tree->splat_budget > 0 ? &*loaded.lod_tree : nullptr),
       lens_(options.lens),
       in_parts_(options.memory_budget > 0) {
   if (lens_.enabled()) {
@@ -34,7 +35,7 @@ FrameRenderer::FrameRenderer(const RenderOptions& options, const cli::LoadedScen
 void FrameRenderer::decide_holding(const Camera& camera, const RenderSettings& settings) {
   if (decided_) return;
   decided_ = true;
-  if (in_parts_ || lod_) return;
+  if (in_parts_ || lod_ || lod_tree_) return;
   if (instances_) {
     // A scene file's copies stay placed copies of their files, taken by every frame (in parts where they
     // do not fit), under --memory-budget, when some move (each time of a shutter places them anew), and
@@ -84,13 +85,22 @@ RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& ba
       warned_over_budget_ = true;
     }
   }
+  if (lod_tree_) {
+    // The tree's cut for this camera, decoded from the file held whole; a cut like the last frame's is kept.
+    const LodTreeCut cut = lod_tree_->tree->select(camera, lod_tree_->splat_budget);
+    if (cut.nodes != lod_tree_cut_ || lod_tree_cut_.empty()) {
+      lod_scene_ = lod_tree_->tree->load(cut.nodes);
+      lod_tree_cut_ = cut.nodes;
+    }
+  }
   if (renderer_) decide_holding(camera, settings);  // may merge a scene file's copies into scene_
-  const GaussianScene& scene = lod_ ? lod_scene_ : *scene_;
+  const bool per_frame_scene = lod_ || lod_tree_;
+  const GaussianScene& scene = per_frame_scene ? lod_scene_ : *scene_;
   RenderImage image;
   if (renderer_) {
     image = file_in_parts_        ? renderer_->render(*file_in_parts_, camera, settings)
             : instances_          ? renderer_->render(*instances_, camera, settings)
-            : !in_parts_ && !lod_ ? renderer_->render(camera, settings)
+            : !in_parts_ && !per_frame_scene ? renderer_->render(camera, settings)
                                   : renderer_->render(scene, camera, settings);
     gpu_ms_ = renderer_->last_frame_stats().gpu_ms;
     cpu_ms_ = renderer_->last_frame_stats().cpu_ms;

@@ -35,6 +35,8 @@ class FrameRenderer {
   Renderer* gpu() const { return renderer_.get(); }
   // The levels the last frame drew, under --splat-budget (else empty).
   const LodSelection& lod_selection() const { return lod_selection_; }
+  // The nodes of a .rad LOD tree the last frame drew, under --splat-budget (else empty).
+  const std::vector<uint32_t>& lod_tree_cut() const { return lod_tree_cut_; }
 
  private:
   const GaussianScene* scene_;
@@ -48,7 +50,9 @@ class FrameRenderer {
   const cli::LoadedLodSet* lod_;     // a LOD set drawn under --splat-budget
   LodSelection lod_selection_;
   std::unique_ptr<LodStreamer> lod_streamer_;  // reads each frame's levels, the next frame's ahead
-  GaussianScene lod_scene_;                    // the levels the last frame drew
+  GaussianScene lod_scene_;                    // the levels (or the tree's cut) the last frame drew
+  const cli::LoadedLodTree* lod_tree_;         // a .rad LOD tree drawn under --splat-budget
+  std::vector<uint32_t> lod_tree_cut_;         // its nodes in lod_scene_
   bool warned_over_budget_ = false;
   LensFlags lens_;
   // The first frame's choice: the scene set once, or taken by each frame (in parts where it does not fit).

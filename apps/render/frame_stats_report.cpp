@@ -60,4 +60,11 @@ void print_lod_selection(const tilesplat::LodSelection& selection) {
               "(the coarsest levels in view need " + std::to_string(selection.coarsest_splats) + ")");
 }
 
+void print_lod_tree_cut(const tilesplat::SplatLodTree& tree, const std::vector<uint32_t>& cut) {
+  size_t inner = 0;
+  for (const uint32_t node : cut) inner += tree.child_count(node) > 0 ? 1 : 0;
+  print_row("lod tree splats", std::to_string(cut.size()), "");
+  print_row("lod tree inner nodes", std::to_string(inner), "(merged splats drawn for their leaves)");
+}
+
 }  // namespace tilesplat::render_app

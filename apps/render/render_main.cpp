@@ -553,6 +553,8 @@ int run(int argc, char** argv) {
     if (options.stats) print_frame_stats(stats, gpu->device_info());
     if (options.stats && loaded.lod && loaded.lod->splat_budget > 0)
       print_lod_selection(renderer.lod_selection());
+    if (options.stats && loaded.lod_tree && loaded.lod_tree->splat_budget > 0)
+      print_lod_tree_cut(*loaded.lod_tree->tree, renderer.lod_tree_cut());
     if (const auto messages = gpu->validation_messages(); messages > 0)
       cli::print_warning(kProgram, std::to_string(messages) + " Vulkan validation messages (see above)");
   } else {

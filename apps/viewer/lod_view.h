@@ -1,5 +1,6 @@
 // A LOD set drawn under --splat-budget in the viewer: each frame asks for the levels its camera calls for,
-// which a LodStreamer reads on a thread of its own while the window goes on drawing the levels it has.
+// which a LodStreamer reads on a thread of its own while the window goes on drawing the levels it has. A .rad
+// LOD tree is held whole: each frame's cut is chosen and decoded before it (a few ms; no thread).
 #pragma once
 
 #include <atomic>
@@ -12,6 +13,7 @@
 
 #include "tilesplat/camera.h"
 #include "tilesplat/lod_set.h"
+#include "tilesplat/lod_tree.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/vulkan_interop.h"
 
@@ -22,6 +24,7 @@ class LodView {
   // `wake` runs on the streamer's thread when a read is done (glfwPostEmptyEvent: the event loop then
   // sees arrived() and renders).
   LodView(const LodSet& set, uint64_t splat_budget, std::function<void()> wake);
+  LodView(const SplatLodTree& tree, uint64_t splat_budget);
 
   // Before a frame seen from `camera`: asks for its levels, and sets on `renderer` the newest levels read
   // (the first frame waits for its own: there is nothing else to draw).
@@ -41,7 +44,10 @@ class LodView {
 
   // Set on the streamer's thread; declared before the streamer, which may set it until it is destroyed.
   std::atomic<bool> arrived_ = false;
-  std::unique_ptr<LodStreamer> streamer_;
+  std::unique_ptr<LodStreamer> streamer_;  // a LOD set's
+  const SplatLodTree* tree_ = nullptr;     // or a LOD tree's, with its budget and last cut
+  uint64_t tree_budget_ = 0;
+  std::vector<uint32_t> tree_cut_;
   bool drawn_ = false;           // the renderer has levels of the set
   uint64_t drawn_splats_ = 0;    // their Gaussians
   uint64_t wanted_splats_ = 0;   // those of the levels the last camera calls for

@@ -101,10 +101,11 @@ class Viewer {
         mesh_(!options.no_mesh),
         depth_out_(!options.no_depth_out),
         scene_name_(loaded.path.filename().string()),
-        lod_view_(
-            loaded.lod && loaded.lod->splat_budget > 0
-                ? std::make_unique<LodView>(*loaded.lod->set, loaded.lod->splat_budget, glfwPostEmptyEvent)
-                : nullptr),
+        lod_view_(loaded.lod && loaded.lod->splat_budget > 0
+                      ? std::make_unique<LodView>(*loaded.lod->set, loaded.lod->splat_budget, glfwPostEmptyEvent)
+                  : loaded.lod_tree && loaded.lod_tree->splat_budget > 0
+                      ? std::make_unique<LodView>(*loaded.lod_tree->tree, loaded.lod_tree->splat_budget)
+                      : nullptr),
         views_(std::move(views.views)),
         shutters_(std::move(views.shutters)),
         view_(options.common.view),
@@ -556,7 +557,7 @@ int run(int argc, char** argv) {
   const auto renderer = tilesplat::create_renderer(device.external());
   if (loaded.instances)
     renderer->set_scene(*loaded.instances);
-  else if (!loaded.lod || loaded.lod->splat_budget == 0)
+  else if ((!loaded.lod || loaded.lod->splat_budget == 0) && (!loaded.lod_tree || loaded.lod_tree->splat_budget == 0))
     renderer->set_scene(loaded.scene);  // else per frame
 
   Viewer viewer(window.get(), device, *renderer, options, loaded, std::move(views));
