@@ -86,7 +86,8 @@ TEST_P(RadFiles, EachLeafIsItsSourceAsTheEncoderQuantizesIt) {
   LoadReport report;
   const GaussianScene scene = load_scene(path, {}, &report);
   const GaussianScene source = load_scene(testing::shared_scenes() / "playcanvas_test_64_sh3.ply");
-  EXPECT_TRUE(report.format.starts_with("rad (LOD tree of ")) << report.format;
+  EXPECT_TRUE(report.format.starts_with("rad (1 chunk; LOD tree of ")) << report.format;
+  EXPECT_NE(report.format.find("its 64 leaves read; center f32_lebytes, alpha "), std::string::npos) << report.format;
   EXPECT_EQ(report.version, "1");
   ASSERT_EQ(scene.size(), source.size());
   ASSERT_EQ(scene.sh_degree, c.sh_degree);
@@ -368,7 +369,8 @@ TEST(Rad, AFileBuiltFromTheLayoutDecodesEachEncodingAsRadRsDoes) {
   const fs::path path = write_file("built.rad", rad_bytes(2, 1, false, chunk));
   LoadReport report;
   const GaussianScene scene = load_scene(path, {}, &report);
-  EXPECT_EQ(report.format, "rad");
+  EXPECT_EQ(report.format,
+            "rad (1 chunk; center f16_lebytes, alpha r8, rgb f32, scales ln_f16, orientation f16, sh1 s8_delta)");
   ASSERT_EQ(scene.size(), 2u);
   ASSERT_EQ(scene.sh_degree, 1);
   for (int i = 0; i < 2; ++i) {
@@ -515,6 +517,32 @@ TEST(RadCli, RendersALevelOrABudgetedCutAndTellsWhatItDrew) {
   EXPECT_NE(no_level.err.find("has " + std::to_string(tree.levels()) + " levels"), std::string::npos) << no_level.err;
   EXPECT_FALSE(fs::exists(out / "no_level.exr"));
   EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// tilesplat-bench --lod-curve on a tree: level 0, the levels that about halve it, then each budget; a budget
+// past the leaves is level 0's image, and each budgeted row draws the library's cut for its view.
+TEST(RadCli, BenchDrawsTheCurveOfLevelsAndBudgets) {
+  const fs::path rad = kRadDir / "playcanvas_test_64_sh3-lod.rad";
+  const fs::path out = testing::fresh_output_dir();
+  const auto run = testing::run_process(
+      "", TILESPLAT_BENCH_EXE,
+      {rad.string(), "--cameras", testing::bundled_sh3_cameras().string(), "--views", "0", "--width", "160",
+       "--lod-curve", "20,1000", "--warmup", "0", "--repeat", "1", "--csv", (out / "lod.csv").string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const SplatLodTree tree = SplatLodTree::open(rad);
+  std::string table;  // the text table with its columns' runs of blanks as one
+  for (const char c : run.out)
+    if (c != ' ' || table.empty() || table.back() != ' ') table += c;
+  EXPECT_NE(table.find("\nlevel 0 64 "), std::string::npos) << run.out;
+  EXPECT_NE(table.find("\nlevel " + std::to_string(tree.levels() - 1) + " 1 "), std::string::npos) << run.out;
+  const Camera view = resize_camera(load_cameras_json(testing::bundled_sh3_cameras())[0].camera, 160, 90);
+  EXPECT_NE(table.find("\nbudget 20 " + std::to_string(tree.select(view, 20).nodes.size()) + " "), std::string::npos)
+      << run.out;
+  const std::string csv = testing::read_file(out / "lod.csv");
+  // The last row, the budget of 1,000: all 64 leaves, level 0's image (PSNR inf).
+  const std::string last = csv.substr(csv.rfind("\n", csv.size() - 2) + 1);
+  EXPECT_NE(last.find(",1000,64.0,"), std::string::npos) << csv;
+  EXPECT_NE(last.find(",inf,"), std::string::npos) << csv;
 }
 
 }  // namespace

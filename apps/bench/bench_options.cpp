@@ -137,8 +137,8 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
   parser.section("LOD report");
   parser.add_value(
       "--lod-curve", "N[,N...]",
-      "measure a LOD set (lod-meta.json, one SCENE): every level whole, then each splat budget N (the "
-      "levels each view calls for, docs/big-scenes.md); per row the Gaussians drawn, the GPU time, the "
+      "measure a LOD set (lod-meta.json) or a .rad LOD tree (one SCENE): its levels whole, then each "
+      "splat budget N (what each view calls for, docs/big-scenes.md); per row the Gaussians drawn, the GPU time, the "
       "host's time to choose and gather, and PSNR and max abs against level 0; --markdown, --csv and "
       "--plot (PSNR against Gaussians drawn) write the report",
       [&options](const std::string& text) {

@@ -42,9 +42,35 @@ std::string row_label(const Row& row) {
   return row.level >= 0 ? "level " + std::to_string(row.level) : "budget " + cli::group_thousands(row.budget);
 }
 
-std::vector<Row> plan_rows(const LodSet& set, std::vector<uint64_t> budgets) {
+Source source_of(const LodSet& set) {
+  Source source;
+  for (int level = 0; level < set.levels(); ++level) source.levels.push_back(level);
+  source.load_level = [&set](int level) { return set.load_level(level); };
+  source.choose = [&set](const Camera& view, uint64_t budget) {
+    return set.load_selection(select_lod_levels(set, view, budget));
+  };
+  return source;
+}
+
+Source source_of(const SplatLodTree& tree) {
+  Source source;
+  // A tree has dozens of levels, most a few percent apart: those about halving the Gaussians make the curve.
+  size_t listed = 0;
+  for (int level = 0; level < tree.levels(); ++level) {
+    const size_t size = tree.level_nodes(level).size();
+    if (level == 0 || size <= listed / 2) {
+      source.levels.push_back(level);
+      listed = size;
+    }
+  }
+  source.load_level = [&tree](int level) { return tree.load_level(level); };
+  source.choose = [&tree](const Camera& view, uint64_t budget) { return tree.load(tree.select(view, budget).nodes); };
+  return source;
+}
+
+std::vector<Row> plan_rows(const Source& source, std::vector<uint64_t> budgets) {
   std::vector<Row> rows;
-  for (int level = 0; level < set.levels(); ++level) rows.push_back(Row{level, 0});
+  for (const int level : source.levels) rows.push_back(Row{level, 0});
   std::sort(budgets.begin(), budgets.end());
   budgets.erase(std::unique(budgets.begin(), budgets.end()), budgets.end());
   for (const uint64_t budget : budgets) rows.push_back(Row{-1, budget});
@@ -55,25 +81,26 @@ int work_units(const std::vector<Row>& rows, const Options& options) {
   return int(rows.size() * options.views.size()) * (options.warmup + options.repeat);
 }
 
-Run measure(const RendererOptions& renderer_options, const LodSet& set, std::vector<Row>& rows,
+Run measure(const RendererOptions& renderer_options, const Source& source, std::vector<Row>& rows,
             const Options& options, const std::function<void(int, int, const std::string&)>& progress) {
   // Every row's scene at every view, gathered once: a level's is the same at every view; a budget's is
-  // what select_lod_levels chooses for the view (timed with its gathering).
-  std::vector<GaussianScene> levels;
-  for (int level = 0; level < set.levels(); ++level) levels.push_back(set.load_level(level));
+  // what the view chooses under it (timed with its gathering).
+  std::vector<GaussianScene> levels(rows.size());
+  for (size_t r = 0; r < rows.size(); ++r)
+    if (rows[r].level >= 0) levels[r] = source.load_level(rows[r].level);
   std::vector<std::vector<GaussianScene>> chosen(rows.size());
   for (size_t r = 0; r < rows.size(); ++r) {
     if (rows[r].level >= 0) continue;
     std::vector<double> select_ms;
     for (const Camera& view : options.views) {
       const auto start = std::chrono::steady_clock::now();
-      chosen[r].push_back(set.load_selection(select_lod_levels(set, view, rows[r].budget)));
+      chosen[r].push_back(source.choose(view, rows[r].budget));
       select_ms.push_back(elapsed_ms(start));
     }
     rows[r].select_ms = cli::median(select_ms);
   }
   const auto scene_of = [&](size_t r, size_t v) -> const GaussianScene& {
-    return rows[r].level >= 0 ? levels[size_t(rows[r].level)] : chosen[r][v];
+    return rows[r].level >= 0 ? levels[r] : chosen[r][v];
   };
 
   auto renderer = Renderer::create(renderer_options);

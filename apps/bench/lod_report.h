@@ -1,8 +1,9 @@
-// tilesplat-bench --lod-curve BUDGETS: what a LOD set's levels and splat budgets cost, and how far each
-// image is from the finest level's.
+// tilesplat-bench --lod-curve BUDGETS: what a LOD set's or a .rad LOD tree's levels and splat budgets cost,
+// and how far each image is from the finest level's.
 //
-// One LOD set (lod-meta.json), rendered at the chosen views: every level whole, then the levels each
-// view calls for under each splat budget (select_lod_levels). Per row: the Gaussians drawn, the GPU
+// One LOD set (lod-meta.json) or tree (.rad), rendered at the chosen views: its levels whole (a set's every
+// level; a tree's level 0 and each level with at most half the Gaussians of the one listed before it), then
+// what each view calls for under each splat budget (select_lod_levels, SplatLodTree::select). Per row: the Gaussians drawn, the GPU
 // frame time (median over repeats, then views), the host's time to choose and gather the levels, and
 // the image's PSNR and largest error against level 0 from the same view (the mean PSNR over the views).
 // The frames of all rows are interleaved (row after row, repeat after repeat) so that a CPU driver's
@@ -16,6 +17,7 @@
 
 #include "tilesplat/camera.h"
 #include "tilesplat/lod_set.h"
+#include "tilesplat/lod_tree.h"
 #include "tilesplat/renderer.h"
 
 namespace tilesplat::lod_report {
@@ -32,8 +34,17 @@ struct Row {
 };
 std::string row_label(const Row& row);  // "level 2", "budget 10,000"
 
-// Every level, then one row per budget (ascending).
-std::vector<Row> plan_rows(const LodSet& set, std::vector<uint64_t> budgets);
+// What the report draws from: a set's or a tree's levels, and what a view chooses under a budget.
+struct Source {
+  std::vector<int> levels;  // the levels measured whole, level 0 first
+  std::function<GaussianScene(int level)> load_level;
+  std::function<GaussianScene(const Camera& view, uint64_t budget)> choose;
+};
+Source source_of(const LodSet& set);
+Source source_of(const SplatLodTree& tree);
+
+// The source's levels, then one row per budget (ascending).
+std::vector<Row> plan_rows(const Source& source, std::vector<uint64_t> budgets);
 
 struct Options {
   std::vector<Camera> views;
@@ -49,7 +60,7 @@ struct Run {
 };
 int work_units(const std::vector<Row>& rows, const Options& options);
 // Renders every row at every view and fills in the measurements. progress(done, total, what) as it goes.
-Run measure(const RendererOptions& renderer_options, const LodSet& set, std::vector<Row>& rows,
+Run measure(const RendererOptions& renderer_options, const Source& source, std::vector<Row>& rows,
             const Options& options, const std::function<void(int, int, const std::string&)>& progress);
 
 std::string text_table(const std::vector<Row>& rows);

@@ -369,10 +369,16 @@ int run_sample_curve(const BenchOptions& options) {
 int run_lod_report(const BenchOptions& options) {
   check_outputs(options, scene_and_camera_inputs(options));
   BenchScene scene;
-  scene.loaded = cli::load_scene_file(options.common.scenes.front(), options.common.strict, kProgram);
-  if (!scene.loaded.lod)
-    throw cli::UsageError("--lod-curve measures a LOD set (lod-meta.json); " +
-                          cli::single_quoted(scene.loaded.path.string()) + " is not one");
+  const fs::path& path = options.common.scenes.front();
+  const bool tree = tilesplat::is_lod_tree(path);
+  // A tree is opened as one where a level is asked for (the report draws its own levels and budgets).
+  cli::LodOptions as_tree;
+  as_tree.level = 0;
+  scene.loaded = cli::load_scene_file(path, options.common.strict, kProgram, cli::SceneHolding::kMerged,
+                                      tree ? as_tree : cli::LodOptions{});
+  if (!scene.loaded.lod && !scene.loaded.lod_tree)
+    throw cli::UsageError("--lod-curve measures a LOD set (lod-meta.json) or a .rad LOD tree; " +
+                          cli::single_quoted(scene.loaded.path.string()) + " is neither");
   scene.name = scene.loaded.path.filename().string();
   if (!options.common.cameras_files.empty()) scene.cameras = options.common.cameras_files.front();
   tilesplat::lod_report::Options lod_options;
@@ -383,8 +389,10 @@ int run_lod_report(const BenchOptions& options) {
   if (!options.common.modes.empty()) lod_options.settings.accuracy = options.common.modes.front();
   cli::apply_training_options(options.common, lod_options.settings);
 
-  const tilesplat::LodSet& set = *scene.loaded.lod->set;
-  std::vector<tilesplat::lod_report::Row> rows = tilesplat::lod_report::plan_rows(set, options.lod_budgets);
+  const tilesplat::lod_report::Source source = scene.loaded.lod
+                                                  ? tilesplat::lod_report::source_of(*scene.loaded.lod->set)
+                                                  : tilesplat::lod_report::source_of(*scene.loaded.lod_tree->tree);
+  std::vector<tilesplat::lod_report::Row> rows = tilesplat::lod_report::plan_rows(source, options.lod_budgets);
   std::printf("scene   %s: %s, %s, %zu views\n", scene.name.c_str(),
               cli::describe_scene(scene.loaded).c_str(),
               cli::format_size(lod_options.views.front().width, lod_options.views.front().height).c_str(),
@@ -396,7 +404,7 @@ int run_lod_report(const BenchOptions& options) {
     cli::FrameProgress progress(kProgram, tilesplat::lod_report::work_units(rows, lod_options),
                                 cli::progress_style(false));
     run = tilesplat::lod_report::measure(
-        cli::renderer_options(options.common), set, rows, lod_options,
+        cli::renderer_options(options.common), source, rows, lod_options,
         [&](int done, int, const std::string& what) { progress.update(done, what); });
   }
   std::printf("device  %s (driver %s)\n\n%s", run.device.name.c_str(), run.device.driver.c_str(),

@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "info_options.h"
 #include "tilesplat/lod_set.h"
+#include "tilesplat/lod_tree.h"
 #include "tilesplat/scene.h"
 
 namespace {
@@ -110,6 +111,13 @@ void print_text(const FileInfo& info) {
               loaded.report.gaussians_in_file, loaded.report.dropped ? ": " : "",
               loaded.report.summary().c_str());
   std::printf("  load         %.1f ms, peak memory +%.1f MB\n", loaded.load_ms, megabytes(info.peak_bytes));
+  if (tilesplat::is_lod_tree(loaded.path)) {
+    const tilesplat::SplatLodTree tree = tilesplat::SplatLodTree::open(loaded.path);
+    std::printf("  lod tree     %s splats, %d levels (0: the leaves; %d: the root)\n",
+                cli::group_thousands(tree.nodes()).c_str(), tree.levels(), tree.levels() - 1);
+    for (int level = 0; level < tree.levels(); ++level)
+      std::printf("  level %-6d %s splats\n", level, cli::group_thousands(tree.level_nodes(level).size()).c_str());
+  }
   if (!loaded.lod) return;
   const tilesplat::LodSet& set = *loaded.lod->set;
   std::printf("  lod set      %d levels, %zu chunks, %zu chunk files%s%s\n", set.levels(),
@@ -153,6 +161,13 @@ nlohmann::json to_json(const FileInfo& info) {
       {"dropped_by_property", dropped},
       {"load_ms", loaded.load_ms},
       {"peak_memory_bytes", info.peak_bytes}};
+  if (tilesplat::is_lod_tree(loaded.path)) {
+    const tilesplat::SplatLodTree tree = tilesplat::SplatLodTree::open(loaded.path);
+    nlohmann::json levels = nlohmann::json::array();
+    for (int level = 0; level < tree.levels(); ++level) levels.push_back(tree.level_nodes(level).size());
+    out["lod_tree_splats"] = tree.nodes();
+    out["lod_tree_levels"] = levels;
+  }
   if (loaded.lod) {
     const tilesplat::LodSet& set = *loaded.lod->set;
     nlohmann::json levels = nlohmann::json::array();

@@ -58,6 +58,12 @@ def test_every_format_loads(shared_scenes):
         scene = tilesplat.load_scene(glb)
         assert scene.size == reference.size and scene.sh_degree == 3, glb.name
         assert np.abs(scene.positions - reference.positions).max() < 1.3e-4, glb.name
+    # Spark's .rad (its own build-lod's files, tests/data/rad): the LOD tree's leaves, positions as float32 bytes.
+    for rad in sorted((REPO / "tests" / "data" / "rad").glob("*.rad")):
+        scene = tilesplat.load_scene(rad)
+        assert scene.size == reference.size, rad.name
+        distances = np.linalg.norm(reference.positions[:, None, :] - scene.positions[None, :, :], axis=2)
+        assert distances.min(axis=1).max() == 0, rad.name
     scene_file = tilesplat.load_scene(REPO / "scenes" / "two_playbots.json")
     assert scene_file.size == 2 * tilesplat.load_scene(BUNDLED_PLAYBOT).size
 

@@ -15,10 +15,10 @@ cd "$(dirname "$0")/../.."
 seconds="${1:-60}"
 build="${FUZZ_BUILD_DIR:-build-fuzz}"
 scenes="${TILESPLAT_SHARED_SCENES:-$(cd .. && pwd)/shared/scenes}"
-readers=(ply splat ksplat spz sog compressed_ply gltf cameras scene_file lod_set scene_in_parts)
+readers=(ply splat ksplat spz sog compressed_ply gltf rad cameras scene_file lod_set scene_in_parts)
 fuzz_flags=(-timeout=10 -rss_limit_mb=2048)
 max_len() {  # a SOG zip or a GLB of 64 Gaussians with SH3 is about 20 kB; the rest fit in 16 kB
-  case "$1" in sog | gltf | lod_set | scene_in_parts | ksplat) echo 65536 ;; *) echo 16384 ;; esac
+  case "$1" in sog | gltf | lod_set | scene_in_parts | ksplat | rad) echo 65536 ;; *) echo 16384 ;; esac
 }
 
 mkdir -p "$build"
@@ -51,6 +51,7 @@ seed() {  # seed READER FILE...: copies the files that exist
 head -c 2048 "$scenes/plant_113648.splat" >"$build/seeds/plant_64.splat" 2>/dev/null || true
 seed splat "$scenes/train_3pts.splat" "$build/seeds/plant_64.splat"
 seed ksplat tests/data/ksplat/playcanvas_test_64_sh3_l{0,1,2}_sh2.ksplat
+seed rad tests/data/rad/*.rad tests/data/rad/*.radc
 seed spz "$scenes/train_3pts.spz" "$scenes/formats/playcanvas_test_64_sh3.v3.spz" "$scenes/formats/playcanvas_test_64_sh3.v4.spz"
 seed sog "$scenes/formats/playcanvas_test_64_sh3.sog"
 seed compressed_ply "$scenes/playcanvas_test_64.compressed.ply" "$scenes/formats/playcanvas_test_64_sh3.compressed.ply"

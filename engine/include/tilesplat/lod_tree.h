@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <memory>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "tilesplat/camera.h"
@@ -18,6 +20,10 @@
 #include "tilesplat/scene.h"
 
 namespace tilesplat {
+
+namespace detail {
+class RadFile;  // scene/rad_file.h: the decoded file
+}  // namespace detail
 
 /// The nodes one camera draws under a splat budget (SplatLodTree::select).
 struct LodTreeCut {
@@ -32,6 +38,8 @@ class TILESPLAT_API SplatLodTree {
   /// Reads the file (chunk files beside it included) and checks the tree: one parent per node, every node
   /// reached from the root. Throws SceneError naming the file, also for a .rad without a LOD tree.
   static SplatLodTree open(const std::filesystem::path& path);
+  /// The same on a .rad in memory (`name` stands for it in errors); one whose chunks are files is refused.
+  static SplatLodTree parse(std::span<const std::byte> data, std::string_view name);
   SplatLodTree(SplatLodTree&&) noexcept;             ///< moves the tree
   SplatLodTree& operator=(SplatLodTree&&) noexcept;  ///< moves the tree
   ~SplatLodTree();
@@ -62,7 +70,7 @@ class TILESPLAT_API SplatLodTree {
 
  private:
   struct Impl;
-  explicit SplatLodTree(std::unique_ptr<Impl> impl);
+  SplatLodTree(std::string name, detail::RadFile&& file);  // throws SceneError for a file without a tree
   std::unique_ptr<Impl> impl_;
 };
 

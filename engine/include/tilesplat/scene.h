@@ -60,7 +60,8 @@ struct DroppedProperty {
 struct TILESPLAT_API LoadReport {
   /// The format as the reader found it from the content: "ply binary_little_endian", "ply ascii",
   /// "compressed ply", "splat", "spz", "sog", "sog (unbundled)", "glb", "gltf", "ksplat level 0 (float32)" (and
-  /// levels 1 and 2, with their layouts).
+  /// levels 1 and 2, with their layouts), "glb (SPZ v3 in KHR_gaussian_splatting_compression_spz_2)", "rad (1
+  /// chunk; LOD tree of N splats, its M leaves read; center f32_lebytes, ...)" (its chunks and encodings).
   std::string format;
   std::string version;           ///< the format's version where it has one ("1.0", "3", "2", ...), else empty
   size_t gaussians_in_file = 0;  ///< Gaussians the file holds, dropped ones included

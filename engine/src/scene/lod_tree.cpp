@@ -26,7 +26,19 @@ struct SplatLodTree::Impl {
   double root_size = 0;
 };
 
-SplatLodTree::SplatLodTree(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+SplatLodTree::SplatLodTree(std::string name, detail::RadFile&& file)
+    : impl_(new Impl{std::move(name), std::move(file)}) {
+  const detail::RadFile& rad = impl_->file;
+  if (!rad.has_lod_tree()) detail::fail(impl_->name, "a .rad without a LOD tree: read it with load_scene");
+  impl_->root_size = rad.node_size(0);
+  double smallest_inner = INFINITY;
+  for (size_t i = 0; i < rad.size(); ++i)
+    if (rad.child_count(i) > 0 && rad.node_size(i) > 0) smallest_inner = std::min(smallest_inner, rad.node_size(i));
+  if (std::isfinite(impl_->root_size) && impl_->root_size > 0 && std::isfinite(smallest_inner))
+    impl_->spark_levels = std::min<int>(
+        kMaxLevels - 1,
+        static_cast<int>(std::floor(std::log(impl_->root_size / smallest_inner) / std::log(kLevelRatio))) + 1);
+}
 SplatLodTree::SplatLodTree(SplatLodTree&&) noexcept = default;
 SplatLodTree& SplatLodTree::operator=(SplatLodTree&&) noexcept = default;
 SplatLodTree::~SplatLodTree() = default;
@@ -34,20 +46,16 @@ SplatLodTree::~SplatLodTree() = default;
 SplatLodTree SplatLodTree::open(const std::filesystem::path& path) {
   detail::FileContents contents;
   detail::open_scene_file(path, contents);
-  const std::string name = path.string();
+  std::string name = path.string();
   if (!detail::is_rad(contents.bytes())) detail::fail(name, "not a .rad file (no RAD0 or RADC magic)");
-  auto impl = std::unique_ptr<Impl>(new Impl{name, detail::RadFile(contents.bytes(), name, detail::sibling_loader(path))});
-  const detail::RadFile& file = impl->file;
-  if (!file.has_lod_tree()) detail::fail(name, "a .rad without a LOD tree: read it with load_scene");
-  impl->root_size = file.node_size(0);
-  double smallest_inner = INFINITY;
-  for (size_t i = 0; i < file.size(); ++i)
-    if (file.child_count(i) > 0 && file.node_size(i) > 0) smallest_inner = std::min(smallest_inner, file.node_size(i));
-  if (std::isfinite(impl->root_size) && impl->root_size > 0 && std::isfinite(smallest_inner))
-    impl->spark_levels = std::min<int>(
-        kMaxLevels - 1,
-        static_cast<int>(std::floor(std::log(impl->root_size / smallest_inner) / std::log(kLevelRatio))) + 1);
-  return SplatLodTree(std::move(impl));
+  detail::RadFile file(contents.bytes(), name, detail::sibling_loader(path));
+  return SplatLodTree(std::move(name), std::move(file));
+}
+
+SplatLodTree SplatLodTree::parse(std::span<const std::byte> data, std::string_view name) {
+  if (!detail::is_rad(data)) detail::fail(name, "not a .rad file (no RAD0 or RADC magic)");
+  detail::RadFile file(data, name, nullptr);
+  return SplatLodTree(std::string(name), std::move(file));
 }
 
 size_t SplatLodTree::nodes() const { return impl_->file.size(); }
