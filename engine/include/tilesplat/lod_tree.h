@@ -45,11 +45,11 @@ class TILESPLAT_API SplatLodTree {
   ~SplatLodTree();
 
   size_t nodes() const;  ///< every splat of the file, inner nodes included
-  int sh_degree() const;
+  int sh_degree() const;  ///< the SH degree of every node (the file's maxSh)
   /// Node `node`'s children are nodes [child_start, child_start + child_count); a leaf has none. Node 0 is
   /// the root. Throws std::out_of_range past nodes().
   uint32_t child_count(uint32_t node) const;
-  uint32_t child_start(uint32_t node) const;
+  uint32_t child_start(uint32_t node) const;  ///< the first child's index (see child_count)
   /// What the cuts compare: 2 x the node's mean scale, widened for an opacity above 1 (Spark's measure).
   double node_size(uint32_t node) const;
   /// Level 0 is the leaves (the capture); level L > 0 is Spark's level view at depth levels() - 1 - L: from

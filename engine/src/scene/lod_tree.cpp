@@ -107,7 +107,8 @@ LodTreeCut SplatLodTree::select(const Camera& camera, uint64_t splat_budget) con
   const auto pixel_scale = [&](uint32_t node) {
     const float* c = file.center(node);
     const double dx = c[0] - camera.position[0], dy = c[1] - camera.position[1], dz = c[2] - camera.position[2];
-    return file.node_size(node) / std::max(std::sqrt(dx * dx + dy * dy + dz * dz), 1e-6);
+    const double scale = file.node_size(node) / std::max(std::sqrt(dx * dx + dy * dy + dz * dz), 1e-6);
+    return std::isnan(scale) ? 0.0 : scale;  // a NaN would break the queue's order: such a node covers nothing
   };
   // Largest pixel scale first; among equals the lower index, so that the cut is deterministic.
   using Entry = std::pair<double, uint32_t>;
