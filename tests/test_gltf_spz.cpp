@@ -58,10 +58,7 @@ Glb split(const std::string& bytes) {
 }
 
 fs::path write(const std::string& name, const Glb& glb) {
-  const fs::path path = testing::temp_dir() / "gltf_spz" / name;
-  fs::create_directories(path.parent_path());
-  std::ofstream(path, std::ios::binary) << testing::glb_bytes(glb.gltf.dump(), glb.bin);
-  return path;
+  return testing::write_temp_file("gltf_spz", name, testing::glb_bytes(glb.gltf.dump(), glb.bin));
 }
 
 Glb spz_2_fixture() { return split(testing::read_file(kDir / kFixtures[0].glb)); }

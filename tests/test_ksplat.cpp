@@ -39,10 +39,7 @@ fs::path ksplat_file(int level, int sh_degree) {
 }
 
 fs::path write_file(const std::string& name, const std::string& bytes) {
-  const fs::path path = testing::temp_dir() / "ksplat" / name;
-  fs::create_directories(path.parent_path());
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
+  return testing::write_temp_file("ksplat", name, bytes);
 }
 
 double sigmoid(double x) { return 1 / (1 + std::exp(-x)); }
@@ -152,13 +149,7 @@ TEST_P(KsplatFiles, RendersAsItsReferenceAndNearItsSource) {
   testing::expect_matches_reference(image, render_reference(scene, camera, RenderSettings{}), 2e-5,
                                     "ksplat level " + std::to_string(level));
   // The source at the SH degree the file keeps: its first (degree + 1)^2 coefficients.
-  GaussianScene truncated = source;
-  truncated.sh_degree = sh_degree;
-  truncated.sh.clear();
-  const size_t kept = size_t((sh_degree + 1) * (sh_degree + 1));
-  for (size_t i = 0; i < source.size(); ++i)
-    truncated.sh.insert(truncated.sh.end(), source.sh.begin() + std::ptrdiff_t(i * 16 * 3),
-                        source.sh.begin() + std::ptrdiff_t((i * 16 + kept) * 3));
+  const GaussianScene truncated = testing::with_sh_degree(source, sh_degree);
   renderer.set_scene(truncated);
   const ImageDifference d = compare_images(image, renderer.render(camera));
   std::printf("[ measure  ] ksplat level %d, SH %d, %zu bytes: %.1f dB against the source PLY (max abs %.2e)\n",

@@ -37,10 +37,7 @@ constexpr double kShC0 = 0.28209479177387814;
 constexpr double kPi = 3.14159265358979323846;
 
 fs::path write_file(const std::string& name, const std::string& bytes) {
-  const fs::path path = testing::temp_dir() / "rad" / name;
-  fs::create_directories(path.parent_path());
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
+  return testing::write_temp_file("rad", name, bytes);
 }
 
 double sigmoid(double x) { return 1 / (1 + std::exp(-x)); }
@@ -145,13 +142,7 @@ TEST_P(RadFiles, LevelZeroRendersAsItsReferenceAndNearItsSource) {
   const RenderImage image = renderer.render(camera);
   testing::expect_matches_reference(image, render_reference(scene, camera, RenderSettings{}), 2e-5, c.file);
   // The source at the SH degree the file keeps: its first (degree + 1)^2 coefficients.
-  GaussianScene truncated = source;
-  truncated.sh_degree = c.sh_degree;
-  truncated.sh.clear();
-  const size_t kept = size_t((c.sh_degree + 1) * (c.sh_degree + 1));
-  for (size_t i = 0; i < source.size(); ++i)
-    truncated.sh.insert(truncated.sh.end(), source.sh.begin() + std::ptrdiff_t(i * 16 * 3),
-                        source.sh.begin() + std::ptrdiff_t((i * 16 + kept) * 3));
+  const GaussianScene truncated = testing::with_sh_degree(source, c.sh_degree);
   renderer.set_scene(truncated);
   const ImageDifference d = compare_images(image, renderer.render(camera));
   std::printf("[ measure  ] %s, %zu bytes: level 0 %.1f dB against the source PLY (max abs %.2e)\n", c.file,

@@ -54,6 +54,24 @@ Camera axis_camera(int width, int height, double focal) {
   return camera;
 }
 
+std::filesystem::path write_temp_file(const std::string& folder, const std::string& name, const std::string& bytes) {
+  const std::filesystem::path path = temp_dir() / folder / name;
+  std::filesystem::create_directories(path.parent_path());
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
+
+GaussianScene with_sh_degree(const GaussianScene& scene, int degree) {
+  GaussianScene truncated = scene;
+  truncated.sh_degree = degree;
+  truncated.sh.clear();
+  const size_t have = size_t(scene.sh_coefficients()), kept = size_t((degree + 1) * (degree + 1));
+  for (size_t i = 0; i < scene.size(); ++i)
+    truncated.sh.insert(truncated.sh.end(), scene.sh.begin() + std::ptrdiff_t(i * have * 3),
+                        scene.sh.begin() + std::ptrdiff_t((i * have + kept) * 3));
+  return truncated;
+}
+
 std::string glb_bytes(std::string json_text, std::string bin) {
   while (json_text.size() % 4) json_text += ' ';
   while (bin.size() % 4) bin += '\0';

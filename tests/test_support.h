@@ -43,6 +43,12 @@ void replay_fuzz_regressions(const std::string& reader, size_t at_least,
 // A directory unique to the running test for temporary files (removed by the OS, not by tests).
 std::filesystem::path temp_dir();
 
+// Writes `bytes` to temp_dir() / folder / name (the folder made) and returns the path.
+std::filesystem::path write_temp_file(const std::string& folder, const std::string& name, const std::string& bytes);
+
+// `scene` at SH degree `degree` <= its own: each Gaussian's first (degree + 1)^2 coefficients.
+GaussianScene with_sh_degree(const GaussianScene& scene, int degree);
+
 // A binary glTF (.glb) of `json_text` and `bin` (each padded to 4 bytes, as the GLB chunks must be).
 std::string glb_bytes(std::string json_text, std::string bin);
 

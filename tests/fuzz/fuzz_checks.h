@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "tilesplat/camera.h"
 #include "tilesplat/scene.h"
 
 namespace tilesplat::fuzz {
@@ -23,6 +24,18 @@ namespace tilesplat::fuzz {
   do {                                                                 \
     if (!(condition)) ::tilesplat::fuzz::invariant_failed(#condition); \
   } while (0)
+
+// A 64x48 pinhole camera `distance` units back from the origin, looking down +z.
+inline tilesplat::Camera camera_looking_at_origin(double distance) {
+  tilesplat::Camera camera;
+  camera.width = 64;
+  camera.height = 48;
+  camera.fx = camera.fy = 50;
+  camera.cx = 32;
+  camera.cy = 24;
+  camera.position = {0, 0, -distance};
+  return camera;
+}
 
 inline bool all_finite(const std::vector<float>& values) {
   for (const float value : values)

@@ -65,14 +65,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (int level = 0; level < set.levels(); ++level) levels_total += set.level_size(level);
     FUZZ_CHECK(levels_total == total);
 
-    // A camera 4 units back from the origin, looking down +z.
-    tilesplat::Camera camera;
-    camera.width = 64;
-    camera.height = 48;
-    camera.fx = camera.fy = 50;
-    camera.cx = 32;
-    camera.cy = 24;
-    camera.position = {0, 0, -4};
+    const tilesplat::Camera camera = tilesplat::fuzz::camera_looking_at_origin(4);
     try {
       for (int level = 0; level < set.levels(); ++level) {
         const tilesplat::GaussianScene scene = set.load_level(level);

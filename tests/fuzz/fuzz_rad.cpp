@@ -45,13 +45,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       const std::vector<uint32_t> nodes = tree.level_nodes(level);
       FUZZ_CHECK(is_cut(tree, nodes));
     }
-    tilesplat::Camera camera;
-    camera.width = 64;
-    camera.height = 48;
-    camera.fx = camera.fy = 50;
-    camera.cx = 32;
-    camera.cy = 24;
-    camera.position = {0, 0, -3};
+    const tilesplat::Camera camera = tilesplat::fuzz::camera_looking_at_origin(3);
     for (uint64_t budget : {uint64_t(0), uint64_t(1), uint64_t(7), uint64_t(100)}) {
       const tilesplat::LodTreeCut cut = tree.select(camera, budget);
       FUZZ_CHECK(is_cut(tree, cut.nodes));
