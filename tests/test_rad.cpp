@@ -25,6 +25,7 @@
 #include "tilesplat/reference.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
+#include "tilesplat/scene_in_parts.h"
 
 namespace tilesplat {
 namespace {
@@ -149,6 +150,41 @@ TEST_P(RadFiles, LevelZeroRendersAsItsReferenceAndNearItsSource) {
               size_t(fs::file_size(kRadDir / c.file)), d.psnr_db, d.max_abs);
   // Measured 42.7 to 45.4 dB: 8-bit colour (clamped to the file's range), log scale, SH and rotation axis.
   EXPECT_GE(d.psnr_db, 40.0);
+  EXPECT_EQ(renderer.validation_messages(), 0u);
+}
+
+// Read part by part (SceneInParts: each part decodes the chunks its leaves lie in): its Gaussians are the
+// whole read's, bit for bit, and a frame rendered in parts under a memory budget is the whole frame.
+TEST_P(RadFiles, ReadPartByPartIsTheWholeRead) {
+  const RadCase c = GetParam();
+  const fs::path path = kRadDir / c.file;
+  LoadReport whole_report, parts_report;
+  const GaussianScene whole = load_scene(path, {}, &whole_report);
+  const SceneInParts in_parts = SceneInParts::open(path, {}, &parts_report);
+  EXPECT_EQ(parts_report.format, whole_report.format);
+  EXPECT_EQ(parts_report.gaussians_in_file, whole_report.gaussians_in_file);
+  ASSERT_EQ(in_parts.size(), whole.size());
+  ASSERT_EQ(in_parts.sh_degree(), whole.sh_degree);
+  EXPECT_GE(SceneInParts::whole_scene_bytes(path),
+            whole.size() * (11 + 3 * uint64_t(whole.sh_coefficients())) * sizeof(float));
+  const GaussianScene loaded = in_parts.load();
+  ASSERT_EQ(loaded.size(), whole.size());
+  EXPECT_EQ(loaded.positions, whole.positions);
+  EXPECT_EQ(loaded.log_scales, whole.log_scales);
+  EXPECT_EQ(loaded.rotations, whole.rotations);
+  EXPECT_EQ(loaded.opacity_logits, whole.opacity_logits);
+  EXPECT_EQ(loaded.sh, whole.sh);
+  const Camera camera = resize_camera(load_cameras_json(testing::bundled_sh3_cameras())[0].camera, 64, 48);
+  Renderer& renderer = testing::validated_renderer();
+  RenderSettings settings;
+  settings.reuse_lists = false;
+  renderer.set_scene(whole);
+  const RenderImage frame = renderer.render(camera, settings);
+  settings.memory_budget = 274 << 10;  // the 64x48 frame holds 0.26 MiB before any Gaussian: a few parts
+  const RenderImage parts = renderer.render(in_parts, camera, settings);
+  EXPECT_GE(renderer.last_frame_stats().scene_parts, 2);
+  EXPECT_EQ(parts.rgba, frame.rgba);
+  renderer.set_scene(whole);  // the renderer holds the last part
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 

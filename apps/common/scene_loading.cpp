@@ -102,11 +102,12 @@ void load_lod_tree(LoadedScene& loaded, const LodOptions& options, const LoadOpt
   loaded.lod_tree = std::move(lod);
 }
 
-// Whether `path` is a binary PLY, an SPZ, a SOG or a .ksplat that `reading` reads part by part: always, or when
+// Whether `path` is a binary PLY, an SPZ, a SOG, a .ksplat or a .rad that `reading` reads part by part: always, or when
 // its Gaussians as floats would take more than half of the host's memory.
 bool reads_in_parts(const fs::path& path, PartReading reading) {
   const bool readable_in_parts = has_extension(path, ".ply") || has_extension(path, ".spz") ||
                                  has_extension(path, ".sog") || has_extension(path, ".ksplat") ||
+                                 has_extension(path, ".rad") ||
                                  path.filename() == "meta.json";
   if (reading == PartReading::kWhole || !readable_in_parts) return false;
   if (reading == PartReading::kInParts) return true;

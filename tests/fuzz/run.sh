@@ -56,9 +56,9 @@ seed spz "$scenes/train_3pts.spz" "$scenes/formats/playcanvas_test_64_sh3.v3.spz
 seed sog "$scenes/formats/playcanvas_test_64_sh3.sog"
 seed compressed_ply "$scenes/playcanvas_test_64.compressed.ply" "$scenes/formats/playcanvas_test_64_sh3.compressed.ply"
 seed gltf "$scenes/formats/playcanvas_test_64_sh3.glb" tests/data/gltf_spz/*.glb
-# The part-by-part reader's dispatch: a few of the PLY seeds, and an SPZ and a SOG.
+# The part-by-part reader's dispatch: a few of the PLY seeds, and an SPZ, a SOG, a .ksplat and a .rad.
 seed scene_in_parts "$scenes/formats/playcanvas_test_64_sh3.v4.spz" "$scenes/formats/playcanvas_test_64_sh3.sog" \
-  tests/data/ksplat/playcanvas_test_64_sh3_l1_sh2.ksplat \
+  tests/data/ksplat/playcanvas_test_64_sh3_l1_sh2.ksplat tests/data/rad/playcanvas_test_64_sh3_sh1-lod.rad \
   $(find "$build/seeds/ply" -type f | sort | head -n 8)
 # LOD set indexes: splat-transform's own (its chunk files are not beside the harness's folder: the index
 # parses, its loads fail) and the valid indexes over the harness's c.ply in regressions/lod_set/.

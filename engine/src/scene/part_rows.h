@@ -15,6 +15,7 @@
 
 #include "scene/ksplat_packed.h"
 #include "scene/ply_rows.h"
+#include "scene/rad_file.h"
 #include "scene/scene_reading.h"
 #include "scene/sog_packed.h"
 #include "scene/spz_packed.h"
@@ -93,6 +94,24 @@ class KsplatPartRows final : public PartRows {
   GaussianScene decode(std::span<const uint32_t> in_file) const override;
   FileContents contents_;
   std::optional<KsplatPacked> packed_;
+  std::vector<float> positions_;
+};
+
+// A Spark .rad, mapped: each part decodes the chunks its Gaussians lie in (scene/rad_file.h), a chunk at a
+// time; only the leaves' positions (and an SH codebook) are held. A LOD tree's leaves are its Gaussians, as
+// load_scene reads them.
+class RadPartRows final : public PartRows {
+ public:
+  RadPartRows(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report);
+
+ private:
+  GaussianScene decode(std::span<const uint32_t> in_file) const override;
+  FileContents contents_;
+  std::string name_;
+  FileLoader load_chunk_;
+  size_t chunk_size_ = 0;
+  std::vector<uint32_t> leaf_nodes_;  // each of the file's Gaussians (a leaf) as a node of the file
+  std::vector<float> sh_codes_;       // the file's SH codebook, if it has one
   std::vector<float> positions_;
 };
 

@@ -239,7 +239,40 @@ bool is_rad(std::span<const std::byte> data) {
 
 RadFile::RadFile(std::span<const std::byte> data, std::string_view name, const FileLoader& load_chunk)
     : name_(name) {
+  read(std::span(reinterpret_cast<const unsigned char*>(data.data()), data.size()), load_chunk);
+}
+
+RadFile RadFile::chunk_of(std::span<const std::byte> data, std::string_view name, const FileLoader& load_chunk,
+                          size_t chunk, const std::vector<float>& codebook) {
+  RadFile file;
+  file.name_ = name;
+  file.only_chunk_ = chunk;
+  file.sh_codes_ = codebook;
+  file.read(std::span(reinterpret_cast<const unsigned char*>(data.data()), data.size()), load_chunk);
+  return file;
+}
+
+RadFile::Chunking RadFile::chunking_of(std::span<const std::byte> data, std::string_view name) {
   const std::span<const unsigned char> bytes(reinterpret_cast<const unsigned char*>(data.data()), data.size());
+  try {
+    const bool alone = bytes.size() >= 4 && load_le<uint32_t>(bytes.data()) == kChunkMagic;
+    const auto [meta, end] = block_json(bytes, alone ? kChunkMagic : kRadMagic, alone ? "chunk" : "header");
+    Chunking chunking;
+    chunking.count = unsigned_member(meta, "count", "header");
+    chunking.chunks = alone ? 1 : member(meta, "chunks", "header").size();
+    chunking.chunk_size = alone ? chunking.count
+                                : meta.contains("chunkSize") ? unsigned_member(meta, "chunkSize", "header")
+                                                             : chunking.count;
+    const uint64_t degree = meta.contains("maxSh") ? unsigned_member(meta, "maxSh", "header") : 0;
+    chunking.sh_degree = static_cast<int>(std::min<uint64_t>(degree, 3));
+    return chunking;
+  } catch (const Property::Failure& failure) {
+    fail(name, failure.what);
+  }
+}
+
+void RadFile::read(std::span<const unsigned char> bytes, const FileLoader& load_chunk) {
+  const std::string_view name = name_;
   try {
     if (bytes.size() >= 4 && load_le<uint32_t>(bytes.data()) == kChunkMagic) {  // one chunk on its own
       read_chunk(bytes, "chunk", 0, 0, true);
@@ -268,9 +301,15 @@ RadFile::RadFile(std::span<const std::byte> data, std::string_view name, const F
         throw Property::Failure{"header: " + std::to_string(count) + " splats, more than a " +
                                 std::to_string(bytes.size()) + "-byte file can hold"};
       if (meta.contains("shCodeCount")) sh_code_count_ = unsigned_member(meta, "shCodeCount", "header");
-      alpha_.resize(count);
+      if (only_chunk_ != SIZE_MAX && only_chunk_ >= ranges.size())
+        throw Property::Failure{"no chunk " + std::to_string(only_chunk_) + " (the file has " +
+                                std::to_string(ranges.size()) + ")"};
+      alpha_.resize(only_chunk_ == SIZE_MAX ? count
+                                            : std::min<uint64_t>(chunk_size, count - only_chunk_ * chunk_size));
+      rebase_ = only_chunk_ == SIZE_MAX ? 0 : only_chunk_ * chunk_size;
       const std::span<const unsigned char> chunk_bytes = bytes.subspan(chunks_start);
       for (size_t c = 0; c < ranges.size(); ++c) {
+        if (only_chunk_ != SIZE_MAX && c != only_chunk_) continue;
         const std::string where = "chunk " + std::to_string(c);
         const json& range = ranges[c];
         const uint64_t length = unsigned_member(range, "bytes", where + " range");
@@ -293,10 +332,19 @@ RadFile::RadFile(std::span<const std::byte> data, std::string_view name, const F
       }
       chunks_ = ranges.size();
     }
-    if (size() > 0) check_tree();
+    if (!sh_labels_.empty() && sh_codes_.size() != sh_code_count_ * kRestComponents[sh_degree_])
+      throw Property::Failure{"SH labels without the codebook (sh1_code, ...) they index"};
   } catch (const Property::Failure& failure) {
     fail(name, failure.what);
   }
+  if (size() > 0 && only_chunk_ == SIZE_MAX) check_tree();
+}
+
+std::string RadFile::format(size_t leaves) const {
+  std::string text = "rad (" + std::to_string(chunks_) + (chunks_ == 1 ? " chunk; " : " chunks; ");
+  if (has_lod_tree())
+    text += "LOD tree of " + std::to_string(size()) + " splats, its " + std::to_string(leaves) + " leaves read; ";
+  return text + encodings_ + ")";
 }
 
 void RadFile::read_chunk(std::span<const unsigned char> chunk, std::string_view where_view, size_t expected_base,
@@ -329,7 +377,7 @@ void RadFile::read_chunk(std::span<const unsigned char> chunk, std::string_view 
                             "; the header's chunking puts " + std::to_string(expected_base) + " to " +
                             std::to_string(expected_base + expected_count) + " there"};
   }
-  const size_t total = alpha_.size(), first = expected_base, n = expected_count;
+  const size_t total = alpha_.size(), first = expected_base - rebase_, n = expected_count;
   const size_t sh_components = kRestComponents[sh_degree_];
   const auto resize_once = [total](std::vector<float>& v, size_t each) {
     if (v.empty()) v.resize(total * each);
@@ -376,7 +424,7 @@ void RadFile::read_chunk(std::span<const unsigned char> chunk, std::string_view 
       const int band = name[2] - '0';
       if (band > sh_degree_) continue;
       if (sh_code_count_ == 0) throw Property::Failure{where + ": " + name + " without the header's shCodeCount"};
-      if (sh_codes_.empty()) sh_codes_.resize(sh_code_count_ * sh_components);
+      if (sh_codes_.size() != sh_code_count_ * sh_components) sh_codes_.assign(sh_code_count_ * sh_components, 0.0f);
       const size_t components = kBandComponents[band];
       const std::vector<double> values = property.values(sh_code_count_, components);
       for (size_t i = 0; i < sh_code_count_; ++i)
@@ -415,36 +463,38 @@ void RadFile::read_chunk(std::span<const unsigned char> chunk, std::string_view 
                               std::to_string(sh_degree_) + " calls for"};
 }
 
-void RadFile::check_tree() const {
-  if (!sh_labels_.empty())
-    for (int band = 1; band <= sh_degree_; ++band)
-      if (sh_codes_.empty()) throw Property::Failure{"SH labels without the codebook (sh1_code, ...) they index"};
-  if (!has_lod_tree()) return;
-  // A tree: every node but the root (0) has one parent, and every node is reached from the root.
-  const size_t total = size();
-  std::vector<uint8_t> parents(total, 0);
-  for (size_t i = 0; i < total; ++i) {
-    if (child_count_[i] == 0) continue;
-    if (child_start_[i] >= total || child_count_[i] > total - child_start_[i])
-      throw Property::Failure{"splat " + std::to_string(i) + "'s children (" + std::to_string(child_count_[i]) +
-                              " from " + std::to_string(child_start_[i]) + ") are past the file's " +
-                              std::to_string(total) + " splats"};
-    for (size_t c = child_start_[i]; c < child_start_[i] + child_count_[i]; ++c)
-      if (c == 0 || parents[c]++ > 0)
-        throw Property::Failure{"splat " + std::to_string(c) + " has two parents in the LOD tree (" +
-                                std::to_string(i) + " is the second)"};
+void RadFile::check_tree_of(std::string_view name, std::span<const uint32_t> counts,
+                            std::span<const uint32_t> starts) {
+  if (counts.empty()) return;
+  try {
+    // A tree: every node but the root (0) has one parent, and every node is reached from the root.
+    const size_t total = counts.size();
+    std::vector<uint8_t> parents(total, 0);
+    for (size_t i = 0; i < total; ++i) {
+      if (counts[i] == 0) continue;
+      if (starts[i] >= total || counts[i] > total - starts[i])
+        throw Property::Failure{"splat " + std::to_string(i) + "'s children (" + std::to_string(counts[i]) +
+                                " from " + std::to_string(starts[i]) + ") are past the file's " +
+                                std::to_string(total) + " splats"};
+      for (size_t c = starts[i]; c < starts[i] + counts[i]; ++c)
+        if (c == 0 || parents[c]++ > 0)
+          throw Property::Failure{"splat " + std::to_string(c) + " has two parents in the LOD tree (" +
+                                  std::to_string(i) + " is the second)"};
+    }
+    std::vector<uint32_t> stack = {0};
+    size_t reached = 0;
+    while (!stack.empty()) {
+      const uint32_t node = stack.back();
+      stack.pop_back();
+      ++reached;
+      for (uint32_t c = starts[node]; c < starts[node] + counts[node]; ++c) stack.push_back(c);
+    }
+    if (reached != total)
+      throw Property::Failure{"the LOD tree reaches " + std::to_string(reached) + " of the file's " +
+                              std::to_string(total) + " splats from its root"};
+  } catch (const Property::Failure& failure) {
+    fail(name, failure.what);
   }
-  std::vector<uint32_t> stack = {0};
-  size_t reached = 0;
-  while (!stack.empty()) {
-    const uint32_t node = stack.back();
-    stack.pop_back();
-    ++reached;
-    for (uint32_t c = child_start_[node]; c < child_start_[node] + child_count_[node]; ++c) stack.push_back(c);
-  }
-  if (reached != total)
-    throw Property::Failure{"the LOD tree reaches " + std::to_string(reached) + " of the file's " +
-                            std::to_string(total) + " splats from its root"};
 }
 
 double RadFile::node_size(size_t node) const {

@@ -33,6 +33,26 @@ class RadFile {
   // (nullptr: such a file is an error). Throws SceneError naming `name` and the broken part.
   RadFile(std::span<const std::byte> data, std::string_view name, const FileLoader& load_chunk);
 
+  // Chunk `chunk` of a .rad alone (its splats numbered from 0; child indices stay the file's), for reading a
+  // file a chunk at a time (RadPartRows). `codebook`: the file's SH codebook (chunk 0's sh_codes(), which a
+  // later chunk's labels index). The tree is not checked: the whole file's read does that.
+  static RadFile chunk_of(std::span<const std::byte> data, std::string_view name, const FileLoader& load_chunk,
+                          size_t chunk, const std::vector<float>& codebook = {});
+  // A .rad's chunk count and splats a chunk, from its header alone (a lone .radc: 1 and its count).
+  struct Chunking {
+    size_t chunks = 0;
+    size_t chunk_size = 0;
+    size_t count = 0;
+    int sh_degree = 0;
+  };
+  static Chunking chunking_of(std::span<const std::byte> data, std::string_view name);
+  const std::vector<float>& sh_codes() const { return sh_codes_; }
+  // What a LoadReport says a .rad is: "rad (N chunks; LOD tree of N splats, its M leaves read; encodings)".
+  std::string format(size_t leaves) const;
+  // The checks the whole read makes of a tree, for child arrays gathered a chunk at a time.
+  static void check_tree_of(std::string_view name, std::span<const uint32_t> child_count,
+                            std::span<const uint32_t> child_start);
+
   size_t size() const { return alpha_.size(); }
   int sh_degree() const { return sh_degree_; }
   bool has_lod_tree() const { return !child_count_.empty(); }
@@ -57,9 +77,15 @@ class RadFile {
  private:
   void read_chunk(std::span<const unsigned char> chunk, std::string_view where, size_t expected_base,
                   size_t expected_count, bool alone);
-  void check_tree() const;  // a LOD tree's children: one parent each, all reached from the root
+  void check_tree() const { check_tree_of(name_, child_count_, child_start_); }
+
+  RadFile() = default;
+  void read(std::span<const unsigned char> bytes, const FileLoader& load_chunk);
 
   std::string name_;
+  // Set by chunk_of: the one chunk read, and its first splat's index in the file (its arrays start there).
+  size_t only_chunk_ = SIZE_MAX;
+  size_t rebase_ = 0;
   int sh_degree_ = 0;
   size_t chunks_ = 0;
   std::string encodings_;

@@ -14,13 +14,7 @@ GaussianScene read_rad(std::span<const std::byte> data, std::string_view name, c
   const RadFile file(data, name, load_chunk);
   const std::vector<uint32_t> leaves = file.leaves();
   GaussianScene scene = file.decode(leaves);
-  // What tilesplat-info shows of the layout: chunks, the tree, each property's encoding.
-  std::string format = "rad (" + std::to_string(file.chunks()) + (file.chunks() == 1 ? " chunk; " : " chunks; ");
-  if (file.has_lod_tree())
-    format += "LOD tree of " + std::to_string(file.size()) + " splats, its " + std::to_string(leaves.size()) +
-              " leaves read; ";
-  format += file.encodings() + ")";
-  finish_scene(scene, name, options, format, "1", report);
+  finish_scene(scene, name, options, file.format(leaves.size()), "1", report);
   return scene;
 }
 

@@ -12,6 +12,7 @@
 
 #include "scene/part_rows.h"
 #include "scene/scene_readers.h"
+#include "tilesplat/scene_description.h"
 
 namespace tilesplat {
 namespace detail {
@@ -142,6 +143,74 @@ KsplatPartRows::KsplatPartRows(const std::filesystem::path& path, const LoadOpti
   }
 }
 
+RadPartRows::RadPartRows(const std::filesystem::path& path, const LoadOptions& options, LoadReport* report)
+    : name_(path.string()), load_chunk_(sibling_loader(path)) {
+  open_scene_file(path, contents_);
+  const RadFile::Chunking chunking = RadFile::chunking_of(contents_.bytes(), name_);
+  chunk_size_ = chunking.chunk_size;
+  // A chunk at a time: the leaves' positions, the Gaussians finish_scene would drop, the tree to check.
+  NonFiniteTally tally(name_, options);
+  std::vector<size_t> dropped;
+  std::vector<uint32_t> child_count, child_start;
+  size_t nodes = 0;
+  for (size_t c = 0; c < chunking.chunks; ++c) {
+    const RadFile chunk = RadFile::chunk_of(contents_.bytes(), name_, load_chunk_, c, sh_codes_);
+    if (c == 0) sh_codes_ = chunk.sh_codes();
+    std::vector<uint32_t> leaves = chunk.leaves();  // in the chunk
+    const GaussianScene block = chunk.decode(leaves);
+    const std::vector<size_t> bad = non_finite_gaussians(block, leaf_nodes_.size(), tally);
+    size_t next_bad = 0;
+    for (size_t i = 0; i < leaves.size(); ++i) {
+      if (next_bad < bad.size() && bad[next_bad] == i) {
+        dropped.push_back(leaf_nodes_.size() + i);
+        ++next_bad;
+      } else {
+        positions_.insert(positions_.end(), block.positions.begin() + std::ptrdiff_t(3 * i),
+                          block.positions.begin() + std::ptrdiff_t(3 * i + 3));
+      }
+    }
+    for (size_t i = 0; i < leaves.size(); ++i) leaves[i] += static_cast<uint32_t>(nodes);
+    leaf_nodes_.insert(leaf_nodes_.end(), leaves.begin(), leaves.end());
+    if (chunk.has_lod_tree())
+      for (size_t i = 0; i < chunk.size(); ++i) {
+        child_count.push_back(chunk.child_count(i));
+        child_start.push_back(chunk.child_start(i));
+      }
+    nodes += chunk.size();
+  }
+  RadFile::check_tree_of(name_, child_count, child_start);
+  if (leaf_nodes_.size() > UINT32_MAX)
+    fail(name_, std::to_string(leaf_nodes_.size()) + " splats: a scene read in parts holds at most 2^32 - 1");
+  set_dropped(leaf_nodes_.size(), dropped);
+  set_positions(positions_);
+  sh_degree_ = chunking.sh_degree;
+  if (report) {
+    // What read_rad reports: the whole file's chunks and leaves (the first chunk's encodings).
+    const RadFile first = RadFile::chunk_of(contents_.bytes(), name_, load_chunk_, 0, sh_codes_);
+    *report = LoadReport{.format = first.format(leaf_nodes_.size()),
+                         .version = "1",
+                         .gaussians_in_file = leaf_nodes_.size(),
+                         .dropped = dropped.size(),
+                         .dropped_by_property = tally.take()};
+  }
+}
+
+GaussianScene RadPartRows::decode(std::span<const uint32_t> in_file) const {
+  // The Gaussians by chunk (ascending, as in_file is): each chunk decoded once for those it holds.
+  std::vector<GaussianScene> scenes;
+  for (size_t i = 0; i < in_file.size();) {
+    const size_t chunk = leaf_nodes_[in_file[i]] / chunk_size_;
+    std::vector<uint32_t> local;
+    for (; i < in_file.size() && leaf_nodes_[in_file[i]] / chunk_size_ == chunk; ++i)
+      local.push_back(static_cast<uint32_t>(leaf_nodes_[in_file[i]] - chunk * chunk_size_));
+    scenes.push_back(RadFile::chunk_of(contents_.bytes(), name_, load_chunk_, chunk, sh_codes_).decode(local));
+  }
+  GaussianScene scene = scenes.size() == 1 ? std::move(scenes.front()) : merge_scenes(scenes);
+  if (scenes.empty()) allocate_scene(scene, 0, sh_degree_);
+  normalize_rotations(scene);  // the rest of read_rad's finish_scene (the dropped ones are not asked for)
+  return scene;
+}
+
 GaussianScene KsplatPartRows::decode(std::span<const uint32_t> in_file) const {
   GaussianScene scene = packed_->decode(in_file);
   normalize_rotations(scene);  // the rest of read_ksplat's finish_scene (the dropped ones are not asked for)
@@ -221,14 +290,15 @@ SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOpt
               detail::SogPacked::from_meta(as_text(bytes), name, detail::sibling_loader(path)), name, options,
               report));
         [[fallthrough]];
-      case detail::Container::kGlb:
       case detail::Container::kRad:
+        return SceneInParts(std::make_shared<const detail::RadPartRows>(path, options, report));
+      case detail::Container::kGlb:
       case detail::Container::kUnknown:
         if (!bytes.empty())
           detail::fail(
               name,
-              "not a PLY file (it does not start with the 'ply' magic line), an SPZ, a SOG or a .ksplat: only "
-              "these are read part by part; load_scene reads the others whole");
+              "not a PLY file (it does not start with the 'ply' magic line), an SPZ, a SOG, a .ksplat or a .rad: "
+              "only these are read part by part; load_scene reads the others whole");
         break;  // empty: the PLY reader says so
     }
   }  // an SPZ's or a SOG's file is let go of once decoded
@@ -254,8 +324,12 @@ uint64_t SceneInParts::whole_scene_bytes(const std::filesystem::path& path) {
                    : 0;
       case detail::Container::kKsplat:
         return detail::KsplatPacked(bytes, name).counts().scene_bytes();
+      case detail::Container::kRad: {
+        // At most every splat of the file (a LOD tree's leaves are fewer), as floats.
+        const detail::RadFile::Chunking chunking = detail::RadFile::chunking_of(bytes, name);
+        return detail::DeclaredCounts{chunking.count, chunking.sh_degree}.scene_bytes();
+      }
       case detail::Container::kGlb:
-      case detail::Container::kRad:
       case detail::Container::kUnknown:
         return 0;
     }
