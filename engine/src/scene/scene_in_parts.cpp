@@ -284,14 +284,14 @@ SceneInParts SceneInParts::open(const std::filesystem::path& path, const LoadOpt
             detail::SogPacked::from_zip(bytes, name), name, options, report));
       case detail::Container::kKsplat:
         return SceneInParts(std::make_shared<const detail::KsplatPartRows>(path, options, report));
-      case detail::Container::kJson:
+      case detail::Container::kRad:
+        return SceneInParts(std::make_shared<const detail::RadPartRows>(path, options, report));
+      case detail::Container::kJson:  // falls through to the refusal below when it is no SOG meta.json
         if (detail::is_sog_meta(as_text(bytes)))
           return SceneInParts(std::make_shared<const detail::SogPartRows>(
               detail::SogPacked::from_meta(as_text(bytes), name, detail::sibling_loader(path)), name, options,
               report));
         [[fallthrough]];
-      case detail::Container::kRad:
-        return SceneInParts(std::make_shared<const detail::RadPartRows>(path, options, report));
       case detail::Container::kGlb:
       case detail::Container::kUnknown:
         if (!bytes.empty())
