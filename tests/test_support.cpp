@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "tilesplat/scene_in_parts.h"
+
 namespace tilesplat::testing {
 
 std::filesystem::path bundled_scene_dir() { return std::filesystem::path(TILESPLAT_SOURCE_DIR) / "scenes"; }
@@ -70,6 +72,35 @@ GaussianScene with_sh_degree(const GaussianScene& scene, int degree) {
     truncated.sh.insert(truncated.sh.end(), scene.sh.begin() + std::ptrdiff_t(i * have * 3),
                         scene.sh.begin() + std::ptrdiff_t((i * have + kept) * 3));
   return truncated;
+}
+
+void expect_read_in_parts_as_whole(const std::filesystem::path& path, const Camera& camera) {
+  SCOPED_TRACE(path.filename().string() + " read part by part");
+  LoadReport whole_report, parts_report;
+  const GaussianScene whole = load_scene(path, {}, &whole_report);
+  const SceneInParts in_parts = SceneInParts::open(path, {}, &parts_report);
+  EXPECT_EQ(parts_report.format, whole_report.format);
+  EXPECT_EQ(parts_report.gaussians_in_file, whole_report.gaussians_in_file);
+  ASSERT_EQ(in_parts.size(), whole.size());
+  ASSERT_EQ(in_parts.sh_degree(), whole.sh_degree);
+  const GaussianScene loaded = in_parts.load();  // every part's Gaussians, decoded as a part decodes them
+  ASSERT_EQ(loaded.size(), whole.size());
+  EXPECT_EQ(loaded.positions, whole.positions);
+  EXPECT_EQ(loaded.log_scales, whole.log_scales);
+  EXPECT_EQ(loaded.rotations, whole.rotations);
+  EXPECT_EQ(loaded.opacity_logits, whole.opacity_logits);
+  EXPECT_EQ(loaded.sh, whole.sh);
+  Renderer& renderer = validated_renderer();
+  RenderSettings settings;
+  settings.reuse_lists = false;
+  renderer.set_scene(whole);
+  const RenderImage frame = renderer.render(camera, settings);
+  settings.memory_budget = 274 << 10;  // the 64x48 frame holds 0.26 MiB before any Gaussian: a few parts
+  const RenderImage parts = renderer.render(in_parts, camera, settings);
+  EXPECT_GE(renderer.last_frame_stats().scene_parts, 2);
+  EXPECT_EQ(parts.rgba, frame.rgba);
+  renderer.set_scene(whole);  // the renderer holds the last part
+  EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
 std::string glb_bytes(std::string json_text, std::string bin) {

@@ -49,6 +49,11 @@ std::filesystem::path write_temp_file(const std::string& folder, const std::stri
 // `scene` at SH degree `degree` <= its own: each Gaussian's first (degree + 1)^2 coefficients.
 GaussianScene with_sh_degree(const GaussianScene& scene, int degree);
 
+// A file read part by part (SceneInParts::open) against load_scene of it: the same report (format, Gaussians in
+// the file), the same Gaussians bit for bit (for files without NaN), and `camera`'s frame rendered in parts
+// under a memory budget that makes a few of them (a 64x48 camera: 274 KiB) the whole frame's.
+void expect_read_in_parts_as_whole(const std::filesystem::path& path, const Camera& camera);
+
 // A binary glTF (.glb) of `json_text` and `bin` (each padded to 4 bytes, as the GLB chunks must be).
 std::string glb_bytes(std::string json_text, std::string bin);
 
