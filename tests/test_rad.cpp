@@ -311,16 +311,24 @@ std::string chunk_bytes(size_t base, size_t count, int max_sh, bool lod_tree, co
   append(chunk, uint64_t(payload.size()));
   return chunk + payload;
 }
-std::string rad_bytes(size_t count, int max_sh, bool lod_tree, const std::string& chunk) {
-  json meta = {{"version", 1}, {"type", "gsplat"}, {"count", count}, {"maxSh", max_sh}, {"chunkSize", 65536},
-               {"allChunkBytes", chunk.size()}, {"chunks", {{{"offset", 0}, {"bytes", chunk.size()}}}}};
+// A RAD0 header over `chunks` (each of `chunk_size` splats but the last), the chunks after it.
+std::string rad_bytes(size_t count, int max_sh, bool lod_tree, const std::vector<std::string>& chunks,
+                      size_t chunk_size = 65536) {
+  json ranges = json::array();
+  std::string bytes;
+  for (const std::string& chunk : chunks) {
+    ranges.push_back({{"offset", bytes.size()}, {"bytes", chunk.size()}});
+    bytes += chunk;
+  }
+  json meta = {{"version", 1},          {"type", "gsplat"},        {"count", count}, {"maxSh", max_sh},
+               {"chunkSize", chunk_size}, {"allChunkBytes", bytes.size()}, {"chunks", ranges}};
   if (lod_tree) meta["lodTree"] = true;
   const std::string text = meta.dump();
   std::string out = "RAD0";
   append(out, uint32_t(text.size()));
   out += text;
   pad8(out);
-  return out + chunk;
+  return out + bytes;
 }
 
 uint16_t half_of(float v) {  // exact for the values used here (small dyadic fractions)
@@ -370,7 +378,7 @@ TEST(Rad, AFileBuiltFromTheLayoutDecodesEachEncodingAsRadRsDoes) {
        {"scales", "ln_f16", scales, {}, false},
        {"orientation", "f16", orientation, {}, true},
        {"sh1", "s8_delta", sh1, {{"min", -2.0}, {"max", 2.0}}, true}});
-  const fs::path path = write_file("built.rad", rad_bytes(2, 1, false, chunk));
+  const fs::path path = write_file("built.rad", rad_bytes(2, 1, false, {chunk}));
   LoadReport report;
   const GaussianScene scene = load_scene(path, {}, &report);
   EXPECT_EQ(report.format,
@@ -395,22 +403,28 @@ TEST(Rad, AFileBuiltFromTheLayoutDecodesEachEncodingAsRadRsDoes) {
   EXPECT_THROW(SplatLodTree::open(path), SceneError);        // no tree to cut
 }
 
-// A LOD tree of three nodes (root 0 with leaves 1 and 2), children as u16 / u32 planes.
-std::string tree_file(std::vector<uint16_t> counts, std::vector<uint32_t> starts) {
+// A LOD tree of the given children (node 0 the root), its properties as float32 planes and its children as u16
+// / u32 planes, in chunks of `chunk_size` nodes.
+std::string tree_file(std::vector<uint16_t> counts, std::vector<uint32_t> starts, size_t chunk_size = 65536) {
   const size_t n = counts.size();
-  std::string center, alpha, rgb, scales, orientation, child_count, child_start;
-  for (size_t i = 0; i < 3 * n; ++i) append(center, float(i));
-  for (size_t i = 0; i < n; ++i) append(alpha, float(i == 0 ? 1.5f : 0.5f));  // the root's kernel is wider
-  for (size_t i = 0; i < 3 * n; ++i) append(rgb, 0.5f);
-  for (size_t i = 0; i < 3 * n; ++i) append(scales, 0.25f);
-  for (size_t i = 0; i < 3 * n; ++i) append(orientation, 0.0f);
-  for (uint16_t v : counts) append(child_count, v);
-  for (uint32_t v : starts) append(child_start, v);
-  return rad_bytes(n, 0, true,
-                   chunk_bytes(0, n, 0, true,
-                               {{"center", "f32", center}, {"alpha", "f32", alpha}, {"rgb", "f32", rgb},
-                                {"scales", "f32", scales}, {"orientation", "f32", orientation},
-                                {"child_count", "u16", child_count}, {"child_start", "u32", child_start, {}, true}}));
+  std::vector<std::string> chunks;
+  for (size_t base = 0; base < n; base += chunk_size) {
+    const size_t m = std::min(chunk_size, n - base);
+    std::string center, alpha, rgb, scales, orientation, child_count, child_start;
+    for (size_t d = 0; d < 3; ++d)
+      for (size_t i = base; i < base + m; ++i) append(center, float(3 * i + d));
+    for (size_t i = base; i < base + m; ++i) append(alpha, float(i == 0 ? 1.5f : 0.5f));  // the root's is wider
+    for (size_t i = 0; i < 3 * m; ++i) append(rgb, 0.5f);
+    for (size_t i = 0; i < 3 * m; ++i) append(scales, 0.25f);
+    for (size_t i = 0; i < 3 * m; ++i) append(orientation, 0.0f);
+    for (size_t i = base; i < base + m; ++i) append(child_count, counts[i]);
+    for (size_t i = base; i < base + m; ++i) append(child_start, starts[i]);
+    chunks.push_back(chunk_bytes(base, m, 0, true,
+                                 {{"center", "f32", center}, {"alpha", "f32", alpha}, {"rgb", "f32", rgb},
+                                  {"scales", "f32", scales}, {"orientation", "f32", orientation},
+                                  {"child_count", "u16", child_count}, {"child_start", "u32", child_start, {}, true}}));
+  }
+  return rad_bytes(n, 0, true, chunks, chunk_size);
 }
 
 TEST(Rad, ATreeBuiltFromTheLayoutCutsAndWidensItsInnerNodes) {
@@ -430,6 +444,28 @@ TEST(Rad, ATreeBuiltFromTheLayoutCutsAndWidensItsInnerNodes) {
   EXPECT_NEAR(tree.node_size(1), 0.5, 1e-6);
   EXPECT_EQ(load_scene(path).size(), 2u);  // the leaves
   EXPECT_FALSE(is_lod_tree(kRadDir / "make_rad.sh"));
+}
+
+// A tree in chunks of two nodes, read part by part (a chunk at a time): the same report as the whole read (the
+// file's splats and chunks, not its first chunk's) and the same leaves.
+TEST(Rad, ATreeInSeveralChunksReadsPartByPartAsWhole) {
+  const fs::path path = write_file("chunked_tree.rad", tree_file({2, 0, 2, 0, 0}, {1, 0, 3, 0, 0}, 2));
+  LoadReport whole_report, parts_report;
+  const GaussianScene whole = load_scene(path, {}, &whole_report);
+  EXPECT_EQ(whole_report.format,
+            "rad (3 chunks; LOD tree of 5 splats, its 3 leaves read; center f32, alpha f32, rgb f32, scales f32, "
+            "orientation f32, child_count u16, child_start u32)");
+  const SceneInParts in_parts = SceneInParts::open(path, {}, &parts_report);
+  EXPECT_EQ(parts_report.format, whole_report.format);
+  EXPECT_EQ(parts_report.gaussians_in_file, whole_report.gaussians_in_file);
+  const GaussianScene loaded = in_parts.load();
+  EXPECT_EQ(loaded.positions, whole.positions);
+  EXPECT_EQ(loaded.log_scales, whole.log_scales);
+  EXPECT_EQ(loaded.rotations, whole.rotations);
+  EXPECT_EQ(loaded.opacity_logits, whole.opacity_logits);
+  EXPECT_EQ(loaded.sh, whole.sh);
+  // The leaves, nodes 1, 3 and 4: their centres are 3 i, 3 i + 1, 3 i + 2.
+  EXPECT_EQ(whole.positions, (std::vector<float>{3, 4, 5, 9, 10, 11, 12, 13, 14}));
 }
 
 TEST(Rad, DamagedFilesAreRefusedNamingTheFileAndThePart) {

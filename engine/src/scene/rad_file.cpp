@@ -276,7 +276,8 @@ void RadFile::read(std::span<const unsigned char> bytes, const FileLoader& load_
   try {
     if (bytes.size() >= 4 && load_le<uint32_t>(bytes.data()) == kChunkMagic) {  // one chunk on its own
       read_chunk(bytes, "chunk", 0, 0, true);
-      chunks_ = 1;
+      description_.chunks = 1;
+      description_.splats = size();
     } else {
       const auto [meta, chunks_start] = block_json(bytes, kRadMagic, "header");
       if (unsigned_member(meta, "version", "header") != 1)
@@ -330,21 +331,23 @@ void RadFile::read(std::span<const unsigned char> bytes, const FileLoader& load_
           read_chunk(chunk_bytes.subspan(offset, length), where, base, chunk_count, false);
         }
       }
-      chunks_ = ranges.size();
+      description_.chunks = ranges.size();
+      description_.splats = count;
     }
     if (!sh_labels_.empty() && sh_codes_.size() != sh_code_count_ * kRestComponents[sh_degree_])
       throw Property::Failure{"SH labels without the codebook (sh1_code, ...) they index"};
   } catch (const Property::Failure& failure) {
     fail(name, failure.what);
   }
+  description_.lod_tree = has_lod_tree();
   if (size() > 0 && only_chunk_ == SIZE_MAX) check_tree();
 }
 
-std::string RadFile::format(size_t leaves) const {
-  std::string text = "rad (" + std::to_string(chunks_) + (chunks_ == 1 ? " chunk; " : " chunks; ");
-  if (has_lod_tree())
-    text += "LOD tree of " + std::to_string(size()) + " splats, its " + std::to_string(leaves) + " leaves read; ";
-  return text + encodings_ + ")";
+std::string RadFile::Description::format(size_t leaves) const {
+  std::string text = "rad (" + std::to_string(chunks) + (chunks == 1 ? " chunk; " : " chunks; ");
+  if (lod_tree)
+    text += "LOD tree of " + std::to_string(splats) + " splats, its " + std::to_string(leaves) + " leaves read; ";
+  return text + encodings + ")";
 }
 
 void RadFile::read_chunk(std::span<const unsigned char> chunk, std::string_view where_view, size_t expected_base,
@@ -390,6 +393,7 @@ void RadFile::read_chunk(std::span<const unsigned char> chunk, std::string_view 
     if (child_count_.empty()) child_count_.resize(total), child_start_.resize(total);
   }
 
+  const bool describe = description_.encodings.empty();  // the first chunk read names the encodings
   const json& properties = member(meta, "properties", where);
   if (!properties.is_array()) throw Property::Failure{where + ": 'properties' is not an array"};
   std::vector<std::string> seen;
@@ -448,9 +452,9 @@ void RadFile::read_chunk(std::span<const unsigned char> chunk, std::string_view 
     } else {
       throw Property::Failure{where + ": unknown property '" + name + "'"};
     }
-    if (!described_) encodings_ += (encodings_.empty() ? "" : ", ") + name + " " + property.encoding();
+    if (describe)
+      description_.encodings += (description_.encodings.empty() ? "" : ", ") + name + " " + property.encoding();
   }
-  described_ = true;
   std::vector<const char*> required = {kCenter.name, kAlpha.name, kRgb.name, kScales.name, kOrientation.name};
   if (lod_tree) required.insert(required.end(), {kChildCount.name, kChildStart.name});
   for (const char* name : required)

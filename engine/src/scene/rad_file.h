@@ -47,8 +47,17 @@ class RadFile {
   };
   static Chunking chunking_of(std::span<const std::byte> data, std::string_view name);
   const std::vector<float>& sh_codes() const { return sh_codes_; }
-  // What a LoadReport says a .rad is: "rad (N chunks; LOD tree of N splats, its M leaves read; encodings)".
-  std::string format(size_t leaves) const;
+  // What a LoadReport says of a .rad, from its header and the first chunk read: a value that a reader taking the
+  // file a chunk at a time keeps from its first chunk.
+  struct Description {
+    size_t chunks = 0;
+    size_t splats = 0;      // every splat of the file (a lone .radc: its own), a tree's inner nodes too
+    bool lod_tree = false;
+    std::string encodings;  // "center f32_lebytes, alpha f16, ...", as the first chunk read names them
+    // "rad (N chunks; LOD tree of N splats, its M leaves read; encodings)"
+    std::string format(size_t leaves) const;
+  };
+  const Description& description() const { return description_; }
   // The checks the whole read makes of a tree, for child arrays gathered a chunk at a time.
   static void check_tree_of(std::string_view name, std::span<const uint32_t> child_count,
                             std::span<const uint32_t> child_start);
@@ -56,9 +65,6 @@ class RadFile {
   size_t size() const { return alpha_.size(); }
   int sh_degree() const { return sh_degree_; }
   bool has_lod_tree() const { return !child_count_.empty(); }
-  size_t chunks() const { return chunks_; }
-  // The property encodings as the file names them, e.g. "center f32_lebytes, alpha r8, ..." (tilesplat-info).
-  const std::string& encodings() const { return encodings_; }
 
   uint32_t child_count(size_t node) const { return child_count_[node]; }
   uint32_t child_start(size_t node) const { return child_start_[node]; }
@@ -87,8 +93,7 @@ class RadFile {
   size_t only_chunk_ = SIZE_MAX;
   size_t rebase_ = 0;
   int sh_degree_ = 0;
-  size_t chunks_ = 0;
-  std::string encodings_;
+  Description description_;
   std::vector<float> centers_, alpha_, rgb_, scales_, quats_;  // quats x y z w, as Spark keeps them
   std::vector<float> sh_;                                      // per splat (degree+1)^2-1 coefficients x RGB
   // An SH codebook (shCodeCount entries of the same layout) and each splat's entry, in place of sh_.
@@ -96,7 +101,6 @@ class RadFile {
   std::vector<uint32_t> sh_labels_;
   size_t sh_code_count_ = 0;
   std::vector<uint32_t> child_count_, child_start_;
-  bool described_ = false;  // encodings_ holds the first chunk's
 };
 
 }  // namespace tilesplat::detail

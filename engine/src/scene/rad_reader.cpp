@@ -14,7 +14,7 @@ GaussianScene read_rad(std::span<const std::byte> data, std::string_view name, c
   const RadFile file(data, name, load_chunk);
   const std::vector<uint32_t> leaves = file.leaves();
   GaussianScene scene = file.decode(leaves);
-  finish_scene(scene, name, options, file.format(leaves.size()), "1", report);
+  finish_scene(scene, name, options, file.description().format(leaves.size()), "1", report);
   return scene;
 }
 

@@ -152,10 +152,14 @@ RadPartRows::RadPartRows(const std::filesystem::path& path, const LoadOptions& o
   NonFiniteTally tally(name_, options);
   std::vector<size_t> dropped;
   std::vector<uint32_t> child_count, child_start;
+  RadFile::Description description;  // the first chunk's, as read_rad's whole read reports it
   size_t nodes = 0;
   for (size_t c = 0; c < chunking.chunks; ++c) {
     const RadFile chunk = RadFile::chunk_of(contents_.bytes(), name_, load_chunk_, c, sh_codes_);
-    if (c == 0) sh_codes_ = chunk.sh_codes();
+    if (c == 0) {
+      sh_codes_ = chunk.sh_codes();
+      description = chunk.description();
+    }
     std::vector<uint32_t> leaves = chunk.leaves();  // in the chunk
     const GaussianScene block = chunk.decode(leaves);
     const std::vector<size_t> bad = non_finite_gaussians(block, leaf_nodes_.size(), tally);
@@ -185,9 +189,7 @@ RadPartRows::RadPartRows(const std::filesystem::path& path, const LoadOptions& o
   set_positions(positions_);
   sh_degree_ = chunking.sh_degree;
   if (report) {
-    // What read_rad reports: the whole file's chunks and leaves (the first chunk's encodings).
-    const RadFile first = RadFile::chunk_of(contents_.bytes(), name_, load_chunk_, 0, sh_codes_);
-    *report = LoadReport{.format = first.format(leaf_nodes_.size()),
+    *report = LoadReport{.format = description.format(leaf_nodes_.size()),
                          .version = "1",
                          .gaussians_in_file = leaf_nodes_.size(),
                          .dropped = dropped.size(),
