@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,11 +21,18 @@ namespace fs = std::filesystem;
 
 using namespace tilesplat::info;
 
+// A .rad LOD tree's splats and each level's size (level 0 the leaves).
+struct LodTreeLevels {
+  size_t splats = 0;
+  std::vector<size_t> level_sizes;
+};
+
 struct FileInfo {
   cli::LoadedScene loaded;
   uint64_t file_bytes = 0;
   uint64_t peak_bytes = 0;  // peak resident memory while loading, above what was resident before
   tilesplat::SceneStatistics stats;
+  std::optional<LodTreeLevels> lod_tree;  // for a .rad with a LOD tree
 };
 
 // A file's size; a folder's (an unbundled SOG's meta.json brings its images) counts them all, and a LOD
@@ -77,6 +85,12 @@ FileInfo inspect(const std::string& file, bool strict) {
   info.peak_bytes = peak > before ? peak - before : 0;
   info.file_bytes = file_bytes(file, info.loaded.lod ? info.loaded.lod->set.get() : nullptr);
   info.stats = tilesplat::compute_statistics(info.loaded.scene);
+  if (tilesplat::is_lod_tree(file)) {
+    const tilesplat::SplatLodTree tree = tilesplat::SplatLodTree::open(file);
+    LodTreeLevels levels{.splats = tree.nodes()};
+    for (int level = 0; level < tree.levels(); ++level) levels.level_sizes.push_back(tree.level_nodes(level).size());
+    info.lod_tree = std::move(levels);
+  }
   return info;
 }
 
@@ -111,12 +125,12 @@ void print_text(const FileInfo& info) {
               loaded.report.gaussians_in_file, loaded.report.dropped ? ": " : "",
               loaded.report.summary().c_str());
   std::printf("  load         %.1f ms, peak memory +%.1f MB\n", loaded.load_ms, megabytes(info.peak_bytes));
-  if (tilesplat::is_lod_tree(loaded.path)) {
-    const tilesplat::SplatLodTree tree = tilesplat::SplatLodTree::open(loaded.path);
-    std::printf("  lod tree     %s splats, %d levels (0: the leaves; %d: the root)\n",
-                cli::group_thousands(tree.nodes()).c_str(), tree.levels(), tree.levels() - 1);
-    for (int level = 0; level < tree.levels(); ++level)
-      std::printf("  level %-6d %s splats\n", level, cli::group_thousands(tree.level_nodes(level).size()).c_str());
+  if (info.lod_tree) {
+    const std::vector<size_t>& sizes = info.lod_tree->level_sizes;
+    std::printf("  lod tree     %s splats, %zu levels (0: the leaves; %zu: the root)\n",
+                cli::group_thousands(info.lod_tree->splats).c_str(), sizes.size(), sizes.size() - 1);
+    for (size_t level = 0; level < sizes.size(); ++level)
+      std::printf("  level %-6zu %s splats\n", level, cli::group_thousands(sizes[level]).c_str());
   }
   if (!loaded.lod) return;
   const tilesplat::LodSet& set = *loaded.lod->set;
@@ -161,12 +175,9 @@ nlohmann::json to_json(const FileInfo& info) {
       {"dropped_by_property", dropped},
       {"load_ms", loaded.load_ms},
       {"peak_memory_bytes", info.peak_bytes}};
-  if (tilesplat::is_lod_tree(loaded.path)) {
-    const tilesplat::SplatLodTree tree = tilesplat::SplatLodTree::open(loaded.path);
-    nlohmann::json levels = nlohmann::json::array();
-    for (int level = 0; level < tree.levels(); ++level) levels.push_back(tree.level_nodes(level).size());
-    out["lod_tree_splats"] = tree.nodes();
-    out["lod_tree_levels"] = levels;
+  if (info.lod_tree) {
+    out["lod_tree_splats"] = info.lod_tree->splats;
+    out["lod_tree_levels"] = info.lod_tree->level_sizes;
   }
   if (loaded.lod) {
     const tilesplat::LodSet& set = *loaded.lod->set;

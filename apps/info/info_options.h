@@ -13,7 +13,7 @@ inline constexpr const char* kUsage = "tilesplat-info [options] FILE...";
 inline constexpr const char* kDescription =
     "Prints what each scene file holds: format and version, Gaussians, SH degree, size, boxes, "
     "opacity and scale ranges, non-finite values, and the time and memory loading it took. Reads "
-    ".ply, compressed .ply, .splat, .spz, .sog, SOG meta.json, .glb and .gltf.";
+    ".ply, compressed .ply, .splat, .spz, .sog, SOG meta.json, .ksplat, .rad, .glb and .gltf.";
 
 struct InfoOptions {
   std::vector<std::string> files;

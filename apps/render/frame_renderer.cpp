@@ -88,7 +88,7 @@ RenderImage FrameRenderer::render(const Camera& camera, const RenderSettings& ba
   if (lod_tree_) {
     // The tree's cut for this camera, decoded from the file held whole; a cut like the last frame's is kept.
     const LodTreeCut cut = lod_tree_->tree->select(camera, lod_tree_->splat_budget);
-    if (cut.nodes != lod_tree_cut_ || lod_tree_cut_.empty()) {
+    if (cut.nodes != lod_tree_cut_) {  // a cut holds the root at least: the first frame's always differs
       lod_scene_ = lod_tree_->tree->load(cut.nodes);
       lod_tree_cut_ = cut.nodes;
     }
