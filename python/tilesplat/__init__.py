@@ -6,7 +6,10 @@ Scenes, cameras and the renderer of the C++ engine, with numpy arrays in and out
     scene = tilesplat.load_scene("scene.ply")
     renderer = tilesplat.Renderer()          # the first discrete GPU, else the first device (lavapipe)
     renderer.set_scene(scene)
-    image = renderer.render(tilesplat.Camera.orbit(scene, 960, 540, azimuth_deg=30))
+    camera = tilesplat.Camera.orbit(scene, 960, 540, azimuth_deg=30)
+    image = renderer.render(camera)
+    settings = tilesplat.RenderSettings(antialiasing="mip", background=[1, 1, 1])
+    image = renderer.render(camera, settings, accuracy="depth16")  # keywords override the settings
     image.rgba                               # (540, 960, 4) float32, premultiplied display values (sRGB)
     image.preview()                          # (540, 960, 3) uint8 to show, as the PNG holds it
     image.write_exr("frame.exr")
@@ -23,6 +26,7 @@ from ._core import (
     LodSet,
     MappedPly,
     Renderer,
+    RenderSettings,
     Scene,
     SceneError,
     SceneInParts,
@@ -58,6 +62,7 @@ __all__ = [
     "LodSet",
     "MappedPly",
     "Renderer",
+    "RenderSettings",
     "Scene",
     "SceneError",
     "SceneInParts",
