@@ -30,16 +30,6 @@ namespace {
 constexpr int kMaxRetries = 4;
 }  // namespace
 
-Renderer::Impl::Accumulation Renderer::Impl::accumulation_of(const RenderSettings& settings,
-                                                             uint32_t frames) {
-  return {frames,
-          settings.background,
-          settings.depth,
-          settings.splat_count,
-          settings.stochastic.seed,
-          settings.max_alpha};
-}
-
 SortStrategy& Renderer::Impl::sort(const std::string& name) {
   auto it = sorts.find(name);
   if (it == sorts.end()) it = sorts.emplace(name, make_sort_strategy(name, ctx)).first;
@@ -62,7 +52,7 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
                                                        const ScenePart& part) {
   // A sample of an accumulated lens or shutter frame (next_frame_input) adds to the sums before it; armed
   // for this frame alone, even one that throws.
-  const std::optional<SampleAccumulation> samples = std::exchange(next_frame_samples, std::nullopt);
+  std::optional<FrameAccumulator::Samples> sample = accumulator.take_armed_sample();
   if (scene_in_parts && !rendering_parts)
     throw std::logic_error(
         "the renderer holds the last part of a scene rendered in parts (render(scene, camera, settings) "
@@ -73,22 +63,15 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
   const DeviceCaps device = device_caps();
   start.sorter = &sort(choose_sort_strategy(settings.sort, device, without_waiting));
   const SortTraits traits{start.sorter->name(), start.sorter->frame_plan(), start.sorter->sorts_on_host()};
-  start.samples = samples;
   std::optional<uint32_t> samples_before;
-  if (start.samples) samples_before = start.samples->samples - 1;
-  start.plan = plan_frame(
-      camera, settings,
-      {resources.scene_shape(scene_generation), device, traits, lists, depth_image, part, samples_before});
+  if (sample) samples_before = sample->samples - 1;
+  start.plan = plan_frame(camera, settings,
+                          {resources.scene_shape(scene_generation), device, traits, lists, depth_image, part,
+                           samples_before, accumulator.stochastic_frames_before(settings)});
   resources.prepare_outputs(start.plan, settings);
-  // StochasticSettings::accumulate: this frame's samples follow the previous frame's in the composite
-  // state when it reuses that frame's lists with the same outputs; else they start the mean anew.
-  if (start.plan.stochastic_accumulate && !start.plan.build_lists && accumulated.frames > 0 &&
-      accumulation_of(settings, accumulated.frames) == accumulated)
-    start.plan.stochastic_first_sample = accumulated.frames;
-  start.accumulation =
-      accumulation_of(settings, start.plan.stochastic_first_sample + start.plan.stochastic_samples);
-  accumulated = {};  // the sums are the next frame's once this one completes
-  accumulated_samples.reset();
+  // The sums are this frame's now, and the next frame's once it completes.
+  start.sums = accumulator.frame_started(
+      settings, start.plan.stochastic_first_sample + start.plan.stochastic_samples, std::move(sample));
   // A frame the renderer waits for fills the statistics as it runs; one that goes on without waiting
   // fills them once it is waited for (wait_for_submitted_frame), and until then the last frame's stay.
   if (!without_waiting) stats = {};
@@ -142,10 +125,11 @@ void Renderer::Impl::render_frame(const Camera& camera, const RenderSettings& se
     }
     if (retry > kMaxRetries) throw std::logic_error("composite chunks did not converge");  // one retry suffices
     chunks = needed;
-    // An accumulating frame's first attempt already added to the sums: the mean starts anew.
-    start.plan.stochastic_first_sample = 0;
-    start.accumulation.frames = plan.stochastic_samples;
-    frame = run_frame(composite_only(plan), settings, sorter, depth_image);
+    // The composite alone, which starts the mean of accumulated stochastic frames anew: the first
+    // attempt added to the sums already.
+    const FramePlan again = composite_only(plan);
+    start.sums.stochastic.frames = again.stochastic_first_sample + again.stochastic_samples;
+    frame = run_frame(again, settings, sorter, depth_image);
     stats.retries = retry;
   }
   end_frame(start, frame, std::move(passes), true);
@@ -176,10 +160,9 @@ void Renderer::Impl::check_resort_lists(const FramePlan& plan, const FrameCounte
 void Renderer::Impl::end_frame(const FrameStart& start, const FrameCounters& frame, std::vector<PassTiming> passes,
                                bool lists_whole) {
   if (lists_whole) lists = start.plan.lists;
-  if (start.plan.stochastic_accumulate && lists_whole && stats.complete) accumulated = start.accumulation;
-  stats.accumulated_frames = start.accumulation.frames;  // 0 for the other compositors (no samples)
-  if (start.samples && lists_whole && stats.complete) accumulated_samples = start.samples;
-  stats.accumulated_samples = start.samples ? start.samples->samples : 0;
+  accumulator.frame_completed(start.sums, start.plan.stochastic_accumulate, lists_whole && stats.complete);
+  stats.accumulated_frames = start.sums.stochastic.frames;  // 0 for the other compositors (no samples)
+  stats.accumulated_samples = start.sums.samples ? start.sums.samples->samples : 0;
   stats.passes = std::move(passes);
   stats.reused_sorted_lists = !start.plan.build_lists;
   stats.sort_bits = start.plan.build_lists ? start.plan.sort_bits : 0;
@@ -267,13 +250,7 @@ Renderer::Impl::FrameInput Renderer::Impl::next_frame_input(const Camera& camera
   if (!settings.accumulate_samples || !averages_samples(settings)) return {camera, settings};
   check_accumulated_samples(settings, camera);
   wait_for_submitted_frame();  // the sums it leaves, if it completes, are the ones to continue
-  SampleAccumulation sums{scene_identity, camera, settings, 0};
-  sums.settings.lens.samples = sums.settings.shutter.samples = 0;  // one sample a call, whatever they say
-  if (accumulated_samples) sums.samples = accumulated_samples->samples;
-  if (!accumulated_samples || !(sums == *accumulated_samples)) sums.samples = 0;
-  const int index = int(sums.samples);
-  ++sums.samples;
-  next_frame_samples = sums;
+  const int index = int(accumulator.arm_next_sample(scene_identity, camera, settings));
   // Sample `index`: the camera at its time, seen from its point of the aperture (one joint sample).
   FrameInput sample{camera, settings};
   const Shutter& shutter = settings.shutter;

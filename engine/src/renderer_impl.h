@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "frame/averaged_frames.h"
+#include "frame/frame_accumulator.h"
 #include "frame/frame_plan.h"
 #include "frame/frame_recorder.h"
 #include "frame/frame_resources.h"
@@ -43,29 +44,6 @@ struct Renderer::Impl {
   SortStrategy& sort(const std::string& name);
   DeviceCaps device_caps() const;
 
-  // What a frame was planned as and started from, for its statistics once it completed.
-  // StochasticSettings::accumulate: what the stochastic frames in the composite state's sums were
-  // rendered with beyond their lists, and how many there are. A frame continues them when it reuses
-  // the lists and matches the rest.
-  struct Accumulation {
-    uint32_t frames = 0;
-    std::array<float, 3> background = {0, 0, 0};
-    bool depth = false, splat_count = false;
-    uint32_t seed = 0;
-    double max_alpha = 0;
-    bool operator==(const Accumulation&) const = default;
-  };
-  static Accumulation accumulation_of(const RenderSettings& settings, uint32_t frames);
-  // RenderSettings::accumulate_samples: what the lens and shutter samples in resources.sample_sums were
-  // rendered for (the settings with their sample counts at 0, which do not matter a sample at a time),
-  // and how many there are. A call continues them when it matches.
-  struct SampleAccumulation {
-    uint64_t scene_identity = 0;
-    Camera camera;
-    RenderSettings settings;
-    uint32_t samples = 0;
-    bool operator==(const SampleAccumulation&) const = default;
-  };
   // What one frame renders: the camera and settings asked for, or, for a frame whose lens and shutter
   // samples accumulate, its next sample's pinhole camera and settings (with `samples` armed for
   // begin_frame: the sums that sample leaves).
@@ -87,13 +65,13 @@ struct Renderer::Impl {
   // Renderer::render(camera, settings) of the scene as the buffers hold it (settings_over_moving_copies
   // applied): the frame, its averaged samples, its bands, or one more accumulated sample.
   RenderImage render_set_scene(const Camera& camera, const RenderSettings& settings);
+  // What a frame was planned as and started from, for its statistics once it completed.
   struct FrameStart {
     FramePlan plan;
     SortStrategy* sorter = nullptr;
     uint64_t fallbacks_before = 0;
     std::chrono::steady_clock::time_point time;
-    Accumulation accumulation;  // the sums this frame leaves, when it accumulates
-    std::optional<SampleAccumulation> samples;  // the sample sums it leaves, for a sample of one
+    FrameAccumulator::FrameSums sums;  // what it leaves in the accumulated sums
   };
   // Plans the frame (validating the camera and settings), sizes the outputs and uploads what the
   // frame reads from the host. Waits for a frame in flight first: its buffers are the same.
@@ -176,9 +154,7 @@ struct Renderer::Impl {
   // The tile lists in the buffers: what they were built for (none after set_scene or a frame that
   // failed).
   std::optional<ListKey> lists;
-  Accumulation accumulated;  // the stochastic sums the last frame left (frames 0: none to continue)
-  std::optional<SampleAccumulation> accumulated_samples;  // the sample sums the last frame left
-  std::optional<SampleAccumulation> next_frame_samples;   // next_frame_input's, for begin_frame to take
+  FrameAccumulator accumulator;  // the stochastic frames and the lens and shutter samples summed so far
   uint64_t scene_generation = 0;            // counts set_scene calls (and scene parts uploaded)
   // What accumulated samples are of: counts the scenes set and the renders in parts, but not the
   // placings of moving copies (a sample's time places them anew in the same scene).

@@ -318,6 +318,8 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
   plan.resort_window = stochastic ? 0 : uint32_t(settings.accuracy.resort_window);
   plan.stochastic_samples = stochastic ? settings.stochastic.frames : 0;
   plan.stochastic_accumulate = stochastic && settings.stochastic.accumulate;
+  if (plan.stochastic_accumulate && !plan.build_lists)
+    plan.stochastic_first_sample = context.stochastic_frames_before;
   if (settings.host) {
     plan.host.from_memory = !settings.host->depth.empty();
     plan.host.from_image = context.depth_image;
@@ -334,6 +336,7 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
 
 FramePlan composite_only(FramePlan plan) {
   plan.build_lists = false;
+  plan.stochastic_first_sample = 0;
   plan.passes = frame_passes(plan);
   plan.splits_submissions = splits_submissions(plan);
   return plan;

@@ -149,8 +149,9 @@ struct FramePlan {
   Compositor compositor = Compositor::kSorted;
   uint32_t resort_window = 0;       // kResortComposite's window (AccuracyModes::resort_window)
   uint32_t stochastic_samples = 0;  // kStochasticComposite's averaged samples (StochasticSettings::frames)
-  // StochasticSettings::accumulate: the samples already in the composite state's sums (the renderer
-  // sets it when the frame continues the previous one), and that the sums stay for the next.
+  // StochasticSettings::accumulate: the samples already in the composite state's sums (when the frame
+  // reuses the lists of the frame that left them: FrameContext::stochastic_frames_before), and that the
+  // sums stay for the next.
   uint32_t stochastic_first_sample = 0;
   bool stochastic_accumulate = false;
   HostDepthPlan host;
@@ -177,6 +178,9 @@ struct FrameContext {
   // A sample of an accumulated lens or shutter frame (RenderSettings::accumulate_samples): the samples
   // already in the sums.
   std::optional<uint32_t> samples_before;
+  // StochasticSettings::accumulate: the stochastic frames in the composite state's sums that this frame
+  // continues if it reuses the lists they were rendered on (FrameAccumulator::stochastic_frames_before).
+  uint32_t stochastic_frames_before = 0;
 };
 
 // Validates the camera for this device, the accuracy modes, the compositor's settings and the host
@@ -189,7 +193,8 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
 void validate_scene_parts(const RenderSettings& settings, const std::string& sort_name);
 
 // The same frame's composite alone, on the lists its first attempt built: the re-run of a composite
-// that needed more dispatches than it had (FrameRecorder::composite_chunks).
+// that needed more dispatches than it had (FrameRecorder::composite_chunks). Its first attempt added
+// to any accumulated stochastic sums already, so the re-run starts their mean anew.
 FramePlan composite_only(FramePlan plan);
 
 // The projection a frame's accuracy modes and effects call for, on a scene of this shape.
