@@ -89,7 +89,7 @@ TEST(FrameAccumulator, SamplesContinueForTheSameSceneCameraAndSettings) {
     EXPECT_EQ(sums.arm_next_sample(7, view, settings), call);
     const FrameAccumulator::FrameSums left = sums.frame_started(settings, 0, sums.take_armed_sample());
     ASSERT_TRUE(left.samples);
-    EXPECT_EQ(left.samples_before(), call);
+    EXPECT_EQ(left.samples->before(), call);
     sums.frame_completed(left, false, true);
   }
   // The sample counts do not matter (one sample a call).
@@ -124,7 +124,7 @@ TEST(FrameAccumulator, AnArmedSampleIsTakenOnceAndAnyFrameForgetsTheSums) {
   }
   ASSERT_EQ(sums.samples()->samples, 2u);
   const FrameAccumulator::FrameSums plain = sums.frame_started(RenderSettings{}, 0, sums.take_armed_sample());
-  EXPECT_FALSE(plain.samples_before());
+  EXPECT_FALSE(plain.samples);
   sums.frame_completed(plain, false, true);
   EXPECT_FALSE(sums.samples());
   EXPECT_EQ(sums.arm_next_sample(1, camera(), settings), 0u);

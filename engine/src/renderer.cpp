@@ -53,10 +53,7 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
   // A sample of an accumulated lens or shutter frame (next_frame_input) adds to the sums before it; armed
   // for this frame alone, even one that throws.
   std::optional<FrameAccumulator::Samples> sample = accumulator.take_armed_sample();
-  if (scene_in_parts && !rendering_parts)
-    throw std::logic_error(
-        "the renderer holds the last part of a scene rendered in parts (render(scene, camera, settings) "
-        "under a memory budget), not a whole scene: call set_scene before render(camera, settings)");
+  scene_slot.check_whole_scene();
   FrameStart start;
   start.time = std::chrono::steady_clock::now();
   wait_for_submitted_frame();
@@ -64,10 +61,16 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
   start.sorter = &sort(choose_sort_strategy(settings.sort, device, without_waiting));
   const SortTraits traits{start.sorter->name(), start.sorter->frame_plan(), start.sorter->sorts_on_host()};
   std::optional<uint32_t> samples_before;
-  if (sample) samples_before = sample->samples - 1;
-  start.plan = plan_frame(camera, settings,
-                          {resources.scene_shape(scene_generation), device, traits, lists, depth_image, part,
-                           samples_before, accumulator.stochastic_frames_before(settings)});
+  if (sample) samples_before = sample->before();
+  const FrameContext context{resources.scene_shape(scene_slot.generation()),
+                             device,
+                             traits,
+                             lists,
+                             depth_image,
+                             part,
+                             samples_before,
+                             accumulator.stochastic_frames_before(settings)};
+  start.plan = plan_frame(camera, settings, context);
   resources.prepare_outputs(start.plan, settings);
   // The sums are this frame's now, and the next frame's once it completes.
   start.sums = accumulator.frame_started(
@@ -195,35 +198,33 @@ std::unique_ptr<Renderer> Renderer::create(const RendererOptions& options) {
 void Renderer::set_scene(const GaussianScene& scene) {
   Impl& r = *impl_;
   r.upload_scene(scene);
-  ++r.scene_identity;
-  r.moving_copies.reset();
-  r.scene_in_parts = false;
+  r.scene_slot.set_whole();
 }
 
 void Renderer::set_scene(SceneInstances scene) {
   set_scene(merge_instances(scene));  // where the copies are at time 0
   if (!scene.moves()) return;
-  impl_->moving_copies = std::move(scene);
-  impl_->moving_copies_time = 0.0;
+  impl_->scene_slot.keep_moving_copies(std::move(scene));
 }
 
 RenderSettings Renderer::Impl::settings_over_moving_copies(const Camera& camera,
                                                            const RenderSettings& settings) {
-  if (!moving_copies) return settings;
+  if (!scene_slot.has_moving_copies()) return settings;
   if (settings.shutter.opens()) return shutter_over_moving_models(settings, camera);
   place_moving_copies(0.0);
   return settings;
 }
 
 void Renderer::Impl::place_moving_copies(double time) {
-  if (!moving_copies || time == moving_copies_time) return;
-  upload_scene(merge_instances(*moving_copies, time));
-  moving_copies_time = time;
+  std::optional<GaussianScene> placed = scene_slot.moving_copies_at(time);
+  if (!placed) return;
+  upload_scene(*placed);
+  scene_slot.placed(time);
 }
 
 void Renderer::Impl::upload_scene(const GaussianScene& scene) {
   wait_for_submitted_frame();  // it reads the scene's buffers
-  ++scene_generation;
+  scene_slot.uploaded();
   resources.upload_scene(scene);
 }
 
@@ -250,7 +251,7 @@ Renderer::Impl::FrameInput Renderer::Impl::next_frame_input(const Camera& camera
   if (!settings.accumulate_samples || !averages_samples(settings)) return {camera, settings};
   check_accumulated_samples(settings, camera);
   wait_for_submitted_frame();  // the sums it leaves, if it completes, are the ones to continue
-  const int index = int(accumulator.arm_next_sample(scene_identity, camera, settings));
+  const int index = int(accumulator.arm_next_sample(scene_slot.identity(), camera, settings));
   // Sample `index`: the camera at its time, seen from its point of the aperture (one joint sample).
   FrameInput sample{camera, settings};
   const Shutter& shutter = settings.shutter;

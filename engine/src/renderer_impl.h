@@ -22,6 +22,7 @@
 #include "frame/frame_recorder.h"
 #include "frame/frame_resources.h"
 #include "frame/scene_parts.h"
+#include "frame/scene_slot.h"
 #include "sort/sort_strategy.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene_description.h"
@@ -155,15 +156,7 @@ struct Renderer::Impl {
   // failed).
   std::optional<ListKey> lists;
   FrameAccumulator accumulator;  // the stochastic frames and the lens and shutter samples summed so far
-  uint64_t scene_generation = 0;            // counts set_scene calls (and scene parts uploaded)
-  // What accumulated samples are of: counts the scenes set and the renders in parts, but not the
-  // placings of moving copies (a sample's time places them anew in the same scene).
-  uint64_t scene_identity = 0;
-  std::optional<SceneInstances> moving_copies;  // set_scene(SceneInstances) of copies that move
-  double moving_copies_time = 0;                // where the buffers have them
-  bool scene_in_parts = false;              // the buffers hold a part of a scene, not a whole one
-  uint64_t parts_budget = 0;                // the memory budget those parts were sized for
-  bool rendering_parts = false;             // within render_in_parts: its frames are parts
+  SceneSlot scene_slot;  // what the scene buffers hold: which scene, which upload, moving copies, a part
   uint64_t uploaded_bytes_reported = 0;     // vk::Context::uploaded_bytes() at the last frame's statistics
   std::optional<SubmittedFrame> submitted;  // the frame render_to_image submitted without waiting
   // Its fence and command buffer: declared last, so that it is destroyed first and waits for the

@@ -125,17 +125,8 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
 
   // A whole scene's buffers go: the parts size their own, which the next frame under the same budget
   // reuses.
-  if (!scene_in_parts || parts_budget != budget) resources.release_scene();
-  scene_in_parts = true;  // from the first upload on, even if a part fails
-  parts_budget = budget;
-  struct RenderingParts {  // begin_frame takes this frame's parts, and no other frame
-    bool& flag;
-    explicit RenderingParts(bool& f) : flag(f) { flag = true; }
-    ~RenderingParts() { flag = false; }
-  } rendering(rendering_parts);
-  ++scene_generation;
-  ++scene_identity;
-  moving_copies.reset();  // the buffers hold parts from now on
+  if (scene_slot.start_parts(budget)) resources.release_scene();
+  const SceneSlot::DrawingParts drawing(scene_slot);  // frames of this call's parts, and no other, run on one
   lists.reset();
   FrameStats total;
   total.scene_parts = 0;
@@ -153,7 +144,7 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
           std::async(std::launch::async, gather_part, std::cref(scene), std::cref(order), part.end, capacity);
     resources.upload_scene(part.scene, /*reuse_buffers=*/true);
     part.scene = {};
-    ++scene_generation;  // the lists in the buffers are the previous part's
+    scene_slot.uploaded();  // the lists in the buffers are the previous part's
     lists.reset();
     // Pairs for a part of the capacity the budget was reckoned for (the same from part to part: no new
     // buffers for each).

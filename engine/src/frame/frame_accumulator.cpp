@@ -33,11 +33,6 @@ uint32_t FrameAccumulator::stochastic_frames_before(const RenderSettings& settin
   return stochastic_.frames;
 }
 
-std::optional<uint32_t> FrameAccumulator::FrameSums::samples_before() const {
-  if (!samples) return std::nullopt;
-  return samples->samples - 1;
-}
-
 std::optional<FrameAccumulator::Samples> FrameAccumulator::take_armed_sample() {
   return std::exchange(armed_sample_, std::nullopt);
 }

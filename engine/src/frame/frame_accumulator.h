@@ -40,6 +40,8 @@ class FrameAccumulator {
     Camera camera;
     RenderSettings settings;
     uint32_t samples = 0;
+    // The samples in the sums before the last one (FrameContext::samples_before of the frame that adds it).
+    uint32_t before() const { return samples - 1; }
     bool operator==(const Samples&) const = default;
   };
 
@@ -55,8 +57,6 @@ class FrameAccumulator {
   struct FrameSums {
     StochasticFrames stochastic;     // its stochastic frames, those it continued included
     std::optional<Samples> samples;  // a sample of an accumulated lens or shutter frame
-    // The samples already in the sums (FrameContext::samples_before): none without a sample.
-    std::optional<uint32_t> samples_before() const;
   };
   // Takes the sample armed for this frame (armed for one frame alone, even one that throws before it
   // runs). Call first, before anything that may throw.
