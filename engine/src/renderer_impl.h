@@ -30,6 +30,7 @@
 #include "vulkan/command_stream.h"
 #include "vulkan/context.h"
 #include "vulkan/gpu_timer.h"
+#include "vulkan/readback.h"
 
 namespace tilesplat {
 
@@ -174,18 +175,7 @@ struct RendererAccess {
 
 template <typename T>
 void Renderer::Impl::read_output(const vk::Buffer& buffer, std::vector<T>& out, size_t count) {
-  out.resize(count);
-  if (count == 0) return;  // memcpy must not see the null data() of an empty vector
-  if (buffer.mapped()) {
-    std::memcpy(out.data(), buffer.mapped(), count * sizeof(T));
-    return;
-  }
-  vk::Buffer staging(ctx, count * sizeof(T), vk::MemoryUse::Readback, buffer.name() + " (readback)");
-  ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    VkBufferCopy region{0, 0, count * sizeof(T)};
-    vkCmdCopyBuffer(cmd, buffer.handle(), staging.handle(), 1, &region);
-  });
-  std::memcpy(out.data(), staging.mapped(), count * sizeof(T));
+  vk::read_buffer(ctx, buffer, out, count);
 }
 
 }  // namespace tilesplat
