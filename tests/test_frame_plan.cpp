@@ -138,6 +138,47 @@ TEST(FramePlan, HostDepthImageIsConvertedFirstOnEveryAttempt) {
   EXPECT_FALSE(again.build_lists);
 }
 
+// The recorder reads the plan and the resources only: what it needs of the settings is in the plan.
+TEST(FramePlan, CarriesWhatTheRecorderNeedsOfTheSettings) {
+  RenderSettings settings;
+  settings.depth = false;
+  settings.background = {0.25f, 0.5f, 1.0f};
+  settings.max_alpha = 0.999;
+  settings.accuracy = parse_accuracy_modes("alpha-cutoff=1/64+t-cutoff=0.001");
+  const FramePlan sorted = plan_frame(camera(), settings, context());
+  EXPECT_FALSE(sorted.outputs.depth);
+  EXPECT_TRUE(sorted.outputs.splat_count);
+  EXPECT_EQ(sorted.outputs.background, settings.background);
+  EXPECT_FLOAT_EQ(sorted.outputs.max_alpha, 0.999f);
+  EXPECT_FLOAT_EQ(sorted.outputs.alpha_cutoff, 1.0f / 64);
+  EXPECT_FLOAT_EQ(sorted.outputs.transmittance_cutoff, 0.001f);
+  EXPECT_FALSE(sorted.host.enabled);
+
+  RenderSettings stochastic;
+  stochastic.compositor = Compositor::kStochastic;
+  stochastic.stochastic = {8, 42, StochasticSampler::kSobol, false};
+  const FramePlan binned = plan_frame(camera(), stochastic, context());
+  EXPECT_EQ(binned.stochastic_samples, 8u);
+  EXPECT_EQ(binned.stochastic_seed, 42u);
+  EXPECT_EQ(binned.stochastic_sampler, StochasticSampler::kSobol);
+
+  RenderSettings hosted;
+  hosted.host = HostDepth{};
+  hosted.host->convention = DepthConvention{0.0, 0.1};  // reversed-Z, infinite far plane
+  hosted.host->alpha_threshold = 0.75f;
+  hosted.host->write_depth = true;
+  const FramePlan host = plan_frame(camera(), hosted, context());
+  EXPECT_TRUE(host.host.enabled);
+  EXPECT_TRUE(host.host.write_depth);
+  EXPECT_EQ(host.host.convention, hosted.host->convention);
+  EXPECT_FLOAT_EQ(host.host.surface_alpha, 0.75f);
+  EXPECT_TRUE(host.host.exact_depth_order);
+  hosted.accuracy.depth_key_bits = 24;
+  EXPECT_FALSE(plan_frame(camera(), hosted, context()).host.exact_depth_order) << "shortened keys";
+  hosted.accuracy = parse_accuracy_modes("radial");
+  EXPECT_FALSE(plan_frame(camera(), hosted, context()).host.exact_depth_order) << "sorted by distance";
+}
+
 TEST(FramePlan, ListsAreReusedOnlyWhenEverythingTheyDependOnIsEqual) {
   FrameContext c = context();
   const Camera cam = camera();

@@ -72,7 +72,7 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
                              samples_before,
                              accumulator.stochastic_frames_before(settings)};
   start.plan = plan_frame(camera, settings, context);
-  resources.prepare_outputs(start.plan, settings);
+  resources.prepare_outputs(start.plan, settings.host);
   // The sums are this frame's now, and the next frame's once it completes.
   start.sums = accumulator.frame_started(
       settings, start.plan.stochastic_first_sample + start.plan.stochastic_samples, std::move(sample));
@@ -83,16 +83,17 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
   // Reused lists were built with an equal camera and equal (validated) lights, which are in their
   // buffers still: nothing to upload.
   if (start.plan.build_lists)
-    recorder.set_frame_inputs(camera, settings, start.plan.culling_tiles, resources.scene);
+    recorder.set_frame_inputs(camera, settings.lighting, settings.near_plane, start.plan.culling_tiles,
+                              resources.scene);
   start.fallbacks_before = start.sorter->stall_fallbacks();
   return start;
 }
 
-FrameCounters Renderer::Impl::run_frame(const FramePlan& plan, const RenderSettings& settings, SortStrategy& sorter,
+FrameCounters Renderer::Impl::run_frame(const FramePlan& plan, SortStrategy& sorter,
                                         const ExternalDepthImage* depth_image) {
-  recorder.prepare(plan, settings, resources, sorter);
+  recorder.prepare(plan, resources, sorter);
   vk::CommandStream stream(ctx);
-  recorder.record(stream, plan, settings, resources, sorter, depth_image);
+  recorder.record(stream, plan, resources, sorter, depth_image);
   stream.finish();
   stats.submissions = stream.submissions();
   return resources.frame_counters();
@@ -101,20 +102,20 @@ FrameCounters Renderer::Impl::run_frame(const FramePlan& plan, const RenderSetti
 // A frame re-renders when it wanted more (tile, Gaussian) pairs than the key buffers hold, which
 // grow, or re-runs its composite when a tile's list needs more composite chunks than it had (CPU
 // drivers only; the lists are complete then). A frame on reused lists cannot overflow.
-void Renderer::Impl::render_frame(const Camera& camera, const RenderSettings& settings,
+FramePlan Renderer::Impl::render_frame(const Camera& camera, const RenderSettings& settings,
                                   const ExternalDepthImage* depth_image, const ScenePart& part) {
   FrameStart start = begin_frame(camera, settings, depth_image != nullptr, false, part);
   const FramePlan& plan = start.plan;
   SortStrategy& sorter = *start.sorter;
   uint32_t& chunks = recorder.composite_chunks(plan.compositor);
   std::vector<PassTiming> passes;  // the GPU time of every attempt: a re-rendered frame cost all of them
-  FrameCounters frame = run_frame(plan, settings, sorter, depth_image);
+  FrameCounters frame = run_frame(plan, sorter, depth_image);
   for (int retry = 1;; ++retry) {
     add_timings(passes);
     if (frame.overflow) {
       if (retry > kMaxRetries) throw FrameResources::beyond_key_limit(frame, camera);
       resources.grow_keys_for(frame, camera, /*tight=*/!part.whole());
-      frame = run_frame(plan, settings, sorter, depth_image);
+      frame = run_frame(plan, sorter, depth_image);
       stats.retries = retry;
       continue;
     }
@@ -133,10 +134,11 @@ void Renderer::Impl::render_frame(const Camera& camera, const RenderSettings& se
     // attempt added to the sums already.
     const FramePlan again = composite_only(plan);
     start.sums.stochastic.frames = again.stochastic_first_sample + again.stochastic_samples;
-    frame = run_frame(again, settings, sorter, depth_image);
+    frame = run_frame(again, sorter, depth_image);
     stats.retries = retry;
   }
   end_frame(start, frame, std::move(passes), true);
+  return start.plan;
 }
 
 // The GPU time of the frame's passes, added to `passes` (summed per pass over a frame's attempts).

@@ -1,7 +1,7 @@
 // Frames the renderer does not wait for, and the entry points of vulkan_interop.h. render_to_image
 // with HostFrameSync submits the whole frame (its copies into the host's images included) and returns;
 // with HostCommandBuffer it records the frame into the host's command buffer. Either frame is kept as
-// a SubmittedFrame, and its statistics become the last frame's once it has completed
+// a FrameInFlight, and its statistics become the last frame's once it has completed
 // (wait_for_submitted_frame: at the next frame, set_scene, sort_keys or wait_for_frame).
 #include <chrono>
 #include <stdexcept>
@@ -9,27 +9,8 @@
 
 #include "host_images.h"
 #include "renderer_impl.h"
-#include "vulkan/vk_check.h"
 
 namespace tilesplat {
-
-namespace {
-
-// Waits for a timeline semaphore (a host's, HostCommandBuffer) to reach `value`.
-VkResult wait_for_value(VkDevice device, VkSemaphore timeline, uint64_t value) {
-  VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
-  wait.semaphoreCount = 1;
-  wait.pSemaphores = &timeline;
-  wait.pValues = &value;
-  return vkWaitSemaphores(device, &wait, UINT64_MAX);
-}
-
-}  // namespace
-
-Renderer::Impl::~Impl() {
-  if (submitted && submitted->timeline != VK_NULL_HANDLE)
-    wait_for_value(ctx.device(), submitted->timeline, submitted->value);  // no throwing from a destructor
-}
 
 void Renderer::Impl::submit_frame(const Camera& camera, const RenderSettings& settings,
                                   const ExternalImage& target, const ExternalDepthImage* depth_image,
@@ -37,9 +18,9 @@ void Renderer::Impl::submit_frame(const Camera& camera, const RenderSettings& se
   const FrameStart start = begin_frame(camera, settings, depth_image != nullptr, /*without_waiting=*/true);
   vk::CommandStream stream(ctx);
   stream.wait_first(sync);
-  record_frame_to_images(stream, start, settings, target, depth_image);
-  stream.submit_in_flight(in_flight, sync);
-  keep_submitted(start, stream.submissions());
+  record_frame_to_images(stream, start, target, depth_image);
+  stream.submit_in_flight(in_flight.submission(), sync);
+  in_flight.keep(start, stream.submissions());
 }
 
 void Renderer::Impl::record_frame_into(const HostCommandBuffer& host, const Camera& camera,
@@ -47,46 +28,33 @@ void Renderer::Impl::record_frame_into(const HostCommandBuffer& host, const Came
                                        const ExternalDepthImage* depth_image) {
   const FrameStart start = begin_frame(camera, settings, depth_image != nullptr, /*without_waiting=*/true);
   vk::CommandStream stream(ctx, host.command_buffer);
-  record_frame_to_images(stream, start, settings, target, depth_image);
+  record_frame_to_images(stream, start, target, depth_image);
   stream.end_borrowed();
-  keep_submitted(start, 0, host.timeline, host.value);
+  in_flight.keep(start, 0, host.timeline, host.value);
 }
 
 // A frame that goes on without the renderer waiting for it: its whole recording, from the buffers'
 // sizes to the copies into the host's images. It cannot re-render.
 void Renderer::Impl::record_frame_to_images(vk::CommandStream& stream, const FrameStart& start,
-                                            const RenderSettings& settings, const ExternalImage& target,
-                                            const ExternalDepthImage* depth_image) {
-  recorder.prepare(start.plan, settings, resources, *start.sorter);
-  recorder.record(stream, start.plan, settings, resources, *start.sorter, depth_image);
-  recorder.record_copies_to_images(stream.cmd(), settings, resources, target, depth_image);
-}
-
-void Renderer::Impl::keep_submitted(const FrameStart& start, int submissions, VkSemaphore timeline,
-                                    uint64_t value) {
-  const double cpu_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start.time).count();
-  submitted = SubmittedFrame{start, submissions, cpu_ms, timeline, value};
+                                            const ExternalImage& target, const ExternalDepthImage* depth_image) {
+  recorder.prepare(start.plan, resources, *start.sorter);
+  recorder.record(stream, start.plan, resources, *start.sorter, depth_image);
+  recorder.record_copies_to_images(stream.cmd(), start.plan, resources, target, depth_image);
 }
 
 // Waits for the frame in flight, if any, and makes its statistics the last frame's. It cannot
 // re-render: a frame that overflowed the key buffers or had too few composite chunks was drawn
 // without what did not fit (FrameStats::complete false), and the next frame has what it needs.
 void Renderer::Impl::wait_for_submitted_frame() {
-  if (!submitted) return;
-  const SubmittedFrame frame_info = std::move(*submitted);
-  submitted.reset();
-  if (frame_info.timeline != VK_NULL_HANDLE)
-    TS_VK_CHECK(wait_for_value(ctx.device(), frame_info.timeline, frame_info.value));
-  else
-    in_flight.wait();
+  const std::optional<FrameInFlight::Completed> frame_info = in_flight.wait();
+  if (!frame_info) return;
   const FrameCounters frame = resources.frame_counters();
   stats = {};
   std::vector<PassTiming> passes;
   add_timings(passes);
-  stats.submissions = frame_info.submissions;
-  stats.cpu_ms = frame_info.cpu_ms;
-  const FramePlan& plan = frame_info.start.plan;
+  stats.submissions = frame_info->submissions;
+  stats.cpu_ms = frame_info->cpu_ms;
+  const FramePlan& plan = frame_info->start.plan;
   uint32_t& chunks = recorder.composite_chunks(plan.compositor);
   const bool lists_whole = !frame.overflow;
   if (frame.overflow) {
@@ -98,7 +66,7 @@ void Renderer::Impl::wait_for_submitted_frame() {
     stats.complete = needed <= chunks;
     chunks = needed;
   }
-  end_frame(frame_info.start, frame, std::move(passes), lists_whole);
+  end_frame(frame_info->start, frame, std::move(passes), lists_whole);
 }
 
 std::unique_ptr<Renderer> create_renderer(const ExternalVulkanDevice& device,
@@ -113,9 +81,9 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   check_images(target, nullptr, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   const Renderer::Impl::FrameInput frame = r.next_frame_input(camera, settings);  // a sample, if accumulating
-  r.render_frame(frame.camera, frame.settings);
+  const FramePlan plan = r.render_frame(frame.camera, frame.settings);
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    r.recorder.record_copies_to_images(cmd, frame.settings, r.resources, target, nullptr);
+    r.recorder.record_copies_to_images(cmd, plan, r.resources, target, nullptr);
   });
   r.stats.saturated = r.resources.frame_counters().saturation();
   r.stats.cpu_ms =
@@ -129,9 +97,9 @@ void render_to_image(Renderer& renderer, const Camera& camera, const RenderSetti
   check_images(target, &depth, camera, settings);
   const auto start = std::chrono::steady_clock::now();
   const Renderer::Impl::FrameInput frame = r.next_frame_input(camera, settings);  // a sample, if accumulating
-  r.render_frame(frame.camera, frame.settings, &depth);
+  const FramePlan plan = r.render_frame(frame.camera, frame.settings, &depth);
   r.ctx.submit_and_wait([&](VkCommandBuffer cmd) {
-    r.recorder.record_copies_to_images(cmd, frame.settings, r.resources, target, &depth);
+    r.recorder.record_copies_to_images(cmd, plan, r.resources, target, &depth);
   });
   r.stats.saturated = r.resources.frame_counters().saturation();
   r.stats.cpu_ms =

@@ -5,7 +5,7 @@
 //                needed more dispatches re-runs alone
 //   end_frame    the frame's statistics; its lists become reusable
 // A frame may also go on without the renderer waiting (render_to_image with HostFrameSync or
-// HostCommandBuffer, renderer_async.cpp): it is kept as a SubmittedFrame until wait_for_submitted_frame.
+// HostCommandBuffer, renderer_async.cpp): it is kept in a FrameInFlight until wait_for_submitted_frame.
 #pragma once
 
 #include <chrono>
@@ -18,11 +18,13 @@
 
 #include "frame/averaged_frames.h"
 #include "frame/frame_accumulator.h"
+#include "frame/frame_in_flight.h"
 #include "frame/frame_plan.h"
 #include "frame/frame_recorder.h"
 #include "frame/frame_resources.h"
 #include "frame/scene_parts.h"
 #include "frame/scene_slot.h"
+#include "frame/frame_start.h"
 #include "sort/sort_strategy.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene_description.h"
@@ -39,9 +41,6 @@ struct Renderer::Impl {
   template <typename ContextSource>
   Impl(const RendererOptions& opts, const ContextSource& source)
       : options(opts), ctx(source), timer(ctx), recorder(ctx, timer), resources(ctx), in_flight(ctx) {}
-  // A frame recorded into a host's command buffer may still run on the buffers about to go (a frame
-  // the renderer submitted itself is waited for by in_flight's destructor).
-  ~Impl();
 
   SortStrategy& sort(const std::string& name);
   DeviceCaps device_caps() const;
@@ -67,14 +66,7 @@ struct Renderer::Impl {
   // Renderer::render(camera, settings) of the scene as the buffers hold it (settings_over_moving_copies
   // applied): the frame, its averaged samples, its bands, or one more accumulated sample.
   RenderImage render_set_scene(const Camera& camera, const RenderSettings& settings);
-  // What a frame was planned as and started from, for its statistics once it completed.
-  struct FrameStart {
-    FramePlan plan;
-    SortStrategy* sorter = nullptr;
-    uint64_t fallbacks_before = 0;
-    std::chrono::steady_clock::time_point time;
-    FrameAccumulator::FrameSums sums;  // what it leaves in the accumulated sums
-  };
+  using FrameStart = tilesplat::FrameStart;  // frame/frame_start.h
   // Plans the frame (validating the camera and settings), sizes the outputs and uploads what the
   // frame reads from the host. Waits for a frame in flight first: its buffers are the same.
   // without_waiting: a frame render_to_image submits or records and returns (choose_sort_strategy).
@@ -82,11 +74,11 @@ struct Renderer::Impl {
                          bool without_waiting = false, const ScenePart& part = {});
   // Records and runs one attempt at the plan; returns the counters the GPU wrote. A composite-only
   // frame rewrites only max_tile_pairs, so the others still describe the lists it read.
-  FrameCounters run_frame(const FramePlan& plan, const RenderSettings& settings, SortStrategy& sorter,
-                          const ExternalDepthImage* depth_image);
-  // Renders into the output buffers with retries, and fills the statistics (all but cpu_ms).
-  void render_frame(const Camera& camera, const RenderSettings& settings,
-                    const ExternalDepthImage* depth_image = nullptr, const ScenePart& part = {});
+  FrameCounters run_frame(const FramePlan& plan, SortStrategy& sorter, const ExternalDepthImage* depth_image);
+  // Renders into the output buffers with retries, and fills the statistics (all but cpu_ms). Returns the
+  // frame's plan (its first attempt's).
+  FramePlan render_frame(const Camera& camera, const RenderSettings& settings,
+                         const ExternalDepthImage* depth_image = nullptr, const ScenePart& part = {});
   // The frame's images, read back from the outputs.
   RenderImage read_image(const Camera& camera, const RenderSettings& settings);
   // Depth of field, motion blur: the sample frames averaged (frame/averaged_frames.h), each rendered by
@@ -120,25 +112,14 @@ struct Renderer::Impl {
   void check_resort_lists(const FramePlan& plan, const FrameCounters& frame) const;
   uint64_t device_bytes() const;
 
-  // Frames the renderer does not wait for (renderer_async.cpp).
-  struct SubmittedFrame {
-    FrameStart start;
-    int submissions = 0;
-    double cpu_ms = 0;
-    // Recorded into a host's command buffer: complete once this timeline semaphore reaches `value`
-    // (else the renderer's own submission, in_flight).
-    VkSemaphore timeline = VK_NULL_HANDLE;
-    uint64_t value = 0;
-  };
+  // Frames the renderer does not wait for (renderer_async.cpp): started and submitted or recorded, and
+  // kept in in_flight.
   void submit_frame(const Camera& camera, const RenderSettings& settings, const ExternalImage& target,
                     const ExternalDepthImage* depth_image, const vk::SubmitSync& sync);
   void record_frame_into(const HostCommandBuffer& host, const Camera& camera, const RenderSettings& settings,
                          const ExternalImage& target, const ExternalDepthImage* depth_image);
-  void record_frame_to_images(vk::CommandStream& stream, const FrameStart& start,
-                              const RenderSettings& settings, const ExternalImage& target,
+  void record_frame_to_images(vk::CommandStream& stream, const FrameStart& start, const ExternalImage& target,
                               const ExternalDepthImage* depth_image);
-  void keep_submitted(const FrameStart& start, int submissions, VkSemaphore timeline = VK_NULL_HANDLE,
-                      uint64_t value = 0);
   void wait_for_submitted_frame();
 
   // Reads a device buffer back (through a staging buffer unless it is host-visible).
@@ -159,10 +140,9 @@ struct Renderer::Impl {
   FrameAccumulator accumulator;  // the stochastic frames and the lens and shutter samples summed so far
   SceneSlot scene_slot;  // what the scene buffers hold: which scene, which upload, moving copies, a part
   uint64_t uploaded_bytes_reported = 0;     // vk::Context::uploaded_bytes() at the last frame's statistics
-  std::optional<SubmittedFrame> submitted;  // the frame render_to_image submitted without waiting
-  // Its fence and command buffer: declared last, so that it is destroyed first and waits for the
-  // frame before any buffer the frame uses goes.
-  vk::InFlightSubmission in_flight;
+  // The frame render_to_image started without waiting (its fence, or a host's timeline): declared last,
+  // so that it is destroyed first and waits for the frame before any buffer the frame uses goes.
+  FrameInFlight in_flight;
 };
 
 // How the functions of vulkan_interop.h, which are not members, reach a renderer's implementation.

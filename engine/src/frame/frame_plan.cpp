@@ -12,6 +12,7 @@
 #include "passes/stochastic_composite_pass.h"
 #include "passes/tile_coverage.h"
 #include "settings_checks.h"
+#include "sort/sort_strategy.h"
 #include "shader_io.h"
 #include "tilesplat/reference.h"
 
@@ -317,13 +318,31 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
                               : plan.depth_key_bits + plan.tiles.tile_bits;
   plan.resort_window = stochastic ? 0 : uint32_t(settings.accuracy.resort_window);
   plan.stochastic_samples = stochastic ? settings.stochastic.frames : 0;
+  if (stochastic) {
+    plan.stochastic_seed = settings.stochastic.seed;
+    plan.stochastic_sampler = settings.stochastic.sampler;
+  }
   plan.stochastic_accumulate = stochastic && settings.stochastic.accumulate;
   if (plan.stochastic_accumulate && !plan.build_lists)
     plan.stochastic_first_sample = context.stochastic_frames_before;
+  plan.outputs = {settings.depth,
+                  settings.splat_count,
+                  settings.background,
+                  settings.accuracy.alpha_cutoff,
+                  settings.accuracy.transmittance_cutoff,
+                  float(settings.max_alpha),
+                  settings.accuracy.fp16_blend};
   if (settings.host) {
+    plan.host.enabled = true;
     plan.host.from_memory = !settings.host->depth.empty();
     plan.host.from_image = context.depth_image;
     plan.host.write_depth = settings.host->write_depth;
+    plan.host.convention = settings.host->convention;
+    plan.host.surface_alpha = settings.host->alpha_threshold;
+    // A pixel may stop at its first splat behind the host's surface only when the splats come in exact
+    // view depth order: not with shortened keys, nor sorted by distance.
+    plan.host.exact_depth_order = settings.accuracy.depth_key_bits == 32 &&
+                                  settings.accuracy.sort_depth == AccuracyModes::SortDepth::kView;
   }
   if (context.samples_before)
     plan.sample_sums =

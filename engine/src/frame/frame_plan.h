@@ -5,14 +5,15 @@
 // plan; plans are tested without a device (tests/test_frame_plan.cpp).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "passes/projection_pass.h"
+#include "passes/projection_variant.h"
 #include "passes/tile_grid.h"
-#include "sort/sort_strategy.h"
+#include "sort/frame_sort_plan.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/render_settings.h"
 
@@ -113,9 +114,27 @@ struct ScenePart {
 
 // A frame's use of RenderSettings::host.
 struct HostDepthPlan {
+  bool enabled = false;      // RenderSettings::host is set
   bool from_memory = false;  // HostDepth::depth uploaded as view depths
   bool from_image = false;   // a depth image converted on the device (kHostDepthIn)
   bool write_depth = false;  // the composite writes the surface depth
+  DepthConvention convention;  // of the host's depths (HostDepth::convention)
+  float surface_alpha = 0.5f;  // HostDepth::alpha_threshold
+  // The splats come in exact view-depth order (32-bit keys of view depth): a pixel may stop at its first
+  // splat behind the host's surface.
+  bool exact_depth_order = false;
+};
+
+// What a frame writes and how its composite blends, from the settings: the recorder and the buffers
+// read these, never the settings.
+struct FrameOutputs {
+  bool depth = true;                            // RenderSettings::depth: the expected-depth image
+  bool splat_count = true;                      // RenderSettings::splat_count
+  std::array<float, 3> background = {0, 0, 0};  // RenderSettings::background
+  float alpha_cutoff = 1.0f / 255.0f;           // AccuracyModes::alpha_cutoff
+  float transmittance_cutoff = 1e-4f;           // AccuracyModes::transmittance_cutoff
+  float max_alpha = 0.99f;                      // RenderSettings::max_alpha
+  bool half_colour = false;  // AccuracyModes::fp16_blend: the raster compositor's 16-bit attachment
 };
 
 // RenderSettings::accumulate_samples: the frame is one sample of a lens or shutter frame, added to the
@@ -149,11 +168,14 @@ struct FramePlan {
   Compositor compositor = Compositor::kSorted;
   uint32_t resort_window = 0;       // kResortComposite's window (AccuracyModes::resort_window)
   uint32_t stochastic_samples = 0;  // kStochasticComposite's averaged samples (StochasticSettings::frames)
+  uint32_t stochastic_seed = 0;     // StochasticSettings::seed
+  StochasticSampler stochastic_sampler = StochasticSampler::kHash;
   // StochasticSettings::accumulate: the samples already in the composite state's sums (when the frame
   // reuses the lists of the frame that left them: FrameContext::stochastic_frames_before), and that the
   // sums stay for the next.
   uint32_t stochastic_first_sample = 0;
   bool stochastic_accumulate = false;
+  FrameOutputs outputs;
   HostDepthPlan host;
   std::optional<SampleSums> sample_sums;  // a sample of an accumulated lens or shutter frame
   ScenePart part;                 // of a scene rendered in parts (or the whole scene)

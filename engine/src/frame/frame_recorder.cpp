@@ -24,10 +24,10 @@ FrameRecorder::FrameRecorder(vk::Context& ctx, vk::GpuTimer& timer)
       pack_colour_(ctx),
       sample_accumulate_(ctx) {}
 
-void FrameRecorder::set_frame_inputs(const Camera& camera, const RenderSettings& settings,
+void FrameRecorder::set_frame_inputs(const Camera& camera, const Lighting& lighting, double near_plane,
                                      const TileGrid& tiles, SceneBuffers& scene) {
-  projection_.set_lighting(settings.lighting, scene);  // validates the lights; uploads normals on first use
-  projection_.set_camera(camera, settings.near_plane, tiles);
+  projection_.set_lighting(lighting, scene);  // validates the lights; uploads normals on first use
+  projection_.set_camera(camera, near_plane, tiles);
 }
 
 uint32_t FrameRecorder::chunks_for(Compositor compositor, uint64_t longest_tile_list) const {
@@ -35,8 +35,7 @@ uint32_t FrameRecorder::chunks_for(Compositor compositor, uint64_t longest_tile_
                                                : composite_.chunks_for(longest_tile_list);
 }
 
-void FrameRecorder::prepare(const FramePlan& plan, const RenderSettings& settings, FrameResources& resources,
-                            SortStrategy& sorter) {
+void FrameRecorder::prepare(const FramePlan& plan, FrameResources& resources, SortStrategy& sorter) {
   const uint32_t chunks = composite_chunks(plan.compositor);
   const bool needs_state = plan.compositor == Compositor::kStochastic
                                ? StochasticCompositePass::needs_state(plan.stochastic_samples, chunks) ||
@@ -47,11 +46,11 @@ void FrameRecorder::prepare(const FramePlan& plan, const RenderSettings& setting
   if (plan.compositor == Compositor::kRaster)
     raster_composite_.prepare({plan.tiles.width,
                                plan.tiles.height,
-                               {.write_depth = settings.depth,
-                                .write_count = settings.splat_count,
+                               {.write_depth = plan.outputs.depth,
+                                .write_count = plan.outputs.splat_count,
                                 .host_depth = plan.host.from_memory || plan.host.from_image,
                                 .surface_depth = plan.host.write_depth,
-                                .half_colour = settings.accuracy.fp16_blend}});
+                                .half_colour = plan.outputs.half_colour}});
   if (!plan.build_lists) return;
   projection_.prepare(resources.scene, plan.projection);
   // The depth sort's buffers hold the projected records (more than this frame's after a larger part).
@@ -61,17 +60,15 @@ void FrameRecorder::prepare(const FramePlan& plan, const RenderSettings& setting
 struct FrameRecorder::Recording {
   vk::CommandStream& stream;
   const FramePlan& plan;
-  const RenderSettings& settings;
   FrameResources& res;
   SortStrategy& sorter;
   const ExternalDepthImage* depth_image;
   const vk::Buffer* depth_order = nullptr;  // the depth sort's result, for the prefix sum and key emission
 };
 
-void FrameRecorder::record(vk::CommandStream& stream, const FramePlan& plan, const RenderSettings& settings,
-                           FrameResources& resources, SortStrategy& sorter,
-                           const ExternalDepthImage* depth_image) {
-  Recording r{stream, plan, settings, resources, sorter, depth_image};
+void FrameRecorder::record(vk::CommandStream& stream, const FramePlan& plan, FrameResources& resources,
+                           SortStrategy& sorter, const ExternalDepthImage* depth_image) {
+  Recording r{stream, plan, resources, sorter, depth_image};
   timer_.begin_frame(stream.cmd());
   for (FramePass pass : plan.passes) {
     record_pass(r, pass);
@@ -86,7 +83,7 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
   VkCommandBuffer cmd = r.stream.cmd();  // a host sort flushes the stream: each pass takes the current one
   switch (pass) {
     case FramePass::kHostDepthIn:
-      record_host_depth_in(cmd, *r.depth_image, r.settings.host->convention, res);
+      record_host_depth_in(cmd, *r.depth_image, plan.host.convention, res);
       return;
     case FramePass::kClearCounters:
       vkCmdFillBuffer(cmd, res.counters.handle(), 0, VK_WHOLE_SIZE, 0);
@@ -160,26 +157,26 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
       // The depth order this frame's sort left, or the one a frame on reused lists finds.
       const vk::Buffer& order =
           res.depth_order_in_alt ? res.projected.depth_order.values_alt : res.projected.depth_order.values;
-      const AccuracyModes& modes = r.settings.accuracy;
+      const FrameOutputs& outputs = plan.outputs;
       raster_composite_.record(
           cmd, {.splats = res.projected.splats,
                 .depth_order = order,
                 .counters = res.counters,
                 .out = res.outputs,
-                .background = r.settings.background,
-                .write_depth = r.settings.depth,
-                .write_count = r.settings.splat_count,
-                .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff, float(r.settings.max_alpha)},
-                .host = res.host_surface(r.settings),
-                .half_colour = modes.fp16_blend});
+                .background = outputs.background,
+                .write_depth = outputs.depth,
+                .write_count = outputs.splat_count,
+                .cutoffs = {outputs.alpha_cutoff, outputs.transmittance_cutoff, outputs.max_alpha},
+                .host = res.host_surface(plan.host),
+                .half_colour = outputs.half_colour});
       return;
     }
     case FramePass::kAccumulateSamples:
       vk::barrier(cmd);  // the composite's outputs (the raster composite's resolve) before the sums read them
       sample_accumulate_.record(cmd, res.outputs, res.sample_sums, res.counters,
                                 {.samples_before = plan.sample_sums->before,
-                                 .write_depth = r.settings.depth,
-                                 .write_count = r.settings.splat_count,
+                                 .write_depth = plan.outputs.depth,
+                                 .write_count = plan.outputs.splat_count,
                                  .opaque = plan.sample_sums->opaque});
       vk::barrier(cmd);
       return;
@@ -188,21 +185,21 @@ void FrameRecorder::record_pass(Recording& r, FramePass pass) {
 
 void FrameRecorder::record_composite(Recording& r, FramePass pass) {
   FrameResources& res = r.res;
-  const AccuracyModes& modes = r.settings.accuracy;
+  const FrameOutputs& outputs = r.plan.outputs;
   const CompositeInputs inputs{
       .splats = res.projected.splats,
       .tile_lists = res.lists_in_alt ? res.keys.values_alt : res.keys.values,
       .ranges = res.ranges,
       .out = res.outputs,
-      .background = r.settings.background,
-      .write_depth = r.settings.depth,
-      .write_count = r.settings.splat_count,
-      .cutoffs = {modes.alpha_cutoff, modes.transmittance_cutoff, float(r.settings.max_alpha)}};
+      .background = outputs.background,
+      .write_depth = outputs.depth,
+      .write_count = outputs.splat_count,
+      .cutoffs = {outputs.alpha_cutoff, outputs.transmittance_cutoff, outputs.max_alpha}};
   const VkDeviceAddress counters = res.counters.address();
   if (pass == FramePass::kStochasticComposite)
     stochastic_composite_.record(
         r.stream, inputs,
-        {r.settings.stochastic.frames, r.settings.stochastic.seed, r.settings.stochastic.sampler,
+        {r.plan.stochastic_samples, r.plan.stochastic_seed, r.plan.stochastic_sampler,
          r.plan.stochastic_first_sample, r.plan.stochastic_accumulate},
         {stochastic_chunks_, res.composite_state, counters});
   else if (pass == FramePass::kResortComposite)
@@ -210,7 +207,7 @@ void FrameRecorder::record_composite(Recording& r, FramePass pass) {
                              r.plan.resort_window, counters);
   else
     composite_.record(r.stream.cmd(), inputs, {sorted_chunks_, res.composite_state, counters},
-                      res.host_surface(r.settings),
+                      res.host_surface(r.plan.host),
                       {r.plan.part.carries_in(), r.plan.part.carries_out(), r.plan.part.state_high()});
 }
 
@@ -225,8 +222,8 @@ void FrameRecorder::record_host_depth_in(VkCommandBuffer cmd, const ExternalDept
   vk::barrier(cmd);
 }
 
-void FrameRecorder::record_copies_to_images(VkCommandBuffer cmd, const RenderSettings& settings,
-                                            FrameResources& res, const ExternalImage& target,
+void FrameRecorder::record_copies_to_images(VkCommandBuffer cmd, const FramePlan& plan, FrameResources& res,
+                                            const ExternalImage& target,
                                             const ExternalDepthImage* depth_image) {
   // The colour: as it is for RGBA32F, else packed into the image's texel format first (pack_colour.comp),
   // which counts the values it saturates from zero (a frame on reused lists clears no counters).
@@ -245,10 +242,10 @@ void FrameRecorder::record_copies_to_images(VkCommandBuffer cmd, const RenderSet
   }
   copy_buffer_to_image(cmd, *source, target.image, VK_IMAGE_ASPECT_COLOR_BIT, target.layout, target.width,
                        target.height);
-  if (!depth_image || !settings.host->write_depth) return;
+  if (!depth_image || !plan.host.write_depth) return;
   // The splats' depth where they reached the threshold, and the host's own elsewhere, into the host's
   // depth image (after the frame that wrote host_surface_depth).
-  host_depth_.record_window_depths(cmd, settings.host->convention, res.host_surface_depth,
+  host_depth_.record_window_depths(cmd, plan.host.convention, res.host_surface_depth,
                                    res.host_window_depth, depth_image->width, depth_image->height);
   vk::barrier(cmd);
   copy_buffer_to_image(cmd, res.host_window_depth, depth_image->image, depth_aspect(*depth_image),

@@ -113,7 +113,7 @@ void FrameResources::ensure_projected_records(uint32_t records) {
 // image (host_window_depth holds its window depths, and the depth out before it is copied back); room
 // for the surface depth the composite writes. Then the output images of this frame's size: colour
 // always, depth and counts only while frames ask for them (an output not asked for holds no memory).
-void FrameResources::prepare_outputs(const FramePlan& plan, const RenderSettings& settings) {
+void FrameResources::prepare_outputs(const FramePlan& plan, const std::optional<HostDepth>& host) {
   const uint32_t width = plan.tiles.width, height = plan.tiles.height;
   const size_t pixels = size_t(width) * height;
   const VkDeviceSize depth_bytes = pixels * sizeof(float);
@@ -127,7 +127,7 @@ void FrameResources::prepare_outputs(const FramePlan& plan, const RenderSettings
   ensure(host_window_depth, plan.host.from_image, "host window depth (depth image)");
   ensure(host_surface_depth, plan.host.write_depth, "host surface depth");
   if (plan.host.from_memory) {
-    const std::vector<float> view_depth = host_view_depths(*settings.host);
+    const std::vector<float> view_depth = host_view_depths(*host);
     vk::upload(ctx_, host_view_depth, view_depth.data(), depth_bytes);
   }
 
@@ -145,11 +145,11 @@ void FrameResources::prepare_outputs(const FramePlan& plan, const RenderSettings
   else if (sample_sums.size() != SampleAccumulatePass::sums_bytes(pixels))
     sample_sums = vk::Buffer(ctx_, SampleAccumulatePass::sums_bytes(pixels), vk::MemoryUse::Device,
                              "sample sums (accumulated lens and shutter samples)");
-  if (!settings.depth)
+  if (!plan.outputs.depth)
     outputs.depth.reset();
   else if (outputs.depth.size() == 0)
     outputs.depth = vk::Buffer(ctx_, pixels * 4, vk::MemoryUse::Device, "output depth");
-  if (!settings.splat_count)
+  if (!plan.outputs.splat_count)
     outputs.count.reset();
   else if (outputs.count.size() == 0)
     outputs.count = vk::Buffer(ctx_, pixels * 4, vk::MemoryUse::Device, "output splat count");
@@ -246,16 +246,13 @@ uint64_t FrameResources::device_bytes() const {
   return bytes + projected.depth_order.bytes() + keys.bytes();
 }
 
-CompositePass::HostSurface FrameResources::host_surface(const RenderSettings& settings) const {
+CompositePass::HostSurface FrameResources::host_surface(const HostDepthPlan& host) const {
   CompositePass::HostSurface surface;
-  if (!settings.host) return surface;
+  if (!host.enabled) return surface;
   if (host_view_depth.size() > 0) surface.view_depth = &host_view_depth;
   if (host_surface_depth.size() > 0) surface.surface_depth = &host_surface_depth;
-  surface.surface_alpha = settings.host->alpha_threshold;
-  // A pixel may stop at its first splat behind the host's surface only when the splats come in exact view
-  // depth order: not with shortened keys, nor sorted by distance.
-  surface.exact_depth_order = settings.accuracy.depth_key_bits == 32 &&
-                              settings.accuracy.sort_depth == AccuracyModes::SortDepth::kView;
+  surface.surface_alpha = host.surface_alpha;
+  surface.exact_depth_order = host.exact_depth_order;
   return surface;
 }
 

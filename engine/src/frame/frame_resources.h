@@ -45,7 +45,7 @@ class FrameResources {
 
   // Sizes the outputs and the host's depth buffers for the plan, uploading HostDepth::depth when the
   // plan reads it from memory (before the frame is recorded, outside any command buffer).
-  void prepare_outputs(const FramePlan& plan, const RenderSettings& settings);
+  void prepare_outputs(const FramePlan& plan, const std::optional<HostDepth>& host);
   // Sizes what the lists and the composite need: the key buffers' width, the re-sorting data, and
   // the composite's per-pixel state when it carries any between dispatches.
   void prepare_frame(const FramePlan& plan, bool needs_composite_state);
@@ -63,7 +63,7 @@ class FrameResources {
   uint64_t device_bytes() const;
 
   // What the composite of a frame without a host's depth, or with one, is given of it.
-  CompositePass::HostSurface host_surface(const RenderSettings& settings) const;
+  CompositePass::HostSurface host_surface(const HostDepthPlan& host) const;
 
   SceneBuffers scene;
   ProjectedBuffers projected;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "camera/camera_models.h"
+#include "passes/projection_variant.h"
 #include "passes/key_buffers.h"
 #include "passes/tile_grid.h"
 #include "shader_io.h"
@@ -31,28 +32,6 @@ struct SceneBuffers {
   bool file_normals = false;  // the scene has a usable normal (finite, non-zero) somewhere
   uint32_t count = 0;
   int sh_degree = 0;
-};
-
-// Which projection a frame runs: the accuracy modes it specializes for (AccuracyModes).
-struct ProjectionVariant {
-  int sh_degree = 0;         // evaluated degree: min(scene degree, cap)
-  int stored_sh_degree = 0;  // the scene's
-  bool sh_half = false;
-  bool covariance_half = false;
-  bool opacity_extent = false;
-  bool square_tiles = false;
-  float alpha_inv = 255.0f;
-  uint32_t depth_key_bits = 32;
-  bool distance_key = false;  // key by the centre's distance, not its z (AccuracyModes::SortDepth::kDistance)
-  bool ray_depth = false;  // write ProjectedBuffers::ray_depth
-  uint32_t dilation_tenths = 3;  // the antialiasing mode's low-pass filter, in 0.1 px^2
-  bool compensate_opacity = false;
-  bool lighting = false;      // relighting on (the lights themselves are data: ProjectionPass::set_lighting)
-  bool file_normals = false;  // lit, with the scene's normal buffer (else every splat's shortest axis)
-  uint32_t camera_model = 0;  // tilesplat::CameraModel: the pinhole's code alone unless another is asked for
-  // Records per Gaussian (camera_models::seam_copies): Gaussian i's are i and scene count + i.
-  uint32_t seam_copies() const { return camera_models::seam_copies(CameraModel(camera_model)); }
-  auto operator<=>(const ProjectionVariant&) const = default;
 };
 
 // Bytes of one projected splat record (SPLAT_VEC4S vec4, compute/shader_io.h).

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "passes/key_buffers.h"
+#include "sort/frame_sort_plan.h"
 #include "vulkan/buffer.h"
 #include "vulkan/command_stream.h"
 #include "vulkan/context.h"
@@ -28,10 +29,6 @@ struct SortInput {
   bool depth_in_low_bits = false;
 };
 
-// How a frame uses a strategy. A global sort runs twice: the Gaussians by depth, then the (tile,
-// Gaussian) pairs by tile id. A strategy that bins by tile itself sorts each pair's
-// (tile << 32 | depth bits) key once instead.
-enum class FrameSortPlan { kDepthThenTile, kTileDepthPairs };
 
 class SortStrategy {
  public:
