@@ -112,6 +112,188 @@ PixelRule pixel_rule(const RenderSettings& settings, ReferenceOrder order) {
   return {};
 }
 
+// What render_reference refuses before any work: a camera, region, scene, host depth or setting it
+// cannot draw, and a per-pixel order on what has no rays (it follows the pinhole's) or no tile lists.
+void check_reference_frame(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+                           const PixelRule& rule) {
+  validate(camera);
+  check_region(settings, camera);
+  check_scene(scene);
+  validate_host_depth(settings, camera);
+  check_near_plane(settings.near_plane);
+  check_max_alpha(settings);
+  check_single_frame(settings);
+  check_camera_model(settings, camera);
+  if (!rule.by_ray_depth) return;
+  // The rays of the per-pixel orders are the pinhole's; the raster rule and a host's depth have none.
+  if (camera_models::drawn_model(camera) != CameraModel::kPinhole)
+    throw std::invalid_argument("render_reference: the per-pixel depth order needs a pinhole camera, not " +
+                                std::string(camera_model_name(camera.model)));
+  if (settings.compositor == Compositor::kRaster)
+    throw std::invalid_argument("render_reference: the raster compositor blends in the tile lists' order");
+  if (settings.host)
+    throw std::invalid_argument("render_reference: the per-pixel depth order does not test a host's depth");
+}
+
+// Every Gaussian projected: one record each, two for the equirectangular camera (its seam copies, records
+// n..2n - 1), with what each record sorts by, as the projection keys it (projection.comp's sort_depth):
+// the view depth (a fisheye's or panorama's distance), or in radial sorting the pinhole's and OpenCV
+// camera's distance.
+struct ProjectedRecords {
+  std::vector<ProjectedGaussian> records;
+  std::vector<float> sort_depth;
+};
+
+ProjectedRecords project_records(const GaussianScene& scene, const Camera& camera,
+                                 const RenderSettings& settings) {
+  const size_t n = scene.size();
+  const PreparedLighting lighting = prepare_lighting(settings.lighting);  // validates
+  if (settings.lighting.enabled()) reference::check_normals(scene);
+  const camera_models::ModelLimits limits =
+      camera_models::model_limits(camera);  // a copy: model_limits' lasts until this thread asks again
+  const size_t records = n * camera_models::seam_copies(camera.model);
+  ProjectedRecords projected{std::vector<ProjectedGaussian>(records), std::vector<float>(records)};
+  const bool radial =
+      camera_models::radial_replaces_depth(camera_models::drawn_model(camera), settings.accuracy.sort_depth);
+  parallel_chunks(records, 4096, [&](size_t begin, size_t end) {
+    for (size_t r = begin; r < end; ++r) {
+      const size_t i = r % std::max<size_t>(n, 1);
+      projected.records[r] = reference::project(scene, i, camera, limits, settings.antialiasing, lighting,
+                                                settings.near_plane, uint32_t(r / std::max<size_t>(n, 1)));
+      double depth = projected.records[r].depth;
+      if (radial) {
+        const std::array<double, 3> t =
+            camera.to_camera({double(scene.positions[3 * i]), double(scene.positions[3 * i + 1]),
+                              double(scene.positions[3 * i + 2])});
+        depth = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+      }
+      projected.sort_depth[r] = float(depth);
+    }
+  });
+  return projected;
+}
+
+// The visible records front to back by the float32 depth the GPU sorts on, ties by record index.
+std::vector<uint32_t> depth_order(const ProjectedRecords& projected) {
+  std::vector<uint32_t> order;
+  for (size_t i = 0; i < projected.records.size(); ++i)
+    if (projected.records[i].visible) order.push_back(static_cast<uint32_t>(i));
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t lhs, uint32_t rhs) {
+    return projected.sort_depth[lhs] < projected.sort_depth[rhs];
+  });
+  return order;
+}
+
+// The splats (indices into `order`) of each tile, front to back: a counting sort, whose filling in
+// front-to-back order keeps every list sorted. The raster rule lists a splat wherever its alpha can pass
+// the cut-off (bin_by_alpha_ellipse), the others where the projection's tile rectangle says.
+struct TileLists {
+  int grid_x = 0, grid_y = 0;
+  std::vector<size_t> offsets;  // tile t's splats are splats[offsets[t], offsets[t + 1])
+  std::vector<uint32_t> splats;
+};
+
+TileLists bin_into_tiles(std::vector<ProjectedGaussian>& projected, const std::vector<uint32_t>& order,
+                         const Camera& camera, bool raster) {
+  TileLists lists;
+  lists.grid_x = (camera.width + kTileSize - 1) / kTileSize;
+  lists.grid_y = (camera.height + kTileSize - 1) / kTileSize;
+  if (raster)
+    for (uint32_t index : order) bin_by_alpha_ellipse(projected[index], lists.grid_x, lists.grid_y);
+  const size_t tiles = size_t(lists.grid_x) * size_t(lists.grid_y);
+  lists.offsets.assign(tiles + 1, 0);
+  for (uint32_t index : order) {
+    const ProjectedGaussian& g = projected[index];
+    for (int ty = g.tile_min[1]; ty < g.tile_max[1]; ++ty)
+      for (int tx = g.tile_min[0]; tx < g.tile_max[0]; ++tx)
+        ++lists.offsets[size_t(ty) * size_t(lists.grid_x) + size_t(tx) + 1];
+  }
+  std::partial_sum(lists.offsets.begin(), lists.offsets.end(), lists.offsets.begin());
+  lists.splats.resize(lists.offsets.back());
+  std::vector<size_t> cursor(lists.offsets.begin(), lists.offsets.end() - 1);
+  for (size_t s = 0; s < order.size(); ++s) {
+    const ProjectedGaussian& g = projected[order[s]];
+    for (int ty = g.tile_min[1]; ty < g.tile_max[1]; ++ty)
+      for (int tx = g.tile_min[0]; tx < g.tile_max[0]; ++tx)
+        lists.splats[cursor[size_t(ty) * size_t(lists.grid_x) + size_t(tx)]++] = static_cast<uint32_t>(s);
+  }
+  return lists;
+}
+
+// What every pixel's blend follows: the frame's rules and the host's surfaces.
+struct BlendRules {
+  double max_alpha = 0;
+  bool raster = false;  // the raster rule: no early-out
+  // A host's surfaces, as view depths: a splat blends only in front of them (RenderSettings::host).
+  std::vector<float> host_z;
+  bool surface_out = false;  // RenderImage::host_depth: the depth at which 1 - T reaches surface_alpha
+  double surface_alpha = 0;
+};
+
+// One pixel's front-to-back blend (docs/rendering-math.md): its sums as its splats come.
+struct PixelBlend {
+  double pixel_x = 0, pixel_y = 0;
+  float surface_z = 0;  // the host's surface at this pixel (with host depth)
+  double transmittance = 1.0;
+  double color[3] = {0, 0, 0};
+  double depth_sum = 0, weight_sum = 0;
+  double surface = 0;  // the depth at which 1 - T reached the host's threshold; 0: never
+  uint32_t blended = 0;
+
+  // The splat's alpha at this pixel, or -1 where it is skipped.
+  double alpha_at(const Splat& splat, const BlendRules& rules) const {
+    const double dx = splat.mean[0] - pixel_x;
+    const double dy = splat.mean[1] - pixel_y;
+    const double power =
+        -0.5 * (splat.conic[0] * dx * dx + splat.conic[2] * dy * dy) - splat.conic[1] * dx * dy;
+    if (power > 0) return -1.0;
+    const double alpha = std::min(rules.max_alpha, splat.opacity * std::exp(power));
+    if (alpha < kMinAlpha) return -1.0;
+    // Behind (or at) the host's opaque surface; compared as the float depths the GPU sorts on.
+    if (!rules.host_z.empty() && !(static_cast<float>(splat.depth) < surface_z)) return -1.0;
+    return alpha;
+  }
+  // Blends the splat; false once the pixel is done (this splat not blended).
+  bool blend(const Splat& splat, double alpha, const BlendRules& rules) {
+    const double next_transmittance = transmittance * (1 - alpha);
+    // The raster rule has no early-out: the hardware blend cannot skip a fragment.
+    if (!rules.raster && next_transmittance < kMinTransmittance) return false;
+    const double weight = alpha * transmittance;
+    for (int ch = 0; ch < 3; ++ch) color[ch] += splat.color[ch] * weight;
+    depth_sum += weight * splat.depth;
+    weight_sum += weight;
+    transmittance = next_transmittance;
+    if (rules.surface_out && surface == 0 && 1 - transmittance >= rules.surface_alpha) surface = splat.depth;
+    ++blended;
+    return true;
+  }
+};
+
+// One pixel blended through its tile's list [begin, end): in the list's order, or through the rule's
+// window of splats ordered by depth along the pixel's ray.
+void blend_list(PixelBlend& pixel, const uint32_t* begin, const uint32_t* end,
+                const std::vector<Splat>& splats, const std::vector<reference::RayDepthQuadric>& quadrics,
+                const PixelRule& rule, const BlendRules& rules, const Camera& camera) {
+  if (!rule.by_ray_depth) {
+    for (const uint32_t* it = begin; it != end; ++it) {
+      const double alpha = pixel.alpha_at(splats[*it], rules);
+      if (alpha >= 0 && !pixel.blend(splats[*it], alpha, rules)) break;
+    }
+    return;
+  }
+  const std::array<double, 2> direction = reference::pixel_direction(camera, pixel.pixel_x, pixel.pixel_y);
+  bool done = false;
+  auto release = [&](const std::pair<uint32_t, double>& entry) {
+    done = done || !pixel.blend(splats[entry.first], entry.second, rules);
+  };
+  reference::DepthQueue<std::pair<uint32_t, double>> queue(rule.window);
+  for (const uint32_t* it = begin; it != end && !done; ++it) {
+    const double alpha = pixel.alpha_at(splats[*it], rules);
+    if (alpha >= 0) queue.offer(reference::ray_depth(quadrics[*it], direction), {*it, alpha}, release);
+  }
+  queue.flush(release);
+}
+
 }  // namespace
 
 RenderImage render_reference(const GaussianScene& scene, const Camera& camera,
@@ -143,70 +325,19 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
                            });
   }
   const PixelRule rule = pixel_rule(settings, reference_order);
-  validate(camera);
-  check_region(settings, camera);
-  check_scene(scene);
-  validate_host_depth(settings, camera);
-  check_near_plane(settings.near_plane);
-  check_max_alpha(settings);
-  check_single_frame(settings);
-  check_camera_model(settings, camera);
-  if (rule.by_ray_depth) {
-    // The rays of the per-pixel orders are the pinhole's; the raster rule and a host's depth have none.
-    if (camera_models::drawn_model(camera) != CameraModel::kPinhole)
-      throw std::invalid_argument("render_reference: the per-pixel depth order needs a pinhole camera, not " +
-                                  std::string(camera_model_name(camera.model)));
-    if (settings.compositor == Compositor::kRaster)
-      throw std::invalid_argument("render_reference: the raster compositor blends in the tile lists' order");
-    if (settings.host)
-      throw std::invalid_argument("render_reference: the per-pixel depth order does not test a host's depth");
-  }
-  // A host's surfaces, as view depths: a splat blends only in front of them (RenderSettings::host).
-  const std::vector<float> host_z = settings.host ? host_view_depths(*settings.host) : std::vector<float>{};
-  const bool surface_out = settings.host && settings.host->write_depth;
-  const double surface_alpha = surface_out ? settings.host->alpha_threshold : 0.0;
-  const size_t n = scene.size();
-  const double max_alpha = settings.max_alpha;
+  check_reference_frame(scene, camera, settings, rule);
+  BlendRules rules;
+  rules.max_alpha = settings.max_alpha;
+  rules.raster = settings.compositor == Compositor::kRaster;
+  rules.host_z = settings.host ? host_view_depths(*settings.host) : std::vector<float>{};
+  rules.surface_out = settings.host && settings.host->write_depth;
+  rules.surface_alpha = rules.surface_out ? settings.host->alpha_threshold : 0.0;
 
-  const PreparedLighting lighting = prepare_lighting(settings.lighting);  // validates
-  if (settings.lighting.enabled()) reference::check_normals(scene);
-  const camera_models::ModelLimits limits =
-      camera_models::model_limits(camera);  // a copy: model_limits' lasts until this thread asks again
-
-  // One record per Gaussian, two for the equirectangular camera (its seam copies, records n..2n - 1).
-  const size_t records = n * camera_models::seam_copies(camera.model);
-  std::vector<ProjectedGaussian> projected(records);
-  // What each record sorts by, as the projection keys it (projection.comp's sort_depth): the view depth
-  // (a fisheye's or panorama's distance), or in radial sorting the pinhole's and OpenCV camera's distance.
-  const bool radial =
-      camera_models::radial_replaces_depth(camera_models::drawn_model(camera), settings.accuracy.sort_depth);
-  std::vector<float> sort_depth(records);
-  parallel_chunks(records, 4096, [&](size_t begin, size_t end) {
-    for (size_t r = begin; r < end; ++r) {
-      const size_t i = r % std::max<size_t>(n, 1);
-      projected[r] = reference::project(scene, i, camera, limits, settings.antialiasing, lighting,
-                                        settings.near_plane, uint32_t(r / std::max<size_t>(n, 1)));
-      double depth = projected[r].depth;
-      if (radial) {
-        const std::array<double, 3> t =
-            camera.to_camera({double(scene.positions[3 * i]), double(scene.positions[3 * i + 1]),
-                              double(scene.positions[3 * i + 2])});
-        depth = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-      }
-      sort_depth[r] = float(depth);
-    }
-  });
-
-  // Front to back by the float32 depth the GPU sorts on, ties by record index.
-  std::vector<uint32_t> order;
-  for (size_t i = 0; i < records; ++i)
-    if (projected[i].visible) order.push_back(static_cast<uint32_t>(i));
-  std::stable_sort(order.begin(), order.end(),
-                   [&](uint32_t lhs, uint32_t rhs) { return sort_depth[lhs] < sort_depth[rhs]; });
-
+  ProjectedRecords projected = project_records(scene, camera, settings);
+  const std::vector<uint32_t> order = depth_order(projected);
   std::vector<Splat> splats(order.size());
   for (size_t s = 0; s < order.size(); ++s) {
-    const ProjectedGaussian& g = projected[order[s]];
+    const ProjectedGaussian& g = projected.records[order[s]];
     splats[s] = {{g.mean[0], g.mean[1]},
                  {g.conic[0], g.conic[1], g.conic[2]},
                  g.opacity,
@@ -218,35 +349,8 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
   parallel_chunks(quadrics.size(), 4096, [&](size_t begin, size_t end) {
     for (size_t s = begin; s < end; ++s) quadrics[s] = reference::ray_depth_quadric(scene, order[s], camera);
   });
-
-  // Bin the splats into per-tile lists (counting sort); filling in front-to-back order keeps
-  // every list sorted. The raster rule lists a splat wherever its alpha can pass the cut-off.
-  const int grid_x = (camera.width + kTileSize - 1) / kTileSize;
-  const int grid_y = (camera.height + kTileSize - 1) / kTileSize;
-  const bool raster = settings.compositor == Compositor::kRaster;
-  if (raster)
-    for (uint32_t index : order) bin_by_alpha_ellipse(projected[index], grid_x, grid_y);
-  const size_t tiles = size_t(grid_x) * size_t(grid_y);
-  std::vector<size_t> tile_offsets(tiles + 1, 0);
-  for (uint32_t index : order) {
-    const ProjectedGaussian& g = projected[index];
-    for (int ty = g.tile_min[1]; ty < g.tile_max[1]; ++ty)
-      for (int tx = g.tile_min[0]; tx < g.tile_max[0]; ++tx)
-        ++tile_offsets[size_t(ty) * size_t(grid_x) + size_t(tx) + 1];
-  }
-  std::partial_sum(tile_offsets.begin(), tile_offsets.end(), tile_offsets.begin());
-  std::vector<uint32_t> tile_splats(tile_offsets.back());
-  {
-    std::vector<size_t> cursor(tile_offsets.begin(), tile_offsets.end() - 1);
-    for (size_t s = 0; s < order.size(); ++s) {
-      const ProjectedGaussian& g = projected[order[s]];
-      for (int ty = g.tile_min[1]; ty < g.tile_max[1]; ++ty)
-        for (int tx = g.tile_min[0]; tx < g.tile_max[0]; ++tx)
-          tile_splats[cursor[size_t(ty) * size_t(grid_x) + size_t(tx)]++] = static_cast<uint32_t>(s);
-    }
-  }
-  projected.clear();
-  projected.shrink_to_fit();
+  const TileLists lists = bin_into_tiles(projected.records, order, camera, rules.raster);
+  projected = {};
 
   // The pixels composited: the whole image's, or a region's (the tiles' lists are the whole image's).
   const PixelRegion region = resolved_region(settings.region, camera.width, camera.height);
@@ -256,83 +360,37 @@ RenderImage render_reference(const GaussianScene& scene, const Camera& camera, c
   image.rgba.assign(image.pixels() * 4, 0.0f);
   if (settings.depth) image.depth.assign(image.pixels(), 0.0f);
   if (settings.splat_count) image.splat_count.assign(image.pixels(), 0);
-  if (surface_out) image.host_depth.assign(image.pixels(), 0.0f);
+  if (rules.surface_out) image.host_depth.assign(image.pixels(), 0.0f);
 
   const double background[3] = {settings.background[0], settings.background[1], settings.background[2]};
   const size_t width = size_t(camera.width);
   const size_t x0 = size_t(region.x), y0 = size_t(region.y);
   const size_t x1 = x0 + size_t(region.width), y1 = y0 + size_t(region.height);
-  parallel_chunks(size_t(grid_y), 1, [&](size_t row_begin, size_t row_end) {
+  parallel_chunks(size_t(lists.grid_y), 1, [&](size_t row_begin, size_t row_end) {
     for (size_t ty = std::max(row_begin, y0 / kTileSize); ty < row_end && ty * kTileSize < y1; ++ty)
       for (size_t tx = x0 / kTileSize; tx * kTileSize < x1; ++tx) {
-        const size_t tile = ty * size_t(grid_x) + tx;
-        const uint32_t* list_begin = tile_splats.data() + tile_offsets[tile];
-        const uint32_t* list_end = tile_splats.data() + tile_offsets[tile + 1];
+        const size_t tile = ty * size_t(lists.grid_x) + tx;
+        const uint32_t* list_begin = lists.splats.data() + lists.offsets[tile];
+        const uint32_t* list_end = lists.splats.data() + lists.offsets[tile + 1];
         const size_t y_end = std::min(y1, (ty + 1) * kTileSize);
         const size_t x_end = std::min(x1, (tx + 1) * kTileSize);
         for (size_t py = std::max(y0, ty * kTileSize); py < y_end; ++py)
           for (size_t px = std::max(x0, tx * kTileSize); px < x_end; ++px) {
-            const double pixel_x = double(px) + 0.5, pixel_y = double(py) + 0.5;
-            double transmittance = 1.0;
-            double color[3] = {0, 0, 0};
-            double depth_sum = 0, weight_sum = 0;
-            double surface = 0;  // the depth at which 1 - T reached the host's threshold; 0: never
-            uint32_t blended = 0;
-            const float surface_z = host_z.empty() ? 0.0f : host_z[py * width + px];
-            // The splat's alpha at this pixel, or -1 where it is skipped.
-            auto alpha_at = [&](const Splat& splat) {
-              const double dx = splat.mean[0] - pixel_x;
-              const double dy = splat.mean[1] - pixel_y;
-              const double power =
-                  -0.5 * (splat.conic[0] * dx * dx + splat.conic[2] * dy * dy) - splat.conic[1] * dx * dy;
-              if (power > 0) return -1.0;
-              const double alpha = std::min(max_alpha, splat.opacity * std::exp(power));
-              if (alpha < kMinAlpha) return -1.0;
-              // Behind (or at) the host's opaque surface; compared as the float depths the GPU sorts on.
-              if (!host_z.empty() && !(static_cast<float>(splat.depth) < surface_z)) return -1.0;
-              return alpha;
-            };
-            // Blends the splat; false once the pixel is done (this splat not blended).
-            auto blend = [&](const Splat& splat, double alpha) {
-              const double next_transmittance = transmittance * (1 - alpha);
-              // The raster rule has no early-out: the hardware blend cannot skip a fragment.
-              if (!raster && next_transmittance < kMinTransmittance) return false;
-              const double weight = alpha * transmittance;
-              for (int ch = 0; ch < 3; ++ch) color[ch] += splat.color[ch] * weight;
-              depth_sum += weight * splat.depth;
-              weight_sum += weight;
-              transmittance = next_transmittance;
-              if (surface_out && surface == 0 && 1 - transmittance >= surface_alpha) surface = splat.depth;
-              ++blended;
-              return true;
-            };
-            if (!rule.by_ray_depth) {
-              for (const uint32_t* it = list_begin; it != list_end; ++it) {
-                const double alpha = alpha_at(splats[*it]);
-                if (alpha >= 0 && !blend(splats[*it], alpha)) break;
-              }
-            } else {
-              const std::array<double, 2> direction = reference::pixel_direction(camera, pixel_x, pixel_y);
-              bool done = false;
-              auto release = [&](const std::pair<uint32_t, double>& entry) {
-                done = done || !blend(splats[entry.first], entry.second);
-              };
-              reference::DepthQueue<std::pair<uint32_t, double>> queue(rule.window);
-              for (const uint32_t* it = list_begin; it != list_end && !done; ++it) {
-                const double alpha = alpha_at(splats[*it]);
-                if (alpha >= 0)
-                  queue.offer(reference::ray_depth(quadrics[*it], direction), {*it, alpha}, release);
-              }
-              queue.flush(release);
-            }
-            const size_t pixel = (py - y0) * size_t(region.width) + (px - x0);
+            PixelBlend pixel;
+            pixel.pixel_x = double(px) + 0.5;
+            pixel.pixel_y = double(py) + 0.5;
+            pixel.surface_z = rules.host_z.empty() ? 0.0f : rules.host_z[py * width + px];
+            blend_list(pixel, list_begin, list_end, splats, quadrics, rule, rules, camera);
+            const size_t out = (py - y0) * size_t(region.width) + (px - x0);
             for (size_t ch = 0; ch < 3; ++ch)
-              image.rgba[pixel * 4 + ch] = static_cast<float>(color[ch] + transmittance * background[ch]);
-            image.rgba[pixel * 4 + 3] = static_cast<float>(1.0 - transmittance);
+              image.rgba[out * 4 + ch] =
+                  static_cast<float>(pixel.color[ch] + pixel.transmittance * background[ch]);
+            image.rgba[out * 4 + 3] = static_cast<float>(1.0 - pixel.transmittance);
             if (settings.depth)
-              image.depth[pixel] = weight_sum > 0 ? static_cast<float>(depth_sum / weight_sum) : 0.0f;
-            if (settings.splat_count) image.splat_count[pixel] = blended;
-            if (surface_out) image.host_depth[pixel] = host_depth_out(*settings.host, surface, pixel);
+              image.depth[out] =
+                  pixel.weight_sum > 0 ? static_cast<float>(pixel.depth_sum / pixel.weight_sum) : 0.0f;
+            if (settings.splat_count) image.splat_count[out] = pixel.blended;
+            if (rules.surface_out) image.host_depth[out] = host_depth_out(*settings.host, pixel.surface, out);
           }
       }
   });
