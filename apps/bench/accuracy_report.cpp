@@ -148,13 +148,276 @@ int work_units(const Options& options, int scene_sh_degree) {
          (raster ? views : 0);  // the raster rule's references
 }
 
+namespace {
+
+using Step = std::function<void(const std::string&)>;
+
+// The float64 references a scene's rows are held to.
+struct References {
+  std::vector<RenderImage> views;      // each view's
+  std::vector<RenderImage> ray_order;  // each view's in the exact ray order (pinhole views; else none at all)
+  std::vector<RenderImage> path;       // the path's frames (frame 0 is the first view's)
+  std::vector<RenderImage> raster;     // the raster rule's at each view, when a row draws with it
+};
+
+// Raw change between two frames: the excess over a sequence that stands still.
+double flicker_of(const RenderImage& a0, const RenderImage& a1) {
+  return temporal_excess(a0, a1, a0, a0, kFlickerThreshold).flicker_fraction;
+}
+
+// The depth-warped difference of a path's frames f - 1 and f.
+TemporalDifference warp_of(const std::vector<RenderImage>& frames, const std::vector<Camera>& path,
+                           size_t f) {
+  return depth_warp_difference(frames[f - 1], path[f - 1], frames[f], path[f], kWarpBlock, kWarpThreshold);
+}
+
+// The view-consistency pair's difference: the same camera turned in place.
+TemporalDifference inconsistency_of(const RenderImage& a, const RenderImage& b,
+                                    const std::vector<Camera>& turned) {
+  return rotation_inconsistency(a, turned[0], b, turned[1], kConsistencyBlock, kConsistencyThreshold);
+}
+
+// The view-consistency pair: the first view and the same camera turned in place, at a size where a
+// block of pixels stands for one pixel of the view; none without an angle.
+std::vector<Camera> turned_pair(const Options& options) {
+  if (options.consistency_angle <= 0) return {};
+  const Camera& view = options.views.front();
+  const Camera large = resize_camera(view, kConsistencyScale * view.width, kConsistencyScale * view.height);
+  return camera_path(CameraPath::kPan, large, {}, 2, options.consistency_angle);
+}
+
+// The references of the views (and their exact ray order) and of the path's frames.
+References render_references(const GaussianScene& scene, const Options& options,
+                             const std::vector<Camera>& path, const RenderSettings& settings,
+                             const Step& step) {
+  References refs;
+  for (size_t v = 0; v < options.views.size(); ++v) {
+    refs.views.push_back(render_reference(scene, options.views[v], settings));
+    step("float64 reference, " + options.view_names[v]);
+    // The exact per-pixel order's rays are a pinhole's; other views get no such reference.
+    if (options.views[v].model == CameraModel::kPinhole)
+      refs.ray_order.push_back(
+          render_reference(scene, options.views[v], settings, ReferenceOrder::kRayDepth));
+    step("float64 reference in exact ray order, " + options.view_names[v]);
+  }
+  // path[0] is the first view: its reference is already made.
+  for (size_t f = 0; f < path.size(); ++f) {
+    if (f == 0) {
+      refs.path.push_back(refs.views.front());
+      continue;
+    }
+    refs.path.push_back(render_reference(scene, path[f], settings));
+    step("float64 reference, path frame " + std::to_string(f));
+  }
+  return refs;
+}
+
+// The float64 reference's raster rule at each view, when a row draws with the raster compositor.
+std::vector<RenderImage> render_raster_references(const GaussianScene& scene, const Options& options,
+                                                  const std::vector<Row>& rows,
+                                                  const RenderSettings& settings, const Step& step) {
+  std::vector<RenderImage> raster;
+  if (std::none_of(rows.begin(), rows.end(),
+                   [](const Row& row) { return row.compositor == Compositor::kRaster; }))
+    return raster;
+  RenderSettings raster_rule = settings;
+  raster_rule.compositor = Compositor::kRaster;
+  for (size_t v = 0; v < options.views.size(); ++v) {
+    raster.push_back(render_reference(scene, options.views[v], raster_rule));
+    step("float64 reference's raster rule, " + options.view_names[v]);
+  }
+  return raster;
+}
+
+// The reference's own change, flicker, popping and depth-warped popping along the path.
+void measure_reference_path(SceneReport& report, const std::vector<RenderImage>& frames,
+                            const std::vector<Camera>& path) {
+  for (size_t f = 1; f < frames.size(); ++f) {
+    const double pairs = double(path.size() - 1);
+    report.reference_change += frame_change(frames[f - 1], frames[f]) / pairs;
+    report.reference_flicker += flicker_of(frames[f - 1], frames[f]) / pairs;
+  }
+  for (size_t f = 2; f < frames.size(); ++f)
+    report.reference_pops +=
+        popping(frames[f - 2], frames[f - 1], frames[f], kFlickerThreshold).flicker_fraction /
+        double(path.size() - 2);
+  for (size_t f = 1; f < frames.size(); ++f) {
+    report.reference_warp_pops_per_step.push_back(warp_of(frames, path, f).flicker_fraction);
+    report.reference_warp_pops += report.reference_warp_pops_per_step.back() / double(path.size() - 1);
+  }
+}
+
+// The float64 reference's inconsistency over the turned pair, in the centre-depth order and in the exact
+// ray order (none there for a camera that is not a pinhole's, whose rays it does not follow).
+void measure_reference_consistency(SceneReport& report, const GaussianScene& scene,
+                                   const std::vector<Camera>& turned, const RenderSettings& settings,
+                                   const Step& step) {
+  auto pair_inconsistency = [&](ReferenceOrder order,
+                                const std::string& what) -> std::optional<TemporalDifference> {
+    std::vector<RenderImage> pair;
+    for (size_t f = 0; f < turned.size(); ++f) {
+      if (order != ReferenceOrder::kRayDepth || turned[f].model == CameraModel::kPinhole)
+        pair.push_back(render_reference(scene, turned[f], settings, order));
+      step(what + ", turned view " + std::to_string(f));
+    }
+    if (pair.size() != turned.size()) return std::nullopt;
+    return inconsistency_of(pair[0], pair[1], turned);
+  };
+  const TemporalDifference centre_order = *pair_inconsistency(ReferenceOrder::kSettings, "float64 reference");
+  report.reference_inconsistency = centre_order.flicker_fraction;
+  report.reference_inconsistency_mean = centre_order.mean_abs;
+  if (const auto exact =
+          pair_inconsistency(ReferenceOrder::kRayDepth, "float64 reference in exact ray order")) {
+    report.exact_order_inconsistency = exact->flicker_fraction;
+    report.exact_order_inconsistency_mean = exact->mean_abs;
+  }
+}
+
+// A row's frames at every view: timed (median GPU time of the repeats, per pass too), and held to the
+// references (and, for another compositor, to the sorted compositor's frame timed alike).
+void measure_views(ModeResult& result, Renderer& renderer, const Row& row, const RenderSettings& settings,
+                   const Options& options, const References& refs, const Step& step) {
+  double psnr_vs_sorted_sum = 0, psnr_vs_rule_sum = 0, psnr_vs_ray_order_sum = 0;
+  std::vector<double> sorted_ms_per_view;
+  std::vector<double> frame_ms_per_view;
+  std::map<std::string, std::vector<double>> pass_ms_per_view;
+  std::vector<std::string> pass_order;
+  double psnr_sum = 0, ssim_sum = 0;
+  for (size_t v = 0; v < options.views.size(); ++v) {
+    RenderImage image;
+    std::vector<double> frames;
+    std::map<std::string, std::vector<double>> passes;
+    for (int r = 0; r < options.warmup + options.repeat; ++r) {
+      image = renderer.render(options.views[v], settings);
+      const FrameStats& stats = renderer.last_frame_stats();
+      if (r >= options.warmup) {
+        frames.push_back(stats.gpu_ms);
+        // A pass recorded several times a frame counts once, with its total.
+        std::map<std::string, double> frame_passes;
+        for (const auto& pass : stats.passes) {
+          if (std::find(pass_order.begin(), pass_order.end(), pass.name) == pass_order.end())
+            pass_order.push_back(pass.name);
+          frame_passes[pass.name] += pass.gpu_ms;
+        }
+        for (const auto& [name, ms] : frame_passes) passes[name].push_back(ms);
+      }
+      if (v == 0) result.intersections = stats.intersections;
+      step(result.name + ", " + options.view_names[v]);
+    }
+    frame_ms_per_view.push_back(cli::median(frames));
+    for (const auto& [name, samples] : passes) pass_ms_per_view[name].push_back(cli::median(samples));
+    if (row.compositor != Compositor::kSorted) {  // the sorted compositor's frames, timed alike
+      RenderSettings sorted = settings;
+      sorted.compositor = Compositor::kSorted;
+      // fp16-blend is the raster's attachment format; the sorted compositor blends in float32.
+      sorted.accuracy.fp16_blend = false;
+      RenderImage sorted_image;
+      std::vector<double> sorted_frames;
+      for (int r = 0; r < options.warmup + options.repeat; ++r) {
+        sorted_image = renderer.render(options.views[v], sorted);
+        if (r >= options.warmup) sorted_frames.push_back(renderer.last_frame_stats().gpu_ms);
+        step(result.name + ", the sorted compositor's frame, " + options.view_names[v]);
+      }
+      sorted_ms_per_view.push_back(cli::median(sorted_frames));
+      psnr_vs_sorted_sum += compare_images(image, sorted_image).psnr_db;
+    }
+    if (row.compositor == Compositor::kRaster)
+      psnr_vs_rule_sum += compare_images(image, refs.raster[v]).psnr_db;
+    if (refs.ray_order.size() == options.views.size())
+      psnr_vs_ray_order_sum += compare_images(image, refs.ray_order[v]).psnr_db;
+    const ImageDifference difference = compare_images(image, refs.views[v]);
+    psnr_sum += difference.psnr_db;
+    ssim_sum += ssim(image, refs.views[v]);
+    result.max_abs = std::max(result.max_abs, difference.max_abs);
+  }
+  result.frame_ms = cli::median(frame_ms_per_view);
+  for (const auto& name : pass_order) result.passes.push_back({name, cli::median(pass_ms_per_view[name])});
+  result.psnr_db = psnr_sum / double(options.views.size());
+  if (row.compositor != Compositor::kSorted) {
+    result.psnr_vs_sorted_db = psnr_vs_sorted_sum / double(options.views.size());
+    result.sorted_frame_ms = cli::median(sorted_ms_per_view);
+  }
+  if (row.compositor == Compositor::kRaster)
+    result.psnr_vs_rule_db = psnr_vs_rule_sum / double(options.views.size());
+  result.psnr_vs_ray_order_db = refs.ray_order.size() == options.views.size()
+                                    ? psnr_vs_ray_order_sum / double(options.views.size())
+                                    : std::numeric_limits<double>::quiet_NaN();
+  result.ssim = ssim_sum / double(options.views.size());
+}
+
+// A row along the path, each frame with its depth (the timed frames leave it out): change, flicker,
+// excess over the reference's, popping, depth-warped popping.
+void measure_path(ModeResult& result, Renderer& renderer, const RenderSettings& settings,
+                  const std::vector<Camera>& path, const std::vector<RenderImage>& path_references,
+                  const Step& step) {
+  RenderSettings path_settings = settings;
+  path_settings.depth = true;
+  std::vector<RenderImage> frames;
+  for (size_t f = 0; f < path.size(); ++f) {
+    frames.push_back(renderer.render(path[f], path_settings));
+    step(result.name + ", path frame " + std::to_string(f));
+  }
+  for (size_t f = 1; f < frames.size(); ++f) {
+    const double pairs = double(frames.size() - 1);
+    result.frame_change += frame_change(frames[f - 1], frames[f]) / pairs;
+    result.flicker += flicker_of(frames[f - 1], frames[f]) / pairs;
+    result.excess +=
+        temporal_excess(frames[f - 1], frames[f], path_references[f - 1], path_references[f]).mean_abs /
+        pairs;
+  }
+  for (size_t f = 2; f < frames.size(); ++f) {
+    const TemporalDifference pops = popping(frames[f - 2], frames[f - 1], frames[f], kFlickerThreshold);
+    result.pops += pops.flicker_fraction / double(frames.size() - 2);
+    result.pop_mean += pops.mean_abs / double(frames.size() - 2);
+  }
+  for (size_t f = 1; f < frames.size(); ++f) {
+    const TemporalDifference warped = warp_of(frames, path, f);
+    result.warp_pops_per_step.push_back(warped.flicker_fraction);
+    result.warp_pops += warped.flicker_fraction / double(frames.size() - 1);
+    result.warp_mean += warped.mean_abs / double(frames.size() - 1);
+  }
+}
+
+// One row: its frames at the views, along the path and over the turned pair.
+ModeResult measure_row(Renderer& renderer, const Row& row, const Options& options, const References& refs,
+                       const std::vector<Camera>& path, const std::vector<Camera>& turned, const Step& step) {
+  ModeResult result;
+  result.modes = row.modes;
+  result.compositor = row.compositor;
+  result.name = row_name(row);
+  result.psnr_vs_sorted_db = std::numeric_limits<double>::quiet_NaN();
+  result.psnr_vs_rule_db = std::numeric_limits<double>::quiet_NaN();
+  RenderSettings settings;
+  settings.sort = options.sort;
+  settings.depth = false;
+  settings.splat_count = false;
+  settings.accuracy = row.modes;
+  settings.compositor = row.compositor;
+  settings.reuse_lists = false;  // the repeats time whole frames, not the composite on reused lists
+  measure_views(result, renderer, row, settings, options, refs, step);
+  measure_path(result, renderer, settings, path, refs.path, step);
+  if (!turned.empty()) {
+    std::vector<RenderImage> pair;
+    for (size_t f = 0; f < turned.size(); ++f) {
+      pair.push_back(renderer.render(turned[f], settings));
+      step(result.name + ", turned view " + std::to_string(f));
+    }
+    const TemporalDifference inconsistency = inconsistency_of(pair[0], pair[1], turned);
+    result.inconsistency = inconsistency.flicker_fraction;
+    result.inconsistency_mean = inconsistency.mean_abs;
+  }
+  return result;
+}
+
+}  // namespace
+
 SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const Options& options,
                           const std::function<void(int, int, const std::string&)>& progress) {
   if (options.views.empty()) throw std::invalid_argument("accuracy report: no views");
   const std::vector<Row> rows = report_rows(options, scene.sh_degree);
   const int total = work_units(options, scene.sh_degree);
   int done = 0;
-  auto step = [&](const std::string& what) { progress(++done, total, what); };
+  const Step step = [&](const std::string& what) { progress(++done, total, what); };
 
   SceneReport report;
   report.path = options.path;
@@ -164,222 +427,22 @@ SceneReport measure_scene(Renderer& renderer, const GaussianScene& scene, const 
   reference_settings.depth = true;  // the path's depth-warped popping needs it
   reference_settings.splat_count = false;
 
-  std::vector<RenderImage> references, ray_order_references;
-  for (size_t v = 0; v < options.views.size(); ++v) {
-    references.push_back(render_reference(scene, options.views[v], reference_settings));
-    step("float64 reference, " + options.view_names[v]);
-    // The exact per-pixel order's rays are a pinhole's; other views get no such reference.
-    if (options.views[v].model == CameraModel::kPinhole)
-      ray_order_references.push_back(
-          render_reference(scene, options.views[v], reference_settings, ReferenceOrder::kRayDepth));
-    step("float64 reference in exact ray order, " + options.view_names[v]);
-  }
   const Bounds bounds = compute_bounds(scene);
   const std::vector<Camera> path =
       camera_path(options.path, options.views.front(), {bounds.center[0], bounds.center[1], bounds.center[2]},
                   options.path_frames, options.path_step);
-  // path[0] is the first view: its reference is already made.
-  std::vector<RenderImage> path_references;
-  for (size_t f = 0; f < path.size(); ++f) {
-    if (f == 0) {
-      path_references.push_back(references.front());
-      continue;
-    }
-    path_references.push_back(render_reference(scene, path[f], reference_settings));
-    step("float64 reference, path frame " + std::to_string(f));
-  }
-  // Raw change between two frames: the excess over a sequence that stands still.
-  auto flicker_of = [](const RenderImage& a0, const RenderImage& a1) {
-    return temporal_excess(a0, a1, a0, a0, kFlickerThreshold).flicker_fraction;
-  };
-  for (size_t f = 1; f < path_references.size(); ++f) {
-    const double pairs = double(path.size() - 1);
-    report.reference_change += frame_change(path_references[f - 1], path_references[f]) / pairs;
-    report.reference_flicker += flicker_of(path_references[f - 1], path_references[f]) / pairs;
-  }
-  for (size_t f = 2; f < path_references.size(); ++f)
-    report.reference_pops += popping(path_references[f - 2], path_references[f - 1], path_references[f],
-                                     kFlickerThreshold).flicker_fraction /
-                             double(path.size() - 2);
-  auto warp_of = [&path](const std::vector<RenderImage>& frames, size_t f) {
-    return depth_warp_difference(frames[f - 1], path[f - 1], frames[f], path[f], kWarpBlock, kWarpThreshold);
-  };
-  for (size_t f = 1; f < path_references.size(); ++f) {
-    report.reference_warp_pops_per_step.push_back(warp_of(path_references, f).flicker_fraction);
-    report.reference_warp_pops += report.reference_warp_pops_per_step.back() / double(path.size() - 1);
-  }
-
-  // The view-consistency pair: the first view and the same camera turned in place, at a size where a
-  // block of pixels stands for one pixel of the view.
-  std::vector<Camera> turned;
-  if (options.consistency_angle > 0) {
-    const Camera& view = options.views.front();
-    const Camera large = resize_camera(view, kConsistencyScale * view.width, kConsistencyScale * view.height);
-    turned = camera_path(CameraPath::kPan, large, {}, 2, options.consistency_angle);
-  }
-  auto inconsistency_of = [&turned](const RenderImage& a, const RenderImage& b) {
-    return rotation_inconsistency(a, turned[0], b, turned[1], kConsistencyBlock, kConsistencyThreshold);
-  };
+  const std::vector<Camera> turned = turned_pair(options);
   report.consistency_angle = turned.empty() ? 0 : options.consistency_angle;
-  if (!turned.empty()) {
-    // The float64 reference's pair in `order`; none in the exact ray order, whose rays are a pinhole's, for
-    // another camera (as for the views above).
-    auto reference_pair_inconsistency = [&](ReferenceOrder order,
-                                            const std::string& what) -> std::optional<TemporalDifference> {
-      std::vector<RenderImage> pair;
-      for (size_t f = 0; f < turned.size(); ++f) {
-        if (order != ReferenceOrder::kRayDepth || turned[f].model == CameraModel::kPinhole)
-          pair.push_back(render_reference(scene, turned[f], reference_settings, order));
-        step(what + ", turned view " + std::to_string(f));
-      }
-      if (pair.size() != turned.size()) return std::nullopt;
-      return inconsistency_of(pair[0], pair[1]);
-    };
-    const TemporalDifference centre_order =
-        *reference_pair_inconsistency(ReferenceOrder::kSettings, "float64 reference");
-    report.reference_inconsistency = centre_order.flicker_fraction;
-    report.reference_inconsistency_mean = centre_order.mean_abs;
-    if (const auto exact =
-            reference_pair_inconsistency(ReferenceOrder::kRayDepth, "float64 reference in exact ray order")) {
-      report.exact_order_inconsistency = exact->flicker_fraction;
-      report.exact_order_inconsistency_mean = exact->mean_abs;
-    }
-  }
 
-  // The float64 reference's raster rule at each view, when a row draws with the raster compositor.
-  std::vector<RenderImage> raster_references;
-  if (std::any_of(rows.begin(), rows.end(),
-                  [](const Row& row) { return row.compositor == Compositor::kRaster; })) {
-    RenderSettings raster_rule = reference_settings;
-    raster_rule.compositor = Compositor::kRaster;
-    for (size_t v = 0; v < options.views.size(); ++v) {
-      raster_references.push_back(render_reference(scene, options.views[v], raster_rule));
-      step("float64 reference's raster rule, " + options.view_names[v]);
-    }
-  }
+  // The references: the views', the path's, the turned pair's, the raster rule's.
+  References refs = render_references(scene, options, path, reference_settings, step);
+  measure_reference_path(report, refs.path, path);
+  if (!turned.empty()) measure_reference_consistency(report, scene, turned, reference_settings, step);
+  refs.raster = render_raster_references(scene, options, rows, reference_settings, step);
 
   renderer.set_scene(scene);
-  for (const Row& row : rows) {
-    const AccuracyModes& m = row.modes;
-    ModeResult result;
-    result.modes = m;
-    result.compositor = row.compositor;
-    result.name = row_name(row);
-    result.psnr_vs_sorted_db = std::numeric_limits<double>::quiet_NaN();
-    result.psnr_vs_rule_db = std::numeric_limits<double>::quiet_NaN();
-    RenderSettings settings;
-    settings.sort = options.sort;
-    settings.depth = false;
-    settings.splat_count = false;
-    settings.accuracy = m;
-    settings.compositor = row.compositor;
-    settings.reuse_lists = false;  // the repeats time whole frames, not the composite on reused lists
-    double psnr_vs_sorted_sum = 0, psnr_vs_rule_sum = 0, psnr_vs_ray_order_sum = 0;
-    std::vector<double> sorted_ms_per_view;
-
-    std::vector<double> frame_ms_per_view;
-    std::map<std::string, std::vector<double>> pass_ms_per_view;
-    std::vector<std::string> pass_order;
-    double psnr_sum = 0, ssim_sum = 0;
-    for (size_t v = 0; v < options.views.size(); ++v) {
-      RenderImage image;
-      std::vector<double> frames;
-      std::map<std::string, std::vector<double>> passes;
-      for (int r = 0; r < options.warmup + options.repeat; ++r) {
-        image = renderer.render(options.views[v], settings);
-        const FrameStats& stats = renderer.last_frame_stats();
-        if (r >= options.warmup) {
-          frames.push_back(stats.gpu_ms);
-          // A pass recorded several times a frame counts once, with its total.
-          std::map<std::string, double> frame_passes;
-          for (const auto& pass : stats.passes) {
-            if (std::find(pass_order.begin(), pass_order.end(), pass.name) == pass_order.end())
-              pass_order.push_back(pass.name);
-            frame_passes[pass.name] += pass.gpu_ms;
-          }
-          for (const auto& [name, ms] : frame_passes) passes[name].push_back(ms);
-        }
-        if (v == 0) result.intersections = stats.intersections;
-        step(result.name + ", " + options.view_names[v]);
-      }
-      frame_ms_per_view.push_back(cli::median(frames));
-      for (const auto& [name, samples] : passes) pass_ms_per_view[name].push_back(cli::median(samples));
-      if (row.compositor != Compositor::kSorted) {  // the sorted compositor's frames, timed alike
-        RenderSettings sorted = settings;
-        sorted.compositor = Compositor::kSorted;
-        // fp16-blend is the raster's attachment format; the sorted compositor blends in float32.
-        sorted.accuracy.fp16_blend = false;
-        RenderImage sorted_image;
-        std::vector<double> sorted_frames;
-        for (int r = 0; r < options.warmup + options.repeat; ++r) {
-          sorted_image = renderer.render(options.views[v], sorted);
-          if (r >= options.warmup) sorted_frames.push_back(renderer.last_frame_stats().gpu_ms);
-          step(result.name + ", the sorted compositor's frame, " + options.view_names[v]);
-        }
-        sorted_ms_per_view.push_back(cli::median(sorted_frames));
-        psnr_vs_sorted_sum += compare_images(image, sorted_image).psnr_db;
-      }
-      if (row.compositor == Compositor::kRaster)
-        psnr_vs_rule_sum += compare_images(image, raster_references[v]).psnr_db;
-      if (ray_order_references.size() == options.views.size())
-        psnr_vs_ray_order_sum += compare_images(image, ray_order_references[v]).psnr_db;
-      const ImageDifference difference = compare_images(image, references[v]);
-      psnr_sum += difference.psnr_db;
-      ssim_sum += ssim(image, references[v]);
-      result.max_abs = std::max(result.max_abs, difference.max_abs);
-    }
-    result.frame_ms = cli::median(frame_ms_per_view);
-    for (const auto& name : pass_order) result.passes.push_back({name, cli::median(pass_ms_per_view[name])});
-    result.psnr_db = psnr_sum / double(options.views.size());
-    if (row.compositor != Compositor::kSorted) {
-      result.psnr_vs_sorted_db = psnr_vs_sorted_sum / double(options.views.size());
-      result.sorted_frame_ms = cli::median(sorted_ms_per_view);
-    }
-    if (row.compositor == Compositor::kRaster)
-      result.psnr_vs_rule_db = psnr_vs_rule_sum / double(options.views.size());
-    result.psnr_vs_ray_order_db = ray_order_references.size() == options.views.size()
-                                      ? psnr_vs_ray_order_sum / double(options.views.size())
-                                      : std::numeric_limits<double>::quiet_NaN();
-    result.ssim = ssim_sum / double(options.views.size());
-
-    // The path with each frame's depth (the timed frames leave it out).
-    RenderSettings path_settings = settings;
-    path_settings.depth = true;
-    std::vector<RenderImage> frames;
-    for (size_t f = 0; f < path.size(); ++f) {
-      frames.push_back(renderer.render(path[f], path_settings));
-      step(result.name + ", path frame " + std::to_string(f));
-    }
-    for (size_t f = 1; f < frames.size(); ++f) {
-      const double pairs = double(frames.size() - 1);
-      result.frame_change += frame_change(frames[f - 1], frames[f]) / pairs;
-      result.flicker += flicker_of(frames[f - 1], frames[f]) / pairs;
-      result.excess +=
-          temporal_excess(frames[f - 1], frames[f], path_references[f - 1], path_references[f]).mean_abs / pairs;
-    }
-    for (size_t f = 2; f < frames.size(); ++f) {
-      const TemporalDifference pops = popping(frames[f - 2], frames[f - 1], frames[f], kFlickerThreshold);
-      result.pops += pops.flicker_fraction / double(frames.size() - 2);
-      result.pop_mean += pops.mean_abs / double(frames.size() - 2);
-    }
-    for (size_t f = 1; f < frames.size(); ++f) {
-      const TemporalDifference warped = warp_of(frames, f);
-      result.warp_pops_per_step.push_back(warped.flicker_fraction);
-      result.warp_pops += warped.flicker_fraction / double(frames.size() - 1);
-      result.warp_mean += warped.mean_abs / double(frames.size() - 1);
-    }
-    if (!turned.empty()) {
-      std::vector<RenderImage> pair;
-      for (size_t f = 0; f < turned.size(); ++f) {
-        pair.push_back(renderer.render(turned[f], settings));
-        step(result.name + ", turned view " + std::to_string(f));
-      }
-      const TemporalDifference inconsistency = inconsistency_of(pair[0], pair[1]);
-      result.inconsistency = inconsistency.flicker_fraction;
-      result.inconsistency_mean = inconsistency.mean_abs;
-    }
-    report.modes.push_back(std::move(result));
-  }
+  for (const Row& row : rows)
+    report.modes.push_back(measure_row(renderer, row, options, refs, path, turned, step));
   return report;
 }
 
