@@ -408,36 +408,10 @@ int merge(const RenderOptions& options) {
   return cli::kExitOk;
 }
 
-int run(int argc, char** argv) {
-  cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
-  RenderOptions options;
-  cli::ArgParser parser(kProgram, kUsage, kDescription);
-  add_render_options(parser, options);
-  if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
-  if (parser.seen("--merge-manifests")) return merge(options);
-  check_render_flags(parser, options);
-  const bool sequence = renders_sequence(parser);
-  if (options.reference) {
-    for (const char* gpu_flag : {"--device", "--validation", "--sort", "--mode"})
-      if (parser.seen(gpu_flag))
-        cli::print_warning(kProgram, std::string(gpu_flag) + " has no effect with --reference (CPU renderer)");
-  }
-  const cli::Shard shard =
-      sequence ? cli::resolve_shard(options.shard, options.shard_count, environment) : cli::Shard{};
-  cli::check_output_path(sequence ? cli::frame_file("-o", options.output, 0) : options.output, "-o");
-  if (!options.png.empty())
-    cli::check_output_path(sequence ? cli::frame_file("--png", options.png, 0) : options.png, "--png");
-
-  // The GPU renderer takes a scene file's models as placed copies of their files, and merges them only
-  // when their frame fits the device (FrameRenderer::decide_holding); the reference merges them at load
-  // unless some move (each time of a shutter places them anew).
-  const cli::SceneHolding holding =
-      !options.reference ? cli::SceneHolding::kInstances : cli::SceneHolding::kInstancesIfMoving;
-  const cli::PartReading reading =
-      options.read_in_parts ? cli::PartReading::kInParts : cli::PartReading::kInPartsWhenLarge;
-  cli::LoadedScene loaded = sequence ? cli::load_scene_file(options.common.scene, options.common.strict,
-                                                            kProgram, holding, options.common.lod, reading)
-                                     : cli::load_scene_and_camera(options.common, kProgram, holding, reading);
+// The frames to render: the one view, or the sequence's (each camera in the --camera-model asked for), with
+// the scene effects reshaped by the flags.
+std::vector<Frame> plan_frames(const cli::ArgParser& parser, const RenderOptions& options,
+                               const cli::LoadedScene& loaded, bool sequence) {
   std::vector<Frame> frames;
   if (sequence) {
     frames = plan_sequence(parser, options, loaded);
@@ -462,7 +436,14 @@ int run(int argc, char** argv) {
       frame.shutter.end_camera = cli::camera_for_frame(options.camera_model, *frame.shutter.end_camera);
   }
   reshape_scene_effects(parser, options, frames);
+  return frames;
+}
 
+// The frames' RenderSettings: the scene file's, the flags over them. Every frame's image must hold the
+// --region, checked before anything renders.
+tilesplat::RenderSettings render_settings(const cli::ArgParser& parser, const RenderOptions& options,
+                                          const cli::LoadedScene& loaded, const std::vector<Frame>& frames,
+                                          bool sequence) {
   tilesplat::RenderSettings settings;
   if (!options.common.sorts.empty()) settings.sort = options.common.sorts.front();
   if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
@@ -473,7 +454,7 @@ int run(int argc, char** argv) {
   if (options.no_count) settings.splat_count = false;
   settings.memory_budget = options.memory_budget;
   settings.region = options.region;
-  for (const Frame& frame : frames) {  // every frame's image must hold the region, before any renders
+  for (const Frame& frame : frames) {
     try {
       tilesplat::validate(options.region, frame.camera.width, frame.camera.height);
     } catch (const std::invalid_argument& error) {
@@ -488,6 +469,19 @@ int run(int argc, char** argv) {
     settings.stochastic.frames = static_cast<uint32_t>(options.stochastic_frames);
   }
   settings.stochastic.sampler = options.stochastic_sampler;
+  // A scene file's lens and shutter: the view's own for one frame; for many, each frame's view has its own.
+  if (!sequence) {
+    settings.lens = frames.front().lens;
+    settings.shutter = frames.front().shutter;
+  }
+  return settings;
+}
+
+// How the frames are written: the EXR's channels, compression, colour and attributes (the command line,
+// the scene and its hash, the settings), and the PNG preview's grading (the scene file's, the flags over it).
+FrameWriter frame_writer(const cli::ArgParser& parser, const RenderOptions& options,
+                         const cli::LoadedScene& loaded, const tilesplat::RenderSettings& settings,
+                         const std::vector<Frame>& frames, bool sequence, int argc, char** argv) {
   FrameWriter writer;
   if (loaded.description) {
     writer.preview.exposure_stops = loaded.description->effects.exposure_stops;
@@ -506,11 +500,6 @@ int run(int argc, char** argv) {
   writer.exr.opaque_alpha = settings.background != std::array<float, 3>{0, 0, 0};
   writer.exr.attributes["scene"] = loaded.path.string();
   writer.exr.attributes["sceneSha256"] = cli::sha256_file_hex(loaded.path);
-  // A scene file's lens and shutter: the view's own for one frame; for many, each frame's view has its own.
-  if (!sequence) {
-    settings.lens = frames.front().lens;
-    settings.shutter = frames.front().shutter;
-  }
   writer.exr.attributes["renderSettings"] =
       settings_text(settings, options.lens, options.shutter, loaded.lod);
   if (sequence && !options.lens.enabled() &&
@@ -527,19 +516,12 @@ int run(int argc, char** argv) {
         (parser.seen("--sample-pattern")
              ? ", pattern:" + std::string(tilesplat::sample_pattern_name(options.shutter.pattern))
              : "");
+  return writer;
+}
 
-  if (sequence) {
-    // Everything besides the camera that makes two runs' files differ, for the manifest.
-    std::string settings_line = writer.exr.attributes["renderSettings"] +
-                                " exr=" + (options.half ? "half" : "float") + "," +
-                                tilesplat::to_string(options.compression) + "," +
-                                tilesplat::to_string(options.exr_colour) + (writer.exr.alpha ? ",A" : "") +
-                                (settings.depth ? ",Z" : "") + (settings.splat_count ? ",splats" : "");
-    if (!options.png.empty()) settings_line += " png=" + png_settings_text(writer.preview);
-    return render_sequence(options, frames, shard, loaded, settings, writer, settings_line);
-  }
-
-  const Frame& frame = frames.front();
+// One frame rendered and written, with its statistics (--stats) and a line of summary on stderr.
+int render_frame(const RenderOptions& options, const cli::LoadedScene& loaded, const Frame& frame,
+                 const tilesplat::RenderSettings& settings, FrameWriter& writer) {
   FrameRenderer renderer(options, loaded);
   writer.exr.attributes["sortStrategy"] = renderer.sort_strategy(settings);
   const tilesplat::RenderImage image = renderer.render(frame.camera, settings);
@@ -576,6 +558,50 @@ int run(int argc, char** argv) {
       loaded.camera_description + ", " + timing + " -> " + written + "\n";
   std::fputs(summary.c_str(), stderr);
   return cli::kExitOk;
+}
+
+int run(int argc, char** argv) {
+  cli::load_sort_plugins(argc, argv);  // before the parser lists and checks the sort names
+  RenderOptions options;
+  cli::ArgParser parser(kProgram, kUsage, kDescription);
+  add_render_options(parser, options);
+  if (cli::parse_and_handle_info_flags(parser, argc, argv, options.common)) return cli::kExitOk;
+  if (parser.seen("--merge-manifests")) return merge(options);
+  check_render_flags(parser, options);
+  const bool sequence = renders_sequence(parser);
+  if (options.reference) {
+    for (const char* gpu_flag : {"--device", "--validation", "--sort", "--mode"})
+      if (parser.seen(gpu_flag))
+        cli::print_warning(kProgram,
+                           std::string(gpu_flag) + " has no effect with --reference (CPU renderer)");
+  }
+  const cli::Shard shard =
+      sequence ? cli::resolve_shard(options.shard, options.shard_count, environment) : cli::Shard{};
+  cli::check_output_path(sequence ? cli::frame_file("-o", options.output, 0) : options.output, "-o");
+  if (!options.png.empty())
+    cli::check_output_path(sequence ? cli::frame_file("--png", options.png, 0) : options.png, "--png");
+
+  // The GPU renderer takes a scene file's models as placed copies of their files, and merges them only
+  // when their frame fits the device (FrameRenderer::decide_holding); the reference merges them at load
+  // unless some move (each time of a shutter places them anew).
+  const cli::SceneHolding holding =
+      !options.reference ? cli::SceneHolding::kInstances : cli::SceneHolding::kInstancesIfMoving;
+  const cli::PartReading reading =
+      options.read_in_parts ? cli::PartReading::kInParts : cli::PartReading::kInPartsWhenLarge;
+  cli::LoadedScene loaded = sequence ? cli::load_scene_file(options.common.scene, options.common.strict,
+                                                            kProgram, holding, options.common.lod, reading)
+                                     : cli::load_scene_and_camera(options.common, kProgram, holding, reading);
+  const std::vector<Frame> frames = plan_frames(parser, options, loaded, sequence);
+  const tilesplat::RenderSettings settings = render_settings(parser, options, loaded, frames, sequence);
+  FrameWriter writer = frame_writer(parser, options, loaded, settings, frames, sequence, argc, argv);
+  if (!sequence) return render_frame(options, loaded, frames.front(), settings, writer);
+  // Everything besides the camera that makes two runs' files differ, for the manifest.
+  std::string settings_line =
+      writer.exr.attributes["renderSettings"] + " exr=" + (options.half ? "half" : "float") + "," +
+      tilesplat::to_string(options.compression) + "," + tilesplat::to_string(options.exr_colour) +
+      (writer.exr.alpha ? ",A" : "") + (settings.depth ? ",Z" : "") + (settings.splat_count ? ",splats" : "");
+  if (!options.png.empty()) settings_line += " png=" + png_settings_text(writer.preview);
+  return render_sequence(options, frames, shard, loaded, settings, writer, settings_line);
 }
 
 }  // namespace
