@@ -34,34 +34,45 @@ std::vector<size_t> pareto_front(const std::vector<ScatterPoint>& points, bool y
   return front;
 }
 
-std::string scatter_svg(const ScatterChart& chart) {
-  constexpr double kHeight = 560;
-  constexpr double kRadius = 5;
-  constexpr double kLabelGap = 4;     // between a circle and its label
-  constexpr double kLineHeight = 14;  // one step of a label's nudge
-  constexpr double kAscent = 10;      // of a label above its baseline, and its descent below
-  constexpr double kDescent = 3;
-  const std::string pareto_style =
-      "fill=\"none\" stroke=\"#555\" stroke-width=\"1.5\" stroke-dasharray=\"6 4\"";
+namespace {
 
-  // The points with a place on the x axis; y values without one are clamped below.
-  std::vector<size_t> drawn;
-  std::vector<ScatterPoint> drawn_points;
-  std::vector<double> xs;
-  std::vector<double> ys;
-  for (size_t i = 0; i < chart.points.size(); ++i) {
-    const ScatterPoint& point = chart.points[i];
-    if (!usable(point.x, chart.x_scale)) continue;
-    drawn.push_back(i);
-    drawn_points.push_back(point);
-    xs.push_back(point.x);
-    if (usable(point.y, chart.y_scale)) ys.push_back(point.y);
+constexpr double kHeight = 560;
+constexpr double kRadius = 5;
+constexpr double kLabelGap = 4;     // between a circle and its label
+constexpr double kLineHeight = 14;  // one step of a label's nudge
+constexpr double kAscent = 10;      // of a label above its baseline, and its descent below
+constexpr double kDescent = 3;
+// The band past the axis's end where a y without a place on the axis goes.
+constexpr double kBand = 24;
+const char* const kParetoStyle =
+    "fill=\"none\" stroke=\"#555\" stroke-width=\"1.5\" stroke-dasharray=\"6 4\"";
+
+// A drawn point: its circle, its label (with the note of a clamped y) and where the label went.
+struct Placed {
+  double cx = 0;
+  double cy = 0;
+  std::string label;
+  bool on_front = false;
+  double label_x = 0;
+  double baseline = 0;
+  bool label_right = true;
+};
+
+struct Box {
+  double x0, y0, x1, y1;
+  bool overlaps(const Box& other) const {
+    return x0 < other.x1 && other.x0 < x1 && y0 < other.y1 && other.y0 < y1;
   }
+};
 
-  const double width = std::max(kMinWidth, title_width(chart.title, chart.subtitle));
-  std::string out;
+// The legend line under the titles, and the plot area below it with its axes (and, for y values without a
+// place on the axis, bands past the axis's ends: +inf at the top, whose tick reads infinity, and the rest at
+// the bottom, not onto an end tick where they would read as that value).
+PlotArea draw_frame(std::string& out, const ScatterChart& chart,
+                    const std::vector<ScatterPoint>& drawn_points, const std::vector<double>& xs,
+                    const std::vector<double>& ys, double width) {
   const double legend_y = draw_titles(out, chart.title, chart.subtitle) + 8;
-  out += "<g class=\"legend\">\n" + line(kMargin, legend_y, kMargin + 26, legend_y, pareto_style);
+  out += "<g class=\"legend\">\n" + line(kMargin, legend_y, kMargin + 26, legend_y, kParetoStyle);
   out += text(kMargin + 32, legend_y + 4,
               std::string("Pareto front: no other point is both left of and ") +
                   (chart.y_higher_is_better ? "above" : "below") + " it (outlined)",
@@ -75,9 +86,6 @@ std::string scatter_svg(const ScatterChart& chart) {
   area.bottom = kHeight - kMargin - 40;
   area.x_axis = make_axis(chart.x_scale, xs);
   area.y_axis = chart.y_scale == Scale::kLinear ? make_range_axis(ys) : make_axis(chart.y_scale, ys);
-  // A y without a place on the axis goes on a band past the axis's end, not onto its end tick where
-  // it would read as that value: +inf at the top, whose tick reads infinity, and the rest at the bottom.
-  constexpr double kBand = 24;
   bool infinite_y = false;
   bool other_unusable_y = false;
   for (const ScatterPoint& point : drawn_points) {
@@ -94,18 +102,14 @@ std::string scatter_svg(const ScatterChart& chart) {
     out += line(area.left, area.top, area.right, area.top, "stroke=\"#e3e3e3\" stroke-dasharray=\"2 3\"");
     out += text(area.left - 8, area.top + 4, "\u221E", "class=\"tick-label\" text-anchor=\"end\"");
   }
+  return area;
+}
 
-  struct Placed {
-    double cx = 0;
-    double cy = 0;
-    std::string label;  // with the note of a clamped y
-    bool on_front = false;
-    double label_x = 0;
-    double baseline = 0;
-    bool label_right = true;
-  };
-  std::vector<Placed> placed(drawn.size());
-  for (size_t d = 0; d < drawn.size(); ++d) {
+// Each point's circle on the area, a y without a place on the axis on its band with a note in its label.
+std::vector<Placed> place_points(const ScatterChart& chart, const std::vector<ScatterPoint>& drawn_points,
+                                 const PlotArea& area) {
+  std::vector<Placed> placed(drawn_points.size());
+  for (size_t d = 0; d < drawn_points.size(); ++d) {
     const ScatterPoint& point = drawn_points[d];
     Placed& p = placed[d];
     p.cx = area.px(point.x);
@@ -120,18 +124,13 @@ std::string scatter_svg(const ScatterChart& chart) {
       p.label += " (y = " + data_number(point.y) + ")";
     }
   }
-  const std::vector<size_t> front = pareto_front(drawn_points, chart.y_higher_is_better);
-  for (const size_t d : front) placed[d].on_front = true;
+  return placed;
+}
 
-  // Labels, top to bottom: beside the point on the right, else on the left where the right would
-  // leave the chart, else moved down or up a line at a time until they clear the labels placed so
-  // far and every circle. A crowded chart may still overlap; it stays readable in the tooltips.
-  struct Box {
-    double x0, y0, x1, y1;
-    bool overlaps(const Box& other) const {
-      return x0 < other.x1 && other.x0 < x1 && y0 < other.y1 && other.y0 < y1;
-    }
-  };
+// Labels, top to bottom: beside the point on the right, else on the left where the right would leave the
+// chart, else moved down or up a line at a time until they clear the labels placed so far and every circle.
+// A crowded chart may still overlap; it stays readable in the tooltips.
+void place_labels(std::vector<Placed>& placed, const PlotArea& area, double width) {
   std::vector<Box> obstacles;
   for (const Placed& p : placed)
     obstacles.push_back({p.cx - kRadius, p.cy - kRadius, p.cx + kRadius, p.cy + kRadius});
@@ -181,14 +180,19 @@ std::string scatter_svg(const ScatterChart& chart) {
       p.label_right = fallback_right;
     }
   }
+}
 
-  out += "<g class=\"points\">\n";
+// The Pareto front's line, the leaders of moved labels, the circles (with their data and tooltips), the
+// labels.
+std::string draw_points(const ScatterChart& chart, const std::vector<ScatterPoint>& drawn_points,
+                        const std::vector<Placed>& placed, const std::vector<size_t>& front) {
+  std::string out = "<g class=\"points\">\n";
   std::string coordinates;
   for (const size_t d : front) {
     if (!coordinates.empty()) coordinates += ' ';
     coordinates += num(placed[d].cx) + "," + num(placed[d].cy);
   }
-  out += "<polyline class=\"pareto\" points=\"" + coordinates + "\" " + pareto_style + "/>\n";
+  out += "<polyline class=\"pareto\" points=\"" + coordinates + "\" " + kParetoStyle + "/>\n";
   // A label moved off its point's line gets a leader back to it.
   for (const Placed& p : placed)
     if (std::fabs(p.baseline - (p.cy + 4)) > 0.5)
@@ -214,6 +218,30 @@ std::string scatter_svg(const ScatterChart& chart) {
                     "\" text-anchor=\"" + (p.label_right ? "start" : "end") + "\"");
   }
   out += "</g>\n";
+  return out;
+}
+
+}  // namespace
+
+std::string scatter_svg(const ScatterChart& chart) {
+  // The points with a place on the x axis; y values without one are clamped below.
+  std::vector<ScatterPoint> drawn_points;
+  std::vector<double> xs;
+  std::vector<double> ys;
+  for (const ScatterPoint& point : chart.points) {
+    if (!usable(point.x, chart.x_scale)) continue;
+    drawn_points.push_back(point);
+    xs.push_back(point.x);
+    if (usable(point.y, chart.y_scale)) ys.push_back(point.y);
+  }
+  const double width = std::max(kMinWidth, title_width(chart.title, chart.subtitle));
+  std::string out;
+  const PlotArea area = draw_frame(out, chart, drawn_points, xs, ys, width);
+  std::vector<Placed> placed = place_points(chart, drawn_points, area);
+  const std::vector<size_t> front = pareto_front(drawn_points, chart.y_higher_is_better);
+  for (const size_t d : front) placed[d].on_front = true;
+  place_labels(placed, area, width);
+  out += draw_points(chart, drawn_points, placed, front);
   return document_open(width, kHeight) + out + "</svg>\n";
 }
 
