@@ -179,6 +179,38 @@ TEST(FramePlan, CarriesWhatTheRecorderNeedsOfTheSettings) {
   EXPECT_FALSE(plan_frame(camera(), hosted, context()).host.exact_depth_order) << "sorted by distance";
 }
 
+// Whether the composite keeps per-pixel state between its dispatches is the plan's to say, from the
+// dispatches the last frame left (FrameContext::composite_chunks) or a re-run's.
+TEST(FramePlan, DecidesTheCompositeState) {
+  FrameContext c = context();
+  const FramePlan one = plan_frame(camera(), {}, c);
+  EXPECT_EQ(one.composite_chunks, 1u);
+  EXPECT_FALSE(one.composite_state);
+  const FramePlan rerun = composite_only(one, 3);
+  EXPECT_EQ(rerun.composite_chunks, 3u);
+  EXPECT_TRUE(rerun.composite_state) << "chunks carry their pixels' state";
+  EXPECT_EQ(composite_only(rerun).composite_chunks, 3u) << "0 keeps the plan's";
+  c.composite_chunks = 2;
+  EXPECT_TRUE(plan_frame(camera(), {}, c).composite_state);
+  c.composite_chunks = 1;
+  c.part = ScenePart{0, false};
+  EXPECT_TRUE(plan_frame(camera(), {}, c).composite_state) << "the next part goes on from these pixels";
+  c.part = {};
+  RenderSettings raster;
+  raster.compositor = Compositor::kRaster;
+  c.composite_chunks = 4;
+  EXPECT_FALSE(plan_frame(camera(), raster, c).composite_state) << "the hardware blends";
+  c.composite_chunks = 1;
+  RenderSettings stochastic;
+  stochastic.compositor = Compositor::kStochastic;
+  stochastic.stochastic.frames = 1;
+  EXPECT_FALSE(plan_frame(camera(), stochastic, c).composite_state);
+  stochastic.stochastic.accumulate = true;
+  EXPECT_TRUE(plan_frame(camera(), stochastic, c).composite_state) << "frames that add up across calls";
+  stochastic.stochastic = {};
+  EXPECT_TRUE(plan_frame(camera(), stochastic, c).composite_state) << "16 samples summed";
+}
+
 TEST(FramePlan, ListsAreReusedOnlyWhenEverythingTheyDependOnIsEqual) {
   FrameContext c = context();
   const Camera cam = camera();

@@ -70,7 +70,8 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
                              depth_image,
                              part,
                              samples_before,
-                             accumulator.stochastic_frames_before(settings)};
+                             accumulator.stochastic_frames_before(settings),
+                             recorder.composite_chunks(settings.compositor)};
   start.plan = plan_frame(camera, settings, context);
   resources.prepare_outputs(start.plan, settings.host);
   // The sums are this frame's now, and the next frame's once it completes.
@@ -132,7 +133,7 @@ FramePlan Renderer::Impl::render_frame(const Camera& camera, const RenderSetting
     chunks = needed;
     // The composite alone, which starts the mean of accumulated stochastic frames anew: the first
     // attempt added to the sums already.
-    const FramePlan again = composite_only(plan);
+    const FramePlan again = composite_only(plan, chunks);
     start.sums.stochastic.frames = again.stochastic_first_sample + again.stochastic_samples;
     frame = run_frame(again, sorter, depth_image);
     stats.retries = retry;

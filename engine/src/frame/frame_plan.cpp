@@ -278,6 +278,27 @@ ProjectionVariant projection_variant(const RenderSettings& settings, const Scene
   return v;
 }
 
+namespace {
+
+// Whether the composite keeps per-pixel state between its dispatches (FrameResources::composite_state):
+// the stochastic one for more than one sample or chunk, or frames that add up across calls; the sorted
+// ones for more than one chunk, or a part of a scene whose pixels go on in the next part; the raster one
+// never (the hardware blends).
+bool needs_composite_state(const FramePlan& plan) {
+  switch (plan.compositor) {
+    case Compositor::kStochastic:
+      return StochasticCompositePass::needs_state(plan.stochastic_samples, plan.composite_chunks) ||
+             plan.stochastic_accumulate;
+    case Compositor::kRaster:
+      return false;
+    case Compositor::kSorted:
+      break;
+  }
+  return plan.composite_chunks > 1 || !plan.part.whole();
+}
+
+}  // namespace
+
 FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const FrameContext& context) {
   check_camera(camera, settings, context.device);
   validate(settings.accuracy);
@@ -348,14 +369,18 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
     plan.sample_sums =
         SampleSums{*context.samples_before, settings.background != std::array<float, 3>{0, 0, 0}};
 
+  plan.composite_chunks = std::max(context.composite_chunks, 1u);
+  plan.composite_state = needs_composite_state(plan);
   plan.passes = frame_passes(plan);
   plan.splits_submissions = splits_submissions(plan);
   return plan;
 }
 
-FramePlan composite_only(FramePlan plan) {
+FramePlan composite_only(FramePlan plan, uint32_t composite_chunks) {
   plan.build_lists = false;
   plan.stochastic_first_sample = 0;
+  if (composite_chunks > 0) plan.composite_chunks = composite_chunks;
+  plan.composite_state = needs_composite_state(plan);
   plan.passes = frame_passes(plan);
   plan.splits_submissions = splits_submissions(plan);
   return plan;

@@ -175,6 +175,11 @@ struct FramePlan {
   // sums stay for the next.
   uint32_t stochastic_first_sample = 0;
   bool stochastic_accumulate = false;
+  // The composite's dispatches per tile list (CompositePass::Chunks: FrameContext::composite_chunks, or a
+  // re-run's, composite_only), and whether it keeps per-pixel state between its dispatches: chunks or
+  // stochastic samples that add up, the parts of a scene in parts, accumulated stochastic frames.
+  uint32_t composite_chunks = 1;
+  bool composite_state = false;
   FrameOutputs outputs;
   HostDepthPlan host;
   std::optional<SampleSums> sample_sums;  // a sample of an accumulated lens or shutter frame
@@ -203,6 +208,9 @@ struct FrameContext {
   // StochasticSettings::accumulate: the stochastic frames in the composite state's sums that this frame
   // continues if it reuses the lists they were rendered on (FrameAccumulator::stochastic_frames_before).
   uint32_t stochastic_frames_before = 0;
+  // The composite's dispatches per tile list for this compositor, as the last frame left them
+  // (FrameRecorder::composite_chunks).
+  uint32_t composite_chunks = 1;
 };
 
 // Validates the camera for this device, the accuracy modes, the compositor's settings and the host
@@ -215,9 +223,10 @@ FramePlan plan_frame(const Camera& camera, const RenderSettings& settings, const
 void validate_scene_parts(const RenderSettings& settings, const std::string& sort_name);
 
 // The same frame's composite alone, on the lists its first attempt built: the re-run of a composite
-// that needed more dispatches than it had (FrameRecorder::composite_chunks). Its first attempt added
-// to any accumulated stochastic sums already, so the re-run starts their mean anew.
-FramePlan composite_only(FramePlan plan);
+// that needed more dispatches than it had (FrameRecorder::composite_chunks), with `composite_chunks` of
+// them (0: as many as the plan had). Its first attempt added to any accumulated stochastic sums already,
+// so the re-run starts their mean anew.
+FramePlan composite_only(FramePlan plan, uint32_t composite_chunks = 0);
 
 // The projection a frame's accuracy modes and effects call for, on a scene of this shape.
 ProjectionVariant projection_variant(const RenderSettings& settings, const SceneShape& scene,

@@ -36,13 +36,7 @@ uint32_t FrameRecorder::chunks_for(Compositor compositor, uint64_t longest_tile_
 }
 
 void FrameRecorder::prepare(const FramePlan& plan, FrameResources& resources, SortStrategy& sorter) {
-  const uint32_t chunks = composite_chunks(plan.compositor);
-  const bool needs_state = plan.compositor == Compositor::kStochastic
-                               ? StochasticCompositePass::needs_state(plan.stochastic_samples, chunks) ||
-                                     plan.stochastic_accumulate
-                           : plan.compositor == Compositor::kRaster ? false
-                                                                    : chunks > 1 || !plan.part.whole();
-  resources.prepare_frame(plan, needs_state);
+  resources.prepare_frame(plan, plan.composite_state);
   if (plan.compositor == Compositor::kRaster)
     raster_composite_.prepare({plan.tiles.width,
                                plan.tiles.height,
@@ -201,12 +195,12 @@ void FrameRecorder::record_composite(Recording& r, FramePass pass) {
         r.stream, inputs,
         {r.plan.stochastic_samples, r.plan.stochastic_seed, r.plan.stochastic_sampler,
          r.plan.stochastic_first_sample, r.plan.stochastic_accumulate},
-        {stochastic_chunks_, res.composite_state, counters});
+        {r.plan.composite_chunks, res.composite_state, counters});
   else if (pass == FramePass::kResortComposite)
     composite_resort_.record(r.stream.cmd(), inputs, res.projected.ray_depth, r.plan.lists.camera,
                              r.plan.resort_window, counters);
   else
-    composite_.record(r.stream.cmd(), inputs, {sorted_chunks_, res.composite_state, counters},
+    composite_.record(r.stream.cmd(), inputs, {r.plan.composite_chunks, res.composite_state, counters},
                       res.host_surface(r.plan.host),
                       {r.plan.part.carries_in(), r.plan.part.carries_out(), r.plan.part.state_high()});
 }

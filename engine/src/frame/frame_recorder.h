@@ -33,22 +33,22 @@ class FrameRecorder {
   // Writes what the projection reads from the host: the lights (validating them; uploading the
   // scene's normals on its first lit frame) and the camera with its near plane. Outside any command
   // buffer; not needed for a frame on reused lists, whose camera and lights are those in the buffers.
-  void set_frame_inputs(const Camera& camera, const Lighting& lighting, double near_plane, const TileGrid& tiles,
-                        SceneBuffers& scene);
+  void set_frame_inputs(const Camera& camera, const Lighting& lighting, double near_plane,
+                        const TileGrid& tiles, SceneBuffers& scene);
   // Sizes the buffers, attachments and scratch the plan's passes use (the outputs it asks for). Outside
   // any command buffer, before record(). The recorder reads the plan and the resources, never the settings:
   // what it needs of them, plan_frame wrote into the plan.
   void prepare(const FramePlan& plan, FrameResources& resources, SortStrategy& sorter);
   // Records the plan's passes (the GPU timer's frame begins with them).
-  void record(vk::CommandStream& stream, const FramePlan& plan, FrameResources& resources, SortStrategy& sorter,
-              const ExternalDepthImage* depth_image);
+  void record(vk::CommandStream& stream, const FramePlan& plan, FrameResources& resources,
+              SortStrategy& sorter, const ExternalDepthImage* depth_image);
   // What the host sees of a frame (render_to_image): its colour in the target's format and, with a
   // depth image and HostDepth::write_depth, the splats' depth.
   void record_copies_to_images(VkCommandBuffer cmd, const FramePlan& plan, FrameResources& resources,
                                const ExternalImage& target, const ExternalDepthImage* depth_image);
 
-  // Dispatches per composite for this compositor (CompositePass::Chunks), as the last frame left it;
-  // and how many a tile list of this length needs.
+  // Dispatches per composite for this compositor (CompositePass::Chunks), as the last frame left it: what
+  // the next plan takes (FrameContext::composite_chunks); and how many a tile list of this length needs.
   uint32_t& composite_chunks(Compositor compositor) {
     return compositor == Compositor::kStochastic ? stochastic_chunks_ : sorted_chunks_;
   }
