@@ -11,7 +11,6 @@
 // Data flows one way; the only host read-back is the counters (and the image) after the fence.
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -24,6 +23,7 @@
 #include "renderer_impl.h"
 #include "settings_checks.h"
 #include "sort/key_sort_run.h"
+#include "vulkan/readback.h"
 
 namespace tilesplat {
 
@@ -188,7 +188,7 @@ void Renderer::Impl::end_frame(const FrameStart& start, const FrameCounters& fra
 // RenderImage::host_depth: the composite's surface view depths in the host's convention, the host's
 // own depth (or its far value) where the splats' alpha never reached the threshold.
 void Renderer::Impl::read_host_depth(const HostDepth& host, std::vector<float>& out, size_t pixels) {
-  read_output(resources.host_surface_depth, out, pixels);
+  vk::read_buffer(ctx, resources.host_surface_depth, out, pixels);
   for (size_t i = 0; i < pixels; ++i) out[i] = host_depth_out(host, out[i], i);
 }
 
@@ -310,9 +310,9 @@ RenderImage Renderer::Impl::read_image(const Camera& camera, const RenderSetting
   image.width = int(resources.outputs.width);
   image.height = int(resources.outputs.height);
   const size_t pixels = image.pixels();
-  read_output(resources.outputs.rgba, image.rgba, pixels * 4);
-  if (settings.depth) read_output(resources.outputs.depth, image.depth, pixels);
-  if (settings.splat_count) read_output(resources.outputs.count, image.splat_count, pixels);
+  vk::read_buffer(ctx, resources.outputs.rgba, image.rgba, pixels * 4);
+  if (settings.depth) vk::read_buffer(ctx, resources.outputs.depth, image.depth, pixels);
+  if (settings.splat_count) vk::read_buffer(ctx, resources.outputs.count, image.splat_count, pixels);
   if (settings.host && settings.host->write_depth) read_host_depth(*settings.host, image.host_depth, pixels);
   return crop(image, tile_aligned(settings.region, camera.width, camera.height),
               resolved_region(settings.region, camera.width, camera.height));

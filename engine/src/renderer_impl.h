@@ -32,7 +32,6 @@
 #include "vulkan/command_stream.h"
 #include "vulkan/context.h"
 #include "vulkan/gpu_timer.h"
-#include "vulkan/readback.h"
 
 namespace tilesplat {
 
@@ -122,9 +121,6 @@ struct Renderer::Impl {
                               const ExternalDepthImage* depth_image);
   void wait_for_submitted_frame();
 
-  // Reads a device buffer back (through a staging buffer unless it is host-visible).
-  template <typename T>
-  void read_output(const vk::Buffer& buffer, std::vector<T>& out, size_t count);
   void read_host_depth(const HostDepth& host, std::vector<float>& out, size_t pixels);
 
   RendererOptions options;
@@ -152,10 +148,5 @@ struct RendererAccess {
     return std::unique_ptr<Renderer>(new Renderer(std::move(impl)));
   }
 };
-
-template <typename T>
-void Renderer::Impl::read_output(const vk::Buffer& buffer, std::vector<T>& out, size_t count) {
-  vk::read_buffer(ctx, buffer, out, count);
-}
 
 }  // namespace tilesplat

@@ -12,12 +12,12 @@
 
 namespace tilesplat {
 
-// Sorts `keys` (only their low key_bits, 1 to 64, may be set) with `sorter`, timing it with `timer`.
-// Throws std::invalid_argument for key_bits out of range, more than 2^31 keys or a key with higher bits.
+// Throws std::invalid_argument for key_bits out of 1..64, more than 2^31 keys or a key with bits above
+// key_bits: what run_key_sort takes, checked before any device work (Renderer::sort_keys).
+void check_sort_keys(const std::vector<uint64_t>& keys, uint32_t key_bits);
+
+// Sorts `keys`, which check_sort_keys accepted, with `sorter`, timing it with `timer`.
 Renderer::SortRun run_key_sort(vk::Context& ctx, vk::GpuTimer& timer, SortStrategy& sorter,
                                const std::vector<uint64_t>& keys, uint32_t key_bits);
-
-// The checks of run_key_sort, on their own: a caller checks before it waits for any device work.
-void check_sort_keys(const std::vector<uint64_t>& keys, uint32_t key_bits);
 
 }  // namespace tilesplat
