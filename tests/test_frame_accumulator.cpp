@@ -6,18 +6,14 @@
 
 #include "frame/frame_accumulator.h"
 #include "frame/frame_plan.h"
+#include "test_support.h"
 
 namespace tilesplat {
 namespace {
 
+// A 64x48 camera at the origin looking down +z.
 Camera camera() {
-  Camera c;
-  c.width = 64;
-  c.height = 48;
-  c.fx = c.fy = 50;
-  c.cx = 32;
-  c.cy = 24;
-  return c;
+  return testing::axis_camera(64, 48, 50);
 }
 
 RenderSettings stochastic(bool accumulate = true) {
