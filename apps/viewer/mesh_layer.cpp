@@ -27,141 +27,57 @@ constexpr float kBoxColours[6][3] = {{0.80f, 0.30f, 0.08f}, {0.70f, 0.25f, 0.06f
 constexpr float kGridColour[3] = {0.0f, 1.0f, 1.0f};
 constexpr int kGridLines = 21;  // each way
 
-bool has_features(VkPhysicalDevice device, VkFormat format, VkFormatFeatureFlags features) {
-  VkFormatProperties properties;
-  vkGetPhysicalDeviceFormatProperties(device, format, &properties);
-  return (properties.optimalTilingFeatures & features) == features;
-}
-
-VkShaderModule make_module(VkDevice vk, const char* name) {
+vk::UniqueShaderModule make_module(VkDevice vk, const char* name) {
   const std::span<const uint32_t> words = shaders::find(name);
   if (words.empty()) throw std::logic_error(std::string("viewer shader not embedded: ") + name);
-  VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  info.codeSize = words.size_bytes();
-  info.pCode = words.data();
-  VkShaderModule module = VK_NULL_HANDLE;
-  vk_check(vkCreateShaderModule(vk, &info, nullptr, &module), "vkCreateShaderModule");
-  return module;
+  return vk::make_shader_module(vk, words);
 }
 
 }  // namespace
 
+// A constructor that throws runs no destructor of its own, but its members' do: whatever was made so far
+// releases itself.
 MeshLayer::MeshLayer(const WindowDevice& device, const Bounds& bounds, uint32_t width, uint32_t height)
     : device_(device), vk_(device.device()), width_(width), height_(height) {
   const double radius = std::max(bounds.radius, 1e-3);
   near_ = 0.01 * radius;
   far_ = 100.0 * radius;
-  const VkPhysicalDevice physical = device.physical_device();
-  if (!has_features(physical, kDepthFormat,
-                    VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT |
-                        VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
+  vk::Context& context = device.context();
+  if (!vk::format_supports(context, kDepthFormat,
+                           VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                               VK_FORMAT_FEATURE_TRANSFER_SRC_BIT | VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
     throw std::runtime_error(device.name() +
                              ": D32_SFLOAT depth buffers are not supported (run with --no-mesh)");
-  if (!has_features(physical, kPictureFormat,
-                    VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT | VK_FORMAT_FEATURE_BLIT_SRC_BIT))
+  if (!vk::format_supports(context, kPictureFormat,
+                           VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT | VK_FORMAT_FEATURE_BLIT_SRC_BIT))
     throw std::runtime_error(device.name() +
                              ": R16G16B16A16_SFLOAT cannot be blended into and blitted (run with "
                              "--no-mesh)");
-  try {
-    picture_ =
-        make_image(kPictureFormat, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                   VK_IMAGE_ASPECT_COLOR_BIT);
-    depth_ = make_image(kDepthFormat,
-                        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                            VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                        VK_IMAGE_ASPECT_DEPTH_BIT);
-    splats_ = make_image(kSplatFormat, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
-                         VK_IMAGE_ASPECT_COLOR_BIT);
-    build_geometry(bounds);
-    create_render_passes();
-    create_pipelines();
-
-    VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-    pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    pool.queueFamilyIndex = device.queue_family();
-    vk_check(vkCreateCommandPool(vk_, &pool, nullptr, &command_pool_), "vkCreateCommandPool");
-    VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    allocate.commandPool = command_pool_;
-    allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    allocate.commandBufferCount = 1;
-    vk_check(vkAllocateCommandBuffers(vk_, &allocate, &box_commands_), "vkAllocateCommandBuffers");
-    vk_check(vkAllocateCommandBuffers(vk_, &allocate, &grid_commands_), "vkAllocateCommandBuffers");
-    VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-    vk_check(vkCreateSemaphore(vk_, &semaphore, nullptr, &box_drawn_), "vkCreateSemaphore");
-    vk_check(vkCreateSemaphore(vk_, &semaphore, nullptr, &splats_drawn_), "vkCreateSemaphore");
-    VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    vk_check(vkCreateFence(vk_, &fence, nullptr, &box_fence_), "vkCreateFence");
-    vk_check(vkCreateFence(vk_, &fence, nullptr, &grid_fence_), "vkCreateFence");
-  } catch (...) {
-    destroy();  // a throwing constructor runs no destructor
-    throw;
-  }
+  picture_ =
+      vk::Image(context, kPictureFormat, width_, height_,
+                VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "the mesh's picture");
+  depth_ = vk::Image(context, kDepthFormat, width_, height_,
+                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                         VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                     "the mesh's depth");
+  splats_ = vk::Image(context, kSplatFormat, width_, height_,
+                      VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, "the splats over black");
+  build_geometry(bounds);
+  create_render_passes();
+  create_pipelines();
+  command_pool_ = vk::make_command_pool(vk_, device.queue_family());
+  box_commands_ = vk::allocate_command_buffer(vk_, command_pool_.get());
+  grid_commands_ = vk::allocate_command_buffer(vk_, command_pool_.get());
+  box_drawn_ = vk::make_semaphore(vk_);
+  splats_drawn_ = vk::make_semaphore(vk_);
+  box_fence_ = vk::make_fence(vk_);
+  grid_fence_ = vk::make_fence(vk_);
 }
 
 MeshLayer::~MeshLayer() {
-  destroy();
-}
-
-void MeshLayer::destroy() {
-  for (auto [fence, pending] : {std::pair{box_fence_, box_pending_}, std::pair{grid_fence_, grid_pending_}})
+  for (auto [fence, pending] :
+       {std::pair{box_fence_.get(), box_pending_}, std::pair{grid_fence_.get(), grid_pending_}})
     if (pending) vkWaitForFences(vk_, 1, &fence, VK_TRUE, std::numeric_limits<uint64_t>::max());
-  for (VkPipeline p : {box_pipeline_, grid_pipeline_, over_pipeline_})
-    if (p) vkDestroyPipeline(vk_, p, nullptr);
-  for (VkPipelineLayout l : {mesh_layout_, over_layout_})
-    if (l) vkDestroyPipelineLayout(vk_, l, nullptr);
-  if (descriptor_pool_) vkDestroyDescriptorPool(vk_, descriptor_pool_, nullptr);
-  if (set_layout_) vkDestroyDescriptorSetLayout(vk_, set_layout_, nullptr);
-  if (sampler_) vkDestroySampler(vk_, sampler_, nullptr);
-  if (framebuffer_) vkDestroyFramebuffer(vk_, framebuffer_, nullptr);
-  for (VkRenderPass p : {box_pass_, over_pass_})
-    if (p) vkDestroyRenderPass(vk_, p, nullptr);
-  if (vertices_) vkDestroyBuffer(vk_, vertices_, nullptr);
-  if (vertex_memory_) vkFreeMemory(vk_, vertex_memory_, nullptr);
-  for (VkSemaphore s : {box_drawn_, splats_drawn_})
-    if (s) vkDestroySemaphore(vk_, s, nullptr);
-  for (VkFence f : {box_fence_, grid_fence_})
-    if (f) vkDestroyFence(vk_, f, nullptr);
-  if (command_pool_) vkDestroyCommandPool(vk_, command_pool_, nullptr);
-  destroy_image(picture_);
-  destroy_image(depth_);
-  destroy_image(splats_);
-}
-
-MeshLayer::Image MeshLayer::make_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect) {
-  Image made;
-  VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-  info.imageType = VK_IMAGE_TYPE_2D;
-  info.format = format;
-  info.extent = {width_, height_, 1};
-  info.mipLevels = 1;
-  info.arrayLayers = 1;
-  info.samples = VK_SAMPLE_COUNT_1_BIT;
-  info.tiling = VK_IMAGE_TILING_OPTIMAL;
-  info.usage = usage;
-  vk_check(vkCreateImage(vk_, &info, nullptr, &made.image), "vkCreateImage (mesh layer)");
-  VkMemoryRequirements requirements;
-  vkGetImageMemoryRequirements(vk_, made.image, &requirements);
-  VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  allocate.allocationSize = requirements.size;
-  allocate.memoryTypeIndex = device_.memory_type(requirements.memoryTypeBits, 0, 0, "the viewer's mesh");
-  const VkResult allocated = vkAllocateMemory(vk_, &allocate, nullptr, &made.memory);
-  if (allocated != VK_SUCCESS) destroy_image(made);
-  vk_check(allocated, "vkAllocateMemory (mesh layer)");
-  vk_check(vkBindImageMemory(vk_, made.image, made.memory, 0), "vkBindImageMemory");
-  VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-  view.image = made.image;
-  view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-  view.format = format;
-  view.subresourceRange = {aspect, 0, 1, 0, 1};
-  vk_check(vkCreateImageView(vk_, &view, nullptr, &made.view), "vkCreateImageView");
-  return made;
-}
-
-void MeshLayer::destroy_image(Image& image) {
-  if (image.view) vkDestroyImageView(vk_, image.view, nullptr);
-  if (image.image) vkDestroyImage(vk_, image.image, nullptr);
-  if (image.memory) vkFreeMemory(vk_, image.memory, nullptr);
-  image = {};
 }
 
 // A cube at the scene's centre, a third of its radius across each way (the scene runs through it),
@@ -199,23 +115,11 @@ void MeshLayer::build_geometry(const Bounds& bounds) {
   }
   grid_vertices_ = uint32_t(vertices.size()) - box_vertices_;
 
-  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  info.size = vertices.size() * sizeof(Vertex);
-  info.usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
-  vk_check(vkCreateBuffer(vk_, &info, nullptr, &vertices_), "vkCreateBuffer (mesh)");
-  VkMemoryRequirements requirements;
-  vkGetBufferMemoryRequirements(vk_, vertices_, &requirements);
-  VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  allocate.allocationSize = requirements.size;
-  allocate.memoryTypeIndex = device_.memory_type(
-      requirements.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-      0, "the viewer's mesh");
-  vk_check(vkAllocateMemory(vk_, &allocate, nullptr, &vertex_memory_), "vkAllocateMemory (mesh)");
-  vk_check(vkBindBufferMemory(vk_, vertices_, vertex_memory_, 0), "vkBindBufferMemory");
-  void* mapped = nullptr;
-  vk_check(vkMapMemory(vk_, vertex_memory_, 0, info.size, 0, &mapped), "vkMapMemory");
-  std::memcpy(mapped, vertices.data(), info.size);
-  vkUnmapMemory(vk_, vertex_memory_);
+  // Host-visible (Upload), so the vertices are written where the device reads them.
+  const VkDeviceSize bytes = vertices.size() * sizeof(Vertex);
+  vertices_ = vk::Buffer(device_.context(), bytes, vk::MemoryUse::Upload, "the mesh's vertices",
+                         VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  std::memcpy(vertices_.mapped(), vertices.data(), bytes);
 }
 
 void MeshLayer::create_render_passes() {
@@ -266,21 +170,23 @@ void MeshLayer::create_render_passes() {
     info.pSubpasses = &subpass;
     info.dependencyCount = 2;
     info.pDependencies = dependencies;
-    vk_check(vkCreateRenderPass(vk_, &info, nullptr, first ? &box_pass_ : &over_pass_), "vkCreateRenderPass");
+    vk::check(vkCreateRenderPass(vk_, &info, nullptr, (first ? box_pass_ : over_pass_).receive(vk_)),
+              "vkCreateRenderPass");
   }
-  const VkImageView views[] = {picture_.view, depth_.view};
+  const VkImageView views[] = {picture_.view(), depth_.view()};
   VkFramebufferCreateInfo framebuffer{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
-  framebuffer.renderPass = box_pass_;  // compatible with over_pass_: same formats, one subpass
+  framebuffer.renderPass = box_pass_.get();  // compatible with over_pass_: same formats, one subpass
   framebuffer.attachmentCount = 2;
   framebuffer.pAttachments = views;
   framebuffer.width = width_;
   framebuffer.height = height_;
   framebuffer.layers = 1;
-  vk_check(vkCreateFramebuffer(vk_, &framebuffer, nullptr, &framebuffer_), "vkCreateFramebuffer");
+  vk::check(vkCreateFramebuffer(vk_, &framebuffer, nullptr, framebuffer_.receive(vk_)),
+            "vkCreateFramebuffer");
 }
 
-VkPipeline MeshLayer::make_pipeline(VkShaderModule vertex, VkShaderModule fragment,
-                                    VkPrimitiveTopology topology, bool mesh, VkRenderPass pass) {
+vk::UniquePipeline MeshLayer::make_pipeline(VkShaderModule vertex, VkShaderModule fragment,
+                                            VkPrimitiveTopology topology, bool mesh, VkRenderPass pass) {
   VkPipelineShaderStageCreateInfo stages[2]{};
   stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
   stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
@@ -342,11 +248,11 @@ VkPipeline MeshLayer::make_pipeline(VkShaderModule vertex, VkShaderModule fragme
   info.pMultisampleState = &multisample;
   info.pDepthStencilState = &depth;
   info.pColorBlendState = &blend_state;
-  info.layout = mesh ? mesh_layout_ : over_layout_;
+  info.layout = (mesh ? mesh_layout_ : over_layout_).get();
   info.renderPass = pass;
-  VkPipeline pipeline = VK_NULL_HANDLE;
-  vk_check(vkCreateGraphicsPipelines(vk_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline),
-           "vkCreateGraphicsPipelines");
+  vk::UniquePipeline pipeline;
+  vk::check(vkCreateGraphicsPipelines(vk_, VK_NULL_HANDLE, 1, &info, nullptr, pipeline.receive(vk_)),
+            "vkCreateGraphicsPipelines");
   return pipeline;
 }
 
@@ -354,26 +260,27 @@ void MeshLayer::create_pipelines() {
   VkSamplerCreateInfo sampler{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   sampler.magFilter = sampler.minFilter = VK_FILTER_NEAREST;
   sampler.addressModeU = sampler.addressModeV = sampler.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-  vk_check(vkCreateSampler(vk_, &sampler, nullptr, &sampler_), "vkCreateSampler");
+  vk::check(vkCreateSampler(vk_, &sampler, nullptr, sampler_.receive(vk_)), "vkCreateSampler");
   VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
                                        VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
   VkDescriptorSetLayoutCreateInfo set_layout{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   set_layout.bindingCount = 1;
   set_layout.pBindings = &binding;
-  vk_check(vkCreateDescriptorSetLayout(vk_, &set_layout, nullptr, &set_layout_),
-           "vkCreateDescriptorSetLayout");
+  vk::check(vkCreateDescriptorSetLayout(vk_, &set_layout, nullptr, set_layout_.receive(vk_)),
+            "vkCreateDescriptorSetLayout");
   const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
   VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool.maxSets = 1;
   pool.poolSizeCount = 1;
   pool.pPoolSizes = &size;
-  vk_check(vkCreateDescriptorPool(vk_, &pool, nullptr, &descriptor_pool_), "vkCreateDescriptorPool");
+  vk::check(vkCreateDescriptorPool(vk_, &pool, nullptr, descriptor_pool_.receive(vk_)),
+            "vkCreateDescriptorPool");
   VkDescriptorSetAllocateInfo allocate{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  allocate.descriptorPool = descriptor_pool_;
+  allocate.descriptorPool = descriptor_pool_.get();
   allocate.descriptorSetCount = 1;
-  allocate.pSetLayouts = &set_layout_;
-  vk_check(vkAllocateDescriptorSets(vk_, &allocate, &splats_set_), "vkAllocateDescriptorSets");
-  const VkDescriptorImageInfo image{sampler_, splats_.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  allocate.pSetLayouts = set_layout_.address();
+  vk::check(vkAllocateDescriptorSets(vk_, &allocate, &splats_set_), "vkAllocateDescriptorSets");
+  const VkDescriptorImageInfo image{sampler_.get(), splats_.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   write.dstSet = splats_set_;
   write.descriptorCount = 1;
@@ -385,29 +292,25 @@ void MeshLayer::create_pipelines() {
   VkPipelineLayoutCreateInfo layout{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   layout.pushConstantRangeCount = 1;
   layout.pPushConstantRanges = &push;
-  vk_check(vkCreatePipelineLayout(vk_, &layout, nullptr, &mesh_layout_), "vkCreatePipelineLayout");
+  vk::check(vkCreatePipelineLayout(vk_, &layout, nullptr, mesh_layout_.receive(vk_)),
+            "vkCreatePipelineLayout");
   layout = {VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   layout.setLayoutCount = 1;
-  layout.pSetLayouts = &set_layout_;
-  vk_check(vkCreatePipelineLayout(vk_, &layout, nullptr, &over_layout_), "vkCreatePipelineLayout");
+  layout.pSetLayouts = set_layout_.address();
+  vk::check(vkCreatePipelineLayout(vk_, &layout, nullptr, over_layout_.receive(vk_)),
+            "vkCreatePipelineLayout");
 
-  VkShaderModule modules[4] = {};
-  try {
-    modules[0] = make_module(vk_, "mesh_transform");
-    modules[1] = make_module(vk_, "flat_colour");
-    modules[2] = make_module(vk_, "fullscreen_triangle");
-    modules[3] = make_module(vk_, "splats_over");
-    box_pipeline_ =
-        make_pipeline(modules[0], modules[1], VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, true, box_pass_);
-    grid_pipeline_ = make_pipeline(modules[0], modules[1], VK_PRIMITIVE_TOPOLOGY_LINE_LIST, true, over_pass_);
-    over_pipeline_ =
-        make_pipeline(modules[2], modules[3], VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, false, over_pass_);
-  } catch (...) {
-    for (VkShaderModule m : modules)
-      if (m) vkDestroyShaderModule(vk_, m, nullptr);
-    throw;
-  }
-  for (VkShaderModule m : modules) vkDestroyShaderModule(vk_, m, nullptr);
+  // The modules are needed only while the pipelines are made.
+  const vk::UniqueShaderModule transform = make_module(vk_, "mesh_transform");
+  const vk::UniqueShaderModule flat = make_module(vk_, "flat_colour");
+  const vk::UniqueShaderModule fullscreen = make_module(vk_, "fullscreen_triangle");
+  const vk::UniqueShaderModule over = make_module(vk_, "splats_over");
+  box_pipeline_ =
+      make_pipeline(transform.get(), flat.get(), VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, true, box_pass_.get());
+  grid_pipeline_ =
+      make_pipeline(transform.get(), flat.get(), VK_PRIMITIVE_TOPOLOGY_LINE_LIST, true, over_pass_.get());
+  over_pipeline_ = make_pipeline(fullscreen.get(), over.get(), VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST, false,
+                                 over_pass_.get());
 }
 
 std::array<double, 16> MeshLayer::view_matrix(const Camera& camera) {
@@ -441,21 +344,22 @@ std::array<double, 16> MeshLayer::projection(const Camera& camera) const {
 }
 
 void MeshLayer::begin(VkCommandBuffer cmd) {
-  vk_check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+  vk::check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  vk_check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+  vk::check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
 }
 
 void MeshLayer::wait_for(VkFence fence, bool& pending) {
   if (!pending) return;
-  vk_check(vkWaitForFences(vk_, 1, &fence, VK_TRUE, std::numeric_limits<uint64_t>::max()), "vkWaitForFences");
+  vk::check(vkWaitForFences(vk_, 1, &fence, VK_TRUE, std::numeric_limits<uint64_t>::max()),
+            "vkWaitForFences");
   pending = false;
 }
 
 void MeshLayer::submit(VkCommandBuffer cmd, VkSemaphore wait, VkSemaphore signal, VkFence fence) {
-  vk_check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-  if (fence) vk_check(vkResetFences(vk_, 1, &fence), "vkResetFences");
+  vk::check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  if (fence) vk::check(vkResetFences(vk_, 1, &fence), "vkResetFences");
   const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
   VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   info.waitSemaphoreCount = wait ? 1 : 0;
@@ -465,7 +369,7 @@ void MeshLayer::submit(VkCommandBuffer cmd, VkSemaphore wait, VkSemaphore signal
   info.pCommandBuffers = &cmd;
   info.signalSemaphoreCount = signal ? 1 : 0;
   info.pSignalSemaphores = &signal;
-  vk_check(vkQueueSubmit(device_.queue(), 1, &info, fence), "vkQueueSubmit (mesh)");
+  vk::check(vkQueueSubmit(device_.queue(), 1, &info, fence), "vkQueueSubmit (mesh)");
 }
 
 bool MeshLayer::depth_testable(const RenderSettings& settings) {
@@ -486,8 +390,8 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
   // those modes the splats are drawn over the background alone, without the mesh.
   const bool mesh = depth_testable(settings);
   // The previous frame's command buffers are free again (the renderer waits for its own frame).
-  wait_for(box_fence_, box_pending_);
-  wait_for(grid_fence_, grid_pending_);
+  wait_for(box_fence_.get(), box_pending_);
+  wait_for(grid_fence_.get(), grid_pending_);
   const std::array<double, 16> projection_matrix = projection(camera);
   const std::array<double, 16> view = view_matrix(camera);
   float clip_from_world[16];
@@ -499,7 +403,7 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
     }
   const VkDeviceSize offset = 0;
   VkRenderPassBeginInfo pass{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-  pass.framebuffer = framebuffer_;
+  pass.framebuffer = framebuffer_.get();
   pass.renderArea = {{0, 0}, {width_, height_}};
 
   // 1. The box, into a cleared picture (the scene's background) and depth buffer.
@@ -507,17 +411,18 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
   VkClearValue clears[2];
   clears[0].color = {{settings.background[0], settings.background[1], settings.background[2], 1.0f}};
   clears[1].depthStencil = {1.0f, 0};
-  pass.renderPass = box_pass_;
+  pass.renderPass = box_pass_.get();
   pass.clearValueCount = 2;
   pass.pClearValues = clears;
   vkCmdBeginRenderPass(box_commands_, &pass, VK_SUBPASS_CONTENTS_INLINE);
-  vkCmdBindPipeline(box_commands_, VK_PIPELINE_BIND_POINT_GRAPHICS, box_pipeline_);
-  vkCmdPushConstants(box_commands_, mesh_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(clip_from_world),
-                     clip_from_world);
-  vkCmdBindVertexBuffers(box_commands_, 0, 1, &vertices_, &offset);
+  vkCmdBindPipeline(box_commands_, VK_PIPELINE_BIND_POINT_GRAPHICS, box_pipeline_.get());
+  vkCmdPushConstants(box_commands_, mesh_layout_.get(), VK_SHADER_STAGE_VERTEX_BIT, 0,
+                     sizeof(clip_from_world), clip_from_world);
+  const VkBuffer vertex_buffer = vertices_.handle();
+  vkCmdBindVertexBuffers(box_commands_, 0, 1, &vertex_buffer, &offset);
   if (mesh) vkCmdDraw(box_commands_, box_vertices_, 1, 0, 0);
   vkCmdEndRenderPass(box_commands_);
-  submit(box_commands_, VK_NULL_HANDLE, box_drawn_, box_fence_);
+  submit(box_commands_, VK_NULL_HANDLE, box_drawn_.get(), box_fence_.get());
   box_pending_ = true;
 
   // 2. The splats, cut by the box's depth and writing theirs where they reach alpha 0.5, over black
@@ -529,11 +434,11 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
                                     {},
                                     depth_out && writes_depth_out(settings),
                                     0.5f};
-  const ExternalImage target{splats_.image, width_, height_, kSplatFormat, VK_IMAGE_LAYOUT_UNDEFINED};
-  const ExternalDepthImage depth{depth_.image, width_, height_, kDepthFormat,
+  const ExternalImage target{splats_.handle(), width_, height_, kSplatFormat, VK_IMAGE_LAYOUT_UNDEFINED};
+  const ExternalDepthImage depth{depth_.handle(), width_, height_, kDepthFormat,
                                  VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
-  const VkSemaphore waits[] = {box_drawn_};
-  const VkSemaphore signals[] = {splats_drawn_};
+  const VkSemaphore waits[] = {box_drawn_.get()};
+  const VkSemaphore signals[] = {splats_drawn_.get()};
   try {
     render_to_image(renderer, camera, splat_settings, target, mesh ? &depth : nullptr,
                     HostFrameSync{waits, {}, {}, signals, {}});
@@ -543,7 +448,7 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
     const VkPipelineStageFlags stage = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
     VkSubmitInfo consume{VK_STRUCTURE_TYPE_SUBMIT_INFO};
     consume.waitSemaphoreCount = 1;
-    consume.pWaitSemaphores = &box_drawn_;
+    consume.pWaitSemaphores = box_drawn_.address();
     consume.pWaitDstStageMask = &stage;
     vkQueueSubmit(device_.queue(), 1, &consume, VK_NULL_HANDLE);
     throw;
@@ -558,25 +463,25 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
   to_sampled.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
   to_sampled.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
   to_sampled.srcQueueFamilyIndex = to_sampled.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_sampled.image = splats_.image;
+  to_sampled.image = splats_.handle();
   to_sampled.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
   vkCmdPipelineBarrier(grid_commands_, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
                        VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1, &to_sampled);
-  pass.renderPass = over_pass_;
+  pass.renderPass = over_pass_.get();
   pass.clearValueCount = 0;
   pass.pClearValues = nullptr;
   vkCmdBeginRenderPass(grid_commands_, &pass, VK_SUBPASS_CONTENTS_INLINE);
-  vkCmdBindPipeline(grid_commands_, VK_PIPELINE_BIND_POINT_GRAPHICS, over_pipeline_);
-  vkCmdBindDescriptorSets(grid_commands_, VK_PIPELINE_BIND_POINT_GRAPHICS, over_layout_, 0, 1, &splats_set_,
-                          0, nullptr);
+  vkCmdBindPipeline(grid_commands_, VK_PIPELINE_BIND_POINT_GRAPHICS, over_pipeline_.get());
+  vkCmdBindDescriptorSets(grid_commands_, VK_PIPELINE_BIND_POINT_GRAPHICS, over_layout_.get(), 0, 1,
+                          &splats_set_, 0, nullptr);
   vkCmdDraw(grid_commands_, 3, 1, 0, 0);
-  vkCmdBindPipeline(grid_commands_, VK_PIPELINE_BIND_POINT_GRAPHICS, grid_pipeline_);
-  vkCmdPushConstants(grid_commands_, mesh_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(clip_from_world),
-                     clip_from_world);
-  vkCmdBindVertexBuffers(grid_commands_, 0, 1, &vertices_, &offset);
+  vkCmdBindPipeline(grid_commands_, VK_PIPELINE_BIND_POINT_GRAPHICS, grid_pipeline_.get());
+  vkCmdPushConstants(grid_commands_, mesh_layout_.get(), VK_SHADER_STAGE_VERTEX_BIT, 0,
+                     sizeof(clip_from_world), clip_from_world);
+  vkCmdBindVertexBuffers(grid_commands_, 0, 1, &vertex_buffer, &offset);
   if (mesh) vkCmdDraw(grid_commands_, grid_vertices_, 1, box_vertices_, 0);
   vkCmdEndRenderPass(grid_commands_);
-  submit(grid_commands_, splats_drawn_, VK_NULL_HANDLE, grid_fence_);
+  submit(grid_commands_, splats_drawn_.get(), VK_NULL_HANDLE, grid_fence_.get());
   grid_pending_ = true;
 }
 

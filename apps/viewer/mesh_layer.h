@@ -15,6 +15,9 @@
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
+#include "vulkan/buffer.h"
+#include "vulkan/handle.h"
+#include "vulkan/image.h"
 #include "window_device.h"
 
 namespace tilesplat::viewer {
@@ -23,7 +26,7 @@ class MeshLayer {
  public:
   // Geometry sized to the scene's bounds; images of `width` x `height`.
   MeshLayer(const WindowDevice& device, const Bounds& bounds, uint32_t width, uint32_t height);
-  ~MeshLayer();
+  ~MeshLayer();  // waits for the layer's submissions; the handles then release themselves
   MeshLayer(const MeshLayer&) = delete;
   MeshLayer& operator=(const MeshLayer&) = delete;
 
@@ -39,7 +42,7 @@ class MeshLayer {
   bool writes_depth_out(const RenderSettings& settings) const;
 
   // The composed picture, R16G16B16A16_SFLOAT in TRANSFER_SRC_OPTIMAL after draw(), for the blit.
-  VkImage picture() const { return picture_.image; }
+  VkImage picture() const { return picture_.handle(); }
   static constexpr VkFormat kPictureFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
   static constexpr VkImageLayout kPictureLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
   uint32_t width() const { return width_; }
@@ -51,51 +54,43 @@ class MeshLayer {
   static std::array<double, 16> view_matrix(const Camera& camera);
 
  private:
-  struct Image {
-    VkImage image = VK_NULL_HANDLE;
-    VkDeviceMemory memory = VK_NULL_HANDLE;
-    VkImageView view = VK_NULL_HANDLE;
-  };
   struct Vertex {
     float position[3];
     float colour[3];
   };
-  Image make_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect);
-  void destroy_image(Image& image);
   void build_geometry(const Bounds& bounds);
   void create_render_passes();
   void create_pipelines();
-  VkPipeline make_pipeline(VkShaderModule vertex, VkShaderModule fragment, VkPrimitiveTopology topology,
-                           bool mesh, VkRenderPass pass);
+  vk::UniquePipeline make_pipeline(VkShaderModule vertex, VkShaderModule fragment,
+                                   VkPrimitiveTopology topology, bool mesh, VkRenderPass pass);
   void begin(VkCommandBuffer cmd);
   // Resets `fence` (when given) and submits `cmd`, after `wait` and signalling `signal` (either may be null).
   void submit(VkCommandBuffer cmd, VkSemaphore wait, VkSemaphore signal, VkFence fence);
   void wait_for(VkFence fence, bool& pending);
-  void destroy();
 
+  // Declared in the order they are made, each after what it refers to: they are destroyed in the reverse one.
   const WindowDevice& device_;
   VkDevice vk_;
   uint32_t width_, height_;
   double near_, far_;  // the mesh's depth range, from the scene's size
-  Image picture_;      // the mesh's colour, then the splats over it and the grid
-  Image depth_;        // D32_SFLOAT: the box's depth, the splats' where dense, the grid's
-  Image splats_;       // what render_to_image writes: the splats' premultiplied RGBA over black
-  VkBuffer vertices_ = VK_NULL_HANDLE;
-  VkDeviceMemory vertex_memory_ = VK_NULL_HANDLE;
+  vk::Image picture_;  // the mesh's colour, then the splats over it and the grid
+  vk::Image depth_;    // D32_SFLOAT: the box's depth, the splats' where dense, the grid's
+  vk::Image splats_;   // what render_to_image writes: the splats' premultiplied RGBA over black
+  vk::Buffer vertices_;
   uint32_t box_vertices_ = 0, grid_vertices_ = 0;
-  VkRenderPass box_pass_ = VK_NULL_HANDLE;   // clears colour and depth
-  VkRenderPass over_pass_ = VK_NULL_HANDLE;  // keeps them, ends with the picture ready to blit
-  VkFramebuffer framebuffer_ = VK_NULL_HANDLE;
-  VkSampler sampler_ = VK_NULL_HANDLE;
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
-  VkDescriptorSet splats_set_ = VK_NULL_HANDLE;
-  VkPipelineLayout mesh_layout_ = VK_NULL_HANDLE, over_layout_ = VK_NULL_HANDLE;
-  VkPipeline box_pipeline_ = VK_NULL_HANDLE, grid_pipeline_ = VK_NULL_HANDLE, over_pipeline_ = VK_NULL_HANDLE;
-  VkCommandPool command_pool_ = VK_NULL_HANDLE;
-  VkCommandBuffer box_commands_ = VK_NULL_HANDLE, grid_commands_ = VK_NULL_HANDLE;
-  VkSemaphore box_drawn_ = VK_NULL_HANDLE, splats_drawn_ = VK_NULL_HANDLE;
-  VkFence box_fence_ = VK_NULL_HANDLE, grid_fence_ = VK_NULL_HANDLE;
+  vk::UniqueRenderPass box_pass_;   // clears colour and depth
+  vk::UniqueRenderPass over_pass_;  // keeps them, ends with the picture ready to blit
+  vk::UniqueFramebuffer framebuffer_;
+  vk::UniqueSampler sampler_;
+  vk::UniqueDescriptorSetLayout set_layout_;
+  vk::UniqueDescriptorPool descriptor_pool_;
+  VkDescriptorSet splats_set_ = VK_NULL_HANDLE;  // from descriptor_pool_, freed with it
+  vk::UniquePipelineLayout mesh_layout_, over_layout_;
+  vk::UniquePipeline box_pipeline_, grid_pipeline_, over_pipeline_;
+  vk::UniqueCommandPool command_pool_;
+  VkCommandBuffer box_commands_ = VK_NULL_HANDLE, grid_commands_ = VK_NULL_HANDLE;  // from command_pool_
+  vk::UniqueSemaphore box_drawn_, splats_drawn_;
+  vk::UniqueFence box_fence_, grid_fence_;
   bool box_pending_ = false, grid_pending_ = false;  // the fences have a submission to wait for
 };
 

@@ -5,20 +5,15 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
-#include "image_readback.h"
+#include "vulkan/buffer.h"
 
 namespace tilesplat::viewer {
 
 namespace {
 
 constexpr VkFormat kFloatFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
-
-bool supports(VkPhysicalDevice device, VkFormat format, VkFormatFeatureFlags features) {
-  VkFormatProperties properties;
-  vkGetPhysicalDeviceFormatProperties(device, format, &properties);
-  return (properties.optimalTilingFeatures & features) == features;
-}
 
 bool is_srgb(VkFormat format) {
   return format == VK_FORMAT_B8G8R8A8_SRGB || format == VK_FORMAT_R8G8B8A8_SRGB;
@@ -37,11 +32,12 @@ VkFormat unencoded_twin(VkFormat format) {
 // same bytes through a copy (Swapchain::present).
 VkSurfaceFormatKHR choose_format(const WindowDevice& device) {
   uint32_t count = 0;
-  vk_check(vkGetPhysicalDeviceSurfaceFormatsKHR(device.physical_device(), device.surface(), &count, nullptr),
-           "vkGetPhysicalDeviceSurfaceFormatsKHR");
+  vk::check(vkGetPhysicalDeviceSurfaceFormatsKHR(device.physical_device(), device.surface(), &count, nullptr),
+            "vkGetPhysicalDeviceSurfaceFormatsKHR");
   std::vector<VkSurfaceFormatKHR> formats(count);
-  vk_check(vkGetPhysicalDeviceSurfaceFormatsKHR(device.physical_device(), device.surface(), &count, formats.data()),
-           "vkGetPhysicalDeviceSurfaceFormatsKHR");
+  vk::check(vkGetPhysicalDeviceSurfaceFormatsKHR(device.physical_device(), device.surface(), &count,
+                                                 formats.data()),
+            "vkGetPhysicalDeviceSurfaceFormatsKHR");
   const char* wanted_kind = std::getenv("TILESPLAT_VIEWER_SWAPCHAIN");
   const bool srgb_first = wanted_kind && std::string(wanted_kind) == "srgb";
   std::vector<VkFormat> preferred = {VK_FORMAT_B8G8R8A8_UNORM, VK_FORMAT_R8G8B8A8_UNORM,
@@ -51,10 +47,11 @@ VkSurfaceFormatKHR choose_format(const WindowDevice& device) {
     for (const VkSurfaceFormatKHR& format : formats) {
       if (format.format != wanted) continue;
       // An _SRGB image is written by a copy from its twin, which the blit writes.
-      const bool usable = is_srgb(wanted)
-                              ? supports(device.physical_device(), unencoded_twin(wanted),
-                                         VK_FORMAT_FEATURE_BLIT_DST_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT)
-                              : supports(device.physical_device(), wanted, VK_FORMAT_FEATURE_BLIT_DST_BIT);
+      const bool usable =
+          is_srgb(wanted)
+              ? vk::format_supports(device.context(), unencoded_twin(wanted),
+                                    VK_FORMAT_FEATURE_BLIT_DST_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT)
+              : vk::format_supports(device.context(), wanted, VK_FORMAT_FEATURE_BLIT_DST_BIT);
       if (usable) return format;
     }
   throw std::runtime_error(device.name() + ": the window offers no 8-bit RGBA format that a blit can write");
@@ -95,54 +92,19 @@ std::string format_name(VkFormat format) {
 // ---------------------------------------------------------------------------------------------
 // TransferImage, FloatImage
 
+// Device-local (the engine's images are): where a device keeps optimal-tiling images.
 TransferImage::TransferImage(const WindowDevice& device, VkFormat format, VkFormatFeatureFlags features,
-                             VkImageLayout layout, uint32_t width, uint32_t height)
-    : device_(device.device()), width_(width), height_(height) {
-  if (!supports(device.physical_device(), format, features))
+                             VkImageLayout layout, uint32_t width, uint32_t height) {
+  if (!vk::format_supports(device.context(), format, features))
     throw std::runtime_error(device.name() + ": images of " + format_name(format) +
                              " cannot be blitted or copied as the viewer needs");
-  VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-  info.imageType = VK_IMAGE_TYPE_2D;
-  info.format = format;
-  info.extent = {width, height, 1};
-  info.mipLevels = 1;
-  info.arrayLayers = 1;
-  info.samples = VK_SAMPLE_COUNT_1_BIT;
-  info.tiling = VK_IMAGE_TILING_OPTIMAL;
-  info.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-  info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  vk_check(vkCreateImage(device_, &info, nullptr, &image_), "vkCreateImage (a viewer image)");
-
-  VkMemoryRequirements requirements;
-  vkGetImageMemoryRequirements(device_, image_, &requirements);
-  VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  allocate.allocationSize = requirements.size;
-  // Device-local where the device has it (every GPU); any allowed type otherwise.
-  allocate.memoryTypeIndex = device.memory_type(requirements.memoryTypeBits, 0,
-                                                VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "a viewer image");
-  try {
-    vk_check(vkAllocateMemory(device_, &allocate, nullptr, &memory_), "vkAllocateMemory (a viewer image)");
-    vk_check(vkBindImageMemory(device_, image_, memory_, 0), "vkBindImageMemory (a viewer image)");
-    // Once, so that every use finds the image in the layout made for it.
-    device.submit_and_wait([&](VkCommandBuffer commands) {
-      transition(commands, image_, VK_IMAGE_LAYOUT_UNDEFINED, layout, 0, 0,
-                 VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
-    });
-  } catch (...) {
-    destroy();  // a throwing constructor runs no destructor
-    throw;
-  }
-}
-
-TransferImage::~TransferImage() {
-  destroy();
-}
-
-void TransferImage::destroy() {
-  if (image_) vkDestroyImage(device_, image_, nullptr);
-  if (memory_) vkFreeMemory(device_, memory_, nullptr);
-  image_ = VK_NULL_HANDLE;
-  memory_ = VK_NULL_HANDLE;
+  image_ = vk::Image(device.context(), format, width, height,
+                     VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "a viewer image");
+  // Once, so that every use finds the image in the layout made for it.
+  device.context().submit_and_wait([&](VkCommandBuffer commands) {
+    transition(commands, image_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, layout, 0, 0,
+               VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+  });
 }
 
 FloatImage::FloatImage(const WindowDevice& device, uint32_t width, uint32_t height)
@@ -152,60 +114,28 @@ FloatImage::FloatImage(const WindowDevice& device, uint32_t width, uint32_t heig
 // Swapchain
 
 Swapchain::Swapchain(const WindowDevice& device) : device_(device) {
-  const VkSurfaceFormatKHR surface_format = choose_format(device);
-  format_ = surface_format.format;
-  VkDevice vk = device.device();
-  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pool.queueFamilyIndex = device.queue_family();
-  vk_check(vkCreateCommandPool(vk, &pool, nullptr, &command_pool_), "vkCreateCommandPool");
-  VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  allocate.commandPool = command_pool_;
-  allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  allocate.commandBufferCount = 1;
-  VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  try {
-    vk_check(vkAllocateCommandBuffers(vk, &allocate, &commands_), "vkAllocateCommandBuffers");
-    vk_check(vkCreateSemaphore(vk, &semaphore, nullptr, &image_acquired_), "vkCreateSemaphore");
-    vk_check(vkCreateFence(vk, &fence, nullptr, &blit_fence_), "vkCreateFence");
-  } catch (...) {
-    destroy();
-    throw;
-  }
+  format_ = choose_format(device).format;
+  const VkDevice vk = device.device();
+  command_pool_ = vk::make_command_pool(vk, device.queue_family());
+  commands_ = vk::allocate_command_buffer(vk, command_pool_.get());
+  image_acquired_ = vk::make_semaphore(vk);
+  blit_fence_ = vk::make_fence(vk);
 }
 
-Swapchain::~Swapchain() { destroy(); }
-
-void Swapchain::destroy() {
-  VkDevice vk = device_.device();
-  vkDeviceWaitIdle(vk);
-  destroy_images();
-  if (swapchain_) vkDestroySwapchainKHR(vk, swapchain_, nullptr);
-  if (image_acquired_) vkDestroySemaphore(vk, image_acquired_, nullptr);
-  if (blit_fence_) vkDestroyFence(vk, blit_fence_, nullptr);
-  if (command_pool_) vkDestroyCommandPool(vk, command_pool_, nullptr);
-  swapchain_ = VK_NULL_HANDLE;
-  image_acquired_ = VK_NULL_HANDLE;
-  blit_fence_ = VK_NULL_HANDLE;
-  command_pool_ = VK_NULL_HANDLE;
-}
-
-void Swapchain::destroy_images() {
-  for (VkSemaphore semaphore : blit_done_) vkDestroySemaphore(device_.device(), semaphore, nullptr);
-  blit_done_.clear();
-  images_.clear();  // owned by the swapchain
-  unencoded_.reset();
+Swapchain::~Swapchain() {
+  vkDeviceWaitIdle(device_.device());
 }
 
 void Swapchain::recreate(uint32_t width, uint32_t height) {
   VkDevice vk = device_.device();
-  vk_check(vkDeviceWaitIdle(vk), "vkDeviceWaitIdle");
-  destroy_images();
+  vk::check(vkDeviceWaitIdle(vk), "vkDeviceWaitIdle");
+  blit_done_.clear();
+  images_.clear();
+  unencoded_.reset();
   stale_ = false;
   VkSurfaceCapabilitiesKHR caps;
-  vk_check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(device_.physical_device(), device_.surface(), &caps),
-           "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
+  vk::check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(device_.physical_device(), device_.surface(), &caps),
+            "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
   if (caps.currentExtent.width != std::numeric_limits<uint32_t>::max()) {
     extent_ = caps.currentExtent;
   } else {
@@ -214,8 +144,7 @@ void Swapchain::recreate(uint32_t width, uint32_t height) {
   }
   if (extent_.width == 0 || extent_.height == 0 || width == 0 || height == 0) {
     extent_ = {0, 0};  // minimized: no images until the window is restored
-    if (swapchain_) vkDestroySwapchainKHR(vk, swapchain_, nullptr);
-    swapchain_ = VK_NULL_HANDLE;
+    swapchain_.reset();
     return;
   }
   if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT))
@@ -240,19 +169,16 @@ void Swapchain::recreate(uint32_t width, uint32_t height) {
     info.compositeAlpha = VkCompositeAlphaFlagBitsKHR(caps.supportedCompositeAlpha & -caps.supportedCompositeAlpha);
   info.presentMode = VK_PRESENT_MODE_FIFO_KHR;  // vsync; the one mode every surface has
   info.clipped = VK_TRUE;
-  info.oldSwapchain = swapchain_;
-  VkSwapchainKHR created = VK_NULL_HANDLE;
-  vk_check(vkCreateSwapchainKHR(vk, &info, nullptr, &created), "vkCreateSwapchainKHR");
-  if (swapchain_) vkDestroySwapchainKHR(vk, swapchain_, nullptr);
-  swapchain_ = created;
+  info.oldSwapchain = swapchain_.get();
+  vk::UniqueSwapchain created;
+  vk::check(vkCreateSwapchainKHR(vk, &info, nullptr, created.receive(vk)), "vkCreateSwapchainKHR");
+  swapchain_ = std::move(created);  // the old one goes
 
   uint32_t count = 0;
-  vk_check(vkGetSwapchainImagesKHR(vk, swapchain_, &count, nullptr), "vkGetSwapchainImagesKHR");
+  vk::check(vkGetSwapchainImagesKHR(vk, swapchain_.get(), &count, nullptr), "vkGetSwapchainImagesKHR");
   images_.resize(count);
-  vk_check(vkGetSwapchainImagesKHR(vk, swapchain_, &count, images_.data()), "vkGetSwapchainImagesKHR");
-  VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-  blit_done_.assign(count, VK_NULL_HANDLE);
-  for (VkSemaphore& done : blit_done_) vk_check(vkCreateSemaphore(vk, &semaphore, nullptr, &done), "vkCreateSemaphore");
+  vk::check(vkGetSwapchainImagesKHR(vk, swapchain_.get(), &count, images_.data()), "vkGetSwapchainImagesKHR");
+  for (uint32_t i = 0; i < count; ++i) blit_done_.push_back(vk::make_semaphore(vk));
   if (is_srgb(format_))
     unencoded_ = std::make_unique<TransferImage>(
         device_, unencoded_twin(format_), VK_FORMAT_FEATURE_BLIT_DST_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT,
@@ -281,20 +207,19 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
     throw std::logic_error("Swapchain::present: the source image is not the swapchain's size");
   VkDevice vk = device_.device();
   uint32_t index = 0;
-  const VkResult acquired =
-      vkAcquireNextImageKHR(vk, swapchain_, std::numeric_limits<uint64_t>::max(), image_acquired_, VK_NULL_HANDLE,
-                            &index);
+  const VkResult acquired = vkAcquireNextImageKHR(vk, swapchain_.get(), std::numeric_limits<uint64_t>::max(),
+                                                  image_acquired_.get(), VK_NULL_HANDLE, &index);
   if (acquired == VK_ERROR_OUT_OF_DATE_KHR) {  // nothing acquired, the semaphore stays unsignalled
     stale_ = true;
     return false;
   }
-  if (acquired != VK_SUBOPTIMAL_KHR) vk_check(acquired, "vkAcquireNextImageKHR");
+  if (acquired != VK_SUBOPTIMAL_KHR) vk::check(acquired, "vkAcquireNextImageKHR");
 
   // A suboptimal image was acquired and its semaphore signalled: it is still presented, then replaced.
-  vk_check(vkResetCommandBuffer(commands_, 0), "vkResetCommandBuffer");
+  vk::check(vkResetCommandBuffer(commands_, 0), "vkResetCommandBuffer");
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  vk_check(vkBeginCommandBuffer(commands_, &begin), "vkBeginCommandBuffer");
+  vk::check(vkBeginCommandBuffer(commands_, &begin), "vkBeginCommandBuffer");
   // The previous contents are not needed (UNDEFINED). The source needs no barrier of ours: both
   // render_to_image and the mesh layer's last pass end with one whose second scope is every later
   // command, ours included.
@@ -321,10 +246,11 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
                VK_ACCESS_TRANSFER_READ_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                VK_PIPELINE_STAGE_TRANSFER_BIT);
   }
-  std::unique_ptr<HostBuffer> readback;
+  vk::Buffer readback;
   VkImageLayout window_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
   if (shown) {
-    readback = std::make_unique<HostBuffer>(device_, VkDeviceSize(extent_.width) * extent_.height * 4);
+    readback = vk::Buffer(device_.context(), VkDeviceSize(extent_.width) * extent_.height * 4,
+                          vk::MemoryUse::Readback, "the window's pixels");
     transition(commands_, window_image, window_layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                VK_PIPELINE_STAGE_TRANSFER_BIT);
@@ -332,7 +258,7 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {extent_.width, extent_.height, 1};
-    vkCmdCopyImageToBuffer(commands_, window_image, window_layout, readback->buffer(), 1, &region);
+    vkCmdCopyImageToBuffer(commands_, window_image, window_layout, readback.handle(), 1, &region);
     VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     to_host.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
     to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
@@ -342,35 +268,36 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
   transition(commands_, window_image, window_layout, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
              shown ? VkAccessFlags{0} : VkAccessFlags{VK_ACCESS_TRANSFER_WRITE_BIT}, 0,
              VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
-  vk_check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
+  vk::check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
 
   // The blit waits for the acquired image at the transfer stage, where the first barrier starts.
   const VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_TRANSFER_BIT;
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.waitSemaphoreCount = 1;
-  submit.pWaitSemaphores = &image_acquired_;
+  submit.pWaitSemaphores = image_acquired_.address();
   submit.pWaitDstStageMask = &wait_stage;
   submit.commandBufferCount = 1;
   submit.pCommandBuffers = &commands_;
   submit.signalSemaphoreCount = 1;
-  submit.pSignalSemaphores = &blit_done_[index];
-  vk_check(vkQueueSubmit(device_.queue(), 1, &submit, blit_fence_), "vkQueueSubmit (blit)");
+  submit.pSignalSemaphores = blit_done_[index].address();
+  vk::check(vkQueueSubmit(device_.queue(), 1, &submit, blit_fence_.get()), "vkQueueSubmit (blit)");
 
   VkPresentInfoKHR present{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
   present.waitSemaphoreCount = 1;
-  present.pWaitSemaphores = &blit_done_[index];
+  present.pWaitSemaphores = blit_done_[index].address();
   present.swapchainCount = 1;
-  present.pSwapchains = &swapchain_;
+  present.pSwapchains = swapchain_.address();
   present.pImageIndices = &index;
   const VkResult presented = vkQueuePresentKHR(device_.queue(), &present);
   // Waiting here frees the command buffer and the acquire semaphore for the next frame, and the
   // source for the next render; the renderer waits for its own work anyway, so little is lost.
-  vk_check(vkWaitForFences(vk, 1, &blit_fence_, VK_TRUE, std::numeric_limits<uint64_t>::max()), "vkWaitForFences");
-  vk_check(vkResetFences(vk, 1, &blit_fence_), "vkResetFences");
+  vk::check(vkWaitForFences(vk, 1, blit_fence_.address(), VK_TRUE, std::numeric_limits<uint64_t>::max()),
+            "vkWaitForFences");
+  vk::check(vkResetFences(vk, 1, blit_fence_.address()), "vkResetFences");
   if (shown) {
     // The window's bytes in its format's channel order; the screenshot is R G B.
     const bool bgr = format_ == VK_FORMAT_B8G8R8A8_UNORM || format_ == VK_FORMAT_B8G8R8A8_SRGB;
-    const auto* bytes = static_cast<const uint8_t*>(readback->map());
+    const auto* bytes = readback.mapped_as<const uint8_t>();
     shown->width = extent_.width;
     shown->height = extent_.height;
     shown->rgb.resize(size_t(extent_.width) * extent_.height * 3);
@@ -381,7 +308,7 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
     stale_ = true;
     return false;
   }
-  if (presented != VK_SUBOPTIMAL_KHR) vk_check(presented, "vkQueuePresentKHR");
+  if (presented != VK_SUBOPTIMAL_KHR) vk::check(presented, "vkQueuePresentKHR");
   stale_ = acquired == VK_SUBOPTIMAL_KHR || presented == VK_SUBOPTIMAL_KHR;
   return true;
 }

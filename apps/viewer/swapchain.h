@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "tilesplat/vulkan_interop.h"
+#include "vulkan/handle.h"
+#include "vulkan/image.h"
 #include "window_device.h"
 
 namespace tilesplat::viewer {
@@ -27,21 +29,13 @@ class TransferImage {
   // the format lacks any of `features` (optimal tiling).
   TransferImage(const WindowDevice& device, VkFormat format, VkFormatFeatureFlags features,
                 VkImageLayout layout, uint32_t width, uint32_t height);
-  ~TransferImage();
-  TransferImage(const TransferImage&) = delete;
-  TransferImage& operator=(const TransferImage&) = delete;
 
-  VkImage image() const { return image_; }
-  uint32_t width() const { return width_; }
-  uint32_t height() const { return height_; }
+  VkImage image() const { return image_.handle(); }
+  uint32_t width() const { return image_.width(); }
+  uint32_t height() const { return image_.height(); }
 
  private:
-  void destroy();
-
-  VkDevice device_;
-  VkImage image_ = VK_NULL_HANDLE;
-  VkDeviceMemory memory_ = VK_NULL_HANDLE;
-  uint32_t width_, height_;
+  vk::Image image_;
 };
 
 // An R32G32B32A32_SFLOAT image the renderer writes with render_to_image (TRANSFER_DST) and the
@@ -74,7 +68,7 @@ struct WindowPixels {
 class Swapchain {
  public:
   explicit Swapchain(const WindowDevice& device);
-  ~Swapchain();
+  ~Swapchain();  // waits for the device to be idle; the handles then release themselves
   Swapchain(const Swapchain&) = delete;
   Swapchain& operator=(const Swapchain&) = delete;
 
@@ -97,22 +91,20 @@ class Swapchain {
   bool stale() const { return stale_; }
 
  private:
-  void destroy_images();
-  void destroy();
   void record_blit(VkImage source, VkImageLayout source_layout, VkImage target);
 
   const WindowDevice& device_;
-  VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
+  vk::UniqueSwapchain swapchain_;
   VkFormat format_ = VK_FORMAT_UNDEFINED;
   VkExtent2D extent_{0, 0};
-  std::vector<VkImage> images_;
+  std::vector<VkImage> images_;  // the swapchain's
   // Signalled by the blit's submission and waited on by the presentation of that image. One per
   // image: the presentation engine may still hold an image's semaphore while another is acquired.
-  std::vector<VkSemaphore> blit_done_;
-  VkSemaphore image_acquired_ = VK_NULL_HANDLE;
-  VkFence blit_fence_ = VK_NULL_HANDLE;
-  VkCommandPool command_pool_ = VK_NULL_HANDLE;
-  VkCommandBuffer commands_ = VK_NULL_HANDLE;
+  std::vector<vk::UniqueSemaphore> blit_done_;
+  vk::UniqueSemaphore image_acquired_;
+  vk::UniqueFence blit_fence_;
+  vk::UniqueCommandPool command_pool_;
+  VkCommandBuffer commands_ = VK_NULL_HANDLE;  // from command_pool_, freed with it
   bool stale_ = true;  // no images yet
   bool can_read_back_ = false;  // the window's images were created with TRANSFER_SRC
   // An _SRGB swapchain's _UNORM twin, which the blit writes and whose bytes are copied into the

@@ -19,7 +19,6 @@
 #include <vector>
 
 #include "cli.h"
-#include "image_readback.h"
 #include "lod_view.h"
 #include "mesh_layer.h"
 #include "orbit_controller.h"

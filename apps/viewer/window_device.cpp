@@ -75,104 +75,41 @@ int type_rank(VkPhysicalDevice device) {
 
 }  // namespace
 
-void vk_check(VkResult result, const char* what) {
-  if (result == VK_SUCCESS) return;
-  const char* name = "VkResult error";
-  switch (result) {
-    case VK_ERROR_OUT_OF_HOST_MEMORY: name = "VK_ERROR_OUT_OF_HOST_MEMORY"; break;
-    case VK_ERROR_OUT_OF_DEVICE_MEMORY: name = "VK_ERROR_OUT_OF_DEVICE_MEMORY"; break;
-    case VK_ERROR_INITIALIZATION_FAILED: name = "VK_ERROR_INITIALIZATION_FAILED"; break;
-    case VK_ERROR_DEVICE_LOST: name = "VK_ERROR_DEVICE_LOST"; break;
-    case VK_ERROR_LAYER_NOT_PRESENT: name = "VK_ERROR_LAYER_NOT_PRESENT"; break;
-    case VK_ERROR_EXTENSION_NOT_PRESENT: name = "VK_ERROR_EXTENSION_NOT_PRESENT"; break;
-    case VK_ERROR_INCOMPATIBLE_DRIVER: name = "VK_ERROR_INCOMPATIBLE_DRIVER"; break;
-    case VK_ERROR_SURFACE_LOST_KHR: name = "VK_ERROR_SURFACE_LOST_KHR"; break;
-    case VK_ERROR_NATIVE_WINDOW_IN_USE_KHR: name = "VK_ERROR_NATIVE_WINDOW_IN_USE_KHR"; break;
-    default: break;
-  }
-  throw std::runtime_error(std::string(what) + " failed: " + name + " (" + std::to_string(int(result)) + ")");
+DebugMessenger::DebugMessenger(VkInstance instance, const VkDebugUtilsMessengerCreateInfoEXT& info)
+    : instance_(instance) {
+  auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+  if (!create_messenger) throw std::runtime_error("vkCreateDebugUtilsMessengerEXT is unavailable");
+  vk::check(create_messenger(instance, &info, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
 }
 
+DebugMessenger::~DebugMessenger() {
+  auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+      vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+  if (destroy_messenger) destroy_messenger(instance_, messenger_, nullptr);
+}
+
+// A constructor that throws runs no destructor of its own, but its members' do: whatever was made so far
+// releases itself.
 WindowDevice::WindowDevice(GLFWwindow* window, bool validation, const std::string& device_selector) {
-  try {
-    create_instance(validation);
-    vk_check(glfwCreateWindowSurface(instance_, window, nullptr, &surface_), "creating the window's Vulkan surface");
-    pick_physical_device(device_selector);
-    create_device();
-  } catch (...) {
-    destroy();  // a throwing constructor runs no destructor
-    throw;
-  }
+  create_instance(validation);
+  vk::check(glfwCreateWindowSurface(instance_.get(), window, nullptr, surface_.receive(instance_.get())),
+            "creating the window's Vulkan surface");
+  pick_physical_device(device_selector);
+  create_device();
+  context_ = std::make_unique<vk::Context>(external());
 }
 
-WindowDevice::~WindowDevice() { destroy(); }
-
-void WindowDevice::destroy() {
-  if (device_) vkDestroyDevice(device_, nullptr);
-  if (surface_) vkDestroySurfaceKHR(instance_, surface_, nullptr);
-  if (messenger_) {
-    auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
-    if (destroy_messenger) destroy_messenger(instance_, messenger_, nullptr);
-  }
-  if (instance_) vkDestroyInstance(instance_, nullptr);
-  device_ = VK_NULL_HANDLE;
-  surface_ = VK_NULL_HANDLE;
-  messenger_ = VK_NULL_HANDLE;
-  instance_ = VK_NULL_HANDLE;
+WindowDevice::~WindowDevice() {
+  if (device_) vkDeviceWaitIdle(device_.get());
 }
 
 ExternalVulkanDevice WindowDevice::external() const {
-  return {instance_,          physical_device_,    device_, queue_, queue_family_, shader_float64_,
-          independent_blend_, rasterization_order_};
+  return {instance_.get(), physical_device_, device_.get(),      queue_,
+          queue_family_,   shader_float64_,  independent_blend_, rasterization_order_};
 }
 
 std::string WindowDevice::name() const { return device_name(physical_device_); }
-
-uint32_t WindowDevice::memory_type(uint32_t allowed, VkMemoryPropertyFlags required,
-                                   VkMemoryPropertyFlags preferred, const char* what) const {
-  VkPhysicalDeviceMemoryProperties memory;
-  vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory);
-  uint32_t found = memory.memoryTypeCount;
-  for (uint32_t i = 0; i < memory.memoryTypeCount; ++i) {
-    const VkMemoryPropertyFlags flags = memory.memoryTypes[i].propertyFlags;
-    if (!(allowed & (1u << i)) || (flags & required) != required) continue;
-    if ((flags & preferred) == preferred) return i;
-    if (found == memory.memoryTypeCount) found = i;
-  }
-  if (found == memory.memoryTypeCount) throw std::runtime_error(name() + ": no memory type for " + what);
-  return found;
-}
-
-void WindowDevice::submit_and_wait(const std::function<void(VkCommandBuffer)>& record) const {
-  struct Pool {  // destroyed, with its command buffer, on every way out
-    VkDevice device;
-    VkCommandPool pool = VK_NULL_HANDLE;
-    ~Pool() {
-      if (pool) vkDestroyCommandPool(device, pool, nullptr);
-    }
-  } pool{device_};
-  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
-  pool_info.queueFamilyIndex = queue_family_;
-  vk_check(vkCreateCommandPool(device_, &pool_info, nullptr, &pool.pool), "vkCreateCommandPool");
-  VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  allocate.commandPool = pool.pool;
-  allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  allocate.commandBufferCount = 1;
-  VkCommandBuffer commands = VK_NULL_HANDLE;
-  vk_check(vkAllocateCommandBuffers(device_, &allocate, &commands), "vkAllocateCommandBuffers");
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  vk_check(vkBeginCommandBuffer(commands, &begin), "vkBeginCommandBuffer");
-  record(commands);
-  vk_check(vkEndCommandBuffer(commands), "vkEndCommandBuffer");
-  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &commands;
-  vk_check(vkQueueSubmit(queue_, 1, &submit, VK_NULL_HANDLE), "vkQueueSubmit");
-  vk_check(vkQueueWaitIdle(queue_), "vkQueueWaitIdle");
-}
 
 void WindowDevice::create_instance(bool validation) {
   uint32_t glfw_count = 0;
@@ -205,7 +142,7 @@ void WindowDevice::create_instance(bool validation) {
   info.ppEnabledLayerNames = layers.data();
   info.enabledExtensionCount = uint32_t(extensions.size());
   info.ppEnabledExtensionNames = extensions.data();
-  vk_check(vkCreateInstance(&info, nullptr, &instance_), "vkCreateInstance");
+  vk::check(vkCreateInstance(&info, nullptr, instance_.receive()), "vkCreateInstance");
   if (!validation) return;
 
   VkDebugUtilsMessengerCreateInfoEXT messenger{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
@@ -215,10 +152,7 @@ void WindowDevice::create_instance(bool validation) {
                           VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
   messenger.pfnUserCallback = &WindowDevice::on_validation_message;
   messenger.pUserData = this;
-  auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-      vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-  if (!create_messenger) throw std::runtime_error("vkCreateDebugUtilsMessengerEXT is unavailable");
-  vk_check(create_messenger(instance_, &messenger, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+  messenger_.emplace(instance_.get(), messenger);
 }
 
 VKAPI_ATTR VkBool32 VKAPI_CALL WindowDevice::on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -238,9 +172,10 @@ void WindowDevice::pick_physical_device(const std::string& device_selector) {
   if (selector.empty())
     if (const char* env = std::getenv("TILESPLAT_DEVICE")) selector = env;
   uint32_t count = 0;
-  vk_check(vkEnumeratePhysicalDevices(instance_, &count, nullptr), "vkEnumeratePhysicalDevices");
+  vk::check(vkEnumeratePhysicalDevices(instance_.get(), &count, nullptr), "vkEnumeratePhysicalDevices");
   std::vector<VkPhysicalDevice> devices(count);
-  vk_check(vkEnumeratePhysicalDevices(instance_, &count, devices.data()), "vkEnumeratePhysicalDevices");
+  vk::check(vkEnumeratePhysicalDevices(instance_.get(), &count, devices.data()),
+            "vkEnumeratePhysicalDevices");
   if (devices.empty())
     throw std::runtime_error("no Vulkan device found (install a driver, e.g. Debian's mesa-vulkan-drivers)");
 
@@ -254,7 +189,7 @@ void WindowDevice::pick_physical_device(const std::string& device_selector) {
                                                        : lower(name).find(lower(selector)) != std::string::npos);
     if (!selected) continue;
     uint32_t family = 0;
-    const std::string why = why_unsuitable(devices[i], surface_, family);
+    const std::string why = why_unsuitable(devices[i], surface_.get(), family);
     if (!why.empty()) {
       rejected += (rejected.empty() ? "" : "; ") + name + ": " + why;
       continue;
@@ -322,8 +257,8 @@ void WindowDevice::create_device() {
   info.pQueueCreateInfos = &queue_info;
   info.enabledExtensionCount = uint32_t(extensions.size());
   info.ppEnabledExtensionNames = extensions.data();
-  vk_check(vkCreateDevice(physical_device_, &info, nullptr, &device_), "vkCreateDevice");
-  vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  vk::check(vkCreateDevice(physical_device_, &info, nullptr, device_.receive()), "vkCreateDevice");
+  vkGetDeviceQueue(device_.get(), queue_family_, 0, &queue_);
 }
 
 }  // namespace tilesplat::viewer

@@ -6,17 +6,30 @@
 
 #include <atomic>
 #include <cstdint>
-#include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 
 #include "tilesplat/vulkan_interop.h"
+#include "vulkan/context.h"
+#include "vulkan/handle.h"
 
 struct GLFWwindow;
 
 namespace tilesplat::viewer {
 
-// Throws std::runtime_error "WHAT failed: VK_ERROR_..." unless the result is VK_SUCCESS.
-void vk_check(VkResult result, const char* what);
+// The instance's debug messenger, destroyed through the function the instance gives for it.
+class DebugMessenger {
+ public:
+  DebugMessenger(VkInstance instance, const VkDebugUtilsMessengerCreateInfoEXT& info);
+  ~DebugMessenger();
+  DebugMessenger(const DebugMessenger&) = delete;
+  DebugMessenger& operator=(const DebugMessenger&) = delete;
+
+ private:
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+};
 
 class WindowDevice {
  public:
@@ -25,6 +38,7 @@ class WindowDevice {
   // index or part of its name; empty = the first discrete GPU that can present, else any device
   // that can. Throws std::runtime_error saying why no device fits.
   WindowDevice(GLFWwindow* window, bool validation, const std::string& device_selector);
+  // Waits for the device to be idle; the handles then release themselves, the device's last.
   ~WindowDevice();
   WindowDevice(const WindowDevice&) = delete;
   WindowDevice& operator=(const WindowDevice&) = delete;
@@ -33,44 +47,41 @@ class WindowDevice {
   ExternalVulkanDevice external() const;
 
   VkPhysicalDevice physical_device() const { return physical_device_; }
-  VkDevice device() const { return device_; }
+  VkDevice device() const { return device_.get(); }
   VkQueue queue() const { return queue_; }
   uint32_t queue_family() const { return queue_family_; }
-  VkSurfaceKHR surface() const { return surface_; }
+  VkSurfaceKHR surface() const { return surface_.get(); }
   std::string name() const;
+  // The engine's Vulkan layer on this device (borrowed, as the renderer's is): the viewer's images and
+  // buffers, memory types and one-time submissions go through it.
+  vk::Context& context() const { return *context_; }
 
-  // A memory type among `allowed` (VkMemoryRequirements::memoryTypeBits) with every `required` flag,
-  // one that also has the `preferred` ones where there is one. Throws std::runtime_error naming `what`
-  // when none has the required flags.
-  uint32_t memory_type(uint32_t allowed, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred,
-                       const char* what) const;
-  // Records `record` into a one-time command buffer, submits it and waits for the queue to be idle.
-  void submit_and_wait(const std::function<void(VkCommandBuffer)>& record) const;
-  bool validation() const { return messenger_ != VK_NULL_HANDLE; }
+  bool validation() const { return messenger_.has_value(); }
   uint64_t validation_messages() const { return validation_messages_.load(); }
 
  private:
   void create_instance(bool validation);
   void pick_physical_device(const std::string& selector);
   void create_device();
-  void destroy();
 
   static VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                               VkDebugUtilsMessageTypeFlagsEXT types,
                                                               const VkDebugUtilsMessengerCallbackDataEXT* data,
                                                               void* user);
 
-  VkInstance instance_ = VK_NULL_HANDLE;
-  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
-  VkSurfaceKHR surface_ = VK_NULL_HANDLE;
+  // Declared in the order they are made: they are destroyed in the reverse one.
+  std::atomic<uint64_t> validation_messages_{0};
+  vk::UniqueInstance instance_;
+  std::optional<DebugMessenger> messenger_;  // with validation only
+  vk::UniqueSurface surface_;
   VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
-  VkDevice device_ = VK_NULL_HANDLE;
+  vk::UniqueDevice device_;
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
   bool shader_float64_ = false;
   bool independent_blend_ = false;
   bool rasterization_order_ = false;  // VK_EXT_rasterization_order_attachment_access, enabled
-  std::atomic<uint64_t> validation_messages_{0};
+  std::unique_ptr<vk::Context> context_;
 };
 
 }  // namespace tilesplat::viewer

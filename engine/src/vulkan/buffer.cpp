@@ -7,7 +7,8 @@
 
 namespace tilesplat::vk {
 
-Buffer::Buffer(Context& ctx, VkDeviceSize size, MemoryUse use, std::string name)
+Buffer::Buffer(Context& ctx, VkDeviceSize size, MemoryUse use, std::string name,
+               VkBufferUsageFlags extra_usage)
     : ctx_(&ctx), size_(size), name_(std::move(name)) {
   if (size == 0) size = 16;  // zero-sized buffers are invalid; keep a valid address for empty scenes
   if (size > ctx.limits().max_allocation_size)
@@ -19,7 +20,7 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, MemoryUse use, std::string name)
   info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT |
-               VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT;
+               VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT | extra_usage;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   TS_VK_CHECK(vkCreateBuffer(ctx.device(), &info, nullptr, &buffer_));
 

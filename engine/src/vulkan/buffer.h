@@ -23,7 +23,10 @@ enum class MemoryUse {
 class Buffer {
  public:
   Buffer() = default;
-  Buffer(Context& ctx, VkDeviceSize size, MemoryUse use, std::string name);
+  // Every buffer can be a storage, texel, indirect and transfer buffer with a device address;
+  // `extra_usage` adds others (a host's vertex buffer).
+  Buffer(Context& ctx, VkDeviceSize size, MemoryUse use, std::string name,
+         VkBufferUsageFlags extra_usage = 0);
   ~Buffer() { reset(); }
   Buffer(Buffer&& other) noexcept { *this = std::move(other); }
   Buffer& operator=(Buffer&& other) noexcept;

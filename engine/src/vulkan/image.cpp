@@ -43,6 +43,11 @@ Image::Image(Context& ctx, VkFormat format, uint32_t width, uint32_t height, VkI
   }
   bytes_ = req.size;
   TS_VK_CHECK(vkBindImageMemory(ctx.device(), image_, memory_, 0));
+  // A view only where the usage allows one (an image that is only copied and blitted has none).
+  constexpr VkImageUsageFlags kViewed =
+      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
+      VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT;
+  if (!(usage & kViewed)) return;
   VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   view.image = image_;
   view.viewType = VK_IMAGE_VIEW_TYPE_2D;

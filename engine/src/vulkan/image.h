@@ -1,5 +1,5 @@
 // A device-local 2D image with one view: the raster compositor's colour attachments and its depth
-// attachment (VK_FORMAT_D32_SFLOAT, whose view and copies take the depth aspect).
+// attachment (VK_FORMAT_D32_SFLOAT, whose view and copies take the depth aspect), and the viewer's images.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -26,7 +26,7 @@ class Image {
 
   explicit operator bool() const { return image_ != VK_NULL_HANDLE; }
   VkImage handle() const { return image_; }
-  VkImageView view() const { return view_; }
+  VkImageView view() const { return view_; }  // null for an image only copied (no view usage)
   VkFormat format() const { return format_; }
   VkImageAspectFlags aspect() const;  // depth for VK_FORMAT_D32_SFLOAT, else colour
   uint32_t width() const { return width_; }

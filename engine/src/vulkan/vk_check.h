@@ -20,6 +20,12 @@ class VulkanError : public std::runtime_error {
   VkResult result_;
 };
 
+// Throws VulkanError naming `what` ("vkCreateFence", or a call with its purpose) unless `result` is
+// VK_SUCCESS: for calls whose text alone would not say which of several failed.
+inline void check(VkResult result, const char* what) {
+  if (result != VK_SUCCESS) throw VulkanError(what, result);
+}
+
 }  // namespace tilesplat::vk
 
 #define TS_VK_CHECK(call)                                                  \
