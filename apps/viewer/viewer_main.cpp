@@ -29,7 +29,7 @@
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
 #include "view_effects.h"
-#include "view_shutter.h"
+#include "view_state.h"
 #include "viewer_options.h"
 #include "window_device.h"
 
@@ -39,21 +39,11 @@ namespace cli = tilesplat::cli;
 namespace fs = std::filesystem;
 using tilesplat::viewer::FloatImage;
 using tilesplat::viewer::MeshLayer;
-using tilesplat::viewer::OrbitController;
 using tilesplat::viewer::Swapchain;
 using tilesplat::viewer::WindowDevice;
 
 using namespace tilesplat::viewer;
 constexpr int kDefaultWindowWidth = 960;  // the height follows the view's aspect
-// What key M steps through: the reference; depth16, the web viewers' sort keys; radial, the order a turn
-// in place keeps; resort8, per-pixel re-sorting, more exact than the reference; and the web viewers'
-// shortcuts all together.
-constexpr const char* kModeCycle[] = {"reference", "depth16", "radial", "resort8",
-                                      "depth16+opacity-extent+fp16-sh+fp16-cov"};
-// What key C steps through: the tile compositor, the raster one (which draws no re-sorting: M skips
-// resort8 while it is on) and the stochastic one, whose frames add up while the view rests.
-constexpr std::array<tilesplat::Compositor, 3> kCompositorCycle = {
-    tilesplat::Compositor::kSorted, tilesplat::Compositor::kRaster, tilesplat::Compositor::kStochastic};
 // The stochastic frames a view at rest accumulates before the window stops redrawing it (about 40 dB
 // from the sorted image on the bundled scenes: docs/compositors.md).
 constexpr uint32_t kMaxAccumulatedFrames = 256;
@@ -86,7 +76,9 @@ class GlfwSession {
 
 using WindowHandle = std::unique_ptr<GLFWwindow, decltype(&glfwDestroyWindow)>;
 
-// The interactive state (camera, view, accuracy mode, sort) and the loop that redraws when it changes.
+// How the viewer schedules and shows its frames: the loop that renders when what is shown (ViewState)
+// changes, or while a view at rest refines, and sleeps otherwise; the window's swapchain and the images
+// it is fed from, which follow the window's size; the levels streamed under --splat-budget; the title.
 class Viewer {
  public:
   Viewer(GLFWwindow* window, const WindowDevice& device, tilesplat::Renderer& renderer,
@@ -95,44 +87,15 @@ class Viewer {
         device_(device),
         renderer_(renderer),
         swapchain_(device),
-        bounds_(loaded.bounds()),
-        controller_(loaded.camera, bounds_),
+        view_(options, loaded, std::move(views)),
         mesh_(!options.no_mesh),
-        depth_out_(!options.no_depth_out),
-        scene_name_(loaded.path.filename().string()),
-        lod_view_(loaded.lod && loaded.lod->splat_budget > 0
-                      ? std::make_unique<LodView>(*loaded.lod->set, loaded.lod->splat_budget, glfwPostEmptyEvent)
-                  : loaded.lod_tree && loaded.lod_tree->splat_budget > 0
-                      ? std::make_unique<LodView>(*loaded.lod_tree->tree, loaded.lod_tree->splat_budget)
-                      : nullptr),
-        views_(std::move(views.views)),
-        shutters_(std::move(views.shutters)),
-        view_(options.common.view),
         turn_deg_(options.turn_deg),
-        effects_(options.lens, ViewShutter(loaded.shutter, loaded.camera),
-                 loaded.instances && loaded.instances->moves(),
-                 {bounds_.center[0], bounds_.center[1], bounds_.center[2]}, mesh_),
-        sorts_(sort_cycle()),
-        stochastic_sampler_(options.stochastic_sampler) {
-    cli::apply_scene_settings(loaded, base_settings_);
-    cli::apply_training_options(options.common, base_settings_);
-    for (const char* mode : kModeCycle) modes_.push_back(tilesplat::parse_accuracy_modes(mode));
-    if (!options.common.modes.empty()) mode_ = find_or_append(modes_, options.common.modes.front());
-    if (!options.common.sorts.empty()) sort_ = find_or_append(sorts_, options.common.sorts.front());
-    // --compositor: sorted or raster, and no re-sorting mode with the raster (check_viewer_flags; a scene
-    // file sets no compositor).
-    compositor_ =
-        size_t(std::find(kCompositorCycle.begin(), kCompositorCycle.end(), base_settings_.compositor) -
-               kCompositorCycle.begin());
-    // Key L's lenses, without the box and the grid (drawn through a pinhole): the pinhole, a fisheye of
-    // 180 degrees, the panorama, and --fisheye, --orthographic or --equirectangular where given.
-    lenses_.push_back({});
-    if (!mesh_) {
-      lenses_.push_back({.fisheye_fov_deg = 180.0});
-      lenses_.push_back({.equirectangular = true});
-      if (options.camera_model.enabled()) lens_ = find_or_append(lenses_, options.camera_model);
-    }
-
+        lod_view_(
+            loaded.lod && loaded.lod->splat_budget > 0
+                ? std::make_unique<LodView>(*loaded.lod->set, loaded.lod->splat_budget, glfwPostEmptyEvent)
+            : loaded.lod_tree && loaded.lod_tree->splat_budget > 0
+                ? std::make_unique<LodView>(*loaded.lod_tree->tree, loaded.lod_tree->splat_budget)
+                : nullptr) {
     glfwSetWindowUserPointer(window_, this);
     glfwSetKeyCallback(window_, on_key);
     glfwSetMouseButtonCallback(window_, on_mouse_button);
@@ -165,7 +128,7 @@ class Viewer {
       if (minimized_) continue;
       const auto start = std::chrono::steady_clock::now();
       const bool rendering = needs_render_;
-      if (rendering && turn_deg_ != 0 && frames_ > 0) controller_.turn(turn_deg_);
+      if (rendering && turn_deg_ != 0 && frames_ > 0) view_.controller().turn(turn_deg_);
       if (rendering) render();
       if (needs_present_) needs_present_ = !present();
       if (rendering) {
@@ -181,29 +144,12 @@ class Viewer {
     }
   }
 
-  // The camera and settings of the last frame, for a screenshot. The settings have the depth and
-  // count outputs the scene asks for, which the window's frames leave out.
-  tilesplat::Camera camera() const { return cli::camera_for_frame(lenses_[lens_], controller_.camera()); }
-  tilesplat::RenderSettings settings() const {
-    tilesplat::RenderSettings settings = base_settings_;
-    effects_.apply(camera(), !lenses_[lens_].enabled(), settings);  // keys F and B
-    settings.sort = sorts_[sort_];
-    settings.accuracy = modes_[mode_];
-    settings.compositor = kCompositorCycle[compositor_];
-    // The stochastic compositor: one frame a redraw, added to the mean of the earlier ones until the
-    // camera (or anything else) changes (StochasticSettings::accumulate).
-    settings.stochastic.frames = 1;
-    settings.stochastic.accumulate = true;
-    settings.stochastic.sampler = stochastic_sampler_;
-    // A scene file's sh_degree effect caps every mode, as in tilesplat-render.
-    settings.accuracy.sh_degree_cap =
-        std::min(settings.accuracy.sh_degree_cap, base_settings_.accuracy.sh_degree_cap);
-    return settings;
-  }
+  // The camera and settings of the last frame, for a screenshot.
+  tilesplat::Camera camera() const { return view_.camera(); }
   // The settings of the window's last frame as one render: the stochastic frames it had accumulated
   // in one call (the same image: N calls of 1 frame are 1 call of N).
   tilesplat::RenderSettings screenshot_settings() {
-    tilesplat::RenderSettings shot = settings();
+    tilesplat::RenderSettings shot = view_.settings();
     if (shot.accumulate_samples) {  // the lens or time samples on screen
       tilesplat::wait_for_frame(renderer_);
       screenshot_samples_ = int(std::max(1u, renderer_.last_frame_stats().accumulated_samples));
@@ -246,58 +192,14 @@ class Viewer {
  private:
   static Viewer& self(GLFWwindow* window) { return *static_cast<Viewer*>(glfwGetWindowUserPointer(window)); }
 
-  // What key S steps through: "auto" (the default), then every strategy.
-  static std::vector<std::string> sort_cycle() {
-    std::vector<std::string> sorts = {"auto"};
-    for (const std::string& name : tilesplat::sort_strategies()) sorts.push_back(name);
-    return sorts;
-  }
-
-  // The index of `value` in `list`, appended when it is not there (a --mode outside the cycle).
-  template <typename T>
-  static size_t find_or_append(std::vector<T>& list, const T& value) {
-    const auto found = std::find(list.begin(), list.end(), value);
-    if (found != list.end()) return size_t(found - list.begin());
-    list.push_back(value);
-    return list.size() - 1;
-  }
-
   // The callbacks run inside glfwPollEvents/glfwWaitEvents (C code): they only change state, and
   // the loop does the work that can throw.
   static void on_key(GLFWwindow* window, int key, int, int action, int) {
     if (action == GLFW_RELEASE) return;
-    Viewer& viewer = self(window);
-    switch (key) {
-      case GLFW_KEY_ESCAPE:
-      case GLFW_KEY_Q: glfwSetWindowShouldClose(window, GLFW_TRUE); return;
-      case GLFW_KEY_N:
-      case GLFW_KEY_RIGHT: viewer.step_view(1); return;
-      case GLFW_KEY_P:
-      case GLFW_KEY_LEFT: viewer.step_view(-1); return;
-      case GLFW_KEY_M:
-        viewer.next_mode();
-        break;
-      case GLFW_KEY_S: viewer.sort_ = (viewer.sort_ + 1) % viewer.sorts_.size(); break;
-      case GLFW_KEY_C:
-        viewer.compositor_ = (viewer.compositor_ + 1) % kCompositorCycle.size();
-        if (!viewer.draws(viewer.modes_[viewer.mode_])) viewer.next_mode();
-        break;
-      case GLFW_KEY_D:
-        viewer.depth_out_ = !viewer.depth_out_;
-        break;
-      case GLFW_KEY_F:
-        if (!viewer.effects_.toggle_depth_of_field()) return;
-        break;
-      case GLFW_KEY_B:
-        if (!viewer.effects_.toggle_motion_blur()) return;
-        break;
-      case GLFW_KEY_L:
-        viewer.lens_ = (viewer.lens_ + 1) % viewer.lenses_.size();
-        if (!viewer.draws(viewer.modes_[viewer.mode_])) viewer.next_mode();
-        break;
-      default: return;
-    }
-    viewer.needs_render_ = true;
+    if (key == GLFW_KEY_ESCAPE || key == GLFW_KEY_Q)
+      glfwSetWindowShouldClose(window, GLFW_TRUE);
+    else if (self(window).view_.press(key))
+      self(window).needs_render_ = true;
   }
 
   static void on_mouse_button(GLFWwindow* window, int button, int action, int) {
@@ -322,43 +224,19 @@ class Viewer {
     viewer.cursor_x_ = x;
     viewer.cursor_y_ = y;
     if (viewer.drag_button_ == GLFW_MOUSE_BUTTON_LEFT)
-      viewer.controller_.orbit(dx, dy);
+      viewer.view_.controller().orbit(dx, dy);
     else
-      viewer.controller_.pan(dx, dy);
+      viewer.view_.controller().pan(dx, dy);
     viewer.needs_render_ = true;
   }
 
   static void on_scroll(GLFWwindow* window, double, double steps) {
-    self(window).controller_.zoom(steps);
+    self(window).view_.controller().zoom(steps);
     self(window).needs_render_ = true;
   }
 
-  // Whether the frame draws in `modes`: the compositor's rule and the lens's (the library's own).
-  bool draws(const tilesplat::AccuracyModes& modes) const {
-    return tilesplat::compositor_draws(kCompositorCycle[compositor_], modes) &&
-           tilesplat::camera_draws(camera(), modes);
-  }
-
-  // The next accuracy mode the frame draws (the reference always is one).
-  void next_mode() {
-    do {
-      mode_ = (mode_ + 1) % modes_.size();
-    } while (!draws(modes_[mode_]));
-  }
-
-  void step_view(int step) {
-    if (views_.empty()) return;
-    const int count = int(views_.size());
-    view_ = ((view_ + step) % count + count) % count;
-    controller_.set_camera(views_[size_t(view_)].camera);
-    effects_.set_view_shutter(shutters_.empty()
-                                  ? ViewShutter()
-                                  : ViewShutter(shutters_[size_t(view_)], views_[size_t(view_)].camera));
-    needs_render_ = true;
-  }
-
-  // The swapchain, the float image and the camera follow the framebuffer; a 0x0 one (minimized)
-  // has no swapchain images, and the loop sleeps until it grows again.
+  // The swapchain, the images and the camera follow the framebuffer; a 0x0 one (minimized) has no
+  // swapchain images, and the loop sleeps until it grows again.
   void fit_to_window() {
     resized_ = false;
     int width = 0, height = 0;
@@ -371,23 +249,23 @@ class Viewer {
     image_.reset();
     mesh_layer_.reset();
     if (mesh_)
-      mesh_layer_ = std::make_unique<MeshLayer>(device_, bounds_, extent.width, extent.height);
+      mesh_layer_ = std::make_unique<MeshLayer>(device_, view_.bounds(), extent.width, extent.height);
     else
       image_ = std::make_unique<FloatImage>(device_, extent.width, extent.height);
     shown_extent_ = extent;
-    controller_.resize(int(extent.width), int(extent.height));
+    view_.controller().resize(int(extent.width), int(extent.height));
     needs_render_ = true;
   }
 
   void render() {
-    if (lod_view_) lod_view_->prepare_frame(renderer_, camera());
-    tilesplat::RenderSettings frame = settings();
+    if (lod_view_) lod_view_->prepare_frame(renderer_, view_.camera());
+    tilesplat::RenderSettings frame = view_.settings();
     frame.depth = frame.splat_count = false;  // the window shows colour alone
     // Submitted without waiting (HostFrameSync): the presentation's blit is queued behind it.
     if (mesh_layer_)
-      mesh_layer_->draw(renderer_, controller_.camera(), frame, depth_out_);
+      mesh_layer_->draw(renderer_, view_.pinhole_camera(), frame, view_.depth_out());
     else
-      tilesplat::render_to_image(renderer_, camera(), frame, image_->target(), nullptr,
+      tilesplat::render_to_image(renderer_, view_.camera(), frame, image_->target(), nullptr,
                                  tilesplat::HostFrameSync{});
     // A view at rest goes on refining: its lens samples up to --lens-samples and its time samples up to
     // the shutter's, or the stochastic compositor's frames up to kMaxAccumulatedFrames (the counts lag a
@@ -409,38 +287,16 @@ class Viewer {
   }
 
   // The GPU time is the previous frame's: a frame's statistics come once it has been waited for.
-  std::string lens_name() const {
-    const cli::CameraModelFlags& lens = lenses_[lens_];
-    if (lens.fisheye_fov_deg) return "fisheye " + cli::format_fixed(*lens.fisheye_fov_deg, 0) + " deg";
-    if (lens.view_height) return "orthographic " + cli::format_fixed(*lens.view_height, 2) + " tall";
-    if (lens.equirectangular) return "panorama";
-    return effects_.lens_title(camera(), renderer_.last_frame_stats().accumulated_samples);
-  }
-
   void show_title(double frame_ms) {
-    std::string title = scene_name_;
-    if (!views_.empty()) {
-      const tilesplat::CameraView& view = views_[size_t(view_)];
-      title += " | view " + std::to_string(view_) + (view.name.empty() ? "" : " (" + view.name + ")");
-    }
-    const std::string& ran = renderer_.last_frame_stats().sort_strategy;
-    const std::string sort = sorts_[sort_] == "auto" && !ran.empty() ? "auto (" + ran + ")" : sorts_[sort_];
-    title += " | " + lens_name() + " | " + tilesplat::to_string(modes_[mode_]) + " | " + sort + " | " +
-             tilesplat::to_string(kCompositorCycle[compositor_]) +
-             (kCompositorCycle[compositor_] == tilesplat::Compositor::kStochastic
-                  ? " (" + std::to_string(renderer_.last_frame_stats().accumulated_frames) + " " +
-                        tilesplat::to_string(stochastic_sampler_) + " frames)"
-                  : "") +
-             effects_.motion_title(renderer_.last_frame_stats().accumulated_samples) +
-             (lod_view_ ? lod_view_->title() : "") + " | GPU " +
-             cli::format_fixed(renderer_.last_frame_stats().gpu_ms, 1) + " ms | frame " +
-             cli::format_fixed(frame_ms, 1) + " ms (" +
-             cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps)";
-    if (mesh_layer_ && !MeshLayer::depth_testable(settings()))
+    const tilesplat::FrameStats& last = renderer_.last_frame_stats();
+    std::string title = view_.title(last) + (lod_view_ ? lod_view_->title() : "") + " | GPU " +
+                        cli::format_fixed(last.gpu_ms, 1) + " ms | frame " + cli::format_fixed(frame_ms, 1) +
+                        " ms (" + cli::format_fixed(1000.0 / std::max(frame_ms, 1e-3), 1) + " fps)";
+    if (mesh_layer_ && !MeshLayer::depth_testable(view_.settings()))
       title += " | mesh off: this mode does not depth-test";
-    else if (mesh_layer_ && !depth_out_)
+    else if (mesh_layer_ && !view_.depth_out())
       title += " | no depth out";
-    else if (mesh_layer_ && !mesh_layer_->writes_depth_out(settings()))
+    else if (mesh_layer_ && !mesh_layer_->writes_depth_out(view_.settings()))
       title += " | no depth out: this device's raster compositor writes none";
     glfwSetWindowTitle(window_, title.c_str());
   }
@@ -452,27 +308,11 @@ class Viewer {
   std::unique_ptr<MeshLayer> mesh_layer_;  // else the box, the splats and the grid
   VkExtent2D shown_extent_{0, 0};          // the size of the images above
   Swapchain swapchain_;                    // destroyed first: it waits for the device to be idle
-  tilesplat::Bounds bounds_;
-  OrbitController controller_;
-  bool mesh_;       // draw the box and the grid (not --no-mesh)
-  bool depth_out_;  // the splats write their depth for the grid (D toggles)
-  std::string scene_name_;
-  std::unique_ptr<LodView> lod_view_;         // a LOD set drawn under --splat-budget, else null
-  std::vector<tilesplat::CameraView> views_;  // of --cameras or the scene file; N and P step through them
-  std::vector<tilesplat::Shutter> shutters_;  // the scene file's, one per view; none for --cameras
-  int view_ = 0;
-  double turn_deg_;      // --turn: degrees the camera turns each frame
-  ViewEffects effects_;  // keys F and B: depth of field and motion blur
+  ViewState view_;                         // what is shown
+  bool mesh_;                              // draw the box and the grid (not --no-mesh)
+  double turn_deg_;                        // --turn: degrees the camera turns each frame
+  std::unique_ptr<LodView> lod_view_;      // a LOD set drawn under --splat-budget, else null
   int screenshot_samples_ = 0;
-  std::vector<tilesplat::AccuracyModes> modes_;
-  size_t mode_ = 0;
-  std::vector<std::string> sorts_;
-  size_t sort_ = 0;
-  std::vector<cli::CameraModelFlags> lenses_;  // key L's cycle
-  size_t lens_ = 0;
-  size_t compositor_ = 0;                            // in kCompositorCycle (C cycles)
-  tilesplat::StochasticSampler stochastic_sampler_;  // --stochastic-sampler
-  tilesplat::RenderSettings base_settings_;  // the scene file's background, effects and outputs
 
   int drag_button_ = -1;  // the mouse button held, or -1
   double cursor_x_ = 0, cursor_y_ = 0;
