@@ -228,5 +228,29 @@ TEST(CameraFromMatrices, NonPinholeAndBrokenMatricesAreRejectedNamingWhy) {
   EXPECT_NO_THROW(Camera::from_matrices(float_view, projection, 64, 36, gl.clip));
 }
 
+// A view matrix's 3x3 block follows the rule every rotation the engine reads follows
+// (camera/rotation_check.h): |R^T R - I| at most 1e-3. A host's float rounding passes and so does a
+// file's few digits; a real scale of the scene does not. A mirror is a host's to make, and passes.
+TEST(CameraFromMatrices, TheViewsBlockFollowsTheOneRotationRule) {
+  Camera camera = resize_camera(load_cameras_json(testing::bundled_playbot_cameras()).at(0).camera, 64, 36);
+  const Convention& gl = conventions().front();
+  const Matrix view = view_matrix(camera, true);
+  const Matrix projection = projection_matrix(camera, gl, 0.1, 100.0);
+  const auto scaled_row = [&](double factor) {
+    Matrix scaled = view;
+    for (int c = 0; c < 3; ++c) at(scaled, 0, c) *= factor;
+    return scaled;
+  };
+  // (1 + e)^2 - 1 is about 2e: 4e-4 off, within the tolerance; 2.2e-3 off, past it.
+  EXPECT_NO_THROW(Camera::from_matrices(scaled_row(1.0002), projection, 64, 36, gl.clip));
+  const std::string refused = tilesplat::testing::error_of<std::invalid_argument>(
+      [&] { Camera::from_matrices(scaled_row(1.0011), projection, 64, 36, gl.clip); });
+  EXPECT_NE(refused.find("not rigid: its 3x3 block is not orthonormal"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("tolerance 0.001"), std::string::npos) << refused;
+  Matrix mirrored = view;
+  for (int c = 0; c < 4; ++c) at(mirrored, 0, c) = -at(mirrored, 0, c);
+  EXPECT_NO_THROW(Camera::from_matrices(mirrored, projection, 64, 36, gl.clip));
+}
+
 }  // namespace
 }  // namespace tilesplat

@@ -9,10 +9,13 @@
 #include <string>
 #include <vector>
 
+#include "tilesplat/bounds.h"
 #include "tilesplat/export.h"
-#include "tilesplat/scene.h"
+#include "tilesplat/scene_error.h"
 
 namespace tilesplat {
+
+struct GaussianScene;  // tilesplat/scene.h; the cameras framed on one are defined beside it
 
 /// How a host application's clip space maps onto its image, for Camera::from_matrices(). Both the
 /// Vulkan convention and the OpenGL one are named; anything else is a combination of the two fields.
@@ -108,7 +111,8 @@ struct TILESPLAT_API Camera {
   /// The camera a host application renders with, from its matrices. Both are 4x4, **column-major**
   /// (element (row r, column c) at [c * 4 + r], as glm and OpenGL store them), acting on column vectors:
   /// clip = projection * view * world.
-  /// - `view` maps world to view space; it must be rigid (an orthonormal 3x3 block, last row 0 0 0 1). The
+  /// - `view` maps world to view space; it must be rigid (an orthonormal 3x3 block, |R^T R - I| at most 1e-3
+  ///   as for every rotation the engine reads; last row 0 0 0 1). The
   ///   view space may be right-handed looking down -z (OpenGL, glm::lookAt) or look down +z (the sign of
   ///   the projection's w row says which); a mirrored view is allowed and renders mirrored.
   /// - `projection` must be a pinhole perspective: clip w = +-view z (row 3 = 0 0 +-k 0), no skew and no

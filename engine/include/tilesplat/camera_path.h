@@ -9,7 +9,7 @@
 
 #include "tilesplat/camera.h"
 #include "tilesplat/export.h"
-#include "tilesplat/scene.h"
+#include "tilesplat/scene_error.h"
 
 namespace tilesplat {
 

@@ -11,15 +11,11 @@
 #include <string_view>
 #include <vector>
 
+#include "tilesplat/bounds.h"
 #include "tilesplat/export.h"
+#include "tilesplat/scene_error.h"
 
 namespace tilesplat {
-
-/// Thrown for any file that cannot be read as a scene. what() names the file and the problem.
-class TILESPLAT_API SceneError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 /// Structure-of-arrays storage of N Gaussians. Values are kept as the trainer stores them
 /// (log scales, opacity logits) so that every renderer applies the activations itself, in its
@@ -99,13 +95,6 @@ TILESPLAT_API GaussianScene load_scene(const std::filesystem::path& path, const 
 TILESPLAT_API GaussianScene parse_scene(std::span<const std::byte> data, std::string_view name,
                                         const LoadOptions& options = {}, LoadReport* report = nullptr);
 
-/// Where a scene is, for framing cameras: its box and a robust centre and radius, in world units.
-struct Bounds {
-  double min[3] = {0, 0, 0};     ///< smallest x, y, z of the means
-  double max[3] = {0, 0, 0};     ///< largest x, y, z of the means
-  double center[3] = {0, 0, 0};  ///< robust centre (the median of the means per axis)
-  double radius = 0;             ///< robust radius around center (covers most Gaussians, ignores outliers)
-};
 /// The scene's bounds; all zero for an empty scene.
 TILESPLAT_API Bounds compute_bounds(const GaussianScene& scene);
 

@@ -10,7 +10,6 @@
 #include <string>
 
 #include "camera/camera_models.h"
-#include "tilesplat/scene.h"
 
 namespace tilesplat {
 namespace {
@@ -218,11 +217,6 @@ Camera look_at_camera(const std::array<double, 3>& eye, const std::array<double,
   camera.rotation = {right[0], right[1], right[2], down[0], down[1], down[2], forward[0], forward[1], forward[2]};
   camera.position = eye;
   return camera;
-}
-
-Camera orbit_camera(const GaussianScene& scene, int width, int height, const OrbitParams& params) {
-  if (width <= 0 || height <= 0) throw std::invalid_argument("orbit_camera: width and height must be positive");
-  return orbit_camera(compute_bounds(scene), width, height, params);
 }
 
 Camera orbit_camera(const Bounds& bounds, int width, int height, const OrbitParams& params) {

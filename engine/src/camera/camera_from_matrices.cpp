@@ -4,9 +4,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
+#include "camera/rotation_check.h"
 #include "tilesplat/camera.h"
 
 namespace tilesplat {
@@ -27,24 +29,17 @@ std::string element(const char* matrix, int row, int column) {
   return std::string(matrix) + "(" + std::to_string(row) + ", " + std::to_string(column) + ")";
 }
 
-// Hosts build their matrices in float: a rigid view's rows are orthonormal to about 1e-7.
-constexpr double kOrthonormalTolerance = 1e-5;
-
 void check_view(const Matrix& view) {
   for (int row = 0; row < 4; ++row)
     for (int column = 0; column < 4; ++column)
       if (!std::isfinite(at(view, row, column))) fail(element("view", row, column) + " is not finite");
   if (at(view, 3, 0) != 0 || at(view, 3, 1) != 0 || at(view, 3, 2) != 0 || at(view, 3, 3) != 1)
     fail("the view matrix's last row must be 0 0 0 1 (a rigid transform of world to view space)");
-  for (int a = 0; a < 3; ++a)
-    for (int b = a; b < 3; ++b) {
-      double dot = 0;
-      for (int k = 0; k < 3; ++k) dot += at(view, a, k) * at(view, b, k);
-      if (std::fabs(dot - (a == b ? 1.0 : 0.0)) > kOrthonormalTolerance)
-        fail("the view matrix is not rigid: its 3x3 block is not orthonormal (rows " + std::to_string(a) +
-             " and " + std::to_string(b) + " have dot product " + std::to_string(dot) +
-             "); scale the scene, not the camera");
-    }
+  std::array<double, 9> block{};
+  for (int row = 0; row < 3; ++row)
+    for (int column = 0; column < 3; ++column) block[size_t(row * 3 + column)] = at(view, row, column);
+  if (const std::optional<std::string> problem = orthonormality_problem(block))
+    fail("the view matrix is not rigid: its 3x3 block " + *problem + "; scale the scene, not the camera");
 }
 
 // A relative zero: projections hosts build have exact zeros there, or float rounding of them.

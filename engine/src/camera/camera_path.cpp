@@ -150,13 +150,6 @@ std::vector<Camera> sample_camera_path(const CameraPath& path, int frames, int w
   return cameras;
 }
 
-std::vector<Camera> orbit_cameras(const GaussianScene& scene, int frames, int width, int height,
-                                  const OrbitParams& params) {
-  if (frames < 1) throw std::invalid_argument("orbit_cameras: frames must be at least 1");
-  check_size(width, height);
-  return orbit_cameras(compute_bounds(scene), frames, width, height, params);
-}
-
 std::vector<Camera> orbit_cameras(const Bounds& bounds, int frames, int width, int height,
                                   const OrbitParams& params) {
   if (frames < 1) throw std::invalid_argument("orbit_cameras: frames must be at least 1");

@@ -14,7 +14,7 @@
 #include "camera/json_file.h"
 #include "camera/rotation_check.h"
 #include "tilesplat/camera.h"
-#include "tilesplat/scene.h"
+#include "tilesplat/scene_error.h"
 
 namespace tilesplat {
 namespace {

@@ -3,7 +3,7 @@
 #include <fstream>
 #include <string>
 
-#include "tilesplat/scene.h"
+#include "tilesplat/scene_error.h"
 
 namespace tilesplat {
 

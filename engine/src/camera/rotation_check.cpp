@@ -6,7 +6,7 @@
 
 namespace tilesplat {
 
-std::optional<std::string> rotation_problem(const std::array<double, 9>& m) {
+std::optional<std::string> orthonormality_problem(const std::array<double, 9>& m) {
   double worst = 0;
   for (size_t i = 0; i < 3; ++i)
     for (size_t j = 0; j < 3; ++j) {
@@ -20,6 +20,11 @@ std::optional<std::string> rotation_problem(const std::array<double, 9>& m) {
             << kRotationOrthonormalTolerance << ")";
     return message.str();
   }
+  return std::nullopt;
+}
+
+std::optional<std::string> rotation_problem(const std::array<double, 9>& m) {
+  if (std::optional<std::string> problem = orthonormality_problem(m)) return problem;
   const double determinant = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
                              m[2] * (m[3] * m[7] - m[4] * m[6]);
   if (determinant < 0) return "is a reflection (determinant -1), not a rotation";

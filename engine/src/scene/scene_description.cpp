@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "camera/rotation_check.h"
 #include "scene/json_reader.h"
 #include "scene/scene_readers.h"
 #include "tilesplat/shutter.h"
@@ -34,7 +35,6 @@ constexpr double kMaxFocal = 1e9;           // pixels
 constexpr int kMaxImageSide = 65536;
 constexpr double kMaxRadiance = 1e6;        // background and light colours, light intensity
 constexpr double kMaxExposureStops = 20;
-constexpr double kOrthonormalTolerance = 1e-3;
 constexpr double kDefaultFovDeg = 50;
 constexpr int kFormatVersion = 1;
 
@@ -150,19 +150,8 @@ std::array<double, 9> read_camera_rotation(const Reader& reader, const Node& nod
     const auto row = reader.numbers<3>(Node{node.value[r], element_path(node.path, r)}, -1.001, 1.001);
     std::copy(row.begin(), row.end(), m.begin() + static_cast<std::ptrdiff_t>(r * 3));
   }
-  double worst = 0;
-  for (size_t i = 0; i < 3; ++i)
-    for (size_t j = 0; j < 3; ++j) {
-      double dot = 0;
-      for (size_t k = 0; k < 3; ++k) dot += m[i * 3 + k] * m[j * 3 + k];
-      worst = std::max(worst, std::abs(dot - (i == j ? 1.0 : 0.0)));
-    }
-  if (!(worst <= kOrthonormalTolerance))
-    reader.fail(node.path, "must be a rotation: its rows are not orthonormal (|R R^T - I| = " + format_number(worst) +
-                               ", tolerance " + format_number(kOrthonormalTolerance) + ")");
-  const double det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-                     m[2] * (m[3] * m[7] - m[4] * m[6]);
-  if (det < 0) reader.fail(node.path, "is a reflection (determinant -1), not a rotation");
+  if (const std::optional<std::string> problem = rotation_problem(m))
+    reader.fail(node.path, "must be a rotation, but it " + *problem);
   return m;
 }
 
