@@ -456,17 +456,11 @@ void MeshLayer::draw(Renderer& renderer, const Camera& camera, const RenderSetti
 
   // 3. The splats over the box (premultiplied), then the grid, depth-tested against the splats' depth.
   begin(grid_commands_);
-  VkImageMemoryBarrier to_sampled{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-  to_sampled.oldLayout =
-      VK_IMAGE_LAYOUT_GENERAL;  // where render_to_image leaves an image handed over UNDEFINED
-  to_sampled.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  to_sampled.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
-  to_sampled.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-  to_sampled.srcQueueFamilyIndex = to_sampled.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_sampled.image = splats_.handle();
-  to_sampled.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  vkCmdPipelineBarrier(grid_commands_, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
-                       VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1, &to_sampled);
+  // From GENERAL, where render_to_image leaves an image handed over UNDEFINED.
+  vk::transition(grid_commands_, {splats_.handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_GENERAL,
+                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_MEMORY_WRITE_BIT,
+                                  VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                                  VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT});
   pass.renderPass = over_pass_.get();
   pass.clearValueCount = 0;
   pass.pClearValues = nullptr;

@@ -15,6 +15,7 @@
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene.h"
 #include "tilesplat/vulkan_interop.h"
+#include "vulkan/barriers.h"
 #include "vulkan/buffer.h"
 #include "vulkan/handle.h"
 #include "vulkan/image.h"

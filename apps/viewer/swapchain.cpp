@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "vulkan/barriers.h"
 #include "vulkan/buffer.h"
 
 namespace tilesplat::viewer {
@@ -57,21 +58,6 @@ VkSurfaceFormatKHR choose_format(const WindowDevice& device) {
   throw std::runtime_error(device.name() + ": the window offers no 8-bit RGBA format that a blit can write");
 }
 
-void transition(VkCommandBuffer commands, VkImage image, VkImageLayout from, VkImageLayout to,
-                VkAccessFlags src_access, VkAccessFlags dst_access, VkPipelineStageFlags src_stage,
-                VkPipelineStageFlags dst_stage) {
-  VkImageMemoryBarrier barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-  barrier.oldLayout = from;
-  barrier.newLayout = to;
-  barrier.srcAccessMask = src_access;
-  barrier.dstAccessMask = dst_access;
-  barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  barrier.image = image;
-  barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  vkCmdPipelineBarrier(commands, src_stage, dst_stage, 0, 0, nullptr, 0, nullptr, 1, &barrier);
-}
-
 }  // namespace
 
 std::string format_name(VkFormat format) {
@@ -102,8 +88,8 @@ TransferImage::TransferImage(const WindowDevice& device, VkFormat format, VkForm
                      VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "a viewer image");
   // Once, so that every use finds the image in the layout made for it.
   device.context().submit_and_wait([&](VkCommandBuffer commands) {
-    transition(commands, image_.handle(), VK_IMAGE_LAYOUT_UNDEFINED, layout, 0, 0,
-               VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    vk::transition(commands, {image_.handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED, layout,
+                              0, 0, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT});
   });
 }
 
@@ -223,8 +209,9 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
   // The previous contents are not needed (UNDEFINED). The source needs no barrier of ours: both
   // render_to_image and the mesh layer's last pass end with one whose second scope is every later
   // command, ours included.
-  transition(commands_, images_[index], VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
-             VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+  vk::transition(commands_, {images_[index], VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                             VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
+                             VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT});
   VkImage window_image = images_[index];
   if (!unencoded_) {
     record_blit(source, source_layout, window_image);
@@ -232,9 +219,10 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
     // The blit writes the _UNORM twin (no encoding); its bytes go to the _SRGB image unchanged.
     VkImage twin = unencoded_->image();
     record_blit(source, source_layout, twin);
-    transition(commands_, twin, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-               VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-               VK_PIPELINE_STAGE_TRANSFER_BIT);
+    vk::transition(commands_, {twin, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                               VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                               VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                               VK_PIPELINE_STAGE_TRANSFER_BIT});
     VkImageCopy copy{};
     copy.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     copy.dstSubresource = copy.srcSubresource;
@@ -242,18 +230,20 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
     vkCmdCopyImage(commands_, twin, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, window_image,
                    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
     // Back to the layout the next frame's blit expects, once the copy has read it.
-    transition(commands_, twin, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-               VK_ACCESS_TRANSFER_READ_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-               VK_PIPELINE_STAGE_TRANSFER_BIT);
+    vk::transition(commands_, {twin, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_TRANSFER_READ_BIT,
+                               VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                               VK_PIPELINE_STAGE_TRANSFER_BIT});
   }
   vk::Buffer readback;
   VkImageLayout window_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
   if (shown) {
     readback = vk::Buffer(device_.context(), VkDeviceSize(extent_.width) * extent_.height * 4,
                           vk::MemoryUse::Readback, "the window's pixels");
-    transition(commands_, window_image, window_layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-               VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-               VK_PIPELINE_STAGE_TRANSFER_BIT);
+    vk::transition(commands_, {window_image, VK_IMAGE_ASPECT_COLOR_BIT, window_layout,
+                               VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                               VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                               VK_PIPELINE_STAGE_TRANSFER_BIT});
     window_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
@@ -265,9 +255,10 @@ bool Swapchain::present(VkImage source, VkImageLayout source_layout, VkExtent2D 
     vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
                          &to_host, 0, nullptr, 0, nullptr);
   }
-  transition(commands_, window_image, window_layout, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-             shown ? VkAccessFlags{0} : VkAccessFlags{VK_ACCESS_TRANSFER_WRITE_BIT}, 0,
-             VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+  vk::transition(commands_,
+                 {window_image, VK_IMAGE_ASPECT_COLOR_BIT, window_layout, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                  shown ? VkAccessFlags{0} : VkAccessFlags{VK_ACCESS_TRANSFER_WRITE_BIT}, 0,
+                  VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT});
   vk::check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer");
 
   // The blit waits for the acquired image at the transfer stage, where the first barrier starts.

@@ -4,30 +4,19 @@
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <span>
 #include <stdexcept>
 #include <string_view>
 #include <vector>
 
+#include "vulkan/device_selection.h"
+
 namespace tilesplat::viewer {
 
 namespace {
-
-constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
-
-std::string lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return text;
-}
-
-std::string device_name(VkPhysicalDevice device) {
-  VkPhysicalDeviceProperties properties;
-  vkGetPhysicalDeviceProperties(device, &properties);
-  return properties.deviceName;
-}
 
 // Why `device` cannot run the renderer and present to `surface`, or "" when it can; then `family`
 // is a queue family that computes, has timestamps (the renderer times its passes) and presents.
@@ -62,32 +51,7 @@ std::string why_unsuitable(VkPhysicalDevice device, VkSurfaceKHR surface, uint32
   return "no queue family both computes and presents to the window";
 }
 
-int type_rank(VkPhysicalDevice device) {
-  VkPhysicalDeviceProperties properties;
-  vkGetPhysicalDeviceProperties(device, &properties);
-  switch (properties.deviceType) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-    default: return 3;
-  }
-}
-
 }  // namespace
-
-DebugMessenger::DebugMessenger(VkInstance instance, const VkDebugUtilsMessengerCreateInfoEXT& info)
-    : instance_(instance) {
-  auto create_messenger = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-      vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
-  if (!create_messenger) throw std::runtime_error("vkCreateDebugUtilsMessengerEXT is unavailable");
-  vk::check(create_messenger(instance, &info, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
-}
-
-DebugMessenger::~DebugMessenger() {
-  auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-      vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
-  if (destroy_messenger) destroy_messenger(instance_, messenger_, nullptr);
-}
 
 // A constructor that throws runs no destructor of its own, but its members' do: whatever was made so far
 // releases itself.
@@ -109,50 +73,18 @@ ExternalVulkanDevice WindowDevice::external() const {
           queue_family_,   shader_float64_,  independent_blend_, rasterization_order_};
 }
 
-std::string WindowDevice::name() const { return device_name(physical_device_); }
+std::string WindowDevice::name() const {
+  return vk::physical_device_name(physical_device_);
+}
 
 void WindowDevice::create_instance(bool validation) {
   uint32_t glfw_count = 0;
   const char** glfw_extensions = glfwGetRequiredInstanceExtensions(&glfw_count);
   if (!glfw_extensions)
     throw std::runtime_error("Vulkan cannot present to this window system (no surface extensions)");
-  std::vector<const char*> extensions(glfw_extensions, glfw_extensions + glfw_count);
-  std::vector<const char*> layers;
-  if (validation) {
-    uint32_t count = 0;
-    vkEnumerateInstanceLayerProperties(&count, nullptr);
-    std::vector<VkLayerProperties> available(count);
-    vkEnumerateInstanceLayerProperties(&count, available.data());
-    const auto is_validation = [](const VkLayerProperties& layer) {
-      return std::strcmp(layer.layerName, kValidationLayer) == 0;
-    };
-    if (std::none_of(available.begin(), available.end(), is_validation))
-      throw std::runtime_error(std::string("validation requested but ") + kValidationLayer +
-                               " is not installed (Debian: vulkan-validationlayers)");
-    layers.push_back(kValidationLayer);
-    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-  }
-  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
-  app.pApplicationName = "tilesplat-viewer";
-  app.pEngineName = "tilesplat";
-  app.apiVersion = VK_API_VERSION_1_2;
-  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-  info.pApplicationInfo = &app;
-  info.enabledLayerCount = uint32_t(layers.size());
-  info.ppEnabledLayerNames = layers.data();
-  info.enabledExtensionCount = uint32_t(extensions.size());
-  info.ppEnabledExtensionNames = extensions.data();
-  vk::check(vkCreateInstance(&info, nullptr, instance_.receive()), "vkCreateInstance");
-  if (!validation) return;
-
-  VkDebugUtilsMessengerCreateInfoEXT messenger{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  messenger.messageSeverity =
-      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  messenger.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                          VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-  messenger.pfnUserCallback = &WindowDevice::on_validation_message;
-  messenger.pUserData = this;
-  messenger_.emplace(instance_.get(), messenger);
+  instance_ = vk::UniqueInstance(
+      vk::create_bare_instance(validation, std::span(glfw_extensions, glfw_count), "tilesplat-viewer"));
+  if (validation) messenger_.emplace(instance_.get(), &WindowDevice::on_validation_message, this);
 }
 
 VKAPI_ATTR VkBool32 VKAPI_CALL WindowDevice::on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -165,46 +97,21 @@ VKAPI_ATTR VkBool32 VKAPI_CALL WindowDevice::on_validation_message(VkDebugUtilsM
   return VK_FALSE;
 }
 
-// The selector means what --device means to the other apps (an index in the loader's order, or part
-// of the name), but the device must also present to this window, which a headless renderer never asks.
+// The selector means what --device means to the other apps (an index in the loader's order, a UUID, or
+// part of the name), but the device must also present to this window, which a headless renderer never asks.
 void WindowDevice::pick_physical_device(const std::string& device_selector) {
   std::string selector = device_selector;
   if (selector.empty())
     if (const char* env = std::getenv("TILESPLAT_DEVICE")) selector = env;
-  uint32_t count = 0;
-  vk::check(vkEnumeratePhysicalDevices(instance_.get(), &count, nullptr), "vkEnumeratePhysicalDevices");
-  std::vector<VkPhysicalDevice> devices(count);
-  vk::check(vkEnumeratePhysicalDevices(instance_.get(), &count, devices.data()),
-            "vkEnumeratePhysicalDevices");
-  if (devices.empty())
-    throw std::runtime_error("no Vulkan device found (install a driver, e.g. Debian's mesa-vulkan-drivers)");
-
-  const bool numeric = !selector.empty() && std::all_of(selector.begin(), selector.end(),
-                                                        [](unsigned char c) { return std::isdigit(c); });
-  std::string names, rejected;
-  for (size_t i = 0; i < devices.size(); ++i) {
-    const std::string name = device_name(devices[i]);
-    names += (i ? ", " : "") + std::to_string(i) + ": " + name;
-    const bool selected = selector.empty() || (numeric ? selector == std::to_string(i)
-                                                       : lower(name).find(lower(selector)) != std::string::npos);
-    if (!selected) continue;
-    uint32_t family = 0;
-    const std::string why = why_unsuitable(devices[i], surface_.get(), family);
-    if (!why.empty()) {
-      rejected += (rejected.empty() ? "" : "; ") + name + ": " + why;
-      continue;
-    }
-    // A selector takes its first match that fits, as in the other apps; no selector, the best kind.
-    if (!physical_device_ || (selector.empty() && type_rank(devices[i]) < type_rank(physical_device_))) {
-      physical_device_ = devices[i];
-      queue_family_ = family;
-    }
-  }
-  if (physical_device_) return;
-  if (rejected.empty())
-    throw std::runtime_error("no Vulkan device matches '" + selector + "' (--device or TILESPLAT_DEVICE; devices: " +
-                             names + ")");
-  throw std::runtime_error("no Vulkan device can render to the window (" + rejected + ")");
+  const VkSurfaceKHR surface = surface_.get();
+  physical_device_ = vk::select_physical_device(
+      instance_.get(), selector,
+      [surface](VkPhysicalDevice device) {
+        uint32_t family = 0;
+        return why_unsuitable(device, surface, family);
+      },
+      "render to the window");
+  why_unsuitable(physical_device_, surface, queue_family_);  // "": the family that computes and presents
 }
 
 void WindowDevice::create_device() {

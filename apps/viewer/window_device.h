@@ -18,19 +18,6 @@ struct GLFWwindow;
 
 namespace tilesplat::viewer {
 
-// The instance's debug messenger, destroyed through the function the instance gives for it.
-class DebugMessenger {
- public:
-  DebugMessenger(VkInstance instance, const VkDebugUtilsMessengerCreateInfoEXT& info);
-  ~DebugMessenger();
-  DebugMessenger(const DebugMessenger&) = delete;
-  DebugMessenger& operator=(const DebugMessenger&) = delete;
-
- private:
-  VkInstance instance_ = VK_NULL_HANDLE;
-  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
-};
-
 class WindowDevice {
  public:
   // validation: VK_LAYER_KHRONOS_validation with a messenger that prints and counts its messages,
@@ -72,7 +59,7 @@ class WindowDevice {
   // Declared in the order they are made: they are destroyed in the reverse one.
   std::atomic<uint64_t> validation_messages_{0};
   vk::UniqueInstance instance_;
-  std::optional<DebugMessenger> messenger_;  // with validation only
+  std::optional<vk::DebugMessenger> messenger_;  // with validation only
   vk::UniqueSurface surface_;
   VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
   vk::UniqueDevice device_;

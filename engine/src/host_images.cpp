@@ -4,27 +4,13 @@
 #include <string>
 
 #include "passes/pack_colour_pass.h"
+#include "vulkan/barriers.h"
 
 namespace tilesplat {
 
 namespace {
 
 constexpr VkAccessFlags kAnyAccess = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
-
-void image_barrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout from,
-                   VkImageLayout to, VkAccessFlags src_access, VkAccessFlags dst_access) {
-  VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-  b.oldLayout = from;
-  b.newLayout = to;
-  b.srcAccessMask = src_access;
-  b.dstAccessMask = dst_access;
-  b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.image = image;
-  b.subresourceRange = {aspect, 0, 1, 0, 1};
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
-                       nullptr, 0, nullptr, 1, &b);
-}
 
 VkBufferImageCopy whole_image(VkImageAspectFlags aspect, uint32_t width, uint32_t height) {
   VkBufferImageCopy region{};
@@ -86,23 +72,23 @@ VkImageAspectFlags depth_aspect(const ExternalDepthImage& depth) {
 
 void copy_buffer_to_image(VkCommandBuffer cmd, const vk::Buffer& buffer, VkImage image,
                           VkImageAspectFlags aspect, VkImageLayout layout, uint32_t width, uint32_t height) {
-  image_barrier(cmd, image, aspect, layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_MEMORY_WRITE_BIT,
-                VK_ACCESS_TRANSFER_WRITE_BIT);
+  vk::transition(cmd, {image, aspect, layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                       VK_ACCESS_MEMORY_WRITE_BIT, VK_ACCESS_TRANSFER_WRITE_BIT});
   const VkBufferImageCopy region = whole_image(aspect, width, height);
   vkCmdCopyBufferToImage(cmd, buffer.handle(), image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
   const VkImageLayout final_layout = layout == VK_IMAGE_LAYOUT_UNDEFINED ? VK_IMAGE_LAYOUT_GENERAL : layout;
-  image_barrier(cmd, image, aspect, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout,
-                VK_ACCESS_TRANSFER_WRITE_BIT, kAnyAccess);
+  vk::transition(cmd, {image, aspect, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout,
+                       VK_ACCESS_TRANSFER_WRITE_BIT, kAnyAccess});
 }
 
 void copy_image_to_buffer(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect, VkImageLayout layout,
                           const vk::Buffer& buffer, uint32_t width, uint32_t height) {
-  image_barrier(cmd, image, aspect, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_MEMORY_WRITE_BIT,
-                VK_ACCESS_TRANSFER_READ_BIT);
+  vk::transition(cmd, {image, aspect, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                       VK_ACCESS_MEMORY_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT});
   const VkBufferImageCopy region = whole_image(aspect, width, height);
   vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer.handle(), 1, &region);
-  image_barrier(cmd, image, aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout, VK_ACCESS_TRANSFER_READ_BIT,
-                kAnyAccess);
+  vk::transition(cmd, {image, aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout,
+                       VK_ACCESS_TRANSFER_READ_BIT, kAnyAccess});
 }
 
 }  // namespace tilesplat

@@ -9,6 +9,7 @@
 #include "passes/frame_counters.h"
 #include "passes/tile_coverage.h"
 #include "shader_io.h"
+#include "vulkan/barriers.h"
 #include "vulkan/vk_check.h"
 
 namespace tilesplat {
@@ -45,17 +46,10 @@ void copy_to_buffer(VkCommandBuffer cmd, const vk::Image& image, const vk::Buffe
 // tests are done with it; the render pass then reads it from TRANSFER_DST_OPTIMAL (its dependency
 // waits for this copy).
 void copy_to_depth_image(VkCommandBuffer cmd, const vk::Buffer& buffer, const vk::Image& image) {
-  VkImageMemoryBarrier to_transfer{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-  to_transfer.srcAccessMask = 0;
-  to_transfer.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  to_transfer.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  to_transfer.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-  to_transfer.srcQueueFamilyIndex = to_transfer.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_transfer.image = image.handle();
-  to_transfer.subresourceRange = {image.aspect(), 0, 1, 0, 1};
-  vkCmdPipelineBarrier(cmd,
+  vk::transition(cmd, {image.handle(), image.aspect(), VK_IMAGE_LAYOUT_UNDEFINED,
+                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
                        VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
-                       VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1, &to_transfer);
+                       VK_PIPELINE_STAGE_TRANSFER_BIT});
   const VkBufferImageCopy region = whole_image(image);
   vkCmdCopyBufferToImage(cmd, buffer.handle(), image.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
                          &region);

@@ -171,12 +171,7 @@ void Context::destroy() {
     instance_ = VK_NULL_HANDLE;
     return;
   }
-  if (messenger_) {
-    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
-    if (destroy) destroy(instance_, messenger_, nullptr);
-    messenger_ = VK_NULL_HANDLE;
-  }
+  messenger_.reset();  // before its instance
   if (instance_) {
     vkDestroyInstance(instance_, nullptr);
     instance_ = VK_NULL_HANDLE;
@@ -196,18 +191,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Context::debug_callback(VkDebugUtilsMessageSeveri
 
 void Context::create_instance(bool validation) {
   instance_ = create_bare_instance(validation);
-  if (!validation) return;
-  VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  info.messageSeverity =
-      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-  info.pfnUserCallback = &Context::debug_callback;
-  info.pUserData = this;
-  auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-      vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-  if (!create) throw std::runtime_error("vkCreateDebugUtilsMessengerEXT is unavailable");
-  TS_VK_CHECK(create(instance_, &info, nullptr, &messenger_));
+  if (validation) messenger_.emplace(instance_, &Context::debug_callback, this);
 }
 
 void Context::pick_physical_device(const std::string& selector) {

@@ -5,11 +5,13 @@
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "tilesplat/vulkan_interop.h"
+#include "vulkan/handle.h"
 
 namespace tilesplat::vk {
 
@@ -137,7 +139,7 @@ class Context {
 
   bool owns_handles_ = true;  // false for a borrowed device: instance and device are the host's
   VkInstance instance_ = VK_NULL_HANDLE;
-  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  std::optional<DebugMessenger> messenger_;  // with validation, on an instance of our own
   VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;

@@ -66,13 +66,14 @@ void keep_libraries_loaded_under_sanitizers() {
 #endif
 }
 
-VkInstance create_bare_instance(bool validation) {
+VkInstance create_bare_instance(bool validation, std::span<const char* const> extra_extensions,
+                                const char* application) {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
-  app.pApplicationName = "tilesplat";
+  app.pApplicationName = application;
   app.pEngineName = "tilesplat";
   app.apiVersion = VK_API_VERSION_1_2;
   std::vector<const char*> layers;
-  std::vector<const char*> extensions;
+  std::vector<const char*> extensions(extra_extensions.begin(), extra_extensions.end());
   if (validation) {
     uint32_t count = 0;
     vkEnumerateInstanceLayerProperties(&count, nullptr);
@@ -120,49 +121,60 @@ std::string physical_device_uuid(VkPhysicalDevice device) {
   return text;
 }
 
-VkPhysicalDevice select_physical_device(VkInstance instance, const std::string& selector) {
-  std::vector<VkPhysicalDevice> devices = enumerate_devices(instance);
-  VkPhysicalDevice chosen = VK_NULL_HANDLE;
+namespace {
+
+// The kind select_physical_device prefers without a selector: a discrete GPU, then an integrated one, then
+// anything (lavapipe).
+int kind_rank(VkPhysicalDevice device) {
+  VkPhysicalDeviceProperties properties;
+  vkGetPhysicalDeviceProperties(device, &properties);
+  switch (properties.deviceType) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return 2;
+    default:
+      return 3;
+  }
+}
+
+}  // namespace
+
+VkPhysicalDevice select_physical_device(VkInstance instance, const std::string& selector,
+                                        const DeviceFit& why_unfit, std::string_view purpose) {
+  const std::vector<VkPhysicalDevice> devices = enumerate_devices(instance);
   if (devices.empty())
     throw std::runtime_error(
         "no Vulkan device found (install a driver, e.g. Debian's mesa-vulkan-drivers for lavapipe)");
-  if (selector.empty()) {
-    // Prefer a discrete GPU, then an integrated one, then anything (lavapipe).
-    auto rank = [](VkPhysicalDevice d) {
-      VkPhysicalDeviceProperties p;
-      vkGetPhysicalDeviceProperties(d, &p);
-      switch (p.deviceType) {
-        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
-          return 0;
-        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
-          return 1;
-        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
-          return 2;
-        default:
-          return 3;
+  const bool numeric = !selector.empty() && std::all_of(selector.begin(), selector.end(),
+                                                        [](unsigned char c) { return std::isdigit(c); });
+  const std::string uuid = numeric || selector.empty() ? std::string() : uuid_digits(selector);
+  VkPhysicalDevice chosen = VK_NULL_HANDLE;
+  std::string names, unfit;
+  for (size_t i = 0; i < devices.size(); ++i) {
+    const std::string name = physical_device_name(devices[i]);
+    const std::string device_uuid = physical_device_uuid(devices[i]);
+    names += (i ? ", " : "") + std::to_string(i) + ": " + name + " (" + device_uuid + ")";
+    const bool selected = selector.empty() ? true
+                          : numeric        ? std::stoul(selector) == i
+                          : !uuid.empty()  ? uuid_digits(device_uuid) == uuid
+                                           : lower(name).find(lower(selector)) != std::string::npos;
+    if (!selected || (chosen && !selector.empty())) continue;
+    if (why_unfit) {
+      const std::string why = why_unfit(devices[i]);
+      if (!why.empty()) {
+        unfit += (unfit.empty() ? "" : "; ") + name + ": " + why;
+        continue;
       }
-    };
-    return *std::min_element(devices.begin(), devices.end(),
-                             [&](auto a, auto b) { return rank(a) < rank(b); });
-  } else {
-    const bool numeric =
-        std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
-    const std::string uuid = numeric ? std::string() : uuid_digits(selector);
-    std::string names;
-    for (size_t i = 0; i < devices.size(); ++i) {
-      const std::string name = physical_device_name(devices[i]);
-      const std::string device_uuid = physical_device_uuid(devices[i]);
-      names += (i ? ", " : "") + std::to_string(i) + ": " + name + " (" + device_uuid + ")";
-      if (chosen) continue;
-      const bool match = numeric         ? std::stoul(selector) == i
-                         : !uuid.empty() ? uuid_digits(device_uuid) == uuid
-                                         : lower(name).find(lower(selector)) != std::string::npos;
-      if (match) chosen = devices[i];
     }
-    if (!chosen)
-      throw std::runtime_error("no Vulkan device matches '" + selector + "' (devices: " + names + ")");
+    if (!chosen || kind_rank(devices[i]) < kind_rank(chosen)) chosen = devices[i];
   }
-  return chosen;
+  if (chosen) return chosen;
+  if (unfit.empty())
+    throw std::runtime_error("no Vulkan device matches '" + selector + "' (devices: " + names + ")");
+  throw std::runtime_error("no Vulkan device can " + std::string(purpose) + " (" + unfit + ")");
 }
 
 std::vector<std::string> Context::list_device_uuids() {

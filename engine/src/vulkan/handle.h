@@ -58,6 +58,7 @@ template <typename Handle, void (*Destroy)(Handle, const VkAllocationCallbacks*)
 class UniqueRoot {
  public:
   UniqueRoot() = default;
+  explicit UniqueRoot(Handle handle) : handle_(handle) {}
   ~UniqueRoot() { reset(); }
   UniqueRoot(UniqueRoot&& other) noexcept : handle_(std::exchange(other.handle_, Handle(VK_NULL_HANDLE))) {}
   UniqueRoot& operator=(UniqueRoot&& other) noexcept {
@@ -99,6 +100,39 @@ using UniqueDescriptorPool = Unique<VkDevice, VkDescriptorPool, vkDestroyDescrip
 using UniquePipelineLayout = Unique<VkDevice, VkPipelineLayout, vkDestroyPipelineLayout>;
 using UniquePipeline = Unique<VkDevice, VkPipeline, vkDestroyPipeline>;
 using UniqueShaderModule = Unique<VkDevice, VkShaderModule, vkDestroyShaderModule>;
+
+// The instance's debug messenger (VK_EXT_debug_utils), made and destroyed through the functions the
+// instance gives for them: `callback` hears the validation layer's warnings and errors of every type.
+class DebugMessenger {
+ public:
+  DebugMessenger(VkInstance instance, PFN_vkDebugUtilsMessengerCallbackEXT callback, void* user)
+      : instance_(instance) {
+    VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    info.messageSeverity =
+        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    info.pfnUserCallback = callback;
+    info.pUserData = user;
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+    if (!create)
+      throw VulkanError("vkCreateDebugUtilsMessengerEXT (unavailable)", VK_ERROR_EXTENSION_NOT_PRESENT);
+    check(create(instance, &info, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+  }
+  ~DebugMessenger() {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    if (destroy) destroy(instance_, messenger_, nullptr);
+  }
+  DebugMessenger(const DebugMessenger&) = delete;
+  DebugMessenger& operator=(const DebugMessenger&) = delete;
+
+ private:
+  VkInstance instance_;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+};
 
 inline UniqueSemaphore make_semaphore(VkDevice device) {
   const VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
