@@ -2,7 +2,7 @@
 
 #include <bit>
 
-#include "passes/tile_coverage.h"
+#include "passes/tile_composite_layout.h"
 #include "shader_io.h"
 #include "tilesplat/camera.h"
 #include "tilesplat/reference.h"
@@ -32,21 +32,14 @@ void CompositeResortPass::record(VkCommandBuffer cmd, const CompositeInputs& in,
                                  const Camera& camera, uint32_t window, VkDeviceAddress counters) {
   OutputBuffers& out = in.out;
   const Variant variant{in.write_depth, in.write_count, in.cutoffs, window};
-  auto it = pipelines_.find(variant);
-  if (it == pipelines_.end())
-    it = pipelines_
-             .emplace(variant, vk::ComputePipeline(
-                                   ctx_, "composite_resort", sizeof(CompositeResortPush),
-                                   {{0, variant.write_depth ? 1u : 0u},
-                                    {1, variant.write_count ? 1u : 0u},
-                                    {2, pixels_per_invocation_},
-                                    {3, kTileSize / pixels_per_invocation_},
-                                    {4, std::bit_cast<uint32_t>(variant.cutoffs.alpha)},
-                                    {5, std::bit_cast<uint32_t>(coverage_alpha_inv(variant.cutoffs.alpha))},
-                                    {6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
-                                    {7, variant.window},
-                                    {8, std::bit_cast<uint32_t>(variant.cutoffs.max_alpha)}}))
-             .first;
+  const vk::ComputePipeline& pipeline = pipelines_.get(variant, [&] {
+    std::vector<vk::SpecConstant> spec = composite_spec_constants(
+        variant.write_depth, variant.write_count, pixels_per_invocation_, variant.cutoffs.alpha);
+    spec.insert(spec.end(), {{6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
+                             {7, variant.window},
+                             {8, std::bit_cast<uint32_t>(variant.cutoffs.max_alpha)}});
+    return vk::ComputePipeline(ctx_, "composite_resort", sizeof(CompositeResortPush), spec);
+  });
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
   CompositeResortPush push{in.splats.address(),
@@ -64,8 +57,8 @@ void CompositeResortPass::record(VkCommandBuffer cmd, const CompositeInputs& in,
                            max_tile_splats(),
                            counters,
                            out.first_tile};
-  it->second.bind(cmd, push);
-  it->second.dispatch(cmd, tiles_x, tiles_y);
+  pipeline.bind(cmd, push);
+  pipeline.dispatch(cmd, tiles_x, tiles_y);
 }
 
 }  // namespace tilesplat

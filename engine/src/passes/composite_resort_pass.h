@@ -2,9 +2,8 @@
 // (AccuracyModes::resort_window). Runs instead of CompositePass in that mode.
 #pragma once
 
-#include <map>
-
 #include "passes/composite_pass.h"
+#include "vulkan/pipeline_variants.h"
 
 namespace tilesplat {
 
@@ -33,7 +32,7 @@ class CompositeResortPass {
     uint32_t window = 0;  // AccuracyModes::resort_window
     auto operator<=>(const Variant&) const = default;
   };
-  std::map<Variant, vk::ComputePipeline> pipelines_;
+  vk::PipelineVariants<Variant> pipelines_;
 };
 
 }  // namespace tilesplat

@@ -31,19 +31,16 @@ void HostDepthPass::record_window_depths(VkCommandBuffer cmd, const DepthConvent
 void HostDepthPass::record(VkCommandBuffer cmd, uint32_t direction, const DepthConvention& convention,
                            const vk::Buffer& window, const vk::Buffer& view, uint32_t width,
                            uint32_t height) {
-  auto it = pipelines_.find(direction);
-  if (it == pipelines_.end()) {
+  const vk::ComputePipeline& pipeline = pipelines_.get(direction, [&] {
     const char* shader = ctx_.features().shader_float64 ? "host_depth" : "host_depth_fp32";
-    it = pipelines_
-             .emplace(direction, vk::ComputePipeline(ctx_, shader, sizeof(HostDepthPush), {{0, direction}}))
-             .first;
-  }
+    return vk::ComputePipeline(ctx_, shader, sizeof(HostDepthPush), {{0, direction}});
+  });
   HostDepthPush push{window.address(),    view.address(),      {},    {},
                      float(convention.a), float(convention.b), width, height};
   split_bits(convention.a, push.a_bits);
   split_bits(convention.b, push.b_bits);
-  it->second.bind(cmd, push);
-  it->second.dispatch(cmd, vk::div_ceil(width, 16), vk::div_ceil(height, 16));
+  pipeline.bind(cmd, push);
+  pipeline.dispatch(cmd, vk::div_ceil(width, 16), vk::div_ceil(height, 16));
 }
 
 }  // namespace tilesplat

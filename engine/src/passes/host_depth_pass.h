@@ -3,11 +3,10 @@
 // into the host's convention (host_depth.comp). Buffers hold one float a pixel, row-major.
 #pragma once
 
-#include <map>
-
 #include "tilesplat/camera.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
+#include "vulkan/pipeline_variants.h"
 
 namespace tilesplat {
 
@@ -27,7 +26,7 @@ class HostDepthPass {
               const vk::Buffer& window, const vk::Buffer& view, uint32_t width, uint32_t height);
 
   vk::Context& ctx_;
-  std::map<uint32_t, vk::ComputePipeline> pipelines_;  // by direction (a specialization constant)
+  vk::PipelineVariants<uint32_t> pipelines_;  // by direction (a specialization constant)
 };
 
 }  // namespace tilesplat

@@ -38,14 +38,11 @@ uint32_t PackColourPass::texel_bytes(VkFormat format) {
 void PackColourPass::record(VkCommandBuffer cmd, VkFormat format, const vk::Buffer& rgba,
                             const vk::Buffer& packed, VkDeviceAddress counters, uint32_t width,
                             uint32_t height) {
-  auto it = pipelines_.find(format);
-  if (it == pipelines_.end())
-    it = pipelines_
-             .emplace(format, vk::ComputePipeline(ctx_, "pack_colour", sizeof(PackColourPush),
-                                                  {{0, shader_format(format)}}))
-             .first;
-  it->second.bind(cmd, PackColourPush{rgba.address(), packed.address(), counters, width, height});
-  it->second.dispatch(cmd, vk::div_ceil(width, 16), vk::div_ceil(height, 16));
+  const vk::ComputePipeline& pipeline = pipelines_.get(format, [&] {
+    return vk::ComputePipeline(ctx_, "pack_colour", sizeof(PackColourPush), {{0, shader_format(format)}});
+  });
+  pipeline.bind(cmd, PackColourPush{rgba.address(), packed.address(), counters, width, height});
+  pipeline.dispatch(cmd, vk::div_ceil(width, 16), vk::div_ceil(height, 16));
 }
 
 }  // namespace tilesplat

@@ -2,10 +2,9 @@
 // (R16G16B16A16_SFLOAT, R8G8B8A8_UNORM, R8G8B8A8_SRGB), for render_to_image to copy (pack_colour.comp).
 #pragma once
 
-#include <map>
-
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
+#include "vulkan/pipeline_variants.h"
 
 namespace tilesplat {
 
@@ -21,7 +20,7 @@ class PackColourPass {
 
  private:
   vk::Context& ctx_;
-  std::map<VkFormat, vk::ComputePipeline> pipelines_;  // one per format (a specialization constant)
+  vk::PipelineVariants<VkFormat> pipelines_;  // one per format (a specialization constant)
 };
 
 }  // namespace tilesplat

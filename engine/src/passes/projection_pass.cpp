@@ -92,8 +92,7 @@ void ProjectionPass::set_lighting(const Lighting& lighting, SceneBuffers& scene)
 }
 
 const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant& v, bool texel) {
-  auto it = pipelines_.find(std::make_pair(v, texel));
-  if (it == pipelines_.end()) {
+  return pipelines_.get(std::make_pair(v, texel), [&] {
     const uint32_t stored_coeffs = uint32_t((v.stored_sh_degree + 1) * (v.stored_sh_degree + 1));
     const std::vector<vk::SpecConstant> spec = {{0, uint32_t(v.sh_degree)},
                                                 {1, stored_coeffs},
@@ -113,13 +112,9 @@ const vk::ComputePipeline& ProjectionPass::pipeline_for(const ProjectionVariant&
     const char* shader = texel                            ? "projection_texel"
                          : ctx_.features().shader_float64 ? "projection"
                                                           : "projection_fp32";
-    it = pipelines_
-             .emplace(std::make_pair(v, texel),
-                      vk::ComputePipeline(ctx_, shader, sizeof(ProjectionPush), spec,
-                                          texel ? kTexelBindings : std::vector<VkDescriptorType>{}))
-             .first;
-  }
-  return it->second;
+    return vk::ComputePipeline(ctx_, shader, sizeof(ProjectionPush), spec,
+                               texel ? kTexelBindings : std::vector<VkDescriptorType>{});
+  });
 }
 
 void ProjectionPass::prepare(SceneBuffers& scene, const ProjectionVariant& variant) {

@@ -2,17 +2,17 @@
 #pragma once
 
 #include <compare>
-#include <map>
 #include <utility>
 #include <vector>
 
 #include "camera/camera_models.h"
-#include "passes/projection_variant.h"
 #include "passes/key_buffers.h"
+#include "passes/projection_variant.h"
 #include "passes/tile_grid.h"
 #include "shader_io.h"
 #include "vulkan/buffer.h"
 #include "vulkan/compute_pipeline.h"
+#include "vulkan/pipeline_variants.h"
 
 namespace tilesplat {
 
@@ -75,7 +75,7 @@ class ProjectionPass {
   vk::Buffer camera_params_;
   vk::Buffer light_params_;  // LightParams of compute/projection.comp; grown to the most lights seen
   // Specialization constants per variant, and whether through texel buffers (projection_texel).
-  std::map<std::pair<ProjectionVariant, bool>, vk::ComputePipeline> pipelines_;
+  vk::PipelineVariants<std::pair<ProjectionVariant, bool>> pipelines_;  // with the texel twin or not
   vk::ComputePipeline pack_sh_half_;
   vk::ComputePipeline pack_covariance_half_;
   bool texel_buffers_;  // CPU drivers with float64: projection_texel (vk::texel_buffers_wanted)

@@ -165,29 +165,29 @@ void RasterCompositePass::prepare(const Shape& shape) {
 
 vk::GraphicsPipeline& RasterCompositePass::pipeline(const Variant& v) {
   const Attachments& a = v.attachments;
-  auto it = pipelines_.find(v);
-  if (it != pipelines_.end()) return it->second;
-  vk::GraphicsPipelineDesc desc;
-  if (v.mesh)
-    desc.mesh_shader = "raster_quads";
-  else
-    desc.vertex_shader = "raster_quad";
-  desc.fragment_shader = a.surface_depth ? "raster_blend_surface" : "raster_blend";
-  desc.push_constant_bytes = sizeof(RasterPush);
-  desc.spec = {{0, std::bit_cast<uint32_t>(coverage_alpha_inv(v.cutoffs.alpha))},
-               {1, std::bit_cast<uint32_t>(v.cutoffs.alpha)},
-               {2, std::bit_cast<uint32_t>(v.cutoffs.max_alpha)},
-               {3, a.host_depth ? 1u : 0u}};
-  // Without the counts every blend state is the same, as a device without independentBlend requires.
-  desc.attachments = {{a.half_colour ? kHalfColourFormat : kColourFormat, vk::Blend::kUnder, true},
-                      {kColourFormat, vk::Blend::kUnder, a.write_depth},
-                      {kCountFormat, a.write_count ? vk::Blend::kAdd : vk::Blend::kUnder, a.write_count}};
-  if (a.surface_depth) {
-    desc.attachments.push_back({kCountFormat, vk::Blend::kMin, true});
-    desc.input_attachment = 0;  // the colour, whose alpha is 1 - T
-  }
-  if (a.host_depth) desc.depth_test = vk::DepthTest{kHostSurfacesFormat, VK_COMPARE_OP_LESS};
-  return pipelines_.emplace(v, vk::GraphicsPipeline(ctx_, desc)).first->second;
+  return pipelines_.get(v, [&] {
+    vk::GraphicsPipelineDesc desc;
+    if (v.mesh)
+      desc.mesh_shader = "raster_quads";
+    else
+      desc.vertex_shader = "raster_quad";
+    desc.fragment_shader = a.surface_depth ? "raster_blend_surface" : "raster_blend";
+    desc.push_constant_bytes = sizeof(RasterPush);
+    desc.spec = {{0, std::bit_cast<uint32_t>(coverage_alpha_inv(v.cutoffs.alpha))},
+                 {1, std::bit_cast<uint32_t>(v.cutoffs.alpha)},
+                 {2, std::bit_cast<uint32_t>(v.cutoffs.max_alpha)},
+                 {3, a.host_depth ? 1u : 0u}};
+    // Without the counts every blend state is the same, as a device without independentBlend requires.
+    desc.attachments = {{a.half_colour ? kHalfColourFormat : kColourFormat, vk::Blend::kUnder, true},
+                        {kColourFormat, vk::Blend::kUnder, a.write_depth},
+                        {kCountFormat, a.write_count ? vk::Blend::kAdd : vk::Blend::kUnder, a.write_count}};
+    if (a.surface_depth) {
+      desc.attachments.push_back({kCountFormat, vk::Blend::kMin, true});
+      desc.input_attachment = 0;  // the colour, whose alpha is 1 - T
+    }
+    if (a.host_depth) desc.depth_test = vk::DepthTest{kHostSurfacesFormat, VK_COMPARE_OP_LESS};
+    return vk::GraphicsPipeline(ctx_, desc);
+  });
 }
 
 void RasterCompositePass::record(VkCommandBuffer cmd, const RasterInputs& in) {

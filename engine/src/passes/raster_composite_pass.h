@@ -15,7 +15,6 @@
 #include <array>
 #include <compare>
 #include <cstdint>
-#include <map>
 #include <vector>
 
 #include "passes/composite_pass.h"
@@ -23,6 +22,7 @@
 #include "vulkan/compute_pipeline.h"
 #include "vulkan/graphics_pipeline.h"
 #include "vulkan/image.h"
+#include "vulkan/pipeline_variants.h"
 
 namespace tilesplat {
 
@@ -93,7 +93,7 @@ class RasterCompositePass {
   void check_device(const Shape& shape) const;
 
   vk::Context& ctx_;
-  std::map<Variant, vk::GraphicsPipeline> pipelines_;
+  vk::PipelineVariants<Variant, vk::GraphicsPipeline> pipelines_;
   vk::ComputePipeline resolve_;
   // VkDrawIndirectCommand (4 vertices, the visible splats as instances) or, for the mesh stage,
   // VkDrawMeshTasksIndirectCommandEXT.

@@ -16,14 +16,7 @@ static_assert(sizeof(StochasticCompositePush) <= 128, "Vulkan guarantees 128 byt
 
 }  // namespace
 
-StochasticCompositePass::StochasticCompositePass(vk::Context& ctx)
-    : ctx_(ctx),
-      pixels_per_invocation_(composite_pixels_per_invocation(ctx)),
-      chunk_splats_(composite_chunk_splats(ctx)),
-      texel_buffers_(pixels_per_invocation_ > 1 && vk::texel_buffers_wanted(ctx)) {
-  if (texel_buffers_)
-    unused_output_ = vk::Buffer(ctx, 16, vk::MemoryUse::Device, "stochastic composite unused output");
-}
+StochasticCompositePass::StochasticCompositePass(vk::Context& ctx) : layout_(ctx, "stochastic composite") {}
 
 void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeInputs& in,
                                      const Samples& samples, const CompositePass::Chunks& chunks) {
@@ -32,35 +25,19 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
   const bool with_state = needs_state(samples.count, chunks.count) || samples.keep_sums;
   if (with_state && chunks.state.size() < state_bytes(out.width, out.height))
     throw std::logic_error("stochastic composite: the state buffer is smaller than the image");
-  const std::vector<VkBufferView> views =
-      texel_buffers_ ? composite_texel_views(in.splats, in.tile_lists, out, in.write_depth, in.write_count,
-                                             unused_output_)
-                     : std::vector<VkBufferView>{};
-  const Variant variant{in.write_depth,    in.write_count,
-                        in.cutoffs.alpha,  in.cutoffs.max_alpha,
-                        !views.empty(),    samples.sampler == StochasticSampler::kStratified,
-                        samples.keep_sums, samples.sampler == StochasticSampler::kSobol};
-  auto it = pipelines_.find(variant);
-  if (it == pipelines_.end()) {
-    it = pipelines_
-             .emplace(
-                 variant,
-                 vk::ComputePipeline(
-                     ctx_, variant.texel_buffers ? "composite_stochastic_texel" : "composite_stochastic",
-                     sizeof(StochasticCompositePush),
-                     {{0, variant.write_depth ? 1u : 0u},
-                      {1, variant.write_count ? 1u : 0u},
-                      {2, pixels_per_invocation_},
-                      {3, kTileSize / pixels_per_invocation_},
-                      {4, std::bit_cast<uint32_t>(variant.alpha_cutoff)},
-                      {5, std::bit_cast<uint32_t>(coverage_alpha_inv(variant.alpha_cutoff))},
-                      {6, std::bit_cast<uint32_t>(variant.max_alpha)},
-                      {7, variant.stratified ? 1u : 0u},
-                      {8, variant.keep_sums ? 1u : 0u},
-                      {9, variant.sobol ? 1u : 0u}},
-                     variant.texel_buffers ? composite_texel_bindings() : std::vector<VkDescriptorType>{}))
-             .first;
-  }
+  const std::vector<VkBufferView> views = layout_.texel_views(in);
+  const Variant variant{{in.write_depth, in.write_count, in.cutoffs.alpha, !views.empty()},
+                        in.cutoffs.max_alpha,
+                        samples.sampler == StochasticSampler::kStratified,
+                        samples.keep_sums,
+                        samples.sampler == StochasticSampler::kSobol};
+  const vk::ComputePipeline& pipeline = pipelines_.get(variant, [&] {
+    return layout_.make_pipeline("composite_stochastic", sizeof(StochasticCompositePush), variant.layout,
+                                 {{6, std::bit_cast<uint32_t>(variant.max_alpha)},
+                                  {7, variant.stratified ? 1u : 0u},
+                                  {8, variant.keep_sums ? 1u : 0u},
+                                  {9, variant.sobol ? 1u : 0u}});
+  });
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);
   for (uint32_t sample = samples.first; sample < samples.first + samples.count; ++sample) {
@@ -80,22 +57,22 @@ void StochasticCompositePass::record(vk::CommandStream& stream, const CompositeI
                                    out.width,
                                    out.height,
                                    tiles_x,
-                                   chunk * chunk_splats_,
-                                   chunk_splats_,
+                                   chunk * layout_.chunk_splats(),
+                                   layout_.chunk_splats(),
                                    chunk + 1 == chunks.count ? 1u : 0u,
                                    sample,
                                    samples.first + samples.count,
                                    samples.seed,
                                    out.first_tile};
-      it->second.bind(stream.cmd(), push);
-      if (variant.texel_buffers) it->second.push_texel_views(stream.cmd(), views);
-      it->second.dispatch(stream.cmd(), tiles_x, tiles_y);
+      pipeline.bind(stream.cmd(), push);
+      if (!views.empty()) pipeline.push_texel_views(stream.cmd(), views);
+      pipeline.dispatch(stream.cmd(), tiles_x, tiles_y);
     }
   }
 }
 
 uint32_t StochasticCompositePass::chunks_for(uint64_t longest_tile_list) const {
-  return composite_chunks_needed(longest_tile_list, chunk_splats_);
+  return layout_.chunks_for(longest_tile_list);
 }
 
 }  // namespace tilesplat

@@ -4,12 +4,12 @@
 #pragma once
 
 #include <array>
-#include <map>
 
 #include "passes/composite_pass.h"
 #include "vulkan/buffer.h"
 #include "vulkan/command_stream.h"
 #include "vulkan/compute_pipeline.h"
+#include "vulkan/pipeline_variants.h"
 
 namespace tilesplat {
 
@@ -41,24 +41,17 @@ class StochasticCompositePass {
   static constexpr uint32_t kSamplesPerSubmission = 64;
 
  private:
-  vk::Context& ctx_;
-  uint32_t pixels_per_invocation_;
-  uint32_t chunk_splats_;  // splats per tile and dispatch
-  bool texel_buffers_;  // the CPU layout reads and writes through texel buffers (composite_stochastic_texel)
-  vk::Buffer unused_output_;  // the texel binding of an output that is off
-  // A pipeline of composite_stochastic.comp: its specialization constants by name.
+  TileCompositeLayout layout_;
+  // A pipeline of composite_stochastic.comp: the layout's constants, then its own by name.
   struct Variant {
-    bool write_depth = true;
-    bool write_count = true;
-    float alpha_cutoff = 1.0f / 255.0f;
+    TileCompositeLayout::Variant layout;
     float max_alpha = float(kDefaultMaxAlpha);
-    bool texel_buffers = false;  // the CPU layout (composite_stochastic_texel)
-    bool stratified = false;     // StochasticSampler::kStratified (STRATIFIED)
-    bool keep_sums = false;      // the last sample keeps the sums in the state (KEEP_SUMS)
-    bool sobol = false;          // StochasticSampler::kSobol (SOBOL)
+    bool stratified = false;  // StochasticSampler::kStratified (STRATIFIED)
+    bool keep_sums = false;   // the last sample keeps the sums in the state (KEEP_SUMS)
+    bool sobol = false;       // StochasticSampler::kSobol (SOBOL)
     auto operator<=>(const Variant&) const = default;
   };
-  std::map<Variant, vk::ComputePipeline> pipelines_;
+  vk::PipelineVariants<Variant> pipelines_;
 };
 
 }  // namespace tilesplat
