@@ -408,14 +408,11 @@ int run_frame_bench(const BenchOptions& options) {
       if (!budgeted && (i == 0 || cases[i - 1].scene != c.scene)) renderer->set_scene(scene.loaded.scene);
       const std::string where = scene.name + " " + size_of(c) + " " + c.view_label + " ";
       for (const auto& sort : sorts) {
-        tilesplat::RenderSettings settings;
+        tilesplat::RenderSettings settings = cli::base_render_settings(options.common, scene.loaded);
         settings.sort = sort;
         settings.reuse_lists =
             false;  // every measured frame is a whole frame, not a composite on reused lists
-        if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
         settings.memory_budget = options.memory_budget;
-        cli::apply_scene_settings(scene.loaded, settings);
-        cli::apply_training_options(options.common, settings);
         Collector collector(sort);
         for (int frame = 0; frame < frames_per_row; ++frame) {
           // Rendering reads the image back, which is part of cpu frame; the first measured image of

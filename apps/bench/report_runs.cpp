@@ -152,9 +152,7 @@ int run_effects_report(const BenchOptions& options) {
   effect_options.repeat = options.repeat;
   if (!options.common.sorts.empty()) effect_options.sort = options.common.sorts.front();
 
-  tilesplat::RenderSettings base;
-  if (!options.common.modes.empty()) base.accuracy = options.common.modes.front();
-  cli::apply_scene_settings(scene.loaded, base);
+  const tilesplat::RenderSettings base = cli::base_render_settings(options.common, scene.loaded);
   std::vector<tilesplat::effects::Row> rows = tilesplat::effects::plan_rows(scene.loaded.scene, base);
   std::printf(
       "scene   %s: %s, %s\n", scene.name.c_str(), scene.description.c_str(),
@@ -333,9 +331,7 @@ int run_sample_curve(const BenchOptions& options) {
   curve_options.warmup = std::max(options.warmup, 1);  // llvmpipe compiles each variant on first use
   curve_options.repeat = options.repeat;
   if (!options.common.sorts.empty()) curve_options.sort = options.common.sorts.front();
-  if (!options.common.modes.empty()) curve_options.settings.accuracy = options.common.modes.front();
-  cli::apply_scene_settings(scene.loaded, curve_options.settings);
-  cli::apply_training_options(options.common, curve_options.settings);
+  curve_options.settings = cli::base_render_settings(options.common, scene.loaded);
   std::printf("scene   %s: %s, %s, %zu views, %s samples\n", scene.name.c_str(),
               cli::describe_scene(scene.loaded).c_str(),
               cli::format_size(curve_options.views.front().width, curve_options.views.front().height).c_str(),

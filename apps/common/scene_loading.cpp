@@ -213,6 +213,15 @@ void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings) {
         std::min(settings.accuracy.sh_degree_cap, *description.effects.sh_degree);
 }
 
+RenderSettings base_render_settings(const CommonOptions& options, const LoadedScene& loaded) {
+  RenderSettings settings;
+  if (!options.sorts.empty()) settings.sort = options.sorts.front();
+  if (!options.modes.empty()) settings.accuracy = options.modes.front();  // before the scene caps its SH
+  apply_scene_settings(loaded, settings);
+  apply_training_options(options, settings);
+  return settings;
+}
+
 std::vector<CameraView> load_camera_views(const fs::path& path) {
   std::error_code ec;
   if (!fs::exists(path, ec))

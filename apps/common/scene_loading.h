@@ -120,6 +120,12 @@ Lighting scene_lighting(const SceneEffects& effects);
 // file are applied after this.
 void apply_scene_settings(const LoadedScene& loaded, RenderSettings& settings);
 
+// The settings an app starts its frames from, built in this order: the first --sort and --mode, the scene
+// file's settings (apply_scene_settings: its sh_degree caps the mode's), then the flags that override the
+// file (apply_training_options: --antialiasing, --max-alpha, --compositor). Each app then adds what is its
+// own (tilesplat-render's --region and outputs, the bench's sort per row, the viewer's key cycles).
+RenderSettings base_render_settings(const CommonOptions& options, const LoadedScene& loaded);
+
 // The views of a camera set: a cameras.json, a transforms.json or a COLMAP model (folder or file;
 // tilesplat::load_camera_set). Throws std::runtime_error naming the file when it is missing,
 // malformed or has no views.

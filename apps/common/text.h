@@ -6,10 +6,12 @@
 #include <string_view>
 #include <vector>
 
+#include "quoting.h"
+
 namespace tilesplat::cli {
 
-// 'text', as the apps quote a value in a message.
-std::string single_quoted(std::string_view text);
+// 'text', as the apps and the engine quote a value in a message (text/quoting.h).
+using ::tilesplat::single_quoted;
 // Without leading and trailing spaces and tabs.
 std::string trim(std::string_view text);
 std::string join(const std::vector<std::string>& items, std::string_view separator);

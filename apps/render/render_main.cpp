@@ -170,11 +170,8 @@ std::vector<Frame> plan_frames(const cli::ArgParser& parser, const RenderOptions
 tilesplat::RenderSettings render_settings(const cli::ArgParser& parser, const RenderOptions& options,
                                           const cli::LoadedScene& loaded, const std::vector<Frame>& frames,
                                           bool sequence) {
-  tilesplat::RenderSettings settings;
-  if (!options.common.sorts.empty()) settings.sort = options.common.sorts.front();
-  if (!options.common.modes.empty()) settings.accuracy = options.common.modes.front();
-  cli::apply_scene_settings(loaded, settings);
-  // The flags override the scene file.
+  tilesplat::RenderSettings settings = cli::base_render_settings(options.common, loaded);
+  // tilesplat-render's own flags override the scene file too.
   if (parser.seen("--background") || !loaded.description) settings.background = options.background;
   if (options.no_depth) settings.depth = false;
   if (options.no_count) settings.splat_count = false;
@@ -189,7 +186,6 @@ tilesplat::RenderSettings render_settings(const cli::ArgParser& parser, const Re
       throw cli::UsageError("--region " + tilesplat::to_string(options.region) + ": " + why);
     }
   }
-  cli::apply_training_options(options.common, settings);
   if (options.stochastic_frames > 0) {  // --compositor stochastic or none (check_render_options)
     settings.compositor = tilesplat::Compositor::kStochastic;
     settings.stochastic.frames = static_cast<uint32_t>(options.stochastic_frames);

@@ -51,8 +51,12 @@ ViewState::ViewState(const ViewerOptions& options, const cli::LoadedScene& loade
                {bounds_.center[0], bounds_.center[1], bounds_.center[2]}, mesh_),
       sorts_(sort_cycle()),
       stochastic_sampler_(options.stochastic_sampler) {
-  cli::apply_scene_settings(loaded, base_settings_);
-  cli::apply_training_options(options.common, base_settings_);
+  // The keys choose the mode and the sort (starting from --mode and --sort below): the base is the scene
+  // file's settings and the other flags, whose SH cap then caps every mode of the cycle.
+  cli::CommonOptions flags = options.common;
+  flags.modes.clear();
+  flags.sorts.clear();
+  base_settings_ = cli::base_render_settings(flags, loaded);
   for (const char* mode : kModeCycle) modes_.push_back(parse_accuracy_modes(mode));
   if (!options.common.modes.empty()) mode_ = find_or_append(modes_, options.common.modes.front());
   if (!options.common.sorts.empty()) sort_ = find_or_append(sorts_, options.common.sorts.front());

@@ -81,15 +81,6 @@ class DuplicateKeyCheck {
 
 }  // namespace
 
-std::string single_quoted(std::string_view text) {
-  std::string out;
-  out.reserve(text.size() + 2);
-  out += '\'';
-  out += text;
-  out += '\'';
-  return out;
-}
-
 std::string format_number(double value) {
   std::ostringstream out;
   out.precision(10);

@@ -13,15 +13,17 @@
 #include <string_view>
 #include <vector>
 
+#include "text/quoting.h"
+
 namespace tilesplat::json_reader {
+
+using ::tilesplat::single_quoted;  // text/quoting.h
 
 using nlohmann::json;
 
 // The largest coordinate a position or direction may have: beyond it a value cannot be meant.
 inline constexpr double kMaxCoordinate = 1e9;
 
-// 'text'.
-std::string single_quoted(std::string_view text);
 // '%g' with up to 10 significant digits.
 std::string format_number(double value);
 // "a.b", "a[3]": the JSON path of a member or element.
