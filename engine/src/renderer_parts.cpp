@@ -13,6 +13,7 @@
 #include "camera/camera_models.h"
 #include "frame/averaged_frames.h"
 #include "frame/frame_stats_sum.h"
+#include "frame/part_sizing.h"
 #include "frame/scene_parts.h"
 #include "renderer_impl.h"
 #include "tilesplat/lod_set.h"
@@ -21,9 +22,6 @@
 namespace tilesplat {
 
 namespace {
-
-// The first part's guess of (tile, Gaussian) pairs per Gaussian, as set_scene's first key buffers (4 n).
-constexpr double kFirstPairsPerGaussian = 4;
 
 // The statistics of the parts so far, with one more part's.
 void add_part_stats(FrameStats& total, const FrameStats& part) {
@@ -69,17 +67,7 @@ bool Renderer::Impl::needs_parts(const PartSource& scene, const Camera& camera,
       *std::max_element(bands.begin(), bands.end(),
                         [&](const PixelRegion& a, const PixelRegion& b) { return pixels(a) < pixels(b); });
   const PartCosts costs = part_costs_for(scene, camera, frame, sort_name);
-  // Without a budget, the device's: whole where the frame fits it, as every frame did before budgets.
-  if (settings.memory_budget == 0)
-    return !whole_frame_fits(costs, scene.size(), kFirstPairsPerGaussian, device_capacity());
-  const double whole_bytes =
-      double(costs.fixed) +
-      double(scene.size()) * (double(costs.per_gaussian) + kFirstPairsPerGaussian * double(costs.per_pair));
-  // Under any budget, no buffer past the device's largest allocation and no dispatch past its limit.
-  DeviceCapacity buffers_only = device_capacity();
-  buffers_only.total = UINT64_MAX;
-  return whole_bytes > double(settings.memory_budget) ||
-         !whole_frame_fits(costs, scene.size(), kFirstPairsPerGaussian, buffers_only);
+  return frame_needs_parts(costs, scene.size(), settings.memory_budget, device_capacity());
 }
 
 namespace {
@@ -115,9 +103,7 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
   // The budget counts what the renderer holds, and the strategies used before keep the scratch their
   // largest frames grew: all but this frame's go (made again, by sort(), when a frame asks for them).
   std::erase_if(sorts, [&](const auto& entry) { return entry.first != sort_name; });
-  const DeviceCapacity device = device_capacity();
-  double pairs_per_gaussian = kFirstPairsPerGaussian;
-  size_t capacity = part_capacity(budget, costs, 0, pairs_per_gaussian, device);  // or a clear error
+  PartSizer sizer(costs, budget, device_capacity());  // or a clear error when not one Gaussian fits
   const auto order_start = std::chrono::steady_clock::now();
   const DepthOrder order(scene, camera, settings.near_plane, settings.accuracy,
                          ctx.features().shader_float64 ? kDepthMarginFloat64 : kDepthMarginFloat32);
@@ -130,9 +116,7 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
   lists.reset();
   FrameStats total;
   total.scene_parts = 0;
-  size_t largest_part = 0;  // the scene buffers keep the size of the largest part so far
-  double most_pairs_per_gaussian = 0;
-  GatheredPart part = gather_part(scene, order, 0, capacity);
+  GatheredPart part = gather_part(scene, order, 0, sizer.capacity());
   // The next part, gathered on another thread while this one uploads and renders (on a GPU the host's
   // gathering and placing is most of a part's time). It is gathered for the capacity so far, which a part
   // can only shrink: when the next part then ends elsewhere, it is gathered again.
@@ -140,35 +124,22 @@ void Renderer::Impl::render_in_parts(const PartSource& scene, const Camera& came
   for (uint32_t index = 0;; ++index) {
     const bool last = part.end == order.size();
     if (!last)
-      next =
-          std::async(std::launch::async, gather_part, std::cref(scene), std::cref(order), part.end, capacity);
+      next = std::async(std::launch::async, gather_part, std::cref(scene), std::cref(order), part.end,
+                        sizer.capacity());
     resources.upload_scene(part.scene, /*reuse_buffers=*/true);
     part.scene = {};
     scene_slot.uploaded();  // the lists in the buffers are the previous part's
     lists.reset();
-    // Pairs for a part of the capacity the budget was reckoned for (the same from part to part: no new
-    // buffers for each).
-    resources.reserve_pairs(uint64_t(pairs_per_gaussian * double(capacity)) + 1, wide_keys);
+    resources.reserve_pairs(sizer.reserved_pairs(), wide_keys);
     render_frame(camera, settings, nullptr, ScenePart{index, last});
     lists.reset();  // a part's lists are no frame's
     add_part_stats(total, stats);
-    largest_part = std::max(largest_part, part.gaussians);
     if (last) break;
-    // The next parts: as many pairs per Gaussian as the most any part had (with a margin, as a part with
-    // more pairs than its key buffers hold renders again), and room for the buffers beyond the estimate
-    // (the sort strategy's, the pipelines' own).
-    most_pairs_per_gaussian = std::max(
-        most_pairs_per_gaussian, double(stats.intersections) / double(std::max<size_t>(part.gaussians, 1)));
-    pairs_per_gaussian = std::max(1.0, 1.25 * most_pairs_per_gaussian);
-    const uint64_t estimated =
-        costs.fixed + uint64_t(largest_part) * costs.per_gaussian + resources.keys.bytes();
-    const uint64_t overhead = stats.device_bytes > estimated ? stats.device_bytes - estimated : 0;
-    // Never larger than a part before: the scene buffers keep the largest part's size.
-    capacity = std::min(capacity, part_capacity(budget, costs, overhead, pairs_per_gaussian, device));
+    sizer.part_rendered(part.gaussians, stats.intersections, stats.device_bytes, resources.keys.bytes());
     GatheredPart gathered = next.get();
-    part = order.part_end(gathered.begin, capacity) == gathered.end
+    part = order.part_end(gathered.begin, sizer.capacity()) == gathered.end
                ? std::move(gathered)
-               : gather_part(scene, order, gathered.begin, capacity);
+               : gather_part(scene, order, gathered.begin, sizer.capacity());
   }
   total.gaussians = scene.size();
   total.depth_order_ms = order_time.count();
