@@ -26,19 +26,20 @@ void CompositePass::record(VkCommandBuffer cmd, const CompositeInputs& in, const
   const std::vector<VkBufferView> views = layout_.texel_views(in);
   Variant variant;
   variant.layout = {in.write_depth, in.write_count, in.cutoffs.alpha, !views.empty()};
-  variant.cutoffs = in.cutoffs;
+  variant.transmittance = in.cutoffs.transmittance;
+  variant.max_alpha = in.cutoffs.max_alpha;
   variant.host_depth_in = host.view_depth != nullptr;
   variant.surface_depth_out = host.surface_depth != nullptr;
   variant.exact_depth_order = variant.host_depth_in && host.exact_depth_order;
   variant.chunked = chunks.count > 1 || carry.any();
   const vk::ComputePipeline& pipeline = pipelines_.get(variant, [&] {
     return layout_.make_pipeline("composite", sizeof(CompositePush), variant.layout,
-                                 {{6, std::bit_cast<uint32_t>(variant.cutoffs.transmittance)},
+                                 {{6, std::bit_cast<uint32_t>(variant.transmittance)},
                                   {7, variant.host_depth_in ? 1u : 0u},
                                   {8, variant.surface_depth_out ? 1u : 0u},
                                   {9, variant.exact_depth_order ? 1u : 0u},
                                   {10, variant.chunked ? 1u : 0u},
-                                  {11, std::bit_cast<uint32_t>(variant.cutoffs.max_alpha)}});
+                                  {11, std::bit_cast<uint32_t>(variant.max_alpha)}});
   });
   const uint32_t tiles_x = vk::div_ceil(out.width, kTileSize);
   const uint32_t tiles_y = vk::div_ceil(out.height, kTileSize);

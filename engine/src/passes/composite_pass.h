@@ -57,7 +57,8 @@ class CompositePass {
   // A pipeline of composite.comp: the layout's constants, then its own by name.
   struct Variant {
     TileCompositeLayout::Variant layout;
-    CompositeCutoffs cutoffs;        // transmittance (6) and max_alpha (11); alpha is the layout's
+    float transmittance = 1e-4f;     // CompositeCutoffs::transmittance (6); alpha is the layout's
+    float max_alpha = float(kDefaultMaxAlpha);  // CompositeCutoffs::max_alpha (11)
     bool host_depth_in = false;      // the host's surfaces test each splat (HOST_DEPTH)
     bool surface_depth_out = false;  // the depth where alpha reaches surface_alpha is written (SURFACE_DEPTH)
     bool exact_depth_order = false;  // a pixel is done at its first splat behind the host (HOST_DEPTH_SORTED)
