@@ -381,11 +381,7 @@ int run(int argc, char** argv) {
   // sample of motion blur (key B).
   const cli::LoadedScene loaded =
       cli::load_scene_and_camera(options.common, kProgram, cli::SceneHolding::kInstancesIfMoving);
-  cli::SceneViews views;
-  if (options.common.cameras.empty())
-    views = cli::scene_views(loaded);
-  else
-    views.views = cli::load_camera_views(options.common.cameras);
+  cli::SceneViews views = cli::camera_views(options.common, loaded);
 
   GlfwSession glfw;
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);  // Vulkan presents; no OpenGL context
