@@ -14,18 +14,12 @@
 
 #include "camera/camera_models.h"
 #include "lighting.h"
+#include "reference/sh_basis.h"
 #include "settings_checks.h"
 #include "tilesplat/reference.h"
 
 namespace tilesplat {
 namespace {
-
-constexpr double kShC0 = 0.28209479177387814;
-constexpr double kShC1 = 0.4886025119029199;
-constexpr double kShC2[5] = {1.0925484305920792, -1.0925484305920792, 0.31539156525252005,
-                             -1.0925484305920792, 0.5462742152960396};
-constexpr double kShC3[7] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658, 0.3731763325901154,
-                             -0.4570457994644658, 1.445305721320277, -0.5900435899266435};
 
 // The low-pass filter added to every 2D covariance, per antialiasing mode.
 double low_pass_dilation(Antialiasing mode) {
@@ -130,29 +124,13 @@ std::array<double, 9> covariance3d(const float log_scale[3], const float quat_wx
 std::array<double, 3> eval_sh(int degree, const float* coeffs, const std::array<double, 3>& dir) {
   if (degree < 0 || degree > 3)
     throw std::invalid_argument("eval_sh: degree must be 0..3, got " + std::to_string(degree));
+  const std::array<double, 16> basis = reference::sh_basis(degree, dir[0], dir[1], dir[2]);
+  const int k_count = (degree + 1) * (degree + 1);
   std::array<double, 3> result{};
-  auto sh = [coeffs](int k, int c) { return double(coeffs[k * 3 + c]); };
-  const double x = dir[0], y = dir[1], z = dir[2];
-  const double xx = x * x, yy = y * y, zz = z * z;
-  const double xy = x * y, yz = y * z, xz = x * z;
   for (int c = 0; c < 3; ++c) {
-    double sum = kShC0 * sh(0, c);
-    if (degree > 0) {
-      sum += -kShC1 * y * sh(1, c) + kShC1 * z * sh(2, c) - kShC1 * x * sh(3, c);
-      if (degree > 1) {
-        sum += kShC2[0] * xy * sh(4, c) + kShC2[1] * yz * sh(5, c) +
-               kShC2[2] * (2 * zz - xx - yy) * sh(6, c) + kShC2[3] * xz * sh(7, c) +
-               kShC2[4] * (xx - yy) * sh(8, c);
-        if (degree > 2) {
-          sum += kShC3[0] * y * (3 * xx - yy) * sh(9, c) + kShC3[1] * xy * z * sh(10, c) +
-                 kShC3[2] * y * (4 * zz - xx - yy) * sh(11, c) +
-                 kShC3[3] * z * (2 * zz - 3 * xx - 3 * yy) * sh(12, c) +
-                 kShC3[4] * x * (4 * zz - xx - yy) * sh(13, c) + kShC3[5] * z * (xx - yy) * sh(14, c) +
-                 kShC3[6] * x * (xx - 3 * yy) * sh(15, c);
-        }
-      }
-    }
-    result[static_cast<size_t>(c)] = sum;
+    double sum = 0;
+    for (int k = 0; k < k_count; ++k) sum += basis[size_t(k)] * double(coeffs[k * 3 + c]);
+    result[size_t(c)] = sum;
   }
   return result;
 }
