@@ -266,8 +266,9 @@ TS_PUSH_CONSTANTS(PackCovarianceHalfPush) {
 TS_PUSH_INSTANCE;
 #endif
 
-#if defined(__cplusplus) || defined(TS_PROJECTION_PUSH)
-// The camera of projection.comp, written by the host each frame (ProjectionPass::set_camera).
+#if defined(__cplusplus) || defined(TS_PROJECTION_PUSH) || defined(TS_PROJECTION_BACKWARD_PUSH)
+// The camera of projection.comp (and of projection_backward.comp, which reads the forward's), written by the
+// host each frame (ProjectionPass::set_camera).
 TS_BUFFER(CameraParams) {
   TS_F64 rotation[9];         // world-to-camera rotation, row-major
   TS_F64 centre[3];           // camera centre (world)
@@ -284,7 +285,9 @@ TS_BUFFER(CameraParams) {
 // The same as uvec2 words (projection.comp's camera_word): where each field starts.
 TS_CONST uint CAMERA_ROTATION = 0, CAMERA_CENTRE = 9, CAMERA_FOCAL = 12, CAMERA_CLIP = 16, CAMERA_TILES = 20,
               CAMERA_DISTORTION = 22;
+#endif
 
+#if defined(__cplusplus) || defined(TS_PROJECTION_PUSH)
 // The frame's lights, written by the host (ProjectionPass::set_lighting) in float64 from the same
 // prepared values as the reference's (engine/src/lighting.h).
 struct LightRecord {
@@ -617,6 +620,53 @@ TS_PUSH_CONSTANTS(TileLocalSortPush) {
 TS_PUSH_INSTANCE;
 #endif
 
+// The backward passes (docs/gradients.md). A splat's screen-space gradient: SPLAT_GRADIENT_FLOATS floats
+// per projected record, summed over the pixels it was blended into:
+//   [0, 1] dL/d mean (pixels)        [2, 3, 4] dL/d conic A, B, C     [5] dL/d opacity
+//   [6, 7, 8] dL/d colour r, g, b    [9] dL/d view depth              [10, 11] sum of |dL/d mean| per pixel
+TS_CONST uint SPLAT_GRADIENT_FLOATS = 12;
+// Per pixel, the loss's gradient of the frame's outputs (FrameGradients): dL/d(r, g, b, alpha), then
+// dL/d(expected depth, accumulated depth) as a second, vec2-aligned array.
+// The projection backward's per-Gaussian outputs, laid out as GaussianScene's arrays, and its counter.
+TS_CONST uint BACKWARD_COUNTER_UNFORMED = 0;  // drawn Gaussians whose gradient was not finite (set to 0)
+
+#if defined(__cplusplus) || defined(TS_COMPOSITE_BACKWARD_PUSH)
+// composite_backward.comp (CompositeBackwardPass).
+TS_PUSH_CONSTANTS(CompositeBackwardPush) {
+  TS_REF(Vec4Array) splats;          // the forward's projected records
+  TS_REF(UintArray) sorted_indices;  // the forward's tile lists
+  TS_REF(Uvec2Array) ranges;
+  TS_REF(Vec4Array) pixel_rgba_gradients;  // dL/d(r, g, b, alpha) per pixel
+  TS_REF(Uvec2Array)
+  pixel_depth_gradients;               // dL/d(expected depth, accumulated depth) per pixel (as float bits)
+  TS_REF(FloatArray) splat_gradients;  // SPLAT_GRADIENT_FLOATS per record, summed into
+  vec4 background;
+  uint width;
+  uint height;
+  uint tiles_x;
+}
+TS_PUSH_INSTANCE;
+#endif
+
+#if defined(__cplusplus) || defined(TS_PROJECTION_BACKWARD_PUSH)
+// projection_backward.comp (ProjectionBackwardPass).
+TS_PUSH_CONSTANTS(ProjectionBackwardPush) {
+  TS_REF(FloatArray) positions;  // the scene, as the projection read it
+  TS_REF(FloatArray) log_scales;
+  TS_REF(FloatArray) rotations;
+  TS_REF(FloatArray) opacity_logits;
+  TS_REF(FloatArray) sh;
+  uint64_t camera;                     // the forward's CameraParams
+  TS_REF(UintArray) tile_counts;       // the forward's: 0 = not drawn
+  TS_REF(FloatArray) splat_gradients;  // composite_backward.comp's sums
+  // Out: 3 + 3 + 4 + 1 + 3 K + 2 + 2 floats per Gaussian, each array at its own address.
+  TS_REF(FloatArray) gradients;  // positions (3N), log scales (3N), rotations (4N), logits (N), SH (3KN)
+  TS_REF(UintArray) counters;    // BACKWARD_COUNTER_UNFORMED
+  uint count;
+}
+TS_PUSH_INSTANCE;
+#endif
+
 #ifdef __cplusplus
 // What the C++ compiler can check of the layouts: the blocks' sizes (std430 lays the members out as
 // C++ does here: scalars, 8-byte addresses and doubles, 16-byte vec4) and the 128 bytes of push
@@ -637,7 +687,8 @@ static_assert(sizeof(CompositePush) <= 128 && sizeof(CompositeResortPush) <= 128
               sizeof(OnesweepPassPush) <= 128 && sizeof(BitonicSetupPush) <= 128 &&
               sizeof(BitonicPassPush) <= 128 && sizeof(TileLocalSetupPush) <= 128 &&
               sizeof(TileLocalBinPush) <= 128 && sizeof(TileLocalScanPush) <= 128 &&
-              sizeof(TileLocalSortPush) <= 128);
+              sizeof(TileLocalSortPush) <= 128 && sizeof(CompositeBackwardPush) <= 128 &&
+              sizeof(ProjectionBackwardPush) <= 128);
 }  // namespace tilesplat::shader_io
 #endif
 #endif  // TILESPLAT_SHADER_IO_H

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "backward/backward_plan.h"
 #include "frame/frame_plan.h"
 #include "frame/image_regions.h"
 #include "tilesplat/reference.h"
@@ -508,6 +509,42 @@ TEST(TexelLayouts, MesaMajorVersionFromTheDriverDescription) {
   EXPECT_EQ(vk::mesa_major_version("NVIDIA 580.159.04"), 0);
   EXPECT_EQ(vk::mesa_major_version("SwiftShader driver 5.0.0"), 0);
   EXPECT_EQ(vk::mesa_major_version("Mesa "), 0);
+}
+
+// The backward of a sorted frame (backward/backward_plan.h): its passes in order, what it takes of the
+// forward's plan, and the forward plans it refuses to follow.
+TEST(BackwardPlan, FollowsASortedFrameWithItsOwnPasses) {
+  RenderSettings settings;
+  settings.background = {0.1f, 0.2f, 0.3f};
+  settings.max_alpha = 0.999;
+  settings.antialiasing = Antialiasing::kAntialiased;
+  const FrameContext c = context();
+  const BackwardPlan plan = plan_backward(plan_frame(camera(), settings, c), c.scene, true);
+  EXPECT_EQ(plan.passes,
+            (std::vector<BackwardPass>{BackwardPass::kClearGradients, BackwardPass::kCompositeBackward,
+                                       BackwardPass::kProjectionBackward}));
+  EXPECT_EQ(timed_name(BackwardPass::kClearGradients), nullptr);
+  EXPECT_STREQ(timed_name(BackwardPass::kCompositeBackward), "composite_backward");
+  EXPECT_EQ(plan.tiles.tiles_x, 120u);
+  EXPECT_EQ(plan.background, settings.background);
+  EXPECT_EQ(plan.max_alpha, 0.999f);
+  EXPECT_EQ(plan.antialiasing, Antialiasing::kAntialiased);
+  EXPECT_EQ(plan.gaussians, 500000u);
+  EXPECT_EQ(plan.sh_degree, 3);
+  EXPECT_TRUE(plan.float_atomics);
+}
+
+TEST(BackwardPlan, RefusesAForwardItCannotFollow) {
+  const FrameContext c = context();
+  RenderSettings stochastic;
+  stochastic.compositor = Compositor::kStochastic;
+  EXPECT_THROW(plan_backward(plan_frame(camera(), stochastic, c), c.scene, true), std::logic_error);
+  RenderSettings resort;
+  resort.accuracy.resort_window = 8;
+  EXPECT_THROW(plan_backward(plan_frame(camera(), resort, c), c.scene, true), std::logic_error);
+  RenderSettings region;
+  region.region = {512, 512, 64, 64};
+  EXPECT_THROW(plan_backward(plan_frame(camera(), region, c), c.scene, true), std::logic_error);
 }
 
 }  // namespace

@@ -16,15 +16,16 @@
 #include <string>
 #include <vector>
 
+#include "backward/frame_backward.h"
 #include "frame/averaged_frames.h"
 #include "frame/frame_accumulator.h"
 #include "frame/frame_in_flight.h"
 #include "frame/frame_plan.h"
 #include "frame/frame_recorder.h"
 #include "frame/frame_resources.h"
+#include "frame/frame_start.h"
 #include "frame/scene_parts.h"
 #include "frame/scene_slot.h"
-#include "frame/frame_start.h"
 #include "sort/sort_strategy.h"
 #include "tilesplat/renderer.h"
 #include "tilesplat/scene_description.h"
@@ -136,6 +137,7 @@ struct Renderer::Impl {
   FrameAccumulator accumulator;  // the stochastic frames and the lens and shutter samples summed so far
   SceneSlot scene_slot;  // what the scene buffers hold: which scene, which upload, moving copies, a part
   uint64_t uploaded_bytes_reported = 0;     // vk::Context::uploaded_bytes() at the last frame's statistics
+  std::unique_ptr<FrameBackward> backward;  // Renderer::backward's passes and buffers, from its first call
   // The frame render_to_image started without waiting (its fence, or a host's timeline): declared last,
   // so that it is destroyed first and waits for the frame before any buffer the frame uses goes.
   FrameInFlight in_flight;

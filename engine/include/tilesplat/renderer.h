@@ -12,6 +12,7 @@
 
 #include "tilesplat/camera.h"
 #include "tilesplat/export.h"
+#include "tilesplat/gradients.h"
 #include "tilesplat/image.h"
 #include "tilesplat/render_settings.h"
 #include "tilesplat/scene.h"
@@ -229,6 +230,22 @@ class TILESPLAT_API Renderer {
   /// chooses for it, else level 0 whole; then as render(scene, camera, settings), in parts under a memory
   /// budget. FrameStats::gaussians is what it drew. Throws SceneError for a chunk file it cannot read.
   RenderImage render(const LodSet& set, const Camera& camera, const RenderSettings& settings = {});
+
+  /// The gradient of a loss through the frame render(camera, settings) draws of the scene last set
+  /// (docs/gradients.md): given dL/d(each output pixel), dL/d(each Gaussian's parameter), with the screen
+  /// gradients densification reads. The forward frame is drawn again first, unless the buffers hold its
+  /// tile lists already (RenderSettings::reuse_lists after a render() of the same camera and settings: then
+  /// only its composite runs); the backward passes then walk each pixel's splats back to front on the device
+  /// and carry each splat's gradient through its projection. Sums use float atomic adds where the device
+  /// has them (VK_EXT_shader_atomic_float), so the last bits may differ from run to run; the float64
+  /// reference_backward is the ground truth they are tested against. last_frame_stats() then lists the
+  /// forward's passes and "composite_backward" and "projection_backward". A scene set as placed copies
+  /// (set_scene(SceneInstances)) is differentiated as its merged scene. Throws NotDifferentiable for what
+  /// the backward does not cover (check_differentiable), std::invalid_argument for gradients of the wrong
+  /// size or not finite, and otherwise as render() does; also std::runtime_error for an image the device
+  /// renders only in bands or a tile list longer than one composite dispatch takes on this device.
+  SceneGradients backward(const Camera& camera, const RenderSettings& settings,
+                          const FrameGradients& gradients);
 
   /// What the last render() (or render_to_image()) did and cost. The reference is valid until the
   /// next frame. A frame render_to_image submitted without waiting (HostFrameSync) is described once

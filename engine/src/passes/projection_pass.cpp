@@ -46,7 +46,7 @@ ProjectionPass::ProjectionPass(vk::Context& ctx)
       pack_covariance_half_(ctx, "pack_covariance_half", sizeof(PackCovariancePush)),
       texel_buffers_(vk::texel_buffers_wanted(ctx) && ctx.features().shader_float64) {}
 
-void ProjectionPass::set_camera(const Camera& camera, double near_plane, const TileGrid& tiles) {
+shader_io::CameraParams camera_params(const Camera& camera, double near_plane, const TileGrid& tiles) {
   CameraParams p{};
   std::copy(camera.rotation.begin(), camera.rotation.end(), p.rotation);
   std::copy(camera.position.begin(), camera.position.end(), p.centre);
@@ -61,6 +61,11 @@ void ProjectionPass::set_camera(const Camera& camera, double near_plane, const T
   p.clip[3] = limits.reach;
   std::copy(camera.distortion.begin(), camera.distortion.end(), p.distortion);
   p.tiles = {tiles.first_x, tiles.first_y, tiles.first_x + tiles.tiles_x, tiles.first_y + tiles.tiles_y};
+  return p;
+}
+
+void ProjectionPass::set_camera(const Camera& camera, double near_plane, const TileGrid& tiles) {
+  const CameraParams p = camera_params(camera, near_plane, tiles);
   vk::upload(ctx_, camera_params_, &p, sizeof(p));
 }
 

@@ -54,6 +54,9 @@ struct ProjectedBuffers {
 // Bytes of one Gaussian's per-pixel re-sorting data (RAY_DEPTH_VEC4S, compute/shader_io.h).
 constexpr uint32_t kRayDepthBytes = shader_io::RAY_DEPTH_VEC4S * 16;
 
+// The camera block projection.comp reads (and projection_backward.comp, of the same frame).
+shader_io::CameraParams camera_params(const Camera& camera, double near_plane, const TileGrid& tiles);
+
 class ProjectionPass {
  public:
   explicit ProjectionPass(vk::Context& ctx);

@@ -15,8 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include "backward/gradient_checks.h"
 #include "camera/camera_models.h"
-#include "frame/averaged_frames.h"
 #include "reference/differentiable_projection.h"
 #include "reference/parallel_chunks.h"
 #include "reference/reference_frame.h"
@@ -24,24 +24,6 @@
 #include "tilesplat/gradients.h"
 
 namespace tilesplat {
-
-void check_differentiable(const Camera& camera, const RenderSettings& settings, const std::string& caller) {
-  auto refuse = [&](const std::string& what) {
-    throw NotDifferentiable(caller + ": the backward pass does not cover " + what);
-  };
-  if (camera_models::drawn_model(camera) != CameraModel::kPinhole)
-    refuse(std::string("the ") + camera_model_name(camera.model) + " camera model (only the pinhole's)");
-  if (settings.compositor != Compositor::kSorted)
-    refuse("the " + to_string(settings.compositor) + " compositor (only the sorted one)");
-  if (!(settings.accuracy == AccuracyModes{}))
-    refuse("the accuracy mode " + to_string(settings.accuracy) + " (only the reference)");
-  if (settings.lighting.enabled()) refuse("relighting");
-  if (settings.host) refuse("a host's depth");
-  if (settings.lens.enabled()) refuse("depth of field (RenderSettings::lens)");
-  if (settings.shutter.enabled()) refuse("motion blur (RenderSettings::shutter)");
-  if (settings.accumulate_samples) refuse("accumulated samples");
-  if (!settings.region.whole()) refuse("a region of the image (only the whole image)");
-}
 
 namespace reference {
 namespace {
@@ -212,20 +194,6 @@ std::vector<SplatGradient> composite_backward(const ForwardFrame& frame, const C
   return sum;
 }
 
-void check_gradient_channel(const std::vector<float>& values, size_t per_pixel, size_t pixels,
-                            const char* name) {
-  if (values.empty()) return;
-  if (values.size() != per_pixel * pixels)
-    throw std::invalid_argument("reference_backward: FrameGradients::" + std::string(name) + " has " +
-                                std::to_string(values.size()) + " values, not " +
-                                std::to_string(per_pixel * pixels) + " (" + std::to_string(per_pixel) +
-                                " per pixel) or none");
-  for (size_t k = 0; k < values.size(); ++k)
-    if (!std::isfinite(values[k]))
-      throw std::invalid_argument("reference_backward: FrameGradients::" + std::string(name) + "[" +
-                                  std::to_string(k) + "] is not finite");
-}
-
 // Gaussian i's gradients from its splat's: through the projection's derivatives. False where a value is
 // not finite (the caller leaves the Gaussian at zero and counts it).
 bool gaussian_backward(const GaussianScene& scene, size_t i, const Camera& camera,
@@ -296,11 +264,7 @@ SceneGradients reference_backward(const GaussianScene& scene, const Camera& came
                                   const RenderSettings& settings, const FrameGradients& gradients) {
   using namespace reference;
   const ForwardFrame frame = draw_forward(scene, camera, settings, "reference_backward");
-  const size_t pixels = size_t(camera.width) * size_t(camera.height);
-  check_gradient_channel(gradients.rgb, 3, pixels, "rgb");
-  check_gradient_channel(gradients.alpha, 1, pixels, "alpha");
-  check_gradient_channel(gradients.expected_depth, 1, pixels, "expected_depth");
-  check_gradient_channel(gradients.accumulated_depth, 1, pixels, "accumulated_depth");
+  check_frame_gradients(gradients, camera.width, camera.height, "reference_backward");
 
   const std::vector<SplatGradient> splat_gradients = composite_backward(frame, camera, gradients);
   const size_t n = scene.size();

@@ -350,6 +350,25 @@ void Context::create_device() {
     }
   }
 
+  // Float atomic adds sum the backward passes' gradients (composite_backward.comp); without them the
+  // pass sums by compare-and-swap.
+  VkPhysicalDeviceShaderAtomicFloatFeaturesEXT want_atomic_float{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT};
+  if (has_extension(available, VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME)) {
+    VkPhysicalDeviceShaderAtomicFloatFeaturesEXT has_atomic_float{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT};
+    VkPhysicalDeviceFeatures2 has{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    has.pNext = &has_atomic_float;
+    vkGetPhysicalDeviceFeatures2(physical_device_, &has);
+    if (has_atomic_float.shaderBufferFloat32AtomicAdd) {
+      extensions.push_back(VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME);
+      want_atomic_float.shaderBufferFloat32AtomicAdd = VK_TRUE;
+      *next_feature = &want_atomic_float;
+      next_feature = &want_atomic_float.pNext;
+      features_.buffer_float32_atomic_add = true;
+    }
+  }
+
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   info.pNext = &want;
   info.queueCreateInfoCount = 1;

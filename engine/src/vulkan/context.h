@@ -49,6 +49,9 @@ struct DeviceFeatures {
   // VK_EXT_rasterization_order_attachment_access's rasterizationOrderColorAttachmentAccess: a fragment
   // reads what the earlier fragments blended at its pixel; the raster compositor's depth out.
   bool rasterization_order_colour = false;
+  // VK_EXT_shader_atomic_float's shaderBufferFloat32AtomicAdd (an engine-made device): the backward passes'
+  // sums (else compare-and-swap loops).
+  bool buffer_float32_atomic_add = false;
 };
 
 // Semaphores a submission waits for and signals besides its fence: a host's, around a frame that
