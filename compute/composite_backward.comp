@@ -1,12 +1,16 @@
 #version 460
-// Composite backward: one workgroup per 16x16 tile, one invocation per pixel (docs/gradients.md). Each
-// pixel first walks its tile's list front to back as composite.comp blends it, to find where it stopped,
-// its final transmittance and its depth sums; then it walks back from its last blended splat to the first,
-// recovering each splat's transmittance by division (T_i = T_{i+1} / (1 - alpha_i), as the 3DGS trainer
-// and gsplat do) and forming the splat's screen-space gradient. The tile's splats are staged through
-// shared memory in batches; every invocation of a subgroup visits the same splat at once, so a
-// subgroup sums its pixels' gradients before one invocation adds them to the splat's (a float atomic
-// add, or a compare-and-swap loop where the device has none: TS_CAS_FLOAT_ADD).
+// Composite backward: one workgroup per 16x16 tile (docs/gradients.md). Each pixel first walks its tile's
+// list front to back as composite.comp blends it, to find where it stopped, its final transmittance and
+// its depth sums; then it walks back from its last blended splat to the first, recovering each splat's
+// transmittance by division (T_i = T_{i+1} / (1 - alpha_i), as the 3DGS trainer and gsplat do) and
+// forming the splat's screen-space gradient.
+//
+// As in composite.comp, an invocation owns a column of PIXELS_PER_INVOCATION pixels: 1 on GPUs, 16 on CPU
+// drivers, where each staged splat is then read once per column and its gradient summed over the column
+// in registers. The tile's splats are staged through shared memory in batches, and every invocation visits
+// the same staged splat at once, so a subgroup sums its columns' gradients before one invocation adds them
+// to the splat's (a float atomic add, or a compare-and-swap loop where the device has none:
+// TS_CAS_FLOAT_ADD).
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
@@ -17,18 +21,21 @@
 #define TS_COMPOSITE_BACKWARD_PUSH
 #include "common.glsl"
 
-layout(local_size_x = 16, local_size_y = 16) in;
+layout(local_size_x = 16, local_size_y_id = 3) in;  // local_size_y = 16 / PIXELS_PER_INVOCATION
 // The forward's cut-offs, as composite.comp's (the reference's: the backward covers no other mode).
 layout(constant_id = 0) const float ALPHA_MIN = 1.0 / 255.0;
 layout(constant_id = 1) const float T_MIN = 1e-4;
 layout(constant_id = 2) const float MAX_ALPHA = 0.99;
+layout(constant_id = 4) const uint PIXELS_PER_INVOCATION = 1;  // 1 or 16
 
+const uint P = PIXELS_PER_INVOCATION;
 const uint BATCH = 256;
-shared vec4 s_mean_a_b[BATCH];       // mean relative to the tile origin, A' = -A/2, B' = -B
+const uint TILE_PIXELS = TILE_SIZE * TILE_SIZE;
+shared vec4 s_mean_a_b[BATCH];         // mean relative to the tile origin, A' = -A/2, B' = -B
 shared vec4 s_c_opacity_depth[BATCH];  // C' = -C/2, opacity, view depth, record index (as float bits)
 shared vec4 s_colour[BATCH];
-shared uint s_done;
-shared uint s_last;  // the furthest list position any pixel of the tile blended
+shared uint s_done;  // the tile's pixels done (or outside the image)
+shared uint s_last;  // one past the furthest list position any pixel of the tile blended
 
 #ifdef TS_CAS_FLOAT_ADD
 void add_gradient(uint k, float value) {
@@ -49,10 +56,10 @@ void add_gradient(uint k, float value) { atomicAdd(pc.splat_gradients.v[k], valu
 // Returns the tile's pixels done before the batch: read between the barriers, where no invocation adds
 // to it, so that every invocation sees the same count and leaves the loop together.
 uint stage(uint batch_start, uint list_end, vec2 tile_origin) {
-  uint k = gl_LocalInvocationIndex;
   barrier();
   uint done_before = s_done;
-  if (batch_start + k < list_end) {
+  for (uint k = gl_LocalInvocationIndex; k < BATCH; k += gl_WorkGroupSize.x * gl_WorkGroupSize.y) {
+    if (batch_start + k >= list_end) break;
     uint g = pc.sorted_indices.v[batch_start + k];
     vec4 mdo = pc.splats.v[SPLAT_VEC4S * g];
     vec4 conic = pc.splats.v[SPLAT_VEC4S * g + 1];
@@ -66,137 +73,169 @@ uint stage(uint batch_start, uint list_end, vec2 tile_origin) {
   return done_before;
 }
 
-// The staged splat's alpha at the pixel, in composite.comp's operations; dx, dy and G = exp(power) out.
-float alpha_at(uint j, vec2 pixel, out float dx, out float dy, out float gaussian) {
-  vec4 mab = s_mean_a_b[j];
-  vec4 cod = s_c_opacity_depth[j];
-  dx = mab.x - pixel.x;
-  dy = mab.y - pixel.y;
-  float k0 = mab.z * dx * dx;
-  float k1 = mab.w * dx;
-  float power = k0 + dy * (k1 + cod.x * dy);
-  gaussian = exp(power);
-  return min(MAX_ALPHA, cod.y * gaussian);
-}
+// The invocation's pixels' state. Front to back: T, the depth sums, where each stopped.
+float T[P];
+float depth_sum[P];
+float weight_sum[P];
+uint last[P];  // one past the list position of the pixel's last blended splat (0: none)
+bool done[P];
+// Back to front: the loss's gradients of the pixel's outputs and the sums behind the current splat.
+vec4 g_rgba[P];
+float g_depth[P];   // of D = sum w z (the expected depth's share included)
+float g_weight[P];  // of W = sum w (the expected depth's)
+float final_T[P];
+vec3 behind_rgb[P];
+float behind_depth[P];
+float behind_weight[P];
 
 void main() {
   uvec2 tile = gl_WorkGroupID.xy;
-  uvec2 local = gl_LocalInvocationID.xy;
+  uint local_x = gl_LocalInvocationID.x;
+  uint local_y0 = gl_LocalInvocationID.y * P;  // first row of this invocation in the tile
   vec2 tile_origin = vec2(tile * TILE_SIZE);
-  vec2 pixel = vec2(local) + 0.5;  // relative to the tile origin, as the staged means are
-  uvec2 image_pixel = tile * TILE_SIZE + local;
-  bool inside = image_pixel.x < pc.width && image_pixel.y < pc.height;
-  uint pixel_index = image_pixel.y * pc.width + image_pixel.x;
+  uint image_x = tile.x * TILE_SIZE + local_x;
   uvec2 range = pc.ranges.v[tile.y * pc.tiles_x + tile.x];
 
-  // Front to back: where the pixel stops, as the forward blended it.
-  float T = 1.0;
-  float depth_sum = 0.0, weight_sum = 0.0;
-  bool done = !inside;
-  uint last = 0;  // one past the list position of the last splat blended (0: none)
   if (gl_LocalInvocationIndex == 0) {
     s_done = 0;
     s_last = 0;
   }
-  barrier();
-  if (done) atomicAdd(s_done, 1u);
-  for (uint batch_start = range.x; batch_start < range.y; batch_start += BATCH) {
-    if (stage(batch_start, range.y, tile_origin) == BATCH) break;
-    uint batch_count = min(BATCH, range.y - batch_start);
-    for (uint j = 0; j < batch_count && !done; ++j) {
-      float dx, dy, gaussian;
-      float alpha = alpha_at(j, pixel, dx, dy, gaussian);
-      if (alpha < ALPHA_MIN) continue;
-      float next_T = T * (1.0 - alpha);
-      if (next_T < T_MIN) {
-        done = true;
-        atomicAdd(s_done, 1u);
-        break;
-      }
-      float w = alpha * T;
-      depth_sum += s_c_opacity_depth[j].z * w;
-      weight_sum += w;
-      T = next_T;
-      last = batch_start + j + 1;
-    }
+  uint my_done = 0;
+  for (uint p = 0; p < P; ++p) {
+    uint image_y = tile.y * TILE_SIZE + local_y0 + p;
+    T[p] = 1.0;
+    depth_sum[p] = 0.0;
+    weight_sum[p] = 0.0;
+    last[p] = 0;
+    done[p] = image_x >= pc.width || image_y >= pc.height;
+    my_done += done[p] ? 1u : 0u;
   }
-  if (last > 0) atomicMax(s_last, last);
+  barrier();
+  if (my_done > 0) atomicAdd(s_done, my_done);
 
-  vec4 g_rgba = inside ? pc.pixel_rgba_gradients.v[pixel_index] : vec4(0.0);
-  vec2 g_depths = inside ? uintBitsToFloat(pc.pixel_depth_gradients.v[pixel_index]) : vec2(0.0);
-  // The expected depth E = D / W passes its gradient to D = sum w z and W = sum w.
-  float g_depth = g_depths.y + (weight_sum > 0.0 ? g_depths.x / weight_sum : 0.0);
-  float g_weight = weight_sum > 0.0 ? -g_depths.x * depth_sum / (weight_sum * weight_sum) : 0.0;
-  vec3 behind_rgb = pc.background.rgb * T;
-  float behind_depth = 0.0, behind_weight = 0.0;
-  float final_T = T;
+  // Front to back, in composite.comp's operations: where each pixel stops.
+  for (uint batch_start = range.x; batch_start < range.y; batch_start += BATCH) {
+    if (stage(batch_start, range.y, tile_origin) == TILE_PIXELS) break;
+    uint batch_count = min(BATCH, range.y - batch_start);
+    uint finished = 0;
+    for (uint j = 0; j < batch_count; ++j) {
+      vec4 mab = s_mean_a_b[j];
+      vec4 cod = s_c_opacity_depth[j];
+      float dx = mab.x - (float(local_x) + 0.5);
+      float k0 = mab.z * dx * dx;
+      float k1 = mab.w * dx;
+      for (uint p = 0; p < P; ++p) {
+        float dy = mab.y - (float(local_y0 + p) + 0.5);
+        float power = k0 + dy * (k1 + cod.x * dy);
+        float alpha = min(MAX_ALPHA, cod.y * exp(power));
+        bool hit = !done[p] && alpha >= ALPHA_MIN;
+        float next_T = T[p] * (1.0 - alpha);
+        bool finish = hit && next_T < T_MIN;  // done, and this splat is NOT blended (reference)
+        bool blend = hit && !finish;
+        float w = blend ? alpha * T[p] : 0.0;
+        depth_sum[p] += cod.z * w;
+        weight_sum[p] += w;
+        T[p] = blend ? next_T : T[p];
+        last[p] = blend ? batch_start + j + 1 : last[p];
+        done[p] = done[p] || finish;
+        finished += finish ? 1u : 0u;
+      }
+    }
+    if (finished > 0) atomicAdd(s_done, finished);
+  }
 
-  // Back to front, batch by batch, from the batch of the tile's last blended splat.
+  uint my_last = 0;
+  for (uint p = 0; p < P; ++p) {
+    uint image_y = tile.y * TILE_SIZE + local_y0 + p;
+    bool inside = image_x < pc.width && image_y < pc.height;
+    uint pixel_index = image_y * pc.width + image_x;
+    g_rgba[p] = inside ? pc.pixel_rgba_gradients.v[pixel_index] : vec4(0.0);
+    vec2 g_depths = inside ? uintBitsToFloat(pc.pixel_depth_gradients.v[pixel_index]) : vec2(0.0);
+    // The expected depth E = D / W passes its gradient to D = sum w z and W = sum w.
+    g_depth[p] = g_depths.y + (weight_sum[p] > 0.0 ? g_depths.x / weight_sum[p] : 0.0);
+    g_weight[p] = weight_sum[p] > 0.0 ? -g_depths.x * depth_sum[p] / (weight_sum[p] * weight_sum[p]) : 0.0;
+    final_T[p] = T[p];
+    behind_rgb[p] = pc.background.rgb * T[p];
+    behind_depth[p] = 0.0;
+    behind_weight[p] = 0.0;
+    my_last = max(my_last, last[p]);
+  }
+  if (my_last > 0) atomicMax(s_last, my_last);
   barrier();
   uint tile_last = s_last;
   if (tile_last == 0) return;
+
+  // Back to front, batch by batch, from the batch of the tile's last blended splat.
   uint first_batch = range.x + ((tile_last - 1 - range.x) / BATCH) * BATCH;
   for (int batch_start = int(first_batch); batch_start >= int(range.x); batch_start -= int(BATCH)) {
     stage(uint(batch_start), range.y, tile_origin);
     uint batch_count = min(BATCH, range.y - uint(batch_start));
     for (int j = int(batch_count) - 1; j >= 0; --j) {
       uint position = uint(batch_start + j);
-      float dx, dy, gaussian;
-      float alpha = alpha_at(uint(j), pixel, dx, dy, gaussian);
-      bool blended = position < last && alpha >= ALPHA_MIN;
-      // Every gradient of this splat at this pixel: zero where it was not blended here.
-      vec2 g_mean = vec2(0.0);
-      vec3 g_conic = vec3(0.0);
-      float g_opacity = 0.0, g_depth_out = 0.0;
-      vec3 g_colour = vec3(0.0);
-      if (blended) {
-        float one_minus = 1.0 - alpha;
-        float T_before = T / one_minus;
-        float w = alpha * T_before;
-        vec3 rgb = s_colour[j].rgb;
-        float z = s_c_opacity_depth[j].z;
-        g_colour = g_rgba.rgb * w;
-        g_depth_out = g_depth * w;
-        float g_alpha = g_rgba.a * final_T / one_minus + dot(g_rgba.rgb, T_before * rgb - behind_rgb / one_minus) +
-                        g_depth * (T_before * z - behind_depth / one_minus) +
-                        g_weight * (T_before - behind_weight / one_minus);
-        behind_rgb += rgb * w;
-        behind_depth += z * w;
-        behind_weight += w;
-        T = T_before;
+      vec4 mab = s_mean_a_b[j];
+      vec4 cod = s_c_opacity_depth[j];
+      vec3 rgb = s_colour[j].rgb;
+      float A = -2.0 * mab.z, B = -mab.w, C = -2.0 * cod.x;
+      float opacity = cod.y, z = cod.z;
+      float dx = mab.x - (float(local_x) + 0.5);
+      float k0 = mab.z * dx * dx;
+      float k1 = mab.w * dx;
+      // The splat's gradients summed over the invocation's pixels.
+      vec2 g_mean = vec2(0.0), g_mean_abs = vec2(0.0);
+      vec3 g_conic = vec3(0.0), g_colour = vec3(0.0);
+      float g_opacity = 0.0, g_z = 0.0;
+      bool any_blended = false;
+      for (uint p = 0; p < P; ++p) {
+        float dy = mab.y - (float(local_y0 + p) + 0.5);
+        float power = k0 + dy * (k1 + cod.x * dy);
+        float gaussian = exp(power);
+        float alpha = min(MAX_ALPHA, opacity * gaussian);
+        bool blended = position < last[p] && alpha >= ALPHA_MIN;
+        any_blended = any_blended || blended;
+        float inverse = 1.0 / (1.0 - alpha);  // one division: CPU drivers pay for each
+        float T_before = T[p] * inverse;
+        float w = blended ? alpha * T_before : 0.0;
+        g_colour += g_rgba[p].rgb * w;
+        g_z += g_depth[p] * w;
+        float g_alpha = g_rgba[p].a * final_T[p] * inverse +
+                        dot(g_rgba[p].rgb, T_before * rgb - behind_rgb[p] * inverse) +
+                        g_depth[p] * (T_before * z - behind_depth[p] * inverse) +
+                        g_weight[p] * (T_before - behind_weight[p] * inverse);
+        behind_rgb[p] += rgb * w;
+        behind_depth[p] += z * w;
+        behind_weight[p] += w;
+        T[p] = blended ? T_before : T[p];
         // alpha = min(MAX_ALPHA, opacity G): a capped alpha passes nothing further.
-        float opacity = s_c_opacity_depth[j].y;
-        if (opacity * gaussian <= MAX_ALPHA) {
-          g_opacity = g_alpha * gaussian;
-          float g_power = g_alpha * alpha;
-          // power = -A dx^2 / 2 - B dx dy - C dy^2 / 2 with A = -2 A', B = -B', C = -2 C'.
-          g_conic = vec3(-0.5 * dx * dx, -dx * dy, -0.5 * dy * dy) * g_power;
-          float A = -2.0 * s_mean_a_b[j].z, B = -s_mean_a_b[j].w, C = -2.0 * s_c_opacity_depth[j].x;
-          g_mean = -vec2(A * dx + B * dy, C * dy + B * dx) * g_power;
-        }
+        float g_power = blended && opacity * gaussian <= MAX_ALPHA ? g_alpha * alpha : 0.0;
+        g_opacity += blended && opacity * gaussian <= MAX_ALPHA ? g_alpha * gaussian : 0.0;
+        // power = -A dx^2 / 2 - B dx dy - C dy^2 / 2.
+        g_conic += vec3(-0.5 * dx * dx, -dx * dy, -0.5 * dy * dy) * g_power;
+        vec2 pixel_mean = -vec2(A * dx + B * dy, C * dy + B * dx) * g_power;
+        g_mean += pixel_mean;
+        g_mean_abs += abs(pixel_mean);
       }
-      // The subgroup's pixels visit the same splat together: one add per subgroup and value.
-      if (!subgroupAny(blended)) continue;
-      vec2 s_mean = subgroupAdd(g_mean);
-      vec2 s_abs = subgroupAdd(abs(g_mean));
-      vec3 s_conic = subgroupAdd(g_conic);
-      float s_opacity = subgroupAdd(g_opacity);
-      vec3 s_rgb = subgroupAdd(g_colour);
-      float s_depth = subgroupAdd(g_depth_out);
+      // One add per subgroup and value: the subgroup's columns visit the same splat together.
+      if (!subgroupAny(any_blended)) continue;
+      g_mean = subgroupAdd(g_mean);
+      g_mean_abs = subgroupAdd(g_mean_abs);
+      g_conic = subgroupAdd(g_conic);
+      g_opacity = subgroupAdd(g_opacity);
+      g_colour = subgroupAdd(g_colour);
+      g_z = subgroupAdd(g_z);
       if (subgroupElect()) {
-        uint base = SPLAT_GRADIENT_FLOATS * floatBitsToUint(s_c_opacity_depth[j].w);
-        add_gradient(base + 0, s_mean.x);
-        add_gradient(base + 1, s_mean.y);
-        add_gradient(base + 2, s_conic.x);
-        add_gradient(base + 3, s_conic.y);
-        add_gradient(base + 4, s_conic.z);
-        add_gradient(base + 5, s_opacity);
-        add_gradient(base + 6, s_rgb.r);
-        add_gradient(base + 7, s_rgb.g);
-        add_gradient(base + 8, s_rgb.b);
-        add_gradient(base + 9, s_depth);
-        add_gradient(base + 10, s_abs.x);
-        add_gradient(base + 11, s_abs.y);
+        uint base = SPLAT_GRADIENT_FLOATS * floatBitsToUint(cod.w);
+        add_gradient(base + 0, g_mean.x);
+        add_gradient(base + 1, g_mean.y);
+        add_gradient(base + 2, g_conic.x);
+        add_gradient(base + 3, g_conic.y);
+        add_gradient(base + 4, g_conic.z);
+        add_gradient(base + 5, g_opacity);
+        add_gradient(base + 6, g_colour.r);
+        add_gradient(base + 7, g_colour.g);
+        add_gradient(base + 8, g_colour.b);
+        add_gradient(base + 9, g_z);
+        add_gradient(base + 10, g_mean_abs.x);
+        add_gradient(base + 11, g_mean_abs.y);
       }
     }
   }

@@ -53,6 +53,12 @@ void add_bench_options(cli::ArgParser& parser, BenchOptions& options) {
   cli::add_memory_budget_option(
       parser, options.memory_budget,
       "the table adds the parts and the peak device memory; frame benchmark only; ");
+  parser.add_switch("--backward",
+                    "time training steps: each measured frame is the forward frame and then its backward "
+                    "(Renderer::backward of a fixed random colour gradient, on the forward's lists), whose "
+                    "passes composite_backward and projection_backward join the table; frame benchmark only, "
+                    "pinhole views of the sorted compositor in the reference's modes",
+                    &options.backward);
   parser.add_string(
       "--csv", "FILE.csv",
       "also write the results as CSV: one line per scene, size, view, sort and metric; with several "
@@ -313,6 +319,11 @@ void check_bench_flags(const cli::ArgParser& parser, const BenchOptions& options
         " measures pinhole views (--effects times every camera model itself); "
         "--fisheye, --orthographic and --equirectangular apply to the frame benchmark and the "
         "other reports");
+  if (options.backward && (options.accuracy || options.effects || options.formats || options.scaling ||
+                           !options.lod_budgets.empty() || options.sample_curve || options.memory_budget > 0))
+    throw cli::UsageError(
+        "--backward times the frame benchmark's training steps; it does not apply to the reports or "
+        "--memory-budget");
   if (options.accuracy) {
     for (const char* flag : {"--resolutions", "--orbit", "--json"})
       if (parser.seen(flag)) throw cli::UsageError(std::string(flag) + " does not apply to --accuracy");

@@ -49,6 +49,8 @@ struct BenchOptions {
   std::optional<tilesplat::sample_curve::Effect> sample_curve;
   std::vector<int> sample_counts = tilesplat::sample_curve::kDefaultCounts;
   uint64_t memory_budget = 0;  // --memory-budget: frames under RenderSettings::memory_budget (0: none)
+  bool backward =
+      false;  // --backward: each measured frame is a training step, forward then Renderer::backward
   std::string markdown;
   accuracy::CameraPath path = accuracy::CameraPath::kPan;
   int path_frames = 6;

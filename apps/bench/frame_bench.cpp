@@ -7,6 +7,7 @@
 
 #include "bench_plot.h"
 #include "progress.h"
+#include "tilesplat/gradients.h"
 #include "tilesplat/sort.h"
 
 namespace tilesplat::bench {
@@ -39,6 +40,34 @@ std::string size_label(const Group& group) {
 
 std::string orbit_label(double azimuth_deg) {
   return "azimuth " + cli::format_fixed(azimuth_deg, 1);
+}
+
+// The statistics of a training step: the forward frame render() just drew, then its backward on the
+// forward's lists (a fixed random colour gradient), whose passes and GPU time are added to the frame's.
+tilesplat::FrameStats with_backward(tilesplat::Renderer& renderer, const tilesplat::Camera& camera,
+                                    tilesplat::RenderSettings settings) {
+  tilesplat::FrameStats step = renderer.last_frame_stats();
+  static std::vector<float> gradients;
+  const size_t values = size_t(camera.width) * size_t(camera.height) * 3;
+  if (gradients.size() != values) {
+    gradients.resize(values);
+    uint32_t state = 12345u;
+    for (float& g : gradients) {
+      state = state * 1664525u + 1013904223u;  // a fixed sequence: every run times the same work
+      g = float(state >> 8) / float(1u << 24) * 2.0f - 1.0f;
+    }
+  }
+  settings.reuse_lists = true;
+  const auto start = std::chrono::steady_clock::now();
+  renderer.backward(camera, settings, tilesplat::FrameGradients{gradients, {}, {}, {}});
+  const double backward_cpu_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  for (const tilesplat::PassTiming& pass : renderer.last_frame_stats().passes) {
+    step.passes.push_back(pass);
+    step.gpu_ms += pass.gpu_ms;
+  }
+  step.cpu_ms += backward_cpu_ms;
+  return step;
 }
 
 // Per metric, one sample per view: that view's median. Summarized, they give the median, min and
@@ -421,7 +450,11 @@ int run_frame_bench(const BenchOptions& options) {
                                              ? renderer->render(scene.loaded.scene, c.camera.camera, settings)
                                              : renderer->render(c.camera.camera, settings);
           if (frame == options.warmup) images.push_back(std::move(image));
-          if (frame >= options.warmup) collector.add(renderer->last_frame_stats());
+          // A training step's backward also in the warm-up frames, whose first call builds its pipelines.
+          const tilesplat::FrameStats stats = options.backward
+                                                  ? with_backward(*renderer, c.camera.camera, settings)
+                                                  : renderer->last_frame_stats();
+          if (frame >= options.warmup) collector.add(stats);
           progress.update(++done, where + sort);
         }
         c.results.push_back(collector.take());

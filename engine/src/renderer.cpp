@@ -48,6 +48,24 @@ uint64_t Renderer::Impl::device_bytes() const {
   return bytes;
 }
 
+FramePlan Renderer::Impl::plan_for(const Camera& camera, const RenderSettings& settings, bool depth_image,
+                                   bool without_waiting, const ScenePart& part,
+                                   std::optional<uint32_t> samples_before) {
+  const DeviceCaps device = device_caps();
+  SortStrategy& sorter = sort(choose_sort_strategy(settings.sort, device, without_waiting));
+  const SortTraits traits{sorter.name(), sorter.frame_plan(), sorter.sorts_on_host()};
+  const FrameContext context{resources.scene_shape(scene_slot.generation()),
+                             device,
+                             traits,
+                             lists,
+                             depth_image,
+                             part,
+                             samples_before,
+                             accumulator.stochastic_frames_before(settings),
+                             recorder.composite_chunks(settings.compositor)};
+  return plan_frame(camera, settings, context);
+}
+
 Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, const RenderSettings& settings,
                                                        bool depth_image, bool without_waiting,
                                                        const ScenePart& part) {
@@ -58,21 +76,10 @@ Renderer::Impl::FrameStart Renderer::Impl::begin_frame(const Camera& camera, con
   FrameStart start;
   start.time = std::chrono::steady_clock::now();
   wait_for_submitted_frame();
-  const DeviceCaps device = device_caps();
-  start.sorter = &sort(choose_sort_strategy(settings.sort, device, without_waiting));
-  const SortTraits traits{start.sorter->name(), start.sorter->frame_plan(), start.sorter->sorts_on_host()};
   std::optional<uint32_t> samples_before;
   if (sample) samples_before = sample->before();
-  const FrameContext context{resources.scene_shape(scene_slot.generation()),
-                             device,
-                             traits,
-                             lists,
-                             depth_image,
-                             part,
-                             samples_before,
-                             accumulator.stochastic_frames_before(settings),
-                             recorder.composite_chunks(settings.compositor)};
-  start.plan = plan_frame(camera, settings, context);
+  start.plan = plan_for(camera, settings, depth_image, without_waiting, part, samples_before);
+  start.sorter = &sort(start.plan.sort.name);
   resources.prepare_outputs(start.plan, settings.host);
   // The sums are this frame's now, and the next frame's once it completes.
   start.sums = accumulator.frame_started(

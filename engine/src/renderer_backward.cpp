@@ -21,7 +21,16 @@ SceneGradients Renderer::backward(const Camera& camera, const RenderSettings& se
                              std::to_string(camera.height) +
                              " image is larger than this device renders in one band; the backward takes one");
 
-  const FramePlan forward = impl_->render_frame(camera, frame_settings);
+  // The forward's lists and records: in the buffers already after a render() of this camera and these
+  // settings (with reuse_lists), else drawn now.
+  impl_->wait_for_submitted_frame();
+  FramePlan forward = impl_->plan_for(camera, frame_settings);
+  if (forward.build_lists) {
+    forward = impl_->render_frame(camera, frame_settings);
+  } else {
+    impl_->stats = {};
+    impl_->stats.reused_sorted_lists = true;
+  }
   // The backward walks each tile's list in one dispatch: a list the forward needed more dispatches for
   // (a CPU driver's loop limit, composite.comp) is beyond it.
   if (impl_->recorder.composite_chunks(Compositor::kSorted) > 1)

@@ -67,6 +67,11 @@ struct Renderer::Impl {
   // applied): the frame, its averaged samples, its bands, or one more accumulated sample.
   RenderImage render_set_scene(const Camera& camera, const RenderSettings& settings);
   using FrameStart = tilesplat::FrameStart;  // frame/frame_start.h
+  // The plan of a frame of `camera` and `settings` on what the buffers hold now (validating them), without
+  // recording or changing anything: begin_frame's, and Renderer::backward's test for reusable lists.
+  FramePlan plan_for(const Camera& camera, const RenderSettings& settings, bool depth_image = false,
+                     bool without_waiting = false, const ScenePart& part = {},
+                     std::optional<uint32_t> samples_before = std::nullopt);
   // Plans the frame (validating the camera and settings), sizes the outputs and uploads what the
   // frame reads from the host. Waits for a frame in flight first: its buffers are the same.
   // without_waiting: a frame render_to_image submits or records and returns (choose_sort_strategy).

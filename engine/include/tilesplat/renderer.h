@@ -234,16 +234,17 @@ class TILESPLAT_API Renderer {
   /// The gradient of a loss through the frame render(camera, settings) draws of the scene last set
   /// (docs/gradients.md): given dL/d(each output pixel), dL/d(each Gaussian's parameter), with the screen
   /// gradients densification reads. The forward frame is drawn again first, unless the buffers hold its
-  /// tile lists already (RenderSettings::reuse_lists after a render() of the same camera and settings: then
-  /// only its composite runs); the backward passes then walk each pixel's splats back to front on the device
-  /// and carry each splat's gradient through its projection. Sums use float atomic adds where the device
-  /// has them (VK_EXT_shader_atomic_float), so the last bits may differ from run to run; the float64
-  /// reference_backward is the ground truth they are tested against. last_frame_stats() then lists the
-  /// forward's passes and "composite_backward" and "projection_backward". A scene set as placed copies
-  /// (set_scene(SceneInstances)) is differentiated as its merged scene. Throws NotDifferentiable for what
-  /// the backward does not cover (check_differentiable), std::invalid_argument for gradients of the wrong
-  /// size or not finite, and otherwise as render() does; also std::runtime_error for an image the device
-  /// renders only in bands or a tile list longer than one composite dispatch takes on this device.
+  /// tile lists already (with RenderSettings::reuse_lists, after a render() of the same camera and
+  /// settings: a training step's forward); the backward passes then walk each pixel's splats back to front
+  /// on the device and carry each splat's gradient through its projection. Sums use float atomic adds where
+  /// the device has them (VK_EXT_shader_atomic_float), so the last bits may differ from run to run; the
+  /// float64 reference_backward is the ground truth they are tested against. last_frame_stats() then lists
+  /// the forward's passes (none where its lists were reused: reused_sorted_lists) and "composite_backward"
+  /// and "projection_backward". A scene set as placed copies (set_scene(SceneInstances)) is differentiated as
+  /// its merged scene. Throws NotDifferentiable for what the backward does not cover (check_differentiable),
+  /// std::invalid_argument for gradients of the wrong size or not finite, and otherwise as render() does;
+  /// also std::runtime_error for an image the device renders only in bands or a tile list longer than one
+  /// composite dispatch takes on this device.
   SceneGradients backward(const Camera& camera, const RenderSettings& settings,
                           const FrameGradients& gradients);
 

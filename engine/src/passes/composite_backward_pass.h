@@ -35,6 +35,7 @@ class CompositeBackwardPass {
  private:
   vk::Context& ctx_;
   bool float_atomics_;
+  uint32_t pixels_per_invocation_;            // 16 on CPU drivers (a tile's column), 1 on GPUs
   vk::PipelineVariants<uint32_t> pipelines_;  // by the bits of max_alpha
 };
 
