@@ -11,7 +11,13 @@
 // the same staged splat at once, so a subgroup sums its columns' gradients before one invocation adds them
 // to the splat's (a float atomic add, or a compare-and-swap loop where the device has none:
 // TS_CAS_FLOAT_ADD).
+//
+// llvmpipe ends an invocation after 65535 loop iterations in all (tile_composite_layout.cpp): the loops over
+// a column's pixels are unrolled, so that a splat costs two iterations (one per walk) and a tile list within
+// the forward's one dispatch (8192 splats on CPU drivers) stays within the limit; Renderer::backward refuses
+// a frame with a longer list there.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_vote : require
@@ -101,7 +107,7 @@ void main() {
     s_last = 0;
   }
   uint my_done = 0;
-  for (uint p = 0; p < P; ++p) {
+  [[unroll]] for (uint p = 0; p < P; ++p) {
     uint image_y = tile.y * TILE_SIZE + local_y0 + p;
     T[p] = 1.0;
     depth_sum[p] = 0.0;
@@ -124,7 +130,7 @@ void main() {
       float dx = mab.x - (float(local_x) + 0.5);
       float k0 = mab.z * dx * dx;
       float k1 = mab.w * dx;
-      for (uint p = 0; p < P; ++p) {
+      [[unroll]] for (uint p = 0; p < P; ++p) {
         float dy = mab.y - (float(local_y0 + p) + 0.5);
         float power = k0 + dy * (k1 + cod.x * dy);
         float alpha = min(MAX_ALPHA, cod.y * exp(power));
@@ -145,7 +151,7 @@ void main() {
   }
 
   uint my_last = 0;
-  for (uint p = 0; p < P; ++p) {
+  [[unroll]] for (uint p = 0; p < P; ++p) {
     uint image_y = tile.y * TILE_SIZE + local_y0 + p;
     bool inside = image_x < pc.width && image_y < pc.height;
     uint pixel_index = image_y * pc.width + image_x;
@@ -185,7 +191,7 @@ void main() {
       vec3 g_conic = vec3(0.0), g_colour = vec3(0.0);
       float g_opacity = 0.0, g_z = 0.0;
       bool any_blended = false;
-      for (uint p = 0; p < P; ++p) {
+      [[unroll]] for (uint p = 0; p < P; ++p) {
         float dy = mab.y - (float(local_y0 + p) + 0.5);
         float power = k0 + dy * (k1 + cod.x * dy);
         float gaussian = exp(power);

@@ -115,12 +115,16 @@ void main() {
   // opacity = sigmoid(logit) (times sqrt(det0 / det) where compensated, above its floor).
   float logit = pc.opacity_logits.v[i];
   real sigma = real(1.0 / (1.0 + exp(-logit)));
+  // sigmoid' = e / (1 + e)^2 with e = exp(-|logit|): accurate where sigma (1 - sigma) would cancel (an
+  // opacity near 1, whose 1 - sigma is a few float steps).
+  real e = real(exp(-abs(logit)));
+  real d_sigma = e / ((1.0 + e) * (1.0 + e));
   real g_opacity = g[4 + 1];
   real g_logit;
   if (COMPENSATE_OPACITY) {
     real ratio = max(det0, real(0.0)) / det;
     real compensation = sqrt(max(real(2.5e-5), ratio));
-    g_logit = g_opacity * compensation * sigma * (1.0 - sigma);
+    g_logit = g_opacity * compensation * d_sigma;
     if (det0 > 0.0 && ratio > 2.5e-5) {
       real g_ratio = g_opacity * sigma * 0.5 / compensation;
       g_a += g_ratio * ((c - d) / det - ratio * c / det);
@@ -128,7 +132,7 @@ void main() {
       g_b += g_ratio * (-2.0 * b / det + ratio * 2.0 * b / det);
     }
   } else {
-    g_logit = g_opacity * sigma * (1.0 - sigma);
+    g_logit = g_opacity * d_sigma;
   }
 
   // a = u.u + d, b = u.v, c = v.v + d.

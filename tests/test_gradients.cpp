@@ -205,5 +205,42 @@ TEST(GpuBackward, HardCasesStayFinite) {
   EXPECT_EQ(renderer.validation_messages(), 0u);
 }
 
+// One tile listing 8,000 faint splats a pixel or two wide: every pixel walks the whole list both ways,
+// the most the backward takes in one dispatch on a CPU driver (llvmpipe stops an invocation after 65,535
+// loop iterations in all, silently: a walk cut short would leave the later splats without gradients).
+TEST(GpuBackward, ALongTileListIsWalkedToItsEnd) {
+  const Camera camera = gradient_camera(64, 48);
+  std::mt19937 rng(30);
+  std::uniform_real_distribution<double> in_tile(16.5, 31.5);
+  GaussianScene scene;
+  scene.sh_degree = 0;
+  for (int k = 0; k < 8000; ++k) {
+    const double depth = 4.0 + 1e-4 * k;
+    const double cam[3] = {(in_tile(rng) - camera.cx) / camera.fx * depth,
+                           (in_tile(rng) - camera.cy) / camera.fy * depth, depth};
+    for (size_t row = 0; row < 3; ++row)  // world = W^T cam + position
+      scene.positions.push_back(float(camera.rotation[row] * cam[0] + camera.rotation[3 + row] * cam[1] +
+                                      camera.rotation[6 + row] * cam[2] + camera.position[row]));
+    scene.log_scales.insert(scene.log_scales.end(), {-3.5f, -3.5f, -3.5f});
+    scene.rotations.insert(scene.rotations.end(), {1, 0, 0, 0});
+    scene.opacity_logits.push_back(-2.5f);
+    scene.sh.insert(scene.sh.end(), {0.5f, -0.2f, 0.1f});
+  }
+  Renderer& renderer = testing::validated_renderer();
+  renderer.set_scene(scene);
+  const FrameGradients g = random_gradients(camera.width, camera.height, 31);
+  const SceneGradients gpu = renderer.backward(camera, {}, g);
+  const SceneGradients reference = reference_backward(scene, camera, {}, g);
+  expect_within(compare(gpu, reference, "8,000 splats in one tile"), 1e-4);
+  // The last splats of the list have their gradients too.
+  const std::vector<float> last_gpu(gpu.opacity_logits.end() - 500, gpu.opacity_logits.end());
+  const std::vector<float> last_reference(reference.opacity_logits.end() - 500,
+                                          reference.opacity_logits.end());
+  EXPECT_LT(relative_error(last_gpu, last_reference), 1e-4);
+  double last_sum = 0;
+  for (float v : last_reference) last_sum += std::abs(v);
+  EXPECT_GT(last_sum, 0.0);
+}
+
 }  // namespace
 }  // namespace tilesplat

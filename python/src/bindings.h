@@ -8,11 +8,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <initializer_list>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "tilesplat/image.h"
+#include "tilesplat/renderer.h"
 
 namespace tilesplat::python {
 
@@ -25,6 +27,13 @@ void bind_effects(nb::module_& m);   // effect_bindings.cpp: ThinLens, Shutter a
 void bind_images(nb::module_& m);    // image_bindings.cpp: Image, read_exr, compare_images
 void bind_settings(nb::module_& m);  // settings_bindings.cpp: RenderSettings
 void bind_renderer(nb::module_& m);  // renderer_bindings.cpp: devices, Renderer, render_reference
+
+// The Python Renderer: the engine's renderer, which is neither copyable nor movable, behind a pointer.
+struct RendererHandle {
+  std::unique_ptr<Renderer> renderer;
+};
+// gradient_bindings.cpp: Renderer.backward, reference_backward, NotDifferentiable (bind_renderer calls it).
+void bind_gradients(nb::module_& m, nb::class_<RendererHandle>& renderer);
 
 template <typename T>
 using NumpyArray = nb::ndarray<nb::numpy, T>;

@@ -53,11 +53,6 @@ nb::dict stats_dict(const FrameStats& stats) {
   return out;
 }
 
-// The Python Renderer: the engine's renderer, which is neither copyable nor movable, behind a pointer.
-struct RendererHandle {
-  std::unique_ptr<Renderer> renderer;
-};
-
 nb::dict device_dict(const DeviceInfo& device) {
   nb::dict out;
   out["name"] = device.name;
@@ -72,9 +67,10 @@ nb::dict device_dict(const DeviceInfo& device) {
 }
 
 // tilesplat.Renderer.
-void bind_renderer_class(nb::module_& m) {
-  nb::class_<RendererHandle>(
-      m, "Renderer", "The GPU renderer on one Vulkan device. render() releases the GIL while the frame runs.")
+nb::class_<RendererHandle> bind_renderer_class(nb::module_& m) {
+  return nb::class_<RendererHandle>(
+             m, "Renderer",
+             "The GPU renderer on one Vulkan device. render() releases the GIL while the frame runs.")
       .def(
           "__init__",
           [](RendererHandle* self, const std::string& device, bool validation) {
@@ -204,8 +200,9 @@ void bind_renderer(nb::module_& m) {
   m.def("sort_strategies", &sort_strategies,
         "The sort strategies Renderer.render(sort=...) accepts, besides auto.");
 
-  bind_renderer_class(m);
+  nb::class_<RendererHandle> renderer = bind_renderer_class(m);
   bind_reference(m);
+  bind_gradients(m, renderer);
 }
 
 }  // namespace tilesplat::python

@@ -95,7 +95,7 @@ def test_rgb_colors_near_and_far_planes():
 def test_what_it_does_not_do_is_said():
     inputs = dict(means=np.zeros((1, 3)), quats=[[1.0, 0, 0, 0]], scales=np.ones((1, 3)), opacities=[0.5],
                   colors=np.ones((1, 3)), viewmats=np.eye(4)[None], Ks=np.eye(3)[None], width=8, height=8)
-    for argument, value in [("camera_model", "fisheye"), ("with_ut", True), ("absgrad", True), ("eps2d", 0.1),
+    for argument, value in [("camera_model", "fisheye"), ("with_ut", True), ("eps2d", 0.1),
                             ("radius_clip", 1.0), ("distributed", True), ("covars", np.zeros((1, 3, 3)))]:
         with pytest.raises(NotImplementedError, match=argument):
             tilesplat.rasterization(**inputs, **{argument: value})

@@ -25,6 +25,7 @@ from ._core import (
     LodSelection,
     LodSet,
     MappedPly,
+    NotDifferentiable,
     Renderer,
     RenderSettings,
     Scene,
@@ -47,12 +48,13 @@ from ._core import (
     load_scene,
     orbit_cameras,
     read_exr,
+    reference_backward,
     render_reference,
     shutter_time,
     shutter_times,
     sort_strategies,
 )
-from .gsplat_compat import rasterization
+from .gsplat_compat import rasterization, rasterization_backward
 
 __all__ = [
     "Camera",
@@ -61,6 +63,7 @@ __all__ = [
     "LodSelection",
     "LodSet",
     "MappedPly",
+    "NotDifferentiable",
     "Renderer",
     "RenderSettings",
     "Scene",
@@ -83,7 +86,9 @@ __all__ = [
     "load_scene",
     "orbit_cameras",
     "rasterization",
+    "rasterization_backward",
     "read_exr",
+    "reference_backward",
     "render_reference",
     "shutter_time",
     "shutter_times",

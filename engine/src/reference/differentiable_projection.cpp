@@ -21,7 +21,8 @@ double low_pass_dilation(Antialiasing mode) {
 D sigmoid(const D& logit) {
   const double s =
       logit.v >= 0 ? 1.0 / (1.0 + std::exp(-logit.v)) : std::exp(logit.v) / (1.0 + std::exp(logit.v));
-  return chain(logit, s, s * (1 - s));
+  const double e = std::exp(-std::abs(logit.v));  // s (1 - s) without the cancellation of 1 - s near 1
+  return chain(logit, s, e / ((1 + e) * (1 + e)));
 }
 
 // The row-major rotation of the quaternion as the renderers read it: normalized, and the identity for
