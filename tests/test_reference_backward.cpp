@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "camera/camera_models.h"
+#include "gradient_test_scenes.h"
 #include "reference/differentiable_projection.h"
 #include "reference/reference_backward.h"
 #include "tilesplat/gradients.h"
@@ -23,40 +24,13 @@ namespace {
 constexpr int kWidth = 48, kHeight = 40;
 
 Camera test_camera() {
-  return look_at_camera({0.3, -0.2, -4.0}, {0.0, 0.1, 0.0}, {0, -1, 0}, kWidth, kHeight, 50.0);
+  return testing::gradient_camera(kWidth, kHeight);
 }
-
-// `n` splats a few pixels wide in front of test_camera, with SH to degree 3 and opacities from faint to
-// past the alpha cap.
 GaussianScene random_scene(size_t n, uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  GaussianScene scene;
-  scene.sh_degree = 3;
-  for (size_t i = 0; i < n; ++i) {
-    scene.positions.insert(scene.positions.end(), {0.9f * unit(rng), 0.7f * unit(rng), 0.8f * unit(rng)});
-    scene.log_scales.insert(scene.log_scales.end(),
-                            {-2.2f + 0.5f * unit(rng), -2.2f + 0.5f * unit(rng), -2.2f + 0.5f * unit(rng)});
-    scene.rotations.insert(scene.rotations.end(), {unit(rng), unit(rng), unit(rng), unit(rng)});
-    scene.opacity_logits.push_back(1.5f + 2.5f * unit(rng));
-    for (int k = 0; k < 16; ++k)
-      for (int c = 0; c < 3; ++c) scene.sh.push_back(k == 0 ? 0.8f * unit(rng) : 0.25f * unit(rng));
-  }
-  return scene;
+  return testing::random_splats(n, seed);
 }
-
 FrameGradients random_gradients(uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  const size_t pixels = size_t(kWidth) * kHeight;
-  FrameGradients g;
-  for (size_t k = 0; k < 3 * pixels; ++k) g.rgb.push_back(unit(rng));
-  for (size_t k = 0; k < pixels; ++k) {
-    g.alpha.push_back(unit(rng));
-    g.expected_depth.push_back(0.1f * unit(rng));
-    g.accumulated_depth.push_back(0.1f * unit(rng));
-  }
-  return g;
+  return testing::random_frame_gradients(kWidth, kHeight, seed);
 }
 
 // The loss whose gradient FrameGradients gives: the sum of each output times its gradient.
