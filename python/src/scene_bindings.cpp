@@ -92,6 +92,20 @@ void bind_gaussian_scene(nb::module_& m) {
           "(N,), sh (N, K, 3) with K = 1, 4, 9 or 16. Values are copied as given (a quaternion of any "
           "length: the "
           "renderer normalizes it, and a zero one is the identity); non-finite ones raise ValueError.")
+      .def(
+          "write_ply",
+          [](const GaussianScene& scene, const std::filesystem::path& path) {
+            nb::gil_scoped_release release;
+            write_ply(scene, path);
+          },
+          "path"_a,
+          "Writes the scene as the 3DGS trainer's binary PLY (x y z, f_dc, f_rest, opacity, scale, rot; nx "
+          "ny nz "
+          "when it has normals), which every viewer reads; load_scene gives each value back to the bit (the "
+          "quaternions normalized again, as every reader does). Atomic: "
+          "no partial file. ValueError for inconsistent arrays, RuntimeError naming the file when it cannot "
+          "be "
+          "written.")
       .def("__repr__", [](const GaussianScene& s) {
         return "<tilesplat.Scene " + std::to_string(s.size()) + " Gaussians, SH degree " +
                std::to_string(s.sh_degree) + ">";

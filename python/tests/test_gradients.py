@@ -91,3 +91,26 @@ def test_rasterization_backward_against_finite_differences():
         assert abs(analytic - numeric) <= 2e-2 * abs(numeric) + 2e-3, (name, index, analytic, numeric)
         checked += abs(numeric) > 1e-3
     assert checked >= 5  # the chosen parameters move the loss
+
+
+def test_a_trained_scene_leaves_as_the_trainers_ply(tmp_path):
+    """Scene.write_ply: the arrays a trainer ends with, written as the PLY every viewer reads and loaded back
+    to the bit (its quaternions normalized, as every reader gives them)."""
+    rng = np.random.default_rng(4)
+    n = 50
+    arrays = dict(positions=rng.normal(size=(n, 3)).astype(np.float32),
+                  log_scales=rng.uniform(-5, 0, (n, 3)).astype(np.float32),
+                  rotations=rng.normal(size=(n, 4)).astype(np.float32),
+                  opacity_logits=rng.normal(size=n).astype(np.float32),
+                  sh=rng.normal(size=(n, 16, 3)).astype(np.float32))
+    scene = tilesplat.Scene.from_arrays(**arrays)
+    path = tmp_path / "trained.ply"
+    scene.write_ply(path)
+    back = tilesplat.load_scene(path)
+    for name in ("positions", "log_scales", "opacity_logits", "sh"):
+        assert np.array_equal(getattr(back, name), arrays[name]), name
+    q = arrays["rotations"].astype(np.float64)
+    np.testing.assert_allclose(back.rotations, q / np.linalg.norm(q, axis=1, keepdims=True), atol=1e-7)
+    with pytest.raises(RuntimeError, match="no_such_directory"):
+        scene.write_ply(tmp_path / "no_such_directory" / "trained.ply")
+    assert not (tmp_path / "no_such_directory").exists()

@@ -95,6 +95,15 @@ TILESPLAT_API GaussianScene load_scene(const std::filesystem::path& path, const 
 TILESPLAT_API GaussianScene parse_scene(std::span<const std::byte> data, std::string_view name,
                                         const LoadOptions& options = {}, LoadReport* report = nullptr);
 
+/// Writes the scene as the 3DGS trainer's binary little-endian PLY, which every 3DGS viewer reads: x y z,
+/// nx ny nz (when the scene has normals), f_dc_0..2, f_rest_* (channel-major, as the trainer writes them),
+/// opacity (the logit), scale_0..2 (log scales), rot_0..3 (w x y z), all float. Each value is written as it
+/// is, so load_ply gives every one back to the bit, but for the rotations, which it normalizes again as every
+/// reader does (which moves some of an already normalized scene's by a float step).
+/// Written atomically: a reader never sees part of the file. Throws std::invalid_argument naming the file
+/// for arrays of inconsistent sizes, std::runtime_error naming it when it cannot be written.
+TILESPLAT_API void write_ply(const GaussianScene& scene, const std::filesystem::path& path);
+
 /// The scene's bounds; all zero for an empty scene.
 TILESPLAT_API Bounds compute_bounds(const GaussianScene& scene);
 
