@@ -20,7 +20,6 @@
 #include "reference/differentiable_projection.h"
 #include "reference/parallel_chunks.h"
 #include "reference/reference_frame.h"
-#include "settings_checks.h"
 #include "tilesplat/gradients.h"
 
 namespace tilesplat {
@@ -41,10 +40,7 @@ struct ForwardFrame {
 ForwardFrame draw_forward(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
                           const char* caller) {
   check_differentiable(camera, settings, caller);
-  validate(camera);
-  check_scene(scene, caller);
-  check_near_plane(settings.near_plane);
-  check_max_alpha(settings);
+  check_frame(scene, camera, settings, caller);
   ForwardFrame frame;
   frame.projected = project_records(scene, camera, settings);
   frame.order = depth_order(frame.projected);

@@ -10,9 +10,11 @@
 #include <string>
 
 #include "camera/camera_models.h"
+#include "host_depth.h"
 #include "lighting.h"
 #include "reference/parallel_chunks.h"
 #include "reference/reference_projection.h"
+#include "settings_checks.h"
 
 namespace tilesplat::reference {
 namespace {
@@ -49,6 +51,18 @@ void check_scene(const GaussianScene& scene, const char* caller) {
   if (scene.positions.size() != 3 * n || scene.log_scales.size() != 3 * n ||
       scene.rotations.size() != 4 * n || scene.sh.size() != n * k * 3)
     throw std::invalid_argument(std::string(caller) + ": scene arrays have inconsistent sizes");
+}
+
+void check_frame(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+                 const char* caller) {
+  validate(camera);
+  check_region(settings, camera);
+  check_scene(scene, caller);
+  validate_host_depth(settings, camera);
+  check_near_plane(settings.near_plane);
+  check_max_alpha(settings);
+  check_single_frame(settings);
+  check_camera_model(settings, camera);
 }
 
 ProjectedRecords project_records(const GaussianScene& scene, const Camera& camera,

@@ -23,6 +23,12 @@ inline constexpr double kMinTransmittance = 1e-4;
 // disagree.
 void check_scene(const GaussianScene& scene, const char* caller = "render_reference");
 
+// What every frame of the reference refuses before any work (render_reference, reference_backward): a camera,
+// region, scene, host depth, near plane, alpha cap, lens or shutter or camera model it cannot draw. Throws
+// std::invalid_argument.
+void check_frame(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
+                 const char* caller);
+
 // Every Gaussian projected: one record each, two for the equirectangular camera (its seam copies, records
 // n..2n - 1), with what each record sorts by, as the projection keys it (projection.comp's sort_depth):
 // the view depth (a fisheye's or panorama's distance), or in radial sorting the pinhole's and OpenCV

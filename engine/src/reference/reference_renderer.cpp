@@ -20,7 +20,6 @@
 #include "reference/pixel_order.h"
 #include "reference/reference_frame.h"
 #include "reference/reference_projection.h"
-#include "settings_checks.h"
 #include "tilesplat/reference.h"
 #include "tilesplat/scene_description.h"
 
@@ -49,14 +48,7 @@ PixelRule pixel_rule(const RenderSettings& settings, ReferenceOrder order) {
 // cannot draw, and a per-pixel order on what has no rays (it follows the pinhole's) or no tile lists.
 void check_reference_frame(const GaussianScene& scene, const Camera& camera, const RenderSettings& settings,
                            const PixelRule& rule) {
-  validate(camera);
-  check_region(settings, camera);
-  reference::check_scene(scene);
-  validate_host_depth(settings, camera);
-  check_near_plane(settings.near_plane);
-  check_max_alpha(settings);
-  check_single_frame(settings);
-  check_camera_model(settings, camera);
+  reference::check_frame(scene, camera, settings, "render_reference");
   if (!rule.by_ray_depth) return;
   // The rays of the per-pixel orders are the pinhole's; the raster rule and a host's depth have none.
   if (camera_models::drawn_model(camera) != CameraModel::kPinhole)
