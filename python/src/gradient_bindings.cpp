@@ -36,9 +36,9 @@ FrameGradients frame_gradients(const Camera& camera, const OptionalInput& rgb, c
   return g;
 }
 
-nb::dict gradients_dict(SceneGradients&& g, int sh_degree) {
+// The gradients as arrays shaped like the scene's; `k` the SH coefficients per channel.
+nb::dict gradients_dict(SceneGradients&& g, size_t k) {
   const size_t n = g.opacity_logits.size();
-  const size_t k = size_t((sh_degree + 1) * (sh_degree + 1));
   nb::dict out;
   out["positions"] = owned_array(std::move(g.positions), {n, 3});
   out["log_scales"] = owned_array(std::move(g.log_scales), {n, 3});
@@ -80,10 +80,8 @@ void bind_gradients(nb::module_& m, nb::class_<RendererHandle>& renderer) {
           out = self.renderer->backward(camera, settings, g);
         }
         const size_t n = out.opacity_logits.size();
-        const size_t k = n == 0 ? 1 : out.sh.size() / (3 * n);
-        int degree = 0;
-        while (size_t((degree + 1) * (degree + 1)) < k) ++degree;
-        return gradients_dict(std::move(out), degree);
+        const size_t coefficients = n == 0 ? 1 : out.sh.size() / (3 * n);
+        return gradients_dict(std::move(out), coefficients);
       },
       "camera"_a, "grad_rgb"_a = nb::none(), "grad_alpha"_a = nb::none(),
       "grad_expected_depth"_a = nb::none(), "grad_accumulated_depth"_a = nb::none(),
@@ -107,7 +105,7 @@ void bind_gradients(nb::module_& m, nb::class_<RendererHandle>& renderer) {
           nb::gil_scoped_release release;
           out = reference_backward(scene, camera, settings, g);
         }
-        return gradients_dict(std::move(out), scene.sh_degree);
+        return gradients_dict(std::move(out), size_t(scene.sh_coefficients()));
       },
       "camera"_a, "scene"_a, "grad_rgb"_a = nb::none(), "grad_alpha"_a = nb::none(),
       "grad_expected_depth"_a = nb::none(), "grad_accumulated_depth"_a = nb::none(),
